@@ -1,0 +1,1 @@
+//! Acceleration-bias correction and integration for RIDI.

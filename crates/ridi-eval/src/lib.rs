@@ -1,0 +1,1 @@
+//! Trajectory evaluation for pedestrian inertial navigation.

@@ -1,0 +1,1 @@
+//! Feature and target extraction for RIDI.

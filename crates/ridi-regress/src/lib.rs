@@ -1,0 +1,1 @@
+//! Cascaded placement classification and velocity regression for RIDI.
