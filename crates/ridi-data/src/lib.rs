@@ -9,6 +9,7 @@
 //! parse errors the line and field too.
 
 mod error;
+pub mod resample;
 mod sequence;
 
 pub use error::{DataError, Location, Result};
