@@ -1,0 +1,535 @@
+//! Serializable evaluation reports and their markdown rendering.
+//!
+//! The CLI writes [`EvalReport`] as `report.json` (serde) and [`EvalReport::to_markdown`] as
+//! `report.md`. Method and sequence order is kept as given, so tables read in the order the
+//! pipeline ran things.
+
+use std::fmt::Write as _;
+
+use serde::{Deserialize, Serialize};
+
+use crate::metrics::{ConfusionMatrix, EvalConfig};
+
+/// Trajectory metrics of one method on one sequence, on an aligned estimate.
+///
+/// With `N` frames, errors `eᵢ = estᵢ − gtᵢ`, `L(·)` the horizontal path length and the RTE
+/// rule of [`crate::metrics::rte`]:
+///
+/// | key | formula |
+/// |---|---|
+/// | `mpe_m` | `(1/N) Σ ‖eᵢ‖` (RIDI's MPE) |
+/// | `mpe_pct` | `100 · mpe_m / L(gt)`; `null` if the ground truth does not move |
+/// | `ate_m` | `sqrt((1/N) Σ ‖eᵢ‖²)`, Euclidean |
+/// | `rte_m` | Euclidean RTE, 60 s window by default |
+/// | `ate_ronin_m` | `ate_m / √2`: RoNIN's per-coordinate RMS |
+/// | `rte_ronin_m` | `rte_m / √2`: RoNIN's per-coordinate RTE |
+/// | `rte_5s_m` | Euclidean RTE over a 5 s window by default |
+/// | `path_length_ratio` | `L(est) / L(gt)`; `null` if the ground truth does not move |
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct TrajectoryMetrics {
+    /// Mean positional error, metres.
+    pub mpe_m: f64,
+    /// Mean positional error, % of the ground-truth path length.
+    pub mpe_pct: Option<f64>,
+    /// Absolute trajectory error, Euclidean RMS, metres.
+    pub ate_m: f64,
+    /// Relative trajectory error (long window), Euclidean RMS, metres.
+    pub rte_m: f64,
+    /// Absolute trajectory error, RoNIN per-coordinate RMS, metres.
+    pub ate_ronin_m: f64,
+    /// Relative trajectory error (long window), RoNIN per-coordinate RMS, metres.
+    pub rte_ronin_m: f64,
+    /// Relative trajectory error (short window), Euclidean RMS, metres.
+    pub rte_5s_m: f64,
+    /// Estimated over ground-truth horizontal path length.
+    pub path_length_ratio: Option<f64>,
+}
+
+/// One field of [`TrajectoryMetrics`], to pick a column.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Metric {
+    /// `mpe_m`
+    MpeM,
+    /// `mpe_pct`
+    MpePct,
+    /// `ate_m`
+    AteM,
+    /// `rte_m`
+    RteM,
+    /// `ate_ronin_m`
+    AteRoninM,
+    /// `rte_ronin_m`
+    RteRoninM,
+    /// `rte_5s_m`
+    #[serde(rename = "rte_5s_m")]
+    Rte5sM,
+    /// `path_length_ratio`
+    PathLengthRatio,
+}
+
+impl Metric {
+    /// Every metric, in report column order.
+    pub const ALL: [Self; 8] = [
+        Self::MpeM,
+        Self::MpePct,
+        Self::AteM,
+        Self::RteM,
+        Self::AteRoninM,
+        Self::RteRoninM,
+        Self::Rte5sM,
+        Self::PathLengthRatio,
+    ];
+
+    /// The JSON key of this metric in [`TrajectoryMetrics`].
+    pub fn key(self) -> &'static str {
+        match self {
+            Self::MpeM => "mpe_m",
+            Self::MpePct => "mpe_pct",
+            Self::AteM => "ate_m",
+            Self::RteM => "rte_m",
+            Self::AteRoninM => "ate_ronin_m",
+            Self::RteRoninM => "rte_ronin_m",
+            Self::Rte5sM => "rte_5s_m",
+            Self::PathLengthRatio => "path_length_ratio",
+        }
+    }
+
+    /// Human-readable column header with unit.
+    pub fn label(self) -> &'static str {
+        match self {
+            Self::MpeM => "MPE (m)",
+            Self::MpePct => "MPE (%)",
+            Self::AteM => "ATE (m)",
+            Self::RteM => "RTE (m)",
+            Self::AteRoninM => "ATE RoNIN (m)",
+            Self::RteRoninM => "RTE RoNIN (m)",
+            Self::Rte5sM => "RTE 5 s (m)",
+            Self::PathLengthRatio => "length ratio",
+        }
+    }
+
+    /// The value of this metric, `None` where the metric is undefined.
+    pub fn value(self, m: &TrajectoryMetrics) -> Option<f64> {
+        match self {
+            Self::MpeM => Some(m.mpe_m),
+            Self::MpePct => m.mpe_pct,
+            Self::AteM => Some(m.ate_m),
+            Self::RteM => Some(m.rte_m),
+            Self::AteRoninM => Some(m.ate_ronin_m),
+            Self::RteRoninM => Some(m.rte_ronin_m),
+            Self::Rte5sM => Some(m.rte_5s_m),
+            Self::PathLengthRatio => m.path_length_ratio,
+        }
+    }
+
+    fn format(self, v: Option<f64>) -> String {
+        match (self, v) {
+            (_, None) => "n/a".to_owned(),
+            (Self::MpePct, Some(v)) => format!("{v:.2}"),
+            (_, Some(v)) => format!("{v:.3}"),
+        }
+    }
+}
+
+/// Metrics of one method on one sequence.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct MethodMetrics {
+    /// Method name (e.g. `ridi`, `pdr`, `raw`).
+    pub method: String,
+    /// Its metrics.
+    pub metrics: TrajectoryMetrics,
+}
+
+/// All methods evaluated on one sequence.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct SequenceReport {
+    /// Sequence name.
+    pub sequence: String,
+    /// Device placement of the sequence, when known.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub placement: Option<String>,
+    /// Number of evaluated frames.
+    pub frames: usize,
+    /// One entry per method, in evaluation order.
+    pub methods: Vec<MethodMetrics>,
+}
+
+/// Mean of one method's metrics over the sequences it was evaluated on.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct MethodSummary {
+    /// Method name.
+    pub method: String,
+    /// Number of sequences averaged.
+    pub sequences: usize,
+    /// Field-wise arithmetic mean. Optional fields average the sequences where they are
+    /// defined and are `None` only if they are undefined everywhere.
+    pub mean: TrajectoryMetrics,
+}
+
+/// Field-wise mean of each method's metrics over `sequences`, methods in order of first
+/// appearance. A method missing from some sequences is averaged over those that have it.
+///
+/// For each field `m` and method `k`: `mean_k(m) = (1/|S_k|) Σ_{s ∈ S_k} m(s, k)`, where `S_k`
+/// is the set of sequences with a result for `k` (and, for optional fields, a defined value).
+pub fn summarize(sequences: &[SequenceReport]) -> Vec<MethodSummary> {
+    let mut order: Vec<&str> = Vec::new();
+    for s in sequences {
+        for m in &s.methods {
+            if !order.contains(&m.method.as_str()) {
+                order.push(&m.method);
+            }
+        }
+    }
+    order
+        .into_iter()
+        .map(|method| {
+            let rows: Vec<&TrajectoryMetrics> = sequences
+                .iter()
+                .flat_map(|s| &s.methods)
+                .filter(|m| m.method == method)
+                .map(|m| &m.metrics)
+                .collect();
+            let mean_of = |metric: Metric| mean(rows.iter().filter_map(|m| metric.value(m)));
+            // Required fields are present in every row and `rows` is non-empty, so their mean
+            // is always defined.
+            let required = |metric: Metric| mean_of(metric).unwrap_or(f64::NAN);
+            MethodSummary {
+                method: method.to_owned(),
+                sequences: rows.len(),
+                mean: TrajectoryMetrics {
+                    mpe_m: required(Metric::MpeM),
+                    mpe_pct: mean_of(Metric::MpePct),
+                    ate_m: required(Metric::AteM),
+                    rte_m: required(Metric::RteM),
+                    ate_ronin_m: required(Metric::AteRoninM),
+                    rte_ronin_m: required(Metric::RteRoninM),
+                    rte_5s_m: required(Metric::Rte5sM),
+                    path_length_ratio: mean_of(Metric::PathLengthRatio),
+                },
+            }
+        })
+        .collect()
+}
+
+fn mean(values: impl Iterator<Item = f64>) -> Option<f64> {
+    let (sum, n) = values.fold((0.0, 0usize), |(s, n), v| (s + v, n + 1));
+    (n > 0).then(|| sum / n as f64)
+}
+
+/// A complete evaluation run: what `report.json` holds.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct EvalReport {
+    /// Settings the metrics were computed with.
+    pub config: EvalConfig,
+    /// Per-sequence results.
+    pub sequences: Vec<SequenceReport>,
+    /// Per-method means over sequences ([`summarize`]).
+    pub summary: Vec<MethodSummary>,
+    /// Placement classification results, when a classifier was evaluated.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub placement: Option<ConfusionMatrix>,
+    /// Velocity regression MSE per horizontal channel, (m/s)², when evaluated.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub velocity_mse: Option<[f64; 2]>,
+}
+
+impl EvalReport {
+    /// Builds a report from per-sequence results, computing the summary.
+    pub fn new(config: EvalConfig, sequences: Vec<SequenceReport>) -> Self {
+        let summary = summarize(&sequences);
+        Self {
+            config,
+            sequences,
+            summary,
+            placement: None,
+            velocity_mse: None,
+        }
+    }
+
+    /// Renders the report as markdown: the trajectory table ([`markdown_table`]), then the
+    /// placement confusion matrix and velocity MSE when present.
+    pub fn to_markdown(&self) -> String {
+        let c = &self.config;
+        let mut out = String::from("# Evaluation\n\n");
+        let _ = writeln!(
+            out,
+            "Alignment: {}. RTE window {} s, short RTE window {} s, at {} Hz. \
+             ATE/RTE are Euclidean RMS; the RoNIN columns are per-coordinate (Euclidean / √2).\n",
+            describe_window(c.align),
+            c.rte_window_s,
+            c.short_rte_window_s,
+            c.rate_hz
+        );
+        out.push_str("## Trajectories\n\n");
+        out.push_str(&markdown_table(&self.sequences));
+        if let Some(cm) = &self.placement {
+            out.push_str("\n## Placement classification\n\n");
+            out.push_str(&markdown_confusion(cm));
+        }
+        if let Some([a, b]) = self.velocity_mse {
+            out.push_str("\n## Velocity regression\n\n");
+            let _ = writeln!(out, "MSE per channel: {a:.4} / {b:.4} (m/s)²");
+        }
+        out
+    }
+}
+
+fn describe_window(w: crate::align::AlignWindow) -> String {
+    use crate::align::AlignWindow;
+    match w {
+        AlignWindow::Seconds(s) => format!("2D rigid fit on the first {s} s"),
+        AlignWindow::Frames(n) => format!("2D rigid fit on the first {n} frames"),
+        AlignWindow::All => "2D rigid fit on the whole sequence".to_owned(),
+    }
+}
+
+/// Markdown-safe cell text: pipes would split the cell, newlines would end the row.
+fn cell(text: &str) -> String {
+    text.replace('|', "\\|").replace(['\n', '\r'], " ")
+}
+
+fn row(out: &mut String, cells: &[String]) {
+    out.push('|');
+    for c in cells {
+        out.push(' ');
+        out.push_str(c);
+        out.push_str(" |");
+    }
+    out.push('\n');
+}
+
+fn header(out: &mut String, cells: &[String]) {
+    row(out, cells);
+    row(out, &vec!["---".to_owned(); cells.len()]);
+}
+
+/// Markdown table with one row per (sequence, method) and one column per [`Metric`], followed
+/// by one `mean` row per method ([`summarize`]).
+pub fn markdown_table(sequences: &[SequenceReport]) -> String {
+    let mut out = String::new();
+    let mut head = vec!["sequence".to_owned(), "method".to_owned()];
+    head.extend(Metric::ALL.iter().map(|m| m.label().to_owned()));
+    header(&mut out, &head);
+    let metric_cells = |m: &TrajectoryMetrics| {
+        Metric::ALL
+            .iter()
+            .map(|k| k.format(k.value(m)))
+            .collect::<Vec<_>>()
+    };
+    for s in sequences {
+        for m in &s.methods {
+            let mut cells = vec![cell(&s.sequence), cell(&m.method)];
+            cells.extend(metric_cells(&m.metrics));
+            row(&mut out, &cells);
+        }
+    }
+    for summary in summarize(sequences) {
+        let mut cells = vec![
+            format!("**mean** ({})", summary.sequences),
+            cell(&summary.method),
+        ];
+        cells.extend(metric_cells(&summary.mean));
+        row(&mut out, &cells);
+    }
+    out
+}
+
+/// Markdown table of one metric: one row per sequence, one column per method, and a final
+/// `mean` row. Cells are `n/a` where a method has no result or the metric is undefined.
+pub fn markdown_metric_table(sequences: &[SequenceReport], metric: Metric) -> String {
+    let summary = summarize(sequences);
+    let mut out = String::new();
+    let mut head = vec![format!("sequence ({})", metric.label())];
+    head.extend(summary.iter().map(|s| cell(&s.method)));
+    header(&mut out, &head);
+    for s in sequences {
+        let mut cells = vec![cell(&s.sequence)];
+        cells.extend(summary.iter().map(|k| {
+            let value = s
+                .methods
+                .iter()
+                .find(|m| m.method == k.method)
+                .and_then(|m| metric.value(&m.metrics));
+            metric.format(value)
+        }));
+        row(&mut out, &cells);
+    }
+    let mut cells = vec!["**mean**".to_owned()];
+    cells.extend(summary.iter().map(|k| metric.format(metric.value(&k.mean))));
+    row(&mut out, &cells);
+    out
+}
+
+/// Markdown confusion matrix (rows: truth, columns: prediction) with per-class recall and the
+/// overall accuracy below it.
+pub fn markdown_confusion(cm: &ConfusionMatrix) -> String {
+    let mut out = String::new();
+    let mut head = vec!["truth \\ predicted".to_owned()];
+    head.extend(cm.classes.iter().map(|c| cell(c)));
+    head.push("recall".to_owned());
+    header(&mut out, &head);
+    for (i, (name, counts)) in cm.classes.iter().zip(&cm.counts).enumerate() {
+        let mut cells = vec![cell(name)];
+        cells.extend(counts.iter().map(ToString::to_string));
+        cells.push(percent(cm.recall(i)));
+        row(&mut out, &cells);
+    }
+    let _ = writeln!(
+        out,
+        "\nAccuracy: {} over {} samples.",
+        percent(cm.accuracy()),
+        cm.total()
+    );
+    out
+}
+
+fn percent(v: Option<f64>) -> String {
+    v.map_or_else(|| "n/a".to_owned(), |v| format!("{:.2} %", 100.0 * v))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn metrics(base: f64, pct: Option<f64>) -> TrajectoryMetrics {
+        TrajectoryMetrics {
+            mpe_m: base,
+            mpe_pct: pct,
+            ate_m: base + 1.0,
+            rte_m: base + 2.0,
+            ate_ronin_m: base + 3.0,
+            rte_ronin_m: base + 4.0,
+            rte_5s_m: base + 5.0,
+            path_length_ratio: pct.map(|_| 1.0),
+        }
+    }
+
+    fn sample() -> Vec<SequenceReport> {
+        vec![
+            SequenceReport {
+                sequence: "hang_leg1".into(),
+                placement: Some("leg".into()),
+                frames: 100,
+                methods: vec![
+                    MethodMetrics {
+                        method: "ridi".into(),
+                        metrics: metrics(1.0, Some(2.0)),
+                    },
+                    MethodMetrics {
+                        method: "pdr".into(),
+                        metrics: metrics(10.0, Some(20.0)),
+                    },
+                ],
+            },
+            SequenceReport {
+                sequence: "a|b".into(),
+                placement: None,
+                frames: 50,
+                methods: vec![MethodMetrics {
+                    method: "ridi".into(),
+                    metrics: metrics(3.0, None),
+                }],
+            },
+        ]
+    }
+
+    #[test]
+    fn json_keys_are_exact() {
+        let json = serde_json::to_value(metrics(1.0, Some(2.0))).unwrap();
+        let obj = json.as_object().unwrap();
+        let mut keys: Vec<&str> = obj.keys().map(String::as_str).collect();
+        keys.sort_unstable();
+        let mut expected: Vec<&str> = Metric::ALL.iter().map(|m| m.key()).collect();
+        expected.sort_unstable();
+        assert_eq!(keys, expected);
+        for m in Metric::ALL {
+            assert_eq!(
+                serde_json::to_value(m).unwrap(),
+                serde_json::Value::String(m.key().into())
+            );
+        }
+    }
+
+    #[test]
+    fn summary_means_over_available_values() {
+        let s = summarize(&sample());
+        assert_eq!(s.len(), 2);
+        assert_eq!(s[0].method, "ridi");
+        assert_eq!(s[0].sequences, 2);
+        assert_eq!(s[0].mean.mpe_m, 2.0);
+        assert_eq!(s[0].mean.rte_5s_m, 7.0);
+        // Only the first sequence defines the percentage.
+        assert_eq!(s[0].mean.mpe_pct, Some(2.0));
+        assert_eq!(s[1].method, "pdr");
+        assert_eq!(s[1].sequences, 1);
+        assert_eq!(s[1].mean.ate_m, 11.0);
+        assert!(summarize(&[]).is_empty());
+    }
+
+    #[test]
+    fn report_round_trips_through_json() {
+        let mut report = EvalReport::new(EvalConfig::default(), sample());
+        report.placement =
+            Some(ConfusionMatrix::from_indices(&[0, 1, 1], &[0, 1, 0], &["leg", "bag"]).unwrap());
+        report.velocity_mse = Some([0.016, 0.015]);
+        let text = serde_json::to_string(&report).unwrap();
+        let back: EvalReport = serde_json::from_str(&text).unwrap();
+        assert_eq!(back, report);
+        // Undefined metrics are explicit nulls, not missing keys.
+        assert!(text.contains("\"mpe_pct\":null"));
+    }
+
+    #[test]
+    fn markdown_long_table() {
+        let md = markdown_table(&sample());
+        let lines: Vec<&str> = md.lines().collect();
+        // Header, separator, 3 result rows, 2 mean rows.
+        assert_eq!(lines.len(), 7);
+        assert!(lines[0].starts_with("| sequence | method | MPE (m) | MPE (%) |"));
+        assert_eq!(
+            lines[2],
+            "| hang_leg1 | ridi | 1.000 | 2.00 | 2.000 | 3.000 | 4.000 | 5.000 | 6.000 | 1.000 |"
+        );
+        assert!(lines[4].starts_with("| a\\|b | ridi | 3.000 | n/a |"));
+        assert!(lines[5].starts_with("| **mean** (2) | ridi | 2.000 | 2.00 |"));
+        // Every row has the same number of cells.
+        let cols = |l: &str| l.replace("\\|", "").matches('|').count();
+        assert!(lines.iter().all(|l| cols(l) == cols(lines[0])));
+    }
+
+    #[test]
+    fn markdown_single_metric_table() {
+        let md = markdown_metric_table(&sample(), Metric::AteM);
+        assert_eq!(
+            md,
+            "| sequence (ATE (m)) | ridi | pdr |\n\
+             | --- | --- | --- |\n\
+             | hang_leg1 | 2.000 | 11.000 |\n\
+             | a\\|b | 4.000 | n/a |\n\
+             | **mean** | 3.000 | 11.000 |\n"
+        );
+    }
+
+    #[test]
+    fn markdown_confusion_matrix_and_full_report() {
+        let cm = ConfusionMatrix::from_names(
+            &["leg", "bag", "bag", "bag"],
+            &["leg", "bag", "leg", "bag"],
+            &["leg", "bag"],
+        )
+        .unwrap();
+        let md = markdown_confusion(&cm);
+        assert!(md.contains("| leg | 1 | 0 | 100.00 % |"));
+        assert!(md.contains("| bag | 1 | 2 | 66.67 % |"));
+        assert!(md.contains("Accuracy: 75.00 % over 4 samples."));
+
+        let mut report = EvalReport::new(EvalConfig::default(), sample());
+        report.placement = Some(cm);
+        report.velocity_mse = Some([0.016, 0.015]);
+        let full = report.to_markdown();
+        assert!(full.contains("first 10 s"));
+        assert!(full.contains("## Placement classification"));
+        assert!(full.contains("0.0160 / 0.0150"));
+    }
+}
