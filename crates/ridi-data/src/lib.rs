@@ -6,14 +6,80 @@
 //! a `Sequence` can rely on equal lengths, finite values and increasing time.
 //!
 //! Readers and writers turn files into sequences and back; every error names the file, and
-//! parse errors the line and field too.
+//! parse errors the line and field too. No reader panics on malformed input.
+//!
+//! # Formats
+//!
+//! | format | reader | writer |
+//! | --- | --- | --- |
+//! | RIDI processed `data.csv`: pandas index, then the 27 [`processed::COLUMNS`], time in ns | [`ridi_csv::read`] | [`write_ridi_csv`] |
+//! | RIDI `data_plain.txt`: `N 27`, then N tab-separated rows | [`ridi_plain::read`] | [`write_ridi_plain`] |
+//! | RIDI raw recorder folder (`gyro.txt`, `acce.txt`, ..., `pose.txt`) | [`ridi_raw::read`] | |
+//! | dataset list file (`path,placement` per line) | [`read_list`], [`load_list`] | |
+//!
+//! [`detect`] tells the format of a file or folder (Tyrex folders included) and
+//! [`read_sequence`] reads any RIDI one. [`ReadOptions`] holds the validation limits and the
+//! raw synchronization settings.
+//!
+//! Conventions at the file edges: time is nanoseconds in files and seconds (absolute, `f64`)
+//! in a [`Sequence`]; quaternions are `w, x, y, z` in processed files and `x, y, z, w` in raw
+//! files (Android, Tango). In the processed layout a missing magnetometer is written as zeros and
+//! missing ground truth as `NaN` on every row, and both read back as absent.
+//!
+//! # Example
+//!
+//! Write a tiny sequence in the RIDI processed layout and read it back:
+//!
+//! ```
+//! use ridi_data::ridi_frames::{DeviceVec, WorldFromDevice};
+//! use ridi_data::{read_sequence, write_ridi_csv, OrientationSource, ReadOptions, Sequence, SequenceParts};
+//!
+//! let n = 5;
+//! let seq = Sequence::new(SequenceParts {
+//!     name: "walk1".into(),
+//!     time: (0..n).map(|i| (1_000_000_000 + 5_000_000 * i) as f64 / 1e9).collect(),
+//!     gyro: vec![DeviceVec::new(0.01, -0.02, 0.03); n],
+//!     acce: vec![DeviceVec::new(0.1, 9.9, 0.2); n],
+//!     linacce: vec![DeviceVec::new(0.1, 0.1, 0.2); n],
+//!     gravity: vec![DeviceVec::new(0.0, 9.8, 0.0); n],
+//!     orientation: vec![WorldFromDevice::identity(); n],
+//!     orientation_source: Some(OrientationSource::GameRotationVector),
+//!     ..Default::default()
+//! })?;
+//!
+//! let dir = tempfile::tempdir().unwrap();
+//! let folder = dir.path().join("walk1");
+//! std::fs::create_dir_all(folder.join("processed")).unwrap();
+//! write_ridi_csv(&seq, folder.join("processed/data.csv"))?;
+//!
+//! // The folder is detected as a RIDI capture and named after itself.
+//! let back = read_sequence(&folder, &ReadOptions::default())?;
+//! assert_eq!(back, seq);
+//! assert!(back.ground_truth().is_none() && back.magnet().is_none());
+//! # Ok::<(), Box<dyn std::error::Error>>(())
+//! ```
 
+mod detect;
 mod error;
+mod list;
+pub mod mat;
+mod options;
+pub mod processed;
 pub mod resample;
+pub mod ridi_csv;
+pub mod ridi_plain;
+pub mod ridi_raw;
 mod sequence;
+mod text;
+pub mod tyrex;
+mod write;
 
+pub use detect::{Format, detect, read_sequence};
 pub use error::{DataError, Location, Result};
+pub use list::{ListEntry, load_list, parse_list, read_list};
+pub use options::ReadOptions;
+pub use ridi_frames;
 pub use sequence::{
     GroundTruth, OrientationSource, Sequence, SequenceError, SequenceParts, Validation,
 };
-pub use ridi_frames;
+pub use write::{write_atomically, write_ridi_csv, write_ridi_plain};

@@ -80,7 +80,10 @@ mod tests {
     #[test]
     fn vec3_interpolation_is_componentwise() {
         let t = [0.0, 2.0];
-        let v = [DeviceVec::new(0.0, 2.0, -4.0), DeviceVec::new(2.0, 4.0, 0.0)];
+        let v = [
+            DeviceVec::new(0.0, 2.0, -4.0),
+            DeviceVec::new(2.0, 4.0, 0.0),
+        ];
         let out = interpolate_vec3(&t, &v, &[0.5]);
         assert_eq!(out[0], DeviceVec::new(0.5, 2.5, -3.0));
     }

@@ -1,0 +1,119 @@
+//! Format detection and the reader dispatch.
+
+use std::fmt;
+use std::path::{Path, PathBuf};
+
+use crate::error::{DataError, Location, Result};
+use crate::options::ReadOptions;
+use crate::sequence::Sequence;
+use crate::{ridi_csv, ridi_plain, ridi_raw};
+
+/// The dataset formats ridi-data knows.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum Format {
+    /// RIDI processed `data.csv` (see [`ridi_csv`]).
+    RidiCsv,
+    /// RIDI `data_plain.txt` (see [`ridi_plain`]).
+    RidiPlain,
+    /// RIDI raw recorder folder (see [`ridi_raw`]).
+    RidiRaw,
+    /// Tyrex smartphone benchmark folder (`accelerometer.txt` and `gyroscope-calibrated.txt`).
+    Tyrex,
+}
+
+impl fmt::Display for Format {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(match self {
+            Format::RidiCsv => "RIDI processed csv",
+            Format::RidiPlain => "RIDI data_plain.txt",
+            Format::RidiRaw => "RIDI raw folder",
+            Format::Tyrex => "Tyrex folder",
+        })
+    }
+}
+
+/// What [`detect`] found: the format and the file or folder its reader takes.
+fn locate(path: &Path) -> Result<(Format, PathBuf)> {
+    if path.is_file() {
+        let name = path
+            .file_name()
+            .map(|n| n.to_string_lossy().to_lowercase())
+            .unwrap_or_default();
+        if name.ends_with(".csv") {
+            return Ok((Format::RidiCsv, path.to_path_buf()));
+        }
+        if name.ends_with(".txt") {
+            return Ok((Format::RidiPlain, path.to_path_buf()));
+        }
+        return Err(DataError::format(
+            Location::file(path),
+            "unknown file type: expected a RIDI `.csv` or `data_plain.txt`",
+        ));
+    }
+    if !path.is_dir() {
+        return Err(DataError::format(
+            Location::file(path),
+            "no such file or folder",
+        ));
+    }
+    let has = |p: &str| path.join(p).is_file();
+    // A RIDI capture folder often holds the raw files and `processed/`: the processed file is
+    // what the published dataset ships, with the trimmed, synchronized timeline, so it wins.
+    for (rel, format) in [
+        ("processed/data.csv", Format::RidiCsv),
+        ("data.csv", Format::RidiCsv),
+        ("processed/data_plain.txt", Format::RidiPlain),
+        ("data_plain.txt", Format::RidiPlain),
+    ] {
+        if has(rel) {
+            return Ok((format, path.join(rel)));
+        }
+    }
+    if has("gyro.txt") && has("acce.txt") {
+        return Ok((Format::RidiRaw, path.to_path_buf()));
+    }
+    if has("accelerometer.txt") && has("gyroscope-calibrated.txt") {
+        return Ok((Format::Tyrex, path.to_path_buf()));
+    }
+    Err(DataError::format(
+        Location::file(path),
+        "not a known dataset folder: expected processed/data.csv, data.csv, data_plain.txt, \
+         a RIDI raw folder (gyro.txt, acce.txt, ...) or a Tyrex folder (accelerometer.txt, \
+         gyroscope-calibrated.txt)",
+    ))
+}
+
+/// Detects the format of a file or folder.
+///
+/// Files: `*.csv` is a RIDI processed csv, `*.txt` a `data_plain.txt`. Folders, first match
+/// wins: `processed/data.csv`, `data.csv`, `processed/data_plain.txt`, `data_plain.txt`, a RIDI
+/// raw folder (`gyro.txt` and `acce.txt`), a Tyrex folder (`accelerometer.txt` and
+/// `gyroscope-calibrated.txt`).
+pub fn detect(path: impl AsRef<Path>) -> Result<Format> {
+    locate(path.as_ref()).map(|(f, _)| f)
+}
+
+/// Reads a sequence of any detected RIDI format (see [`detect`]). Tyrex folders are detected
+/// but not read here: use [`tyrex::read`](crate::tyrex::read), which may return several parts.
+pub fn read_sequence(path: impl AsRef<Path>, opts: &ReadOptions) -> Result<Sequence> {
+    let (format, file) = locate(path.as_ref())?;
+    match format {
+        Format::RidiCsv => ridi_csv::read(&file, opts),
+        Format::RidiPlain => ridi_plain::read(&file, opts),
+        Format::RidiRaw => ridi_raw::read(&file, opts),
+        Format::Tyrex => {
+            let mut read = crate::tyrex::read(&file, &crate::tyrex::TyrexOptions::from(opts))?;
+            match read.sequences.len() {
+                1 => Ok(read.sequences.remove(0)),
+                n => Err(DataError::format(
+                    Location::file(&file),
+                    format!(
+                        "the recording has {n} usable parts (split at long tracking or sensor \
+                         gaps): read it with `ridi_data::tyrex::read`, or convert it with \
+                         `ridi convert`, which writes each part"
+                    ),
+                )),
+            }
+        }
+    }
+}

@@ -1,0 +1,100 @@
+//! Dataset list files: which sequences make a dataset split, and where each was carried.
+//!
+//! One entry per line, `path,placement`: the path is absolute or relative to the list file's
+//! folder, the placement (e.g. `body`, `handheld`, `bag`, `leg`) is optional (`path` alone or
+//! `path,`). Blank lines and lines starting with `#` are skipped. Surrounding spaces are
+//! trimmed.
+
+use std::path::{Path, PathBuf};
+
+use crate::detect::read_sequence;
+use crate::error::{DataError, Location, Result};
+use crate::options::ReadOptions;
+use crate::sequence::Sequence;
+use crate::text;
+
+/// One line of a list file.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct ListEntry {
+    /// The sequence, resolved against the list file's folder.
+    pub path: PathBuf,
+    /// Placement label, when given.
+    pub placement: Option<String>,
+    /// 1-based line of the list file, for error messages.
+    pub line: usize,
+}
+
+/// Reads a list file. Only the syntax is checked; [`load_list`] checks that the sequences
+/// exist.
+pub fn read_list(path: impl AsRef<Path>) -> Result<Vec<ListEntry>> {
+    let path = path.as_ref();
+    parse_list(&text::read_file(path)?, path)
+}
+
+/// Parses the content of a list file; `path` is the list file itself (relative entries are
+/// resolved against its folder, errors name it).
+pub fn parse_list(bytes: &[u8], path: &Path) -> Result<Vec<ListEntry>> {
+    let base = path.parent().unwrap_or(Path::new(""));
+    let mut entries = Vec::new();
+    for (line, content) in text::lines(text::as_text(bytes, path)?) {
+        let content = content.trim();
+        if content.starts_with('#') {
+            continue;
+        }
+        let mut cells = content.split(',');
+        let (entry, placement) = (cells.next().unwrap_or("").trim(), cells.next());
+        if cells.next().is_some() {
+            return Err(DataError::format(
+                Location::line(path, line),
+                "expected `path,placement`, found more than two comma-separated fields",
+            ));
+        }
+        if entry.is_empty() {
+            return Err(DataError::format(
+                Location::line(path, line).with_field("path"),
+                "empty sequence path",
+            ));
+        }
+        let placement = placement.map(str::trim).filter(|p| !p.is_empty());
+        if let Some(p) = placement.filter(|p| p.contains(char::is_whitespace)) {
+            return Err(DataError::format(
+                Location::line(path, line).with_field("placement"),
+                format!("placement `{}` contains spaces", text::snippet(p)),
+            ));
+        }
+        entries.push(ListEntry {
+            path: base.join(entry),
+            placement: placement.map(str::to_owned),
+            line,
+        });
+    }
+    Ok(entries)
+}
+
+/// Reads every sequence of a list file, detecting each one's format (see
+/// [`detect`](crate::detect())) and setting its placement from the list when the list gives one.
+///
+/// Every entry is checked to exist before any is read, so a typo fails fast with the list file
+/// and line; errors while reading a sequence name that sequence's file.
+pub fn load_list(path: impl AsRef<Path>, opts: &ReadOptions) -> Result<Vec<Sequence>> {
+    let path = path.as_ref();
+    let entries = read_list(path)?;
+    for e in &entries {
+        if !e.path.exists() {
+            return Err(DataError::format(
+                Location::line(path, e.line).with_field("path"),
+                format!("sequence `{}` does not exist", e.path.display()),
+            ));
+        }
+    }
+    entries
+        .into_iter()
+        .map(|e| {
+            let mut seq = read_sequence(&e.path, opts)?;
+            if e.placement.is_some() {
+                seq.set_placement(e.placement);
+            }
+            Ok(seq)
+        })
+        .collect()
+}

@@ -1,0 +1,229 @@
+//! The RIDI processed layout shared by `data.csv`, `data_plain.txt` and the writers: the 27
+//! columns, and how one table of rows becomes a [`Sequence`].
+
+use std::path::Path;
+
+use ridi_frames::nalgebra::{Quaternion, UnitQuaternion};
+use ridi_frames::{DeviceVec, QuatError, WorldFromDevice};
+
+use crate::error::{DataError, Location, Result};
+use crate::options::ReadOptions;
+use crate::sequence::{GroundTruth, OrientationSource, Sequence, SequenceParts};
+use crate::text;
+
+/// The 27 columns of the RIDI processed layout, in the order the original writes them. `time`
+/// is in nanoseconds; `ori_*` is the Tango ground-truth orientation and `rv_*` the game
+/// rotation vector, both world-from-device in `w, x, y, z` order.
+pub const COLUMNS: [&str; 27] = [
+    "time",
+    "gyro_x",
+    "gyro_y",
+    "gyro_z",
+    "acce_x",
+    "acce_y",
+    "acce_z",
+    "linacce_x",
+    "linacce_y",
+    "linacce_z",
+    "grav_x",
+    "grav_y",
+    "grav_z",
+    "magnet_x",
+    "magnet_y",
+    "magnet_z",
+    "pos_x",
+    "pos_y",
+    "pos_z",
+    "ori_w",
+    "ori_x",
+    "ori_y",
+    "ori_z",
+    "rv_w",
+    "rv_x",
+    "rv_y",
+    "rv_z",
+];
+
+pub(crate) const TIME: usize = 0;
+pub(crate) const GYRO: usize = 1;
+pub(crate) const ACCE: usize = 4;
+pub(crate) const LINACCE: usize = 7;
+pub(crate) const GRAV: usize = 10;
+pub(crate) const MAGNET: usize = 13;
+pub(crate) const POS: usize = 16;
+pub(crate) const ORI: usize = 19;
+pub(crate) const RV: usize = 23;
+
+/// Whether a column may hold NaN: only the ground truth, where NaN on every row is how the
+/// writers say "no ground truth".
+pub(crate) fn nan_policy(column: usize) -> text::Nan {
+    if (POS..RV).contains(&column) {
+        text::Nan::Accept
+    } else {
+        text::Nan::Reject
+    }
+}
+
+/// Parsed rows in [`COLUMNS`] order, each with its line number.
+pub(crate) struct Table {
+    pub rows: Vec<[f64; 27]>,
+    pub lines: Vec<usize>,
+    /// `magnet_*` columns exist (they may still be all zeros, meaning "not recorded").
+    pub has_magnet: bool,
+    /// `pos_*` and `ori_*` columns exist (they may still be all NaN, meaning "none").
+    pub has_ground_truth: bool,
+}
+
+/// Sequence name from a file path: the capture folder for `<name>/processed/data.csv` and
+/// `<name>/data.csv` (also `data_plain.txt`), the file stem otherwise.
+pub(crate) fn name_from_path(path: &Path) -> String {
+    let file_name = |p: &Path| p.file_name().map(|s| s.to_string_lossy().into_owned());
+    let stem = path
+        .file_stem()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    if !matches!(
+        file_name(path).as_deref(),
+        Some("data.csv" | "data_plain.txt")
+    ) {
+        return stem;
+    }
+    let Some(dir) = path.parent() else {
+        return stem;
+    };
+    let dir = if file_name(dir).as_deref() == Some("processed") {
+        dir.parent().unwrap_or(dir)
+    } else {
+        dir
+    };
+    // `data.csv` in the working directory has an empty parent: fall back to the stem.
+    file_name(dir).filter(|n| !n.is_empty()).unwrap_or(stem)
+}
+
+/// A world-from-device rotation from `w, x, y, z`. Components already of unit norm to rounding
+/// are kept bit for bit (renormalizing would change the last bits and break exact round
+/// trips); others are checked against [`WorldFromDevice::NORM_TOLERANCE`] and normalized.
+pub(crate) fn rotation_wxyz(c: [f64; 4]) -> Result<WorldFromDevice, QuatError> {
+    let checked = WorldFromDevice::from_wxyz(c)?;
+    let q = Quaternion::new(c[0], c[1], c[2], c[3]);
+    if (q.norm() - 1.0).abs() <= 4.0 * f64::EPSILON {
+        Ok(WorldFromDevice::from_unit_quaternion(
+            UnitQuaternion::new_unchecked(q),
+        ))
+    } else {
+        Ok(checked)
+    }
+}
+
+fn vec3<F: ridi_frames::Frame>(rows: &[[f64; 27]], at: usize) -> Vec<ridi_frames::Vec3<F>> {
+    rows.iter()
+        .map(|r| ridi_frames::Vec3::new(r[at], r[at + 1], r[at + 2]))
+        .collect()
+}
+
+fn rotations(table: &Table, at: usize, path: &Path) -> Result<Vec<WorldFromDevice>> {
+    table
+        .rows
+        .iter()
+        .zip(&table.lines)
+        .map(|(r, &line)| {
+            rotation_wxyz([r[at], r[at + 1], r[at + 2], r[at + 3]]).map_err(|e| {
+                DataError::format(
+                    Location::line(path, line).with_field(COLUMNS[at]),
+                    format!(
+                        "`{}..{}` is not a rotation: {e}",
+                        COLUMNS[at],
+                        COLUMNS[at + 3]
+                    ),
+                )
+            })
+        })
+        .collect()
+}
+
+fn gt(r: &[f64; 27]) -> &[f64] {
+    &r[POS..RV]
+}
+
+/// Ground truth of the table: `None` when its columns are absent or NaN on every row; an error
+/// naming the first NaN when only some rows have it.
+fn ground_truth(table: &Table, path: &Path) -> Result<Option<GroundTruth>> {
+    if !table.has_ground_truth {
+        return Ok(None);
+    }
+    if table.rows.iter().all(|r| gt(r).iter().all(|v| v.is_nan())) {
+        return Ok(None);
+    }
+    for (r, &line) in table.rows.iter().zip(&table.lines) {
+        if let Some(k) = gt(r).iter().position(|v| v.is_nan()) {
+            return Err(DataError::format(
+                Location::line(path, line).with_field(COLUMNS[POS + k]),
+                "ground truth is NaN here but present on other rows (all NaN means none)",
+            ));
+        }
+    }
+    Ok(Some(GroundTruth {
+        position: vec3::<ridi_frames::World>(&table.rows, POS),
+        orientation: rotations(table, ORI, path)?,
+    }))
+}
+
+/// Builds and validates the sequence of a processed table; `path` names the file in errors.
+pub(crate) fn assemble(table: Table, path: &Path, opts: &ReadOptions) -> Result<Sequence> {
+    let rows = &table.rows;
+    let time: Vec<f64> = rows.iter().map(|r| r[TIME] / 1e9).collect();
+    text::check_time(
+        &time,
+        &table.lines,
+        path,
+        COLUMNS[TIME],
+        opts.validation.max_gap_s,
+    )?;
+    let magnet = table
+        .has_magnet
+        .then(|| vec3::<ridi_frames::Device>(rows, MAGNET))
+        .filter(|m| m.iter().any(|v| *v != DeviceVec::ZERO));
+    let parts = SequenceParts {
+        name: name_from_path(path),
+        placement: None,
+        time,
+        gyro: vec3(rows, GYRO),
+        acce: vec3(rows, ACCE),
+        linacce: vec3(rows, LINACCE),
+        gravity: vec3(rows, GRAV),
+        magnet,
+        orientation: rotations(&table, RV, path)?,
+        orientation_source: Some(OrientationSource::GameRotationVector),
+        ground_truth: ground_truth(&table, path)?,
+        steps: None,
+    };
+    Sequence::with_validation(parts, &opts.validation)
+        .map_err(|e| text::sequence_error(path, Some(&table.lines), e))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn names_come_from_the_capture_folder() {
+        assert_eq!(
+            name_from_path(Path::new("/d/seq1/processed/data.csv")),
+            "seq1"
+        );
+        assert_eq!(name_from_path(Path::new("/d/seq2/data.csv")), "seq2");
+        assert_eq!(name_from_path(Path::new("seq3/data_plain.txt")), "seq3");
+        assert_eq!(name_from_path(Path::new("/d/walk.csv")), "walk");
+        assert_eq!(name_from_path(Path::new("data.csv")), "data");
+    }
+
+    #[test]
+    fn unit_quaternions_are_kept_bit_for_bit() {
+        let c = [0.5f64.sqrt(), 0.0, 0.0, 0.5f64.sqrt()];
+        let r = rotation_wxyz(c).unwrap();
+        assert_eq!(r.to_wxyz(), c);
+        assert!(rotation_wxyz([2.0, 0.0, 0.0, 0.0]).is_err());
+        let r = rotation_wxyz([1.001, 0.0, 0.0, 0.0]).unwrap();
+        assert_eq!(r.to_wxyz(), [1.0, 0.0, 0.0, 0.0]);
+    }
+}

@@ -1,0 +1,182 @@
+//! Reader of RIDI processed `data.csv` files.
+//!
+//! Columns are selected by header name, so the leading unnamed pandas index column, extra
+//! columns of later versions and any column order are all accepted. Required: `time`, `gyro_*`,
+//! `acce_*`, `linacce_*`, `grav_*`, `rv_*`. Optional: `magnet_*` (all zeros also means "not
+//! recorded"), and `pos_*` with `ori_*` together (NaN on every row also means "no ground
+//! truth"). Time is in nanoseconds and becomes absolute seconds.
+
+use std::path::Path;
+
+use crate::error::{DataError, Location, Result};
+use crate::options::ReadOptions;
+use crate::processed::{self, COLUMNS, MAGNET, POS, RV, Table};
+use crate::sequence::Sequence;
+use crate::text;
+
+/// Reads a RIDI processed `data.csv`. The sequence is named after its capture folder (see
+/// [`read_sequence`](crate::read_sequence)), its orientation source is the game rotation vector.
+pub fn read(path: impl AsRef<Path>, opts: &ReadOptions) -> Result<Sequence> {
+    let path = path.as_ref();
+    parse(&text::read_file(path)?, path, opts)
+}
+
+/// Parses the content of a `data.csv`; `path` names the source in errors and gives the name.
+pub fn parse(bytes: &[u8], path: &Path, opts: &ReadOptions) -> Result<Sequence> {
+    let table = parse_table(text::as_text(bytes, path)?, path)?;
+    processed::assemble(table, path, opts)
+}
+
+/// Header cell as a plain name: pandas writes bare names, other tools may quote them.
+fn header_name(cell: &str) -> &str {
+    let c = cell.trim();
+    c.strip_prefix('"')
+        .and_then(|c| c.strip_suffix('"'))
+        .unwrap_or(c)
+        .trim()
+}
+
+/// The [`COLUMNS`] index fed by each file column (`None` for the index and unknown columns).
+struct Header {
+    line: usize,
+    slots: Vec<Option<usize>>,
+    has_magnet: bool,
+    has_ground_truth: bool,
+}
+
+fn parse_header(line: usize, content: &str, path: &Path) -> Result<Header> {
+    let at = |field: &str| Location::line(path, line).with_field(field);
+    let mut slots = Vec::new();
+    let mut found = [false; 27];
+    for cell in text::cells(content, b',') {
+        let name = header_name(cell);
+        let slot = COLUMNS.iter().position(|&c| c == name);
+        if let Some(k) = slot {
+            if found[k] {
+                return Err(DataError::format(at(name), "column appears twice"));
+            }
+            found[k] = true;
+        }
+        slots.push(slot);
+    }
+    // A group is present when any of its columns is; then all of them must be.
+    let group = |range: std::ops::Range<usize>, required: bool, what: &str| -> Result<bool> {
+        if !required && !found[range.clone()].iter().any(|&f| f) {
+            return Ok(false);
+        }
+        match range.clone().find(|&k| !found[k]) {
+            Some(k) => Err(DataError::format(
+                at(COLUMNS[k]),
+                format!("missing column `{}` ({what})", COLUMNS[k]),
+            )),
+            None => Ok(true),
+        }
+    };
+    group(0..MAGNET, true, "required")?;
+    group(RV..27, true, "required")?;
+    let has_magnet = group(MAGNET..POS, false, "the magnet columns come as a set")?;
+    let has_ground_truth = group(POS..RV, false, "ground truth needs all of pos_* and ori_*")?;
+    Ok(Header {
+        line,
+        slots,
+        has_magnet,
+        has_ground_truth,
+    })
+}
+
+fn parse_table(text: &str, path: &Path) -> Result<Table> {
+    let mut lines = text::lines(text);
+    let Some((header_line, header)) = lines.next() else {
+        return Err(DataError::format(
+            Location::file(path),
+            "file is empty: expected a header line and data rows",
+        ));
+    };
+    let header = parse_header(header_line, header, path)?;
+    let width = header.slots.len();
+    let mut rows = Vec::new();
+    let mut row_lines = Vec::new();
+    for (line, content) in lines {
+        let width_error = |fields: usize| {
+            DataError::format(
+                Location::line(path, line),
+                format!(
+                    "{fields} fields where the header on line {} has {width}{}",
+                    header.line,
+                    if fields < width {
+                        " (truncated line?)"
+                    } else {
+                        ""
+                    }
+                ),
+            )
+        };
+        // Columns that are not in the file stay NaN; assemble never reads them.
+        let mut row = [f64::NAN; 27];
+        let mut fields = 0;
+        for (c, cell) in text::cells(content, b',').enumerate() {
+            if let Some(&Some(k)) = header.slots.get(c) {
+                let policy = processed::nan_policy(k);
+                row[k] = text::number(cell, path, line, COLUMNS[k], policy).map_err(|e| {
+                    // A cut line often ends in a partial cell: say so rather than blame it.
+                    match text::cells(content, b',').count() {
+                        n if n != width => width_error(n),
+                        _ => e,
+                    }
+                })?;
+            }
+            fields = c + 1;
+        }
+        if fields != width {
+            return Err(width_error(fields));
+        }
+        rows.push(row);
+        row_lines.push(line);
+    }
+    if rows.is_empty() {
+        return Err(DataError::format(
+            Location::line(path, header.line),
+            "only a header line, no data rows",
+        ));
+    }
+    Ok(Table {
+        rows,
+        lines: row_lines,
+        has_magnet: header.has_magnet,
+        has_ground_truth: header.has_ground_truth,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn header_groups_are_all_or_nothing() {
+        let p = Path::new("h.csv");
+        let full = format!(",{}", COLUMNS.join(","));
+        let h = parse_header(1, &full, p).unwrap();
+        assert!(h.has_magnet && h.has_ground_truth);
+        assert_eq!(h.slots[0], None);
+        assert_eq!(h.slots[1], Some(0));
+        let no_gt: Vec<_> = COLUMNS
+            .iter()
+            .filter(|c| !c.starts_with("pos") && !c.starts_with("ori"))
+            .copied()
+            .collect();
+        let h = parse_header(1, &no_gt.join(","), p).unwrap();
+        assert!(h.has_magnet && !h.has_ground_truth);
+        let partial: Vec<_> = COLUMNS.iter().filter(|&&c| c != "ori_z").copied().collect();
+        let e = parse_header(1, &partial.join(","), p).err().unwrap();
+        assert!(
+            e.to_string()
+                .starts_with("h.csv:1: field `ori_z`: missing column"),
+            "{e}"
+        );
+        let e = parse_header(1, &format!("{full},gyro_x"), p).err().unwrap();
+        assert!(
+            e.to_string().contains("`gyro_x`: column appears twice"),
+            "{e}"
+        );
+    }
+}

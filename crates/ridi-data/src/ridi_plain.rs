@@ -1,0 +1,120 @@
+//! Reader of RIDI `data_plain.txt`, the input of the original C++ tools: a first line `N 27`,
+//! then `N` rows of the 27 processed [`COLUMNS`], tab-separated, without an index column. Any
+//! run of spaces or tabs is accepted as a separator.
+//! Magnet and ground truth follow the `data.csv` conventions (all zeros and all NaN mean absent).
+
+use std::path::Path;
+
+use crate::error::{DataError, Location, Result};
+use crate::options::ReadOptions;
+use crate::processed::{self, COLUMNS, Table};
+use crate::sequence::Sequence;
+use crate::text;
+
+/// Reads a `data_plain.txt`.
+pub fn read(path: impl AsRef<Path>, opts: &ReadOptions) -> Result<Sequence> {
+    let path = path.as_ref();
+    parse(&text::read_file(path)?, path, opts)
+}
+
+/// Parses the content of a `data_plain.txt`; `path` names the source in errors and gives the
+/// name.
+pub fn parse(bytes: &[u8], path: &Path, opts: &ReadOptions) -> Result<Sequence> {
+    let table = parse_table(text::as_text(bytes, path)?, path)?;
+    processed::assemble(table, path, opts)
+}
+
+fn parse_table(text: &str, path: &Path) -> Result<Table> {
+    let mut lines = text::lines(text);
+    let Some((header_line, header)) = lines.next() else {
+        return Err(DataError::format(
+            Location::file(path),
+            "file is empty: expected a `N 27` line and N rows",
+        ));
+    };
+    let mut cells = header.split_ascii_whitespace();
+    let (Some(n), Some(width), None) = (cells.next(), cells.next(), cells.next()) else {
+        return Err(DataError::format(
+            Location::line(path, header_line),
+            format!(
+                "expected `N 27` (row and column counts), found `{}`",
+                text::snippet(header)
+            ),
+        ));
+    };
+    let n = text::count(n, path, header_line, "rows")?;
+    let width = text::count(width, path, header_line, "columns")?;
+    if width != COLUMNS.len() {
+        return Err(DataError::format(
+            Location::line(path, header_line).with_field("columns"),
+            format!("{width} columns announced, the RIDI layout has 27"),
+        ));
+    }
+    if n == 0 {
+        return Err(DataError::format(
+            Location::line(path, header_line).with_field("rows"),
+            "announces no rows",
+        ));
+    }
+    // The count comes from the file: cap the reservation so a bogus count cannot exhaust memory.
+    let mut rows = Vec::with_capacity(n.min(1 << 20));
+    let mut row_lines = Vec::with_capacity(n.min(1 << 20));
+    let mut last_line = header_line;
+    for (line, content) in lines {
+        if rows.len() == n {
+            return Err(DataError::format(
+                Location::line(path, line),
+                format!("more rows than the {n} announced on line {header_line}"),
+            ));
+        }
+        let width_error = |fields: usize| {
+            DataError::format(
+                Location::line(path, line),
+                format!(
+                    "{fields} fields, expected {width}{}",
+                    if fields < width {
+                        " (truncated line?)"
+                    } else {
+                        ""
+                    }
+                ),
+            )
+        };
+        let mut row = [f64::NAN; 27];
+        let mut fields = 0;
+        for (k, cell) in content.split_ascii_whitespace().enumerate() {
+            if let Some(slot) = row.get_mut(k) {
+                let policy = processed::nan_policy(k);
+                *slot = text::number(cell, path, line, COLUMNS[k], policy).map_err(|e| {
+                    // A cut line often ends in a partial cell: say so rather than blame it.
+                    match content.split_ascii_whitespace().count() {
+                        n if n != width => width_error(n),
+                        _ => e,
+                    }
+                })?;
+            }
+            fields = k + 1;
+        }
+        if fields != width {
+            return Err(width_error(fields));
+        }
+        rows.push(row);
+        row_lines.push(line);
+        last_line = line;
+    }
+    if rows.len() < n {
+        return Err(DataError::format(
+            Location::line(path, last_line),
+            format!(
+                "file ends after {} of the {n} rows announced on line {header_line}",
+                rows.len()
+            ),
+        ));
+    }
+    Ok(Table {
+        rows,
+        lines: row_lines,
+        has_magnet: true,
+        has_ground_truth: true,
+    })
+}

@@ -1,0 +1,260 @@
+//! Line and field parsing shared by every text reader, so that all of them turn bytes into
+//! numbers the same way and report errors with the same file, line and field.
+
+use std::path::Path;
+
+use crate::error::{DataError, Location, Result};
+use crate::sequence::SequenceError;
+
+/// Reads a whole file; the readers parse from memory because one pass over a byte slice is much
+/// faster than buffered line reading with a `String` per line.
+pub(crate) fn read_file(path: &Path) -> Result<Vec<u8>> {
+    std::fs::read(path).map_err(|e| DataError::io(path, e))
+}
+
+/// The bytes as UTF-8 text without a leading byte-order mark; the error names the first line
+/// that is not valid UTF-8.
+pub(crate) fn as_text<'a>(bytes: &'a [u8], path: &Path) -> Result<&'a str> {
+    match std::str::from_utf8(bytes) {
+        Ok(s) => Ok(s.strip_prefix('\u{feff}').unwrap_or(s)),
+        Err(e) => {
+            let line = bytes
+                .get(..e.valid_up_to())
+                .map_or(0, |b| b.iter().filter(|&&c| c == b'\n').count())
+                + 1;
+            Err(DataError::format(
+                Location::line(path, line),
+                "is not UTF-8 text",
+            ))
+        }
+    }
+}
+
+/// Non-blank lines with their 1-based numbers, without line endings (`\n` or `\r\n`).
+pub(crate) fn lines(text: &str) -> impl Iterator<Item = (usize, &str)> {
+    text.split('\n')
+        .enumerate()
+        .map(|(i, l)| (i + 1, l.strip_suffix('\r').unwrap_or(l)))
+        .filter(|(_, l)| !l.trim().is_empty())
+}
+
+/// Cells of a line separated by the ASCII byte `sep`, like `str::split` but with a plain byte
+/// loop: cells are short, and `str::split`'s `memchr` set-up cost dominates on them.
+pub(crate) fn cells(line: &str, sep: u8) -> Cells<'_> {
+    Cells {
+        rest: Some(line),
+        sep,
+    }
+}
+
+/// Iterator of [`cells`].
+pub(crate) struct Cells<'a> {
+    rest: Option<&'a str>,
+    sep: u8,
+}
+
+impl<'a> Iterator for Cells<'a> {
+    type Item = &'a str;
+
+    fn next(&mut self) -> Option<&'a str> {
+        let s = self.rest?;
+        match s.bytes().position(|b| b == self.sep) {
+            // `sep` is ASCII, so both slices fall on character boundaries.
+            Some(i) => {
+                self.rest = Some(&s[i + 1..]);
+                Some(&s[..i])
+            }
+            None => {
+                self.rest = None;
+                Some(s)
+            }
+        }
+    }
+}
+
+/// At most 40 characters of `s`, for error messages about cells that may be arbitrarily long.
+pub(crate) fn snippet(s: &str) -> String {
+    match s.char_indices().nth(40) {
+        Some((end, _)) => format!("{}...", &s[..end]),
+        None => s.to_owned(),
+    }
+}
+
+/// Whether NaN is an accepted cell value (infinities never are).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum Nan {
+    Reject,
+    Accept,
+}
+
+/// Parses one numeric cell. `field` is only turned into an owned name when there is an error,
+/// so the hot path allocates nothing.
+pub(crate) fn number(cell: &str, path: &Path, line: usize, field: &str, nan: Nan) -> Result<f64> {
+    let s = cell.trim_ascii();
+    let fail = |message: String| {
+        Err(DataError::format(
+            Location::line(path, line).with_field(field),
+            message,
+        ))
+    };
+    match s.parse::<f64>() {
+        Ok(v) if v.is_finite() => Ok(v),
+        Ok(v) if v.is_nan() && nan == Nan::Accept => Ok(v),
+        Ok(_) => fail(format!("`{}` is not a finite number", snippet(s))),
+        Err(_) if s.is_empty() => fail("empty cell where a number is expected".to_owned()),
+        Err(_) => fail(format!("`{}` is not a number", snippet(s))),
+    }
+}
+
+/// Parses a non-negative integer cell (row and column counts).
+pub(crate) fn count(cell: &str, path: &Path, line: usize, field: &str) -> Result<usize> {
+    let s = cell.trim();
+    s.parse::<usize>().map_err(|_| {
+        DataError::format(
+            Location::line(path, line).with_field(field),
+            format!("`{}` is not a non-negative integer", snippet(s)),
+        )
+    })
+}
+
+/// Checks that `time` (seconds, one entry per line of `lines`) strictly increases without
+/// gaps longer than `max_gap_s`, naming the offending line.
+pub(crate) fn check_time(
+    time: &[f64],
+    lines: &[usize],
+    path: &Path,
+    field: &str,
+    max_gap_s: f64,
+) -> Result<()> {
+    for (i, w) in time.windows(2).enumerate() {
+        let (prev, next) = (w[0], w[1]);
+        let line = lines.get(i + 1).copied().unwrap_or(0);
+        let prev_line = lines.get(i).copied().unwrap_or(0);
+        let at = || Location::line(path, line).with_field(field);
+        if next == prev {
+            return Err(DataError::format(
+                at(),
+                format!("duplicate timestamp (same as line {prev_line})"),
+            ));
+        }
+        if next < prev {
+            return Err(DataError::format(
+                at(),
+                format!(
+                    "timestamp goes back by {:.9} s from line {prev_line}",
+                    prev - next
+                ),
+            ));
+        }
+        if next - prev > max_gap_s {
+            return Err(DataError::format(
+                at(),
+                format!(
+                    "gap of {:.3} s since line {prev_line} exceeds the limit of {max_gap_s} s",
+                    next - prev
+                ),
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// Turns a validation failure into an error naming the file and, when the failure is about one
+/// frame and `lines` maps frames to lines, that line.
+pub(crate) fn sequence_error(path: &Path, lines: Option<&[usize]>, e: SequenceError) -> DataError {
+    let (index, field) = match &e {
+        SequenceError::NotFinite { index, field } => (*index, *field),
+        SequenceError::TimeNotIncreasing { index, .. } | SequenceError::Gap { index, .. } => {
+            (*index, "time")
+        }
+        _ => return DataError::sequence(path, e),
+    };
+    match lines.and_then(|l| l.get(index)) {
+        Some(&line) => {
+            DataError::format(Location::line(path, line).with_field(field), e.to_string())
+        }
+        None => DataError::sequence(path, e),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn p() -> &'static Path {
+        Path::new("f.csv")
+    }
+
+    #[test]
+    fn numbers_parse_and_errors_name_line_and_field() {
+        assert_eq!(number(" 1.5e3 ", p(), 3, "x", Nan::Reject).unwrap(), 1500.0);
+        let e = number("abc", p(), 3, "gyro_x", Nan::Reject).unwrap_err();
+        assert_eq!(
+            e.to_string(),
+            "f.csv:3: field `gyro_x`: `abc` is not a number"
+        );
+        let e = number("inf", p(), 4, "t", Nan::Accept).unwrap_err();
+        assert!(
+            e.to_string()
+                .contains(":4: field `t`: `inf` is not a finite"),
+            "{e}"
+        );
+        assert!(number("NaN", p(), 1, "x", Nan::Reject).is_err());
+        assert!(number("nan", p(), 1, "x", Nan::Accept).unwrap().is_nan());
+        assert!(
+            number("", p(), 1, "x", Nan::Reject)
+                .unwrap_err()
+                .to_string()
+                .contains("empty")
+        );
+    }
+
+    #[test]
+    fn cells_split_like_str_split() {
+        for line in ["", "a", ",", "a,b", ",a,,b,", "é,ü,,"] {
+            let ours: Vec<_> = cells(line, b',').collect();
+            let std: Vec<_> = line.split(',').collect();
+            assert_eq!(ours, std, "{line:?}");
+        }
+    }
+
+    #[test]
+    fn lines_are_numbered_and_blank_ones_skipped() {
+        let v: Vec<_> = lines("a\r\n\n  \nb\n").collect();
+        assert_eq!(v, vec![(1, "a"), (4, "b")]);
+    }
+
+    #[test]
+    fn invalid_utf8_names_its_line() {
+        let e = as_text(b"ok\nok\n\xff", p()).unwrap_err();
+        assert_eq!(e.to_string(), "f.csv:3: is not UTF-8 text");
+        assert_eq!(as_text("\u{feff}x".as_bytes(), p()).unwrap(), "x");
+    }
+
+    #[test]
+    fn snippet_cuts_long_cells_on_char_boundaries() {
+        let long = "é".repeat(100);
+        assert_eq!(snippet(&long).chars().count(), 43);
+        assert_eq!(snippet("short"), "short");
+    }
+
+    #[test]
+    fn time_checks_name_the_later_line() {
+        let lines = [2, 3, 5];
+        let e = check_time(&[0.0, 0.1, 0.1], &lines, p(), "time", 1.0).unwrap_err();
+        assert!(
+            e.to_string()
+                .starts_with("f.csv:5: field `time`: duplicate"),
+            "{e}"
+        );
+        let e = check_time(&[0.0, 0.1, 0.05], &lines, p(), "time", 1.0).unwrap_err();
+        assert!(e.to_string().contains("goes back"), "{e}");
+        let e = check_time(&[0.0, 2.0, 3.0], &lines, p(), "time", 1.0).unwrap_err();
+        assert!(
+            e.to_string()
+                .starts_with("f.csv:3: field `time`: gap of 2.000 s"),
+            "{e}"
+        );
+        check_time(&[0.0, 0.5, 1.0], &lines, p(), "time", 1.0).unwrap();
+    }
+}

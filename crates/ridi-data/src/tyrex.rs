@@ -1,0 +1,759 @@
+//! Reader for the Tyrex smartphone attitude benchmark (Inria Tyrex, "On Attitude Estimation
+//! with Smartphones", PerCom 2017): Android IMU recordings with Qualisys motion-capture ground
+//! truth.
+//!
+//! # Layout
+//! ```text
+//! <root>/datasets/android/<Person>_<Phone>_<Dist>_<Motion>/
+//!     accelerometer.txt          t ax ay az            m/s^2, with gravity
+//!     gyroscope-calibrated.txt   t wx wy wz            rad/s
+//!     rotation-vector.txt        t qx qy qz qw [acc]   Android TYPE_ROTATION_VECTOR, x,y,z,w!
+//!     timeAlignment.txt          timeDiff              s
+//!     record.properties          [Device] Model = ..., [Time] StartTime = ...
+//! <root>/datasets/qualisys/<same name>.mat   QTM "Level 5 MAT-file" export
+//! ```
+//! Text files are space-separated without a header; the first column is seconds on the phone
+//! clock. `linear-acceleration.txt` is not read: it is sparse in some runs, and the linear
+//! acceleration is rebuilt from the accelerometer and the orientation instead.
+//!
+//! # Frames
+//! The device frame is the Android sensor frame. The device orientation is the rotation
+//! vector ([`OrientationSource::RotationVector`]: magnetometer-based, world = east-north-up).
+//! Gravity is `gravity_in_device(orientation, g)` with `g` = [`TyrexOptions::gravity`]
+//! ([`STANDARD_GRAVITY`] by default, the value Android's own gravity sensor uses), and linear
+//! acceleration is accelerometer minus gravity.
+//!
+//! Ground truth keeps the mocap room frame (z up, metres, origin and heading of the room): the
+//! QTM struct's `RigidBodies.Positions` (1x3xN, mm) divided by 1000, and
+//! `RigidBodies.Rotations` (1x9xN, a column-major 3x3 with `p_room = R p_phone`). The rigid body
+//! was defined to coincide with the Android device frame, so `R` is the world-from-device
+//! rotation directly. Frames where the mocap lost the body are `NaN` in the file.
+//!
+//! # Time
+//! Mocap frame `i` (0-based, first exported frame) is at mocap time `i / FrameRate`, and
+//! `phone_time + timeDiff = mocap_time` with `timeDiff` from `timeAlignment.txt` (the authors'
+//! estimate; a residual lag of about 0.02 s remains, see [`TyrexOptions::extra_time_diff_s`]). Output sequences are on the phone clock, on a uniform timeline at
+//! [`TyrexOptions::rate_hz`] over the time covered by every phone stream and the ground truth.
+//!
+//! # Gaps
+//! Mocap losses up to [`TyrexOptions::max_mocap_gap_s`] are interpolated across; a longer one,
+//! or a gap in a phone stream longer than [`TyrexOptions::max_sensor_gap_s`], splits the
+//! recording. Every part at least [`TyrexOptions::min_part_s`] long is returned, named after the
+//! folder with `_part1`, `_part2`, ... when there are several; each split and each dropped part
+//! is reported in [`TyrexRead::warnings`].
+//!
+//! # Example
+//! ```no_run
+//! use ridi_data::tyrex::{self, TyrexOptions};
+//!
+//! let root = std::path::Path::new("tyrex-attitude-smartphones");
+//! for dir in tyrex::list_sequences(root)? {
+//!     let read = tyrex::read(&dir, &TyrexOptions::default())?;
+//!     for w in &read.warnings {
+//!         eprintln!("{}: {w}", dir.display());
+//!     }
+//!     for seq in &read.sequences {
+//!         println!("{} {:?} {:.0} s", seq.name(), seq.placement(), seq.duration());
+//!     }
+//! }
+//! # Ok::<(), ridi_data::DataError>(())
+//! ```
+
+use std::path::{Path, PathBuf};
+
+use ridi_frames::nalgebra::Matrix3;
+use ridi_frames::{
+    DeviceVec, QuatError, STANDARD_GRAVITY, WorldFromDevice, WorldVec, gravity_in_device,
+};
+
+use crate::error::{DataError, Location, Result};
+use crate::mat::{MatFile, MatValue, dims_text};
+use crate::options::ReadOptions;
+use crate::resample::{interpolate_rot, interpolate_vec3, uniform_timeline};
+use crate::sequence::{GroundTruth, OrientationSource, Sequence, SequenceParts, Validation};
+use crate::text::{self, Nan};
+
+/// Mocap frame rate assumed when a `.mat` has no `FrameRate` (the Tyrex captures are 60 Hz).
+pub const DEFAULT_MOCAP_RATE_HZ: f64 = 60.0;
+
+/// The motions (placements) of the benchmark, the last part of a sequence name.
+pub const MOTIONS: [&str; 8] = [
+    "Texting",
+    "Swinging",
+    "AR",
+    "BackPocket",
+    "FrontPocket",
+    "Phoning",
+    "RunningHand",
+    "RunningPocket",
+];
+
+/// How Tyrex folders are turned into sequences.
+#[derive(Debug, Clone, PartialEq)]
+pub struct TyrexOptions {
+    /// Rate of the output timeline, Hz.
+    pub rate_hz: f64,
+    /// Gravity magnitude used to build the gravity channel from the orientation, m/s^2.
+    pub gravity: f64,
+    /// Longest mocap loss interpolated across, seconds (from the last frame before the loss to
+    /// the first after it); longer ones split the recording.
+    pub max_mocap_gap_s: f64,
+    /// Longest interval between two samples of a phone stream, seconds; longer ones split the
+    /// recording.
+    pub max_sensor_gap_s: f64,
+    /// Parts shorter than this are dropped, seconds.
+    pub min_part_s: f64,
+    /// Whether to read the ground truth when the `.mat` file is there.
+    pub ground_truth: bool,
+    /// Added to `timeDiff`: a positive value moves the ground truth earlier on the phone clock.
+    ///
+    /// 0 by default (the authors' alignment as published). Matching the rotation vector's tilt to
+    /// the mocap's over lags in 5 ms steps gives a best value of -0.020 s (median over the 24
+    /// NoDist runs, all within -0.010..-0.030 s). The rotation vector is a filtered output, so
+    /// part of that may be its own latency rather than a clock offset of the raw sensors.
+    pub extra_time_diff_s: f64,
+    /// Limits every output sequence is checked against.
+    pub validation: Validation,
+}
+
+impl Default for TyrexOptions {
+    fn default() -> Self {
+        Self {
+            rate_hz: 200.0,
+            gravity: STANDARD_GRAVITY,
+            max_mocap_gap_s: 0.25,
+            max_sensor_gap_s: 0.1,
+            min_part_s: 10.0,
+            ground_truth: true,
+            extra_time_diff_s: 0.0,
+            validation: Validation::default(),
+        }
+    }
+}
+
+impl From<&ReadOptions> for TyrexOptions {
+    /// The validation limits and timeline rate of the generic reader options, Tyrex defaults
+    /// for the rest.
+    fn from(o: &ReadOptions) -> Self {
+        Self {
+            rate_hz: o.rate_without_pose_hz,
+            validation: o.validation.clone(),
+            ..Self::default()
+        }
+    }
+}
+
+/// What [`read`] found in one folder.
+#[derive(Debug, Clone, PartialEq)]
+pub struct TyrexRead {
+    /// The usable parts of the recording, in time order (one unless gaps split it).
+    pub sequences: Vec<Sequence>,
+    /// Splits, dropped parts and other things a user should know about.
+    pub warnings: Vec<String>,
+    /// `timeDiff` from `timeAlignment.txt`, seconds, when ground truth was read.
+    pub time_diff_s: Option<f64>,
+    /// Device model from `record.properties`, if present.
+    pub device_model: Option<String>,
+}
+
+/// One mocap frame where the body was tracked.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct MocapPose {
+    /// Position in the room frame, metres.
+    pub position: WorldVec,
+    /// Room-from-device rotation.
+    pub orientation: WorldFromDevice,
+}
+
+/// Ground truth at the mocap rate, as stored in the `.mat` (before any resampling).
+#[derive(Debug, Clone, PartialEq)]
+pub struct MocapTrack {
+    /// Frame rate, Hz.
+    pub rate_hz: f64,
+    /// Name of the variable the track was read from (QTM names it after the take).
+    pub variable: String,
+    /// Mocap time of each frame, seconds: `index / rate_hz`.
+    pub time: Vec<f64>,
+    /// Pose per frame; `None` where the mocap lost the body.
+    pub pose: Vec<Option<MocapPose>>,
+}
+
+impl MocapTrack {
+    /// Number of frames with a pose.
+    pub fn valid_count(&self) -> usize {
+        self.pose.iter().filter(|p| p.is_some()).count()
+    }
+}
+
+/// The motion (placement) of a sequence named `<Person>_<Phone>_<Dist>_<Motion>`, one of
+/// [`MOTIONS`] (matched without regard to case, returned in canonical spelling).
+pub fn motion_of(name: &str) -> Option<&'static str> {
+    let last = name.rsplit('_').next()?;
+    MOTIONS
+        .iter()
+        .find(|m| m.eq_ignore_ascii_case(last))
+        .copied()
+}
+
+/// The sequence folders under a Tyrex root, sorted by name. `root` may be the dataset root
+/// (with `datasets/android/`), its `datasets/` folder, or the `android/` folder itself; a
+/// sequence folder is one that holds `accelerometer.txt`.
+pub fn list_sequences(root: impl AsRef<Path>) -> Result<Vec<PathBuf>> {
+    let root = root.as_ref();
+    let base = [
+        root.join("datasets").join("android"),
+        root.join("android"),
+        root.to_path_buf(),
+    ]
+    .into_iter()
+    .find(|p| p.is_dir())
+    .ok_or_else(|| DataError::io(root, std::io::ErrorKind::NotFound.into()))?;
+    let entries = std::fs::read_dir(&base).map_err(|e| DataError::io(&base, e))?;
+    let mut out = Vec::new();
+    for entry in entries {
+        let path = entry.map_err(|e| DataError::io(&base, e))?.path();
+        if path.join("accelerometer.txt").is_file() {
+            out.push(path);
+        }
+    }
+    if out.is_empty() {
+        return Err(DataError::format(
+            Location::file(&base),
+            "no Tyrex sequence folder (with accelerometer.txt) here or in datasets/android/",
+        ));
+    }
+    out.sort();
+    Ok(out)
+}
+
+/// Where the ground truth of the sequence folder `dir` is: `../../qualisys/<name>.mat`.
+pub fn mat_path(dir: &Path) -> Option<PathBuf> {
+    let name = dir.file_name()?;
+    let datasets = dir.parent()?.parent()?;
+    let mut file = datasets.join("qualisys").join(name);
+    file.set_extension("mat");
+    Some(file)
+}
+
+/// Reads the ground truth of a QTM `.mat` export at the mocap rate.
+///
+/// The take is the top-level struct with a `RigidBodies` field (the one named after the file
+/// if several: QTM names the variable after the take, which does not always match the file).
+/// The first rigid body is used. A frame is valid when its position and rotation are finite;
+/// a finite rotation that is not a proper rotation matrix is an error.
+pub fn read_ground_truth(path: impl AsRef<Path>) -> Result<MocapTrack> {
+    let path = path.as_ref();
+    let mat = MatFile::read(path)?;
+    let stem = path.file_stem().map(|s| s.to_string_lossy().into_owned());
+    let has_bodies = |v: &MatValue| v.field("RigidBodies").is_some();
+    let variable = mat
+        .variables()
+        .find(|(n, v)| Some(*n) == stem.as_deref() && has_bodies(v))
+        .or_else(|| mat.variables().find(|(_, v)| has_bodies(v)))
+        .map(|(n, _)| n.to_owned())
+        .ok_or_else(|| {
+            let names: Vec<&str> = mat.variables().map(|(n, _)| n).collect();
+            DataError::format(
+                Location::file(path).with_field("RigidBodies"),
+                format!(
+                    "no variable is a struct with a `RigidBodies` field (variables: {}): \
+                     not a QTM export with rigid bodies",
+                    names.join(", ")
+                ),
+            )
+        })?;
+    let field = |name: &str| format!("{variable}.{name}");
+    let rate_hz = match mat.lookup(&field("FrameRate")) {
+        None => DEFAULT_MOCAP_RATE_HZ,
+        Some(v) => match v.scalar() {
+            Some(r) if r.is_finite() && r > 0.0 => r,
+            _ => {
+                return Err(DataError::format(
+                    Location::file(path).with_field(field("FrameRate")),
+                    format!(
+                        "expected one positive number, found a {} of size {}",
+                        v.kind(),
+                        dims_text(v.dims())
+                    ),
+                ));
+            }
+        },
+    };
+    let (pos, n) = body_channels(&mat, &field("RigidBodies.Positions"), 3)?;
+    let (rot, n_rot) = body_channels(&mat, &field("RigidBodies.Rotations"), 9)?;
+    if n != n_rot {
+        return Err(DataError::format(
+            Location::file(path).with_field(field("RigidBodies.Rotations")),
+            format!("{n_rot} frames, but Positions has {n}"),
+        ));
+    }
+    let mut pose = Vec::with_capacity(n);
+    for i in 0..n {
+        let p = pos(i);
+        let r = rot(i);
+        if !(p[..3].iter().all(|v| v.is_finite()) && r.iter().all(|v| v.is_finite())) {
+            pose.push(None);
+            continue;
+        }
+        let m = Matrix3::from_column_slice(&r);
+        let err = (m.transpose() * m - Matrix3::identity()).abs().max();
+        if err > 1e-3 || m.determinant() <= 0.0 {
+            return Err(DataError::format(
+                Location::file(path).with_field(field("RigidBodies.Rotations")),
+                format!(
+                    "frame {} is not a rotation matrix (|R'R - I| = {err:.2e}, det = {:.3})",
+                    i + 1,
+                    m.determinant()
+                ),
+            ));
+        }
+        pose.push(Some(MocapPose {
+            position: WorldVec::new(p[0] / 1000.0, p[1] / 1000.0, p[2] / 1000.0),
+            orientation: WorldFromDevice::from_matrix(&m),
+        }));
+    }
+    Ok(MocapTrack {
+        rate_hz,
+        variable,
+        time: (0..n).map(|i| i as f64 / rate_hz).collect(),
+        pose,
+    })
+}
+
+/// A per-body array `[bodies, k, frames]` (or `[k, frames]`): the first body's `k` values of a
+/// frame (the first `k` of 9, the rest NaN), and the frame count.
+#[allow(clippy::type_complexity)]
+fn body_channels<'a>(
+    mat: &'a MatFile,
+    field: &str,
+    k: usize,
+) -> Result<(Box<dyn Fn(usize) -> [f64; 9] + 'a>, usize)> {
+    let v = mat.require(field)?;
+    let bad = |what: String| DataError::format(Location::file(mat.path()).with_field(field), what);
+    let num = v
+        .as_numeric()
+        .ok_or_else(|| bad(format!("expected a numeric array, found a {}", v.kind())))?;
+    let (bodies, frames) = match num.dims.as_slice() {
+        [b, kk, n] if *kk == k && *b >= 1 => (*b, *n),
+        [kk, n] if *kk == k => (1, *n),
+        _ => {
+            return Err(bad(format!(
+                "size {}, expected bodies x {k} x frames",
+                dims_text(&num.dims)
+            )));
+        }
+    };
+    if frames == 0 {
+        return Err(bad("no frames".into()));
+    }
+    let data = &num.real;
+    let get = move |i: usize| {
+        let mut out = [f64::NAN; 9];
+        for (c, o) in out.iter_mut().enumerate().take(k) {
+            // Column-major [bodies, k, frames]: body 0, channel c, frame i.
+            *o = data[bodies * (c + k * i)];
+        }
+        out
+    };
+    Ok((Box::new(get), frames))
+}
+
+/// One phone stream: sample times (strictly increasing), values and their line numbers.
+struct Stream<T> {
+    path: PathBuf,
+    time: Vec<f64>,
+    values: Vec<T>,
+    lines: Vec<usize>,
+}
+
+/// Reads a whitespace-separated table whose rows have one of the `widths` (time included),
+/// converting each row with `row`.
+fn read_stream<T>(
+    path: &Path,
+    names: &[&str],
+    widths: &[usize],
+    mut row: impl FnMut(&[f64], usize) -> Result<T>,
+) -> Result<Stream<T>> {
+    let bytes = text::read_file(path)?;
+    let content = text::as_text(&bytes, path)?;
+    // About 45 bytes per row in these files: reserving avoids regrowing the vectors.
+    let guess = content.len() / 40;
+    let (mut time, mut values, mut lines) = (
+        Vec::with_capacity(guess),
+        Vec::with_capacity(guess),
+        Vec::with_capacity(guess),
+    );
+    let mut cells = [0.0; 8];
+    let max = widths.iter().copied().max().unwrap_or(0);
+    for (line, l) in text::lines(content) {
+        let mut n = 0;
+        for cell in l.split_ascii_whitespace() {
+            if n < max {
+                let name = names.get(n).copied().unwrap_or("extra");
+                cells[n] = text::number(cell, path, line, name, Nan::Reject)?;
+            }
+            n += 1;
+        }
+        if !widths.contains(&n) {
+            let expected: Vec<String> = widths.iter().map(|w| w.to_string()).collect();
+            return Err(DataError::format(
+                Location::line(path, line),
+                format!(
+                    "{n} fields, expected {} ({})",
+                    expected.join(" or "),
+                    names.join(" ")
+                ),
+            ));
+        }
+        time.push(cells[0]);
+        values.push(row(&cells[..n], line)?);
+        lines.push(line);
+    }
+    if time.is_empty() {
+        return Err(DataError::format(
+            Location::file(path),
+            "no samples: the file is empty",
+        ));
+    }
+    // Gaps are not errors here: they split the recording (see `intervals`).
+    text::check_time(&time, &lines, path, names[0], f64::INFINITY)?;
+    Ok(Stream {
+        path: path.to_path_buf(),
+        time,
+        values,
+        lines,
+    })
+}
+
+fn read_vec_stream(path: &Path, names: &[&str]) -> Result<Stream<DeviceVec>> {
+    read_stream(path, names, &[4], |c, _| {
+        Ok(DeviceVec::new(c[1], c[2], c[3]))
+    })
+}
+
+fn read_rotation_vector(path: &Path) -> Result<Stream<WorldFromDevice>> {
+    let names = ["t", "qx", "qy", "qz", "qw", "heading_accuracy"];
+    read_stream(path, &names, &[4, 5, 6], |c, line| {
+        let w = match c.get(4) {
+            Some(&w) => w,
+            // Old Android versions give only x, y, z; w >= 0 is implied.
+            None => (1.0 - c[1] * c[1] - c[2] * c[2] - c[3] * c[3])
+                .max(0.0)
+                .sqrt(),
+        };
+        WorldFromDevice::from_xyzw([c[1], c[2], c[3], w]).map_err(|e| {
+            let message = match e {
+                QuatError::NotUnit { norm } => {
+                    format!("quaternion x,y,z,w has norm {norm:.4}, not 1")
+                }
+                other => other.to_string(),
+            };
+            DataError::format(Location::line(path, line).with_field("qw"), message)
+        })
+    })
+}
+
+fn read_time_diff(path: &Path) -> Result<f64> {
+    let bytes = text::read_file(path)?;
+    let content = text::as_text(&bytes, path)?;
+    let mut cells = text::lines(content)
+        .flat_map(|(line, l)| l.split_ascii_whitespace().map(move |c| (line, c)));
+    let (line, cell) = cells.next().ok_or_else(|| {
+        DataError::format(
+            Location::file(path),
+            "empty: expected one number, timeDiff in s",
+        )
+    })?;
+    let value = text::number(cell, path, line, "timeDiff", Nan::Reject)?;
+    if let Some((line, extra)) = cells.next() {
+        return Err(DataError::format(
+            Location::line(path, line),
+            format!("unexpected `{}` after timeDiff", text::snippet(extra)),
+        ));
+    }
+    Ok(value)
+}
+
+/// `Model = ...` of `record.properties`, when the file is there.
+fn read_model(path: &Path) -> Result<Option<String>> {
+    if !path.is_file() {
+        return Ok(None);
+    }
+    let bytes = text::read_file(path)?;
+    let content = text::as_text(&bytes, path)?;
+    Ok(text::lines(content).find_map(|(_, l)| {
+        let (key, value) = l.split_once('=')?;
+        (key.trim() == "Model").then(|| value.trim().to_owned())
+    }))
+}
+
+/// A warning when many accelerometer readings sit exactly at the largest magnitude seen: the
+/// sensor's range was exceeded (the Nexus 5 clips at 2 g, 19.55 m/s^2, in 12-28 % of the samples
+/// of the running sequences), so the linear acceleration is wrong there.
+fn clipping(acce: &Stream<DeviceVec>) -> Option<String> {
+    let abs = |v: &DeviceVec| v.to_array().map(f64::abs);
+    let peak = acce.values.iter().flat_map(abs).fold(0.0, f64::max);
+    let clipped = acce
+        .values
+        .iter()
+        .filter(|v| abs(v).iter().any(|&c| c >= peak - 1e-6))
+        .count();
+    let share = clipped as f64 / acce.values.len() as f64;
+    // No phone accelerometer has a range below 2 g, and a phone at rest repeats its (noise-free
+    // or quantized) reading near 1 g: only peaks well above 1 g can be a range limit.
+    (share > 0.005 && peak > 1.5 * STANDARD_GRAVITY).then(|| {
+        format!(
+            "{}: {:.1} % of the samples are clipped at +-{peak:.3} m/s^2: the accelerometer range \
+             was exceeded",
+            acce.path.display(),
+            share * 100.0
+        )
+    })
+}
+
+/// Time spans without long gaps: `[start, end]` of each run of samples whose spacing stays
+/// within `max_gap`, with a warning for each split.
+fn intervals(time: &[f64], max_gap: f64, mut on_gap: impl FnMut(usize)) -> Vec<(f64, f64)> {
+    let mut out = Vec::new();
+    let Some(&first) = time.first() else {
+        return out;
+    };
+    let mut start = first;
+    for (i, w) in time.windows(2).enumerate() {
+        // A tolerance so that a gap of exactly `max_gap` (e.g. 15 mocap frames) is kept.
+        if w[1] - w[0] > max_gap + 1e-9 {
+            out.push((start, w[0]));
+            on_gap(i + 1);
+            start = w[1];
+        }
+    }
+    out.push((start, time[time.len() - 1]));
+    out
+}
+
+/// Intersection of two sorted lists of disjoint closed intervals.
+fn intersect(a: &[(f64, f64)], b: &[(f64, f64)]) -> Vec<(f64, f64)> {
+    let (mut i, mut j) = (0, 0);
+    let mut out = Vec::new();
+    while i < a.len() && j < b.len() {
+        let start = a[i].0.max(b[j].0);
+        let end = a[i].1.min(b[j].1);
+        if start <= end {
+            out.push((start, end));
+        }
+        if a[i].1 < b[j].1 {
+            i += 1;
+        } else {
+            j += 1;
+        }
+    }
+    out
+}
+
+fn stream_intervals<T>(s: &Stream<T>, max_gap: f64, warnings: &mut Vec<String>) -> Vec<(f64, f64)> {
+    intervals(&s.time, max_gap, |i| {
+        warnings.push(format!(
+            "{}:{}: gap of {:.3} s in the samples at {:.3} s (phone clock): recording split",
+            s.path.display(),
+            s.lines[i],
+            s.time[i] - s.time[i - 1],
+            s.time[i - 1]
+        ));
+    })
+}
+
+/// Reads one sequence folder `datasets/android/<name>/` and, when
+/// [`TyrexOptions::ground_truth`] is set and `datasets/qualisys/<name>.mat` exists, its ground
+/// truth. See the module documentation for frames, time alignment and gap handling.
+pub fn read(dir: impl AsRef<Path>, options: &TyrexOptions) -> Result<TyrexRead> {
+    let dir = dir.as_ref();
+    if !(options.rate_hz.is_finite() && options.rate_hz > 0.0) {
+        return Err(DataError::format(
+            Location::file(dir).with_field("rate_hz"),
+            format!("output rate must be positive, got {}", options.rate_hz),
+        ));
+    }
+    // `.` or `..` have no file name of their own: take the folder's real name.
+    let name = dir
+        .file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .or_else(|| {
+            let real = dir.canonicalize().ok()?;
+            Some(real.file_name()?.to_string_lossy().into_owned())
+        })
+        .unwrap_or_default();
+    let mut warnings = Vec::new();
+    let placement = motion_of(&name);
+    if placement.is_none() {
+        warnings.push(format!(
+            "`{name}` does not end in a known motion ({}): no placement",
+            MOTIONS.join(", ")
+        ));
+    }
+
+    let acce = read_vec_stream(&dir.join("accelerometer.txt"), &["t", "ax", "ay", "az"])?;
+    let gyro = read_vec_stream(
+        &dir.join("gyroscope-calibrated.txt"),
+        &["t", "wx", "wy", "wz"],
+    )?;
+    let rv = read_rotation_vector(&dir.join("rotation-vector.txt"))?;
+    let device_model = read_model(&dir.join("record.properties"))?;
+
+    if let Some(w) = clipping(&acce) {
+        warnings.push(w);
+    }
+    let gap = options.max_sensor_gap_s;
+    let mut spans = stream_intervals(&acce, gap, &mut warnings);
+    spans = intersect(&spans, &stream_intervals(&gyro, gap, &mut warnings));
+    spans = intersect(&spans, &stream_intervals(&rv, gap, &mut warnings));
+
+    let mat = mat_path(dir).filter(|p| options.ground_truth && p.is_file());
+    let mut time_diff_s = None;
+    // Valid mocap frames on the phone clock.
+    let mut truth: Option<(Vec<f64>, Vec<WorldVec>, Vec<WorldFromDevice>)> = None;
+    if let Some(mat) = &mat {
+        let diff = read_time_diff(&dir.join("timeAlignment.txt"))? + options.extra_time_diff_s;
+        time_diff_s = Some(diff);
+        let track = read_ground_truth(mat)?;
+        let (mut t, mut p, mut q) = (Vec::new(), Vec::new(), Vec::new());
+        for (time, pose) in track.time.iter().zip(&track.pose) {
+            if let Some(pose) = pose {
+                t.push(time - diff);
+                p.push(pose.position);
+                q.push(pose.orientation);
+            }
+        }
+        if t.is_empty() {
+            return Err(DataError::format(
+                Location::file(mat).with_field("RigidBodies.Positions"),
+                "the mocap never tracked the body: every frame is NaN",
+            ));
+        }
+        let gt_spans = intervals(&t, options.max_mocap_gap_s, |i| {
+            warnings.push(format!(
+                "{}: mocap lost the body for {:.3} s from {:.3} s (phone clock): recording split",
+                mat.display(),
+                t[i] - t[i - 1],
+                t[i - 1]
+            ));
+        });
+        spans = intersect(&spans, &gt_spans);
+        truth = Some((t, p, q));
+    }
+
+    let mut kept = Vec::new();
+    for &(start, end) in &spans {
+        if end - start >= options.min_part_s {
+            kept.push((start, end));
+        } else if end > start {
+            warnings.push(format!(
+                "part {start:.3}..{end:.3} s (phone clock) is shorter than {} s: dropped",
+                options.min_part_s
+            ));
+        }
+    }
+    if kept.is_empty() {
+        return Err(DataError::format(
+            Location::file(dir),
+            format!(
+                "no stretch of at least {} s where every phone stream{} has data without long gaps",
+                options.min_part_s,
+                if truth.is_some() {
+                    " and the ground truth"
+                } else {
+                    ""
+                }
+            ),
+        ));
+    }
+
+    let mut sequences = Vec::with_capacity(kept.len());
+    for (k, &(start, end)) in kept.iter().enumerate() {
+        let time = uniform_timeline(start, end, options.rate_hz);
+        let orientation = interpolate_rot(&rv.time, &rv.values, &time);
+        let acce_i = interpolate_vec3(&acce.time, &acce.values, &time);
+        let gravity: Vec<DeviceVec> = orientation
+            .iter()
+            .map(|&q| gravity_in_device(q, options.gravity))
+            .collect();
+        let linacce = acce_i.iter().zip(&gravity).map(|(&a, &g)| a - g).collect();
+        let ground_truth = truth.as_ref().map(|(t, p, q)| GroundTruth {
+            position: interpolate_vec3(t, p, &time),
+            orientation: interpolate_rot(t, q, &time),
+        });
+        let part_name = if kept.len() == 1 {
+            name.clone()
+        } else {
+            format!("{name}_part{}", k + 1)
+        };
+        let parts = SequenceParts {
+            name: part_name,
+            placement: placement.map(str::to_owned),
+            gyro: interpolate_vec3(&gyro.time, &gyro.values, &time),
+            acce: acce_i,
+            linacce,
+            gravity,
+            magnet: None,
+            orientation,
+            orientation_source: Some(OrientationSource::RotationVector),
+            ground_truth,
+            steps: None,
+            time,
+        };
+        let seq = Sequence::with_validation(parts, &options.validation)
+            .map_err(|e| DataError::sequence(dir, e))?;
+        sequences.push(seq);
+    }
+    Ok(TyrexRead {
+        sequences,
+        warnings,
+        time_diff_s,
+        device_model,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn intervals_split_only_at_long_gaps() {
+        let t = [0.0, 0.1, 0.2, 0.7, 0.8, 0.9];
+        let mut gaps = Vec::new();
+        assert_eq!(
+            intervals(&t, 0.25, |i| gaps.push(i)),
+            [(0.0, 0.2), (0.7, 0.9)]
+        );
+        assert_eq!(gaps, [3]);
+        // Exactly the limit is not a split, despite rounding in 15 / 60.
+        let t: Vec<f64> = [0.0, 15.0, 16.0].iter().map(|f| f / 60.0).collect();
+        assert_eq!(intervals(&t, 0.25, |_| panic!("split")).len(), 1);
+        assert!(intervals(&[], 1.0, |_| {}).is_empty());
+    }
+
+    #[test]
+    fn intersection_of_interval_lists() {
+        let a = [(0.0, 10.0), (20.0, 30.0)];
+        let b = [(5.0, 25.0), (28.0, 40.0)];
+        assert_eq!(intersect(&a, &b), [(5.0, 10.0), (20.0, 25.0), (28.0, 30.0)]);
+        assert!(intersect(&a, &[]).is_empty());
+        assert_eq!(intersect(&[(0.0, 1.0)], &[(1.0, 2.0)]), [(1.0, 1.0)]);
+    }
+
+    #[test]
+    fn motion_is_the_last_name_part() {
+        assert_eq!(
+            motion_of("Jakob_Nexus5_NoDist_RunningPocket"),
+            Some("RunningPocket")
+        );
+        assert_eq!(motion_of("x_ar"), Some("AR"));
+        assert_eq!(motion_of("Jakob_Nexus5_NoDist_Dancing"), None);
+        assert_eq!(motion_of(""), None);
+    }
+
+    #[test]
+    fn mat_path_is_beside_the_android_folder() {
+        let p = mat_path(Path::new("/d/datasets/android/A_B_C_AR")).unwrap();
+        assert_eq!(p, Path::new("/d/datasets/qualisys/A_B_C_AR.mat"));
+    }
+}

@@ -1,0 +1,114 @@
+//! Writers of the RIDI processed layout: `data.csv` as pandas writes it and `data_plain.txt` as
+//! the C++ tools read it.
+//!
+//! Every value is written with Rust's shortest round-trip float formatting and time as integer
+//! nanoseconds, so reading a written file gives the same sequence back bit for bit, except that
+//! time is rounded to whole nanoseconds, and that what the layout cannot hold is lost: the
+//! name (taken from the path when read), placement, steps and the orientation source (read back
+//! as the game rotation vector).
+//!
+//! What a sequence lacks is written so that the readers take it as absent again:
+//! - no magnetometer: `magnet_*` are zeros (a real magnetometer never reads exactly zero on
+//!   every row, so the readers take all zeros as "not recorded");
+//! - no ground truth: `pos_*` and `ori_*` are `NaN` on every row. Zeros would pass for a device
+//!   standing still at the origin; `NaN` is read as missing by pandas and numpy, and by the
+//!   readers of this crate.
+//!
+//! Files are written atomically: to a temporary file in the target folder, then renamed, so a
+//! crash never leaves a half-written file under the final name.
+
+use std::fmt::Write as _;
+use std::io::Write;
+use std::path::Path;
+
+use crate::error::{DataError, Result};
+use crate::processed::COLUMNS;
+use crate::sequence::Sequence;
+
+/// The 27 values of frame `i` in [`COLUMNS`] order, time excluded (slot 0 is unused).
+fn row(seq: &Sequence, i: usize) -> [f64; 27] {
+    let mut r = [0.0; 27];
+    let mut put = |at: usize, v: &[f64]| r[at..at + v.len()].copy_from_slice(v);
+    put(1, &seq.gyro()[i].to_array());
+    put(4, &seq.acce()[i].to_array());
+    put(7, &seq.linacce()[i].to_array());
+    put(10, &seq.gravity()[i].to_array());
+    if let Some(m) = seq.magnet() {
+        put(13, &m[i].to_array());
+    }
+    match seq.ground_truth() {
+        Some(gt) => {
+            put(16, &gt.position[i].to_array());
+            put(19, &gt.orientation[i].to_wxyz());
+        }
+        None => put(16, &[f64::NAN; 7]),
+    }
+    put(23, &seq.orientation()[i].to_wxyz());
+    r
+}
+
+/// Time of frame `i` in integer nanoseconds (valid sequences have finite times).
+fn time_ns(seq: &Sequence, i: usize) -> i64 {
+    (seq.time()[i] * 1e9).round() as i64
+}
+
+/// Writes `content` to `path` through a temporary file in the same folder, renamed into place
+/// once complete: readers never see a partial file, and a failed write leaves any previous file
+/// untouched. The one way ridi-rs writes output files.
+pub fn write_atomically(
+    path: &Path,
+    content: impl FnOnce(&mut dyn Write) -> std::io::Result<()>,
+) -> Result<()> {
+    let dir = match path.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d,
+        _ => Path::new("."),
+    };
+    let io = |e| DataError::io(path, e);
+    let mut tmp = tempfile::NamedTempFile::new_in(dir).map_err(io)?;
+    {
+        let mut w = std::io::BufWriter::with_capacity(1 << 16, tmp.as_file_mut());
+        content(&mut w).map_err(io)?;
+        w.flush().map_err(io)?;
+    }
+    tmp.as_file().sync_all().map_err(io)?;
+    tmp.persist(path).map_err(|e| io(e.error))?;
+    Ok(())
+}
+
+/// Writes `seq` as a RIDI processed `data.csv`: a header with an empty first name (the pandas
+/// index), then one row per frame `index,time_ns,gyro_x,...,rv_z`.
+pub fn write_ridi_csv(seq: &Sequence, path: impl AsRef<Path>) -> Result<()> {
+    write_atomically(path.as_ref(), |w| {
+        writeln!(w, ",{}", COLUMNS.join(","))?;
+        let mut line = String::with_capacity(512);
+        for i in 0..seq.len() {
+            line.clear();
+            // Formatting into a String cannot fail.
+            let _ = write!(line, "{i},{}", time_ns(seq, i));
+            for v in &row(seq, i)[1..] {
+                let _ = write!(line, ",{v}");
+            }
+            line.push('\n');
+            w.write_all(line.as_bytes())?;
+        }
+        Ok(())
+    })
+}
+
+/// Writes `seq` as a RIDI `data_plain.txt`: `N 27`, then N tab-separated rows without index.
+pub fn write_ridi_plain(seq: &Sequence, path: impl AsRef<Path>) -> Result<()> {
+    write_atomically(path.as_ref(), |w| {
+        writeln!(w, "{} {}", seq.len(), COLUMNS.len())?;
+        let mut line = String::with_capacity(512);
+        for i in 0..seq.len() {
+            line.clear();
+            let _ = write!(line, "{}", time_ns(seq, i));
+            for v in &row(seq, i)[1..] {
+                let _ = write!(line, "\t{v}");
+            }
+            line.push('\n');
+            w.write_all(line.as_bytes())?;
+        }
+        Ok(())
+    })
+}

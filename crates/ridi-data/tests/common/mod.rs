@@ -1,0 +1,145 @@
+//! Fixtures shared by the integration tests: small valid sequences and files built in code.
+
+#![allow(dead_code)]
+
+use std::fmt::Write as _;
+use std::path::Path;
+
+use ridi_data::ridi_frames::nalgebra::Vector3;
+use ridi_data::ridi_frames::{
+    Device, DeviceVec, Rot, WorldFromDevice, WorldVec, gravity_in_device,
+};
+use ridi_data::{GroundTruth, OrientationSource, ReadOptions, Sequence, SequenceParts};
+
+/// First timestamp of the fixtures, ns (a plausible boot-clock value).
+pub const T0_NS: i64 = 172_364_832_413_231;
+
+/// A valid sequence at 200 Hz whose values have many significant digits, so that round trips
+/// test float formatting for real. Times are whole nanoseconds, as files store them.
+pub fn sample_sequence(name: &str, n: usize, ground_truth: bool, magnet: bool) -> Sequence {
+    let time: Vec<f64> = (0..n)
+        .map(|i| (T0_NS + 5_000_000 * i as i64 + (i as i64 * 7919) % 1000) as f64 / 1e9)
+        .collect();
+    let orientation: Vec<WorldFromDevice> = (0..n)
+        .map(|i| {
+            let t = i as f64 / 200.0;
+            WorldFromDevice::from_scaled_axis(Vector3::new(0.3 * t.sin(), 0.2, 0.7 * t))
+        })
+        .collect();
+    let gravity: Vec<DeviceVec> = orientation
+        .iter()
+        .map(|q| gravity_in_device(*q, 9.80665))
+        .collect();
+    let wave = |i: usize, k: f64| {
+        DeviceVec::new(
+            (k * i as f64).sin() / 3.0,
+            (k * i as f64).cos() * 0.7,
+            k / 7.0,
+        )
+    };
+    let linacce: Vec<DeviceVec> = (0..n).map(|i| wave(i, 0.11)).collect();
+    Sequence::new(SequenceParts {
+        name: name.to_owned(),
+        placement: None,
+        gyro: (0..n).map(|i| wave(i, 0.37)).collect(),
+        acce: linacce.iter().zip(&gravity).map(|(a, g)| *a + *g).collect(),
+        linacce,
+        gravity,
+        magnet: magnet.then(|| (0..n).map(|i| wave(i, 0.05) * 40.0).collect()),
+        ground_truth: ground_truth.then(|| GroundTruth {
+            position: (0..n)
+                .map(|i| WorldVec::new(i as f64 * 0.0071, (i as f64 * 0.01).sin(), 1.234567))
+                .collect(),
+            orientation: orientation
+                .iter()
+                .map(|q| *q * Rot::<Device, Device>::from_scaled_axis(Vector3::new(0.0, 0.0, 0.1)))
+                .collect(),
+        }),
+        orientation,
+        orientation_source: Some(OrientationSource::GameRotationVector),
+        steps: None,
+        time,
+    })
+    .expect("fixture sequence is valid")
+}
+
+/// The bytes of a valid RIDI `data.csv` with ground truth and magnet.
+pub fn valid_csv(n: usize) -> Vec<u8> {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("data.csv");
+    ridi_data::write_ridi_csv(&sample_sequence("s", n, true, true), &path).unwrap();
+    std::fs::read(path).unwrap()
+}
+
+/// The bytes of a valid `data_plain.txt`.
+pub fn valid_plain(n: usize) -> Vec<u8> {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("data_plain.txt");
+    ridi_data::write_ridi_plain(&sample_sequence("s", n, true, true), &path).unwrap();
+    std::fs::read(path).unwrap()
+}
+
+/// Options for the small raw fixtures: fewer pose records trimmed than the original's 800.
+pub fn raw_options() -> ReadOptions {
+    ReadOptions {
+        pose_trim: 5,
+        ..ReadOptions::default()
+    }
+}
+
+/// The files of a valid raw folder: sensors at 200 Hz starting slightly before the pose, pose
+/// at 200 Hz with a 1 ms offset, each file with a `#` header. Channels are linear in time
+/// (value = seconds since start times a per-channel factor) so interpolation is checkable.
+pub fn raw_files(n: usize, with_pose: bool) -> Vec<(&'static str, String)> {
+    let sensor = |name: &'static str, factor: f64, base: [f64; 3]| {
+        let mut s = String::from("# t_ns x y z\n");
+        for i in 0..n + 20 {
+            let t_ns = T0_NS + 5_000_000 * i as i64;
+            let t = (5_000_000 * i as i64) as f64 / 1e9;
+            let _ = writeln!(
+                s,
+                "{t_ns} {} {} {}",
+                base[0] + factor * t,
+                base[1],
+                base[2] - factor * t
+            );
+        }
+        (name, s)
+    };
+    let mut files = vec![
+        sensor("gyro.txt", 0.5, [0.0, 0.1, 0.0]),
+        sensor("acce.txt", 0.2, [0.0, 9.9, 0.3]),
+        sensor("linacce.txt", 0.2, [0.0, 0.1, 0.3]),
+        sensor("gravity.txt", 0.0, [0.0, 9.8, 0.0]),
+        sensor("magnet.txt", 1.0, [20.0, -30.0, 5.0]),
+    ];
+    let mut rv = String::from("# t_ns x y z w\n");
+    let mut steps = String::from("# t_ns count\n");
+    for i in 0..n + 20 {
+        let t_ns = T0_NS + 5_000_000 * i as i64;
+        let half = 0.001 * i as f64;
+        let _ = writeln!(rv, "{t_ns} 0 0 {} {}", half.sin(), half.cos());
+        if i % 100 == 0 {
+            let _ = writeln!(steps, "{t_ns} {}", i / 100);
+        }
+    }
+    files.push(("orientation.txt", rv));
+    files.push(("step.txt", steps));
+    if with_pose {
+        let mut pose = String::from("# t_ns tx ty tz qx qy qz qw\n");
+        for i in 0..n {
+            let t_ns = T0_NS + 1_000_000 + 5_000_000 * i as i64;
+            let _ = writeln!(pose, "{t_ns} {} 0.5 1.5 0 0 0 1", 0.01 * i as f64);
+        }
+        files.push(("pose.txt", pose));
+    }
+    files
+}
+
+/// Writes `files` into `dir` (created if needed).
+pub fn write_files(dir: &Path, files: &[(&str, String)]) {
+    std::fs::create_dir_all(dir).unwrap();
+    for (name, content) in files {
+        std::fs::write(dir.join(name), content).unwrap();
+    }
+}

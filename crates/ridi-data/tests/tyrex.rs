@@ -1,0 +1,581 @@
+//! Tyrex reader on synthetic folders: known motion in, known sequence out, and an error naming
+//! file, line and field for each kind of bad input.
+
+mod mat_support;
+
+use std::f64::consts::FRAC_PI_2;
+use std::fmt::Write as _;
+use std::path::PathBuf;
+
+use mat_support::{V, le, qtm_like};
+use ridi_data::ridi_frames::{DeviceVec, STANDARD_GRAVITY, WorldFromDevice};
+use ridi_data::tyrex::{self, TyrexOptions};
+use ridi_data::{DataError, OrientationSource};
+
+const OMEGA: f64 = 0.3;
+const TIME_DIFF: f64 = -2.0;
+
+/// A synthetic run: the phone lies flat, turns about z at `OMEGA` rad/s and moves along room x
+/// at 1 m/s. Phone samples at 200 Hz from 0.003 s for `phone_s` seconds; `frames` mocap frames
+/// at 60 Hz, phone time = mocap time + 2 s.
+struct Fixture {
+    _tmp: tempfile::TempDir,
+    root: PathBuf,
+    dir: PathBuf,
+    mat: PathBuf,
+}
+
+fn yaw(a: f64) -> WorldFromDevice {
+    WorldFromDevice::from_axis_angle(&ridi_data::ridi_frames::nalgebra::Vector3::z_axis(), a)
+}
+
+fn phone_rows(phone_s: f64, row: impl Fn(f64) -> String) -> String {
+    let n = (phone_s * 200.0) as usize;
+    let mut s = String::new();
+    for k in 0..n {
+        let t = 0.003 + k as f64 * 0.005;
+        writeln!(s, "{}", row(t)).unwrap();
+    }
+    s
+}
+
+fn frames(n: usize, lost: &[std::ops::Range<usize>]) -> (Vec<[f64; 3]>, Vec<[f64; 9]>) {
+    let mut p = Vec::new();
+    let mut r = Vec::new();
+    for i in 0..n {
+        let t = i as f64 / 60.0;
+        if lost.iter().any(|l| l.contains(&i)) {
+            p.push([f64::NAN; 3]);
+            r.push([f64::NAN; 9]);
+            continue;
+        }
+        p.push([t * 1000.0, 500.0, 1200.0]);
+        let m = yaw(OMEGA * t).matrix();
+        r.push(m.as_slice().try_into().unwrap());
+    }
+    (p, r)
+}
+
+impl Fixture {
+    fn new(name: &str, phone_s: f64, mocap_frames: usize, lost: &[std::ops::Range<usize>]) -> Self {
+        let tmp = tempfile::tempdir().unwrap();
+        let root = tmp.path().join("tyrex");
+        let dir = root.join("datasets/android").join(name);
+        std::fs::create_dir_all(&dir).unwrap();
+        std::fs::create_dir_all(root.join("datasets/qualisys")).unwrap();
+        let w = |f: &str, s: String| std::fs::write(dir.join(f), s).unwrap();
+        w(
+            "accelerometer.txt",
+            phone_rows(phone_s, |t| format!("{t:.9} {} 0.0 9.80665", 0.1 * t.sin())),
+        );
+        w(
+            "gyroscope-calibrated.txt",
+            phone_rows(phone_s, |t| format!("{:.9} 0.0 0.0 {OMEGA}", t + 0.001)),
+        );
+        w(
+            "rotation-vector.txt",
+            phone_rows(phone_s, |t| {
+                let [x, y, z, q] = yaw(OMEGA * t).to_xyzw();
+                format!("{t:.9} {x} {y} {z} {q} 0.17453292")
+            }),
+        );
+        w("timeAlignment.txt", format!("  {TIME_DIFF:e}\n"));
+        w(
+            "record.properties",
+            "[Device]\nManufacturer = LGE\nModel = Nexus 5\n[Time]\nStartTime = 1".into(),
+        );
+        let (p, r) = frames(mocap_frames, lost);
+        let vars = qtm_like("Take_1", 60.0, &p, &r);
+        let vars: Vec<(&str, V)> = vars.iter().map(|(n, v)| (n.as_str(), v.clone())).collect();
+        let mat = root.join("datasets/qualisys").join(format!("{name}.mat"));
+        std::fs::write(&mat, le().file(&vars, true)).unwrap();
+        Fixture {
+            _tmp: tmp,
+            root,
+            dir,
+            mat,
+        }
+    }
+
+    fn standard() -> Self {
+        Self::new("Ann_Nexus5_NoDist_Texting", 40.0, 60 * 30, &[])
+    }
+
+    fn write(&self, file: &str, content: &str) {
+        std::fs::write(self.dir.join(file), content).unwrap();
+    }
+
+    fn edit(&self, file: &str, f: impl Fn(&str) -> String) {
+        let old = std::fs::read_to_string(self.dir.join(file)).unwrap();
+        self.write(file, &f(&old));
+    }
+
+    fn err(&self) -> String {
+        tyrex::read(&self.dir, &TyrexOptions::default())
+            .unwrap_err()
+            .to_string()
+    }
+}
+
+/// Replaces line `n` (1-based) of `text`.
+fn replace_line(text: &str, n: usize, new: &str) -> String {
+    text.lines()
+        .enumerate()
+        .map(|(i, l)| {
+            if i + 1 == n {
+                new.to_owned()
+            } else {
+                l.to_owned()
+            }
+        })
+        .collect::<Vec<_>>()
+        .join("\n")
+}
+
+#[test]
+fn known_motion_comes_out_aligned_resampled_and_in_the_right_frames() {
+    let fx = Fixture::standard();
+    let read = tyrex::read(&fx.dir, &TyrexOptions::default()).unwrap();
+    assert!(read.warnings.is_empty(), "{:?}", read.warnings);
+    assert_eq!(read.time_diff_s, Some(TIME_DIFF));
+    assert_eq!(read.device_model.as_deref(), Some("Nexus 5"));
+    let [seq] = read.sequences.as_slice() else {
+        panic!("{} parts", read.sequences.len())
+    };
+    assert_eq!(seq.name(), "Ann_Nexus5_NoDist_Texting");
+    assert_eq!(seq.placement(), Some("Texting"));
+    assert_eq!(
+        seq.orientation_source(),
+        Some(OrientationSource::RotationVector)
+    );
+    // Mocap covers phone time 2.0 .. 2 + 1799/60; phone streams 0.004 .. 39.999.
+    let t = seq.time();
+    assert!((t[0] - 2.0).abs() < 1e-12, "{}", t[0]);
+    assert!((t[t.len() - 1] - (2.0 + 1799.0 / 60.0)).abs() <= 0.005);
+    assert!((seq.rate_hz() - 200.0).abs() < 1e-9);
+    let gt = seq.ground_truth().unwrap();
+    for k in (0..seq.len()).step_by(37) {
+        let t = seq.time()[k];
+        let mocap_t = t - 2.0;
+        let p = gt.position[k];
+        assert!(
+            (p.x() - mocap_t).abs() < 1e-9 && (p.y() - 0.5).abs() < 1e-12,
+            "{t} {p:?}"
+        );
+        assert!(
+            gt.orientation[k].angle_to(&yaw(OMEGA * mocap_t)) < 1e-6,
+            "{t}"
+        );
+        assert!(seq.orientation()[k].angle_to(&yaw(OMEGA * t)) < 1e-6, "{t}");
+        assert!((seq.gyro()[k] - DeviceVec::new(0.0, 0.0, OMEGA)).norm() < 1e-12);
+        // Flat phone: gravity is +z in the device frame, whatever the heading.
+        assert!((seq.gravity()[k] - DeviceVec::new(0.0, 0.0, STANDARD_GRAVITY)).norm() < 1e-9);
+        let lin = seq.linacce()[k];
+        assert!(
+            (lin.x() - 0.1 * t.sin()).abs() < 1e-5 && lin.z().abs() < 1e-9,
+            "{lin:?}"
+        );
+    }
+}
+
+#[test]
+fn short_mocap_losses_are_bridged_and_long_ones_split() {
+    // 6 lost frames: 7/60 s between tracked frames, bridged. 21 lost: 22/60 s, split.
+    let fx = Fixture::new(
+        "Bo_Nexus5_NoDist_Swinging",
+        40.0,
+        60 * 30,
+        &[300..306, 900..921],
+    );
+    let read = tyrex::read(&fx.dir, &TyrexOptions::default()).unwrap();
+    let names: Vec<&str> = read.sequences.iter().map(|s| s.name()).collect();
+    assert_eq!(
+        names,
+        [
+            "Bo_Nexus5_NoDist_Swinging_part1",
+            "Bo_Nexus5_NoDist_Swinging_part2"
+        ]
+    );
+    assert_eq!(read.warnings.len(), 1, "{:?}", read.warnings);
+    assert!(
+        read.warnings[0].contains("mocap lost the body for 0.367 s from 16.983 s"),
+        "{:?}",
+        read.warnings
+    );
+    let (a, b) = (&read.sequences[0], &read.sequences[1]);
+    assert!((a.time()[a.len() - 1] - (2.0 + 899.0 / 60.0)).abs() < 0.005);
+    assert!((b.time()[0] - (2.0 + 921.0 / 60.0)).abs() < 1e-12);
+    // Across the bridged loss the straight-line motion is interpolated exactly.
+    let gt = a.ground_truth().unwrap();
+    for (k, &t) in a.time().iter().enumerate() {
+        assert!((gt.position[k].x() - (t - 2.0)).abs() < 1e-9);
+    }
+    // With a larger limit nothing splits.
+    let opts = TyrexOptions {
+        max_mocap_gap_s: 0.5,
+        ..TyrexOptions::default()
+    };
+    assert_eq!(tyrex::read(&fx.dir, &opts).unwrap().sequences.len(), 1);
+    // Parts shorter than min_part_s are dropped with a warning.
+    let opts = TyrexOptions {
+        min_part_s: 14.8,
+        ..TyrexOptions::default()
+    };
+    // Parts of 14.98 s and 14.63 s: the second goes, the first keeps the plain name.
+    let read = tyrex::read(&fx.dir, &opts).unwrap();
+    assert_eq!(read.sequences.len(), 1);
+    assert_eq!(read.sequences[0].name(), "Bo_Nexus5_NoDist_Swinging");
+    assert!(
+        read.warnings
+            .iter()
+            .any(|w| w.contains("shorter than 14.8 s: dropped"))
+    );
+}
+
+#[test]
+fn a_gap_in_a_phone_stream_splits_and_names_its_line() {
+    let fx = Fixture::standard();
+    // Drop 1 s of gyro samples around phone time 20 s.
+    fx.edit("gyroscope-calibrated.txt", |s| {
+        s.lines()
+            .filter(|l| {
+                let t: f64 = l.split(' ').next().unwrap().parse().unwrap();
+                !(19.5..20.5).contains(&t)
+            })
+            .map(|l| format!("{l}\n"))
+            .collect()
+    });
+    let read = tyrex::read(&fx.dir, &TyrexOptions::default()).unwrap();
+    assert_eq!(read.sequences.len(), 2);
+    assert!(
+        read.warnings[0]
+            .contains("gyroscope-calibrated.txt:3901: gap of 1.005 s in the samples at 19.499 s"),
+        "{:?}",
+        read.warnings
+    );
+}
+
+#[test]
+fn without_a_mat_file_there_is_no_ground_truth() {
+    let fx = Fixture::standard();
+    let read = tyrex::read(
+        &fx.dir,
+        &TyrexOptions {
+            ground_truth: false,
+            ..TyrexOptions::default()
+        },
+    )
+    .unwrap();
+    assert!(read.sequences[0].ground_truth().is_none() && read.time_diff_s.is_none());
+    std::fs::remove_file(&fx.mat).unwrap();
+    // timeAlignment.txt is only needed with ground truth.
+    std::fs::remove_file(fx.dir.join("timeAlignment.txt")).unwrap();
+    let read = tyrex::read(&fx.dir, &TyrexOptions::default()).unwrap();
+    let seq = &read.sequences[0];
+    assert!(seq.ground_truth().is_none());
+    // The overlap of the phone streams: gyro starts 1 ms late.
+    assert!((seq.time()[0] - 0.004).abs() < 1e-12);
+    assert!(seq.duration() > 39.9);
+}
+
+#[test]
+fn lists_sequence_folders_from_the_root() {
+    let fx = Fixture::standard();
+    std::fs::create_dir_all(fx.root.join("datasets/android/not_a_sequence")).unwrap();
+    let found = tyrex::list_sequences(&fx.root).unwrap();
+    assert_eq!(found, std::slice::from_ref(&fx.dir));
+    assert_eq!(
+        tyrex::list_sequences(fx.root.join("datasets/android")).unwrap(),
+        found
+    );
+    let e = tyrex::list_sequences(fx.root.join("datasets/qualisys")).unwrap_err();
+    assert!(e.to_string().contains("no Tyrex sequence folder"), "{e}");
+    assert!(matches!(
+        tyrex::list_sequences(fx.root.join("nowhere")),
+        Err(DataError::Io { .. })
+    ));
+}
+
+#[test]
+fn unknown_motion_means_no_placement_and_a_warning() {
+    let fx = Fixture::new("Ann_Nexus5_NoDist_Dancing", 40.0, 900, &[]);
+    let read = tyrex::read(&fx.dir, &TyrexOptions::default()).unwrap();
+    assert_eq!(read.sequences[0].placement(), None);
+    assert!(
+        read.warnings[0].contains("known motion"),
+        "{:?}",
+        read.warnings
+    );
+}
+
+#[test]
+fn rotation_vector_without_w_or_accuracy_is_accepted() {
+    let fx = Fixture::standard();
+    fx.edit("rotation-vector.txt", |s| {
+        s.lines()
+            .map(|l| {
+                let c: Vec<f64> = l.split(' ').map(|x| x.parse().unwrap()).collect();
+                // Without w, Android implies w >= 0: write the sign that makes it so.
+                let s = if c[4] < 0.0 { -1.0 } else { 1.0 };
+                format!("{} {} {} {}\n", c[0], s * c[1], s * c[2], s * c[3])
+            })
+            .collect()
+    });
+    let read = tyrex::read(&fx.dir, &TyrexOptions::default()).unwrap();
+    let seq = &read.sequences[0];
+    let k = seq.len() / 2;
+    assert!(seq.orientation()[k].angle_to(&yaw(OMEGA * seq.time()[k])) < 1e-6);
+}
+
+fn assert_err(fx: &Fixture, expect: &[&str]) {
+    let e = fx.err();
+    for part in expect {
+        assert!(e.contains(part), "`{part}` not in: {e}");
+    }
+}
+
+#[test]
+fn text_errors_name_file_line_and_field() {
+    let fx = Fixture::standard();
+    fx.edit("accelerometer.txt", |s| {
+        replace_line(s, 3, "0.013 0.1 abc 9.8")
+    });
+    assert_err(
+        &fx,
+        &["accelerometer.txt:3: field `ay`: `abc` is not a number"],
+    );
+
+    let fx = Fixture::standard();
+    fx.edit("gyroscope-calibrated.txt", |s| {
+        replace_line(s, 2, "0.009 0.0 0.0")
+    });
+    assert_err(
+        &fx,
+        &["gyroscope-calibrated.txt:2: 3 fields, expected 4 (t wx wy wz)"],
+    );
+
+    let fx = Fixture::standard();
+    fx.edit("rotation-vector.txt", |s| {
+        replace_line(s, 5, "0.001 0 0 0 1 0.1")
+    });
+    assert_err(
+        &fx,
+        &["rotation-vector.txt:5: field `t`: timestamp goes back"],
+    );
+
+    let fx = Fixture::standard();
+    fx.edit("rotation-vector.txt", |s| {
+        replace_line(s, 4, "0.0181 0 0 0 1 0.1")
+    });
+    fx.edit("rotation-vector.txt", |s| {
+        replace_line(s, 5, "0.0181 0 0 0 1 0.1")
+    });
+    assert_err(
+        &fx,
+        &["rotation-vector.txt:5: field `t`: duplicate timestamp"],
+    );
+
+    let fx = Fixture::standard();
+    fx.edit("rotation-vector.txt", |s| {
+        replace_line(s, 7, "0.033 0.5 0.5 0.5 0.9 0.1")
+    });
+    assert_err(
+        &fx,
+        &["rotation-vector.txt:7: field `qw`: quaternion x,y,z,w has norm 1.2"],
+    );
+
+    let fx = Fixture::standard();
+    fx.edit("accelerometer.txt", |s| {
+        replace_line(s, 9, "0.043 0.1 NaN 9.8")
+    });
+    assert_err(&fx, &["accelerometer.txt:9: field `ay`"]);
+
+    let fx = Fixture::standard();
+    fx.write("accelerometer.txt", "\n\n");
+    assert_err(&fx, &["accelerometer.txt: no samples: the file is empty"]);
+
+    let fx = Fixture::standard();
+    fx.write("timeAlignment.txt", "");
+    assert_err(&fx, &["timeAlignment.txt: empty"]);
+
+    let fx = Fixture::standard();
+    fx.write("timeAlignment.txt", "-3.7 s\n");
+    assert_err(&fx, &["timeAlignment.txt:1: unexpected `s` after timeDiff"]);
+
+    let fx = Fixture::standard();
+    fx.write("timeAlignment.txt", "minus three\n");
+    assert_err(
+        &fx,
+        &["timeAlignment.txt:1: field `timeDiff`: `minus` is not a number"],
+    );
+
+    let fx = Fixture::standard();
+    std::fs::remove_file(fx.dir.join("gyroscope-calibrated.txt")).unwrap();
+    let e = tyrex::read(&fx.dir, &TyrexOptions::default()).unwrap_err();
+    assert!(
+        matches!(&e, DataError::Io { path, .. } if path.ends_with("gyroscope-calibrated.txt")),
+        "{e}"
+    );
+}
+
+fn with_mat(vars: Vec<(String, V)>) -> Fixture {
+    let fx = Fixture::standard();
+    let vars: Vec<(&str, V)> = vars.iter().map(|(n, v)| (n.as_str(), v.clone())).collect();
+    std::fs::write(&fx.mat, le().file(&vars, false)).unwrap();
+    fx
+}
+
+fn mat_file_name(fx: &Fixture) -> String {
+    fx.mat.file_name().unwrap().to_string_lossy().into_owned()
+}
+
+#[test]
+fn mat_errors_name_the_file_and_field() {
+    let (p, r) = frames(600, &[]);
+
+    let fx = with_mat(vec![(
+        "Take_1".into(),
+        V::Struct(vec![("FrameRate".into(), V::Num(vec![1, 1], vec![60.0]))]),
+    )]);
+    assert_err(
+        &fx,
+        &[
+            &mat_file_name(&fx),
+            "field `RigidBodies`",
+            "variables: Take_1",
+        ],
+    );
+
+    let mut vars = qtm_like("Take_1", 60.0, &p, &r);
+    if let V::Struct(fields) = &mut vars[0].1
+        && let Some((_, V::Struct(rb))) = fields.iter_mut().find(|(n, _)| n == "RigidBodies")
+    {
+        rb.retain(|(n, _)| n != "Positions");
+    }
+    let fx = with_mat(vars);
+    assert_err(
+        &fx,
+        &[
+            &mat_file_name(&fx),
+            "field `Take_1.RigidBodies.Positions`: no field `Positions` in `Take_1.RigidBodies`",
+        ],
+    );
+
+    let fx = with_mat(qtm_like("Take_1", 60.0, &p, &r[..599]));
+    assert_err(
+        &fx,
+        &["field `Take_1.RigidBodies.Rotations`: 599 frames, but Positions has 600"],
+    );
+
+    let fx = with_mat(qtm_like("Take_1", 0.0, &p, &r));
+    assert_err(
+        &fx,
+        &["field `Take_1.FrameRate`: expected one positive number"],
+    );
+
+    let mut bad = r.clone();
+    bad[42][0] = 2.0;
+    let fx = with_mat(qtm_like("Take_1", 60.0, &p, &bad));
+    assert_err(
+        &fx,
+        &["field `Take_1.RigidBodies.Rotations`: frame 43 is not a rotation matrix"],
+    );
+
+    // A reflection is orthonormal but not a rotation.
+    let mut bad = r.clone();
+    bad[7] = [1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, -1.0];
+    let fx = with_mat(qtm_like("Take_1", 60.0, &p, &bad));
+    assert_err(&fx, &["frame 8 is not a rotation matrix", "det = -1"]);
+
+    let lost = vec![[f64::NAN; 3]; 600];
+    let fx = with_mat(qtm_like("Take_1", 60.0, &lost, &r));
+    assert_err(&fx, &["every frame is NaN"]);
+}
+
+#[test]
+fn truncated_or_mangled_mat_is_an_error_naming_it() {
+    let fx = Fixture::standard();
+    let bytes = std::fs::read(&fx.mat).unwrap();
+    std::fs::write(&fx.mat, &bytes[..bytes.len() / 2]).unwrap();
+    assert_err(
+        &fx,
+        &[
+            &mat_file_name(&fx),
+            "field `Take_1.RigidBodies.Rotations`",
+            "truncated",
+            "of the compressed element at byte 128",
+        ],
+    );
+
+    let fx = with_mat(qtm_like(
+        "Take_1",
+        60.0,
+        &frames(600, &[]).0,
+        &frames(600, &[]).1,
+    ));
+    let bytes = std::fs::read(&fx.mat).unwrap();
+    std::fs::write(&fx.mat, &bytes[..bytes.len() - 1000]).unwrap();
+    assert_err(
+        &fx,
+        &[
+            &mat_file_name(&fx),
+            "field `Take_1.RigidBodies.Rotations`",
+            "truncated",
+        ],
+    );
+
+    let fx = Fixture::standard();
+    std::fs::write(&fx.mat, b"").unwrap();
+    assert_err(&fx, &[&mat_file_name(&fx), "the file is empty"]);
+}
+
+#[test]
+fn bad_options_are_rejected() {
+    let fx = Fixture::standard();
+    let e = tyrex::read(
+        &fx.dir,
+        &TyrexOptions {
+            rate_hz: 0.0,
+            ..TyrexOptions::default()
+        },
+    )
+    .unwrap_err();
+    assert!(e.to_string().contains("rate_hz"), "{e}");
+    let e = tyrex::read(
+        &fx.dir,
+        &TyrexOptions {
+            min_part_s: 1000.0,
+            ..TyrexOptions::default()
+        },
+    )
+    .unwrap_err();
+    assert!(
+        e.to_string().contains("no stretch of at least 1000 s"),
+        "{e}"
+    );
+}
+
+#[test]
+fn read_ground_truth_gives_mocap_rate_frames() {
+    let fx = Fixture::new(
+        "Ann_Nexus5_NoDist_AR",
+        20.0,
+        120,
+        std::slice::from_ref(&(10..12)),
+    );
+    let track = tyrex::read_ground_truth(&fx.mat).unwrap();
+    assert_eq!(
+        (track.rate_hz, track.pose.len(), track.valid_count()),
+        (60.0, 120, 118)
+    );
+    assert_eq!(track.variable, "Take_1");
+    assert!((track.time[90] - 1.5).abs() < 1e-12);
+    let p = track.pose[90].unwrap();
+    assert!((p.position.x() - 1.5).abs() < 1e-12 && (p.position.z() - 1.2).abs() < 1e-12);
+    assert!(p.orientation.angle_to(&yaw(OMEGA * 1.5)) < 1e-9);
+    // Column-major 3x3: a quarter turn about z maps device x to room y.
+    let q = yaw(FRAC_PI_2);
+    let v = q * DeviceVec::new(1.0, 0.0, 0.0);
+    assert!((v.y() - 1.0).abs() < 1e-12);
+    assert!(track.pose[10].is_none() && track.pose[11].is_none());
+}

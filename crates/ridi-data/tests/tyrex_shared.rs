@@ -1,0 +1,305 @@
+//! Checks against the real Tyrex data in `../shared` (beside the checkout). Each test returns
+//! early with a note when the data are not there; the CI script runs them where they are.
+
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+use ridi_data::mat::MatFile;
+use ridi_data::ridi_frames::{WorldFromDevice, WorldVec};
+use ridi_data::tyrex::{self, TyrexOptions};
+
+fn root() -> Option<PathBuf> {
+    let p = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../../../shared/data/raw/tyrex-attitude-smartphones");
+    if p.join("datasets/android").is_dir() {
+        Some(p)
+    } else {
+        eprintln!(
+            "note: {} not found: Tyrex shared-data checks skipped",
+            p.display()
+        );
+        None
+    }
+}
+
+/// One row of `derived/groundtruth/<seq>.csv` (an independent scipy conversion).
+struct CsvRow {
+    t_qtm: f64,
+    t_phone: f64,
+    pos: [f64; 3],
+    wxyz: [f64; 4],
+    valid: bool,
+}
+
+fn read_csv(path: &Path) -> Vec<CsvRow> {
+    let text = std::fs::read_to_string(path).unwrap();
+    let mut lines = text.lines();
+    assert_eq!(
+        lines.next().unwrap(),
+        "t_qtm_s,t_phone_s,pos_x_m,pos_y_m,pos_z_m,ori_w,ori_x,ori_y,ori_z,valid"
+    );
+    lines
+        .filter(|l| !l.is_empty())
+        .map(|l| {
+            let c: Vec<f64> = l.split(',').map(|x| x.parse::<f64>().unwrap()).collect();
+            CsvRow {
+                t_qtm: c[0],
+                t_phone: c[1],
+                pos: [c[2], c[3], c[4]],
+                wxyz: [c[5], c[6], c[7], c[8]],
+                valid: c[9] == 1.0,
+            }
+        })
+        .collect()
+}
+
+fn quat_diff(q: &WorldFromDevice, wxyz: [f64; 4]) -> f64 {
+    let a = q.to_wxyz();
+    // q and -q are the same rotation.
+    let sign = if a.iter().zip(wxyz).map(|(x, y)| x * y).sum::<f64>() < 0.0 {
+        -1.0
+    } else {
+        1.0
+    };
+    a.iter()
+        .zip(wxyz)
+        .map(|(x, y)| (x * sign - y).abs())
+        .fold(0.0, f64::max)
+}
+
+#[test]
+fn qtm_file_structure_is_read() {
+    let Some(root) = root() else { return };
+    let path = root.join("datasets/qualisys/Guillaume_Nexus5_NoDist_Texting.mat");
+    let m = MatFile::read(&path).unwrap();
+    assert!(
+        m.header_text().starts_with("QTM_ver 2.10"),
+        "{}",
+        m.header_text()
+    );
+    let take = "Guillaume_Nexus5_NoDist_Texting";
+    assert_eq!(
+        m.lookup(&format!("{take}.FrameRate")).unwrap().scalar(),
+        Some(60.0)
+    );
+    assert_eq!(
+        m.lookup(&format!("{take}.Frames")).unwrap().scalar(),
+        Some(7200.0)
+    );
+    let pos = m.require(&format!("{take}.RigidBodies.Positions")).unwrap();
+    assert_eq!(pos.dims(), [1, 3, 7200]);
+    let name = m.require(&format!("{take}.RigidBodies.Name")).unwrap();
+    assert_eq!(
+        name.as_cell().unwrap().items[0].as_str(),
+        Some("Nexus5-Handler")
+    );
+    let labels = m
+        .require(&format!("{take}.Trajectories.Labeled.Data"))
+        .unwrap();
+    assert_eq!(labels.dims(), [5, 4, 7200]);
+    // First sample as scipy prints it.
+    assert!((pos.as_numeric().unwrap().real[0] - -7.18589189).abs() < 1e-8);
+}
+
+#[test]
+fn mocap_frames_match_the_independent_csv_conversion() {
+    let Some(root) = root() else { return };
+    let started = Instant::now();
+    let mut worst_pos = 0.0f64;
+    let mut worst_quat = 0.0f64;
+    let mut worst_phone_t = 0.0f64;
+    let mut files = 0;
+    for dir in tyrex::list_sequences(&root).unwrap() {
+        let name = dir.file_name().unwrap().to_string_lossy().into_owned();
+        let track = tyrex::read_ground_truth(tyrex::mat_path(&dir).unwrap()).unwrap();
+        let time_diff: f64 = std::fs::read_to_string(dir.join("timeAlignment.txt"))
+            .unwrap()
+            .trim()
+            .parse()
+            .unwrap();
+        let csv = read_csv(&root.join(format!("derived/groundtruth/{name}.csv")));
+        assert_eq!(track.rate_hz, 60.0);
+        assert_eq!(csv.len(), track.pose.len(), "{name}");
+        for (i, row) in csv.iter().enumerate() {
+            assert!((track.time[i] - row.t_qtm).abs() < 1e-5, "{name} frame {i}");
+            worst_phone_t = worst_phone_t.max((track.time[i] - time_diff - row.t_phone).abs());
+            match &track.pose[i] {
+                None => assert!(!row.valid, "{name} frame {i}: csv valid, reader lost"),
+                Some(p) => {
+                    assert!(row.valid, "{name} frame {i}: csv lost, reader valid");
+                    let d = p.position - WorldVec::from_array(row.pos);
+                    worst_pos = worst_pos.max(d.x().abs().max(d.y().abs()).max(d.z().abs()));
+                    worst_quat = worst_quat.max(quat_diff(&p.orientation, row.wxyz));
+                }
+            }
+        }
+        files += 1;
+    }
+    eprintln!(
+        "{files} .mat files vs csv: max |dpos| {worst_pos:.2e} m, max |dq| {worst_quat:.2e}, \
+         max |dt_phone| {worst_phone_t:.2e} s, {:.2?}",
+        started.elapsed()
+    );
+    assert_eq!(files, 24);
+    // The csv has 6 decimals (metres, quaternion components) and 5 for time.
+    assert!(worst_pos <= 6e-7, "{worst_pos}");
+    assert!(worst_quat <= 6e-7, "{worst_quat}");
+    assert!(worst_phone_t <= 6e-6, "{worst_phone_t}");
+}
+
+#[test]
+fn resampled_ground_truth_matches_the_csv_between_frames() {
+    let Some(root) = root() else { return };
+    let name = "Guillaume_Nexus5_NoDist_Texting";
+    let read = tyrex::read(
+        root.join("datasets/android").join(name),
+        &TyrexOptions::default(),
+    )
+    .unwrap();
+    assert_eq!(read.sequences.len(), 1, "{:?}", read.warnings);
+    assert_eq!(read.device_model.as_deref(), Some("Nexus 5"));
+    assert_eq!(read.time_diff_s, Some(-3.71));
+    let seq = &read.sequences[0];
+    assert_eq!(seq.name(), name);
+    assert_eq!(seq.placement(), Some("Texting"));
+    let gt = seq.ground_truth().unwrap();
+    let csv = read_csv(&root.join(format!("derived/groundtruth/{name}.csv")));
+    let mut worst = 0.0f64;
+    for k in (0..seq.len()).step_by(997) {
+        let t = seq.time()[k];
+        let j = csv.partition_point(|r| r.t_phone <= t);
+        let (a, b) = (&csv[j - 1], &csv[j]);
+        assert!(a.valid && b.valid);
+        let s = (t - a.t_phone) / (b.t_phone - a.t_phone);
+        for c in 0..3 {
+            let expect = a.pos[c] + (b.pos[c] - a.pos[c]) * s;
+            worst = worst.max((gt.position[k].to_array()[c] - expect).abs());
+        }
+        // Orientation: nlerp of the csv quaternions is within 1e-4 of slerp at 60 Hz.
+        let q = WorldFromDevice::from_wxyz(a.wxyz)
+            .unwrap()
+            .slerp(&WorldFromDevice::from_wxyz(b.wxyz).unwrap(), s);
+        assert!(gt.orientation[k].angle_to(&q) < 1e-4, "t {t}");
+    }
+    eprintln!("resampled positions vs csv lerp: max error {worst:.2e} m");
+    // The csv rounds phone time to 10 us; at walking speed that is a few um.
+    assert!(worst < 5e-5, "{worst}");
+}
+
+#[test]
+fn all_24_sequences_read_fast_with_plausible_content() {
+    let Some(root) = root() else { return };
+    let started = Instant::now();
+    let dirs = tyrex::list_sequences(&root).unwrap();
+    assert_eq!(dirs.len(), 24);
+    let opts = TyrexOptions::default();
+    for dir in &dirs {
+        let read = tyrex::read(dir, &opts).unwrap();
+        let name = dir.file_name().unwrap().to_string_lossy().into_owned();
+        let mut total = 0.0;
+        let mut path = 0.0;
+        for seq in &read.sequences {
+            assert!((seq.rate_hz() - 200.0).abs() < 1e-6, "{}", seq.name());
+            assert_eq!(seq.placement(), tyrex::motion_of(&name));
+            total += seq.duration();
+            path += seq.path_length().unwrap();
+            // Tilt from the rotation vector vs tilt from the mocap: same device frame, both z up.
+            let gt = seq.ground_truth().unwrap();
+            let mut tilt = 0.0;
+            for (q, g) in gt.orientation.iter().zip(seq.gravity()) {
+                let up = q.inverse() * WorldVec::new(0.0, 0.0, 1.0);
+                tilt += (up.dot(*g) / g.norm()).clamp(-1.0, 1.0).acos();
+            }
+            let tilt = (tilt / seq.len() as f64).to_degrees();
+            // Over minutes the world-frame acceleration averages to zero, so the accelerometer
+            // rotated to the world by the rotation vector averages to +g on z.
+            let acce = seq
+                .acce()
+                .iter()
+                .zip(seq.orientation())
+                .map(|(a, q)| (*q * *a).z())
+                .sum::<f64>()
+                / seq.len() as f64;
+            eprintln!(
+                "{:45} {:6.1} s {:6.1} m mean tilt diff {tilt:5.2} deg mean world acce z {acce:.2}",
+                seq.name(),
+                seq.duration(),
+                seq.path_length().unwrap(),
+            );
+            assert!(tilt < 5.0, "{}: {tilt} deg", seq.name());
+            // Running saturates the accelerometer (2 g), which biases this mean.
+            if !name.contains("Running") {
+                assert!((9.5..10.3).contains(&acce), "{}: {acce}", seq.name());
+            }
+        }
+        let clipped = read
+            .warnings
+            .iter()
+            .any(|w| w.contains("clipped at +-19.553"));
+        assert_eq!(
+            clipped,
+            name.contains("Running"),
+            "{name}: {:?}",
+            read.warnings
+        );
+        for w in &read.warnings {
+            eprintln!("  warning: {w}");
+        }
+        assert!(total > 60.0, "{name}: only {total} s usable");
+        assert!((10.0..300.0).contains(&path), "{name}: path {path} m");
+    }
+    let elapsed = started.elapsed();
+    eprintln!("24 sequences read in {elapsed:.2?}");
+    // Seconds even in the test profile; release is much faster (docs/bench-tyrex.md).
+    assert!(elapsed.as_secs_f64() < 30.0);
+}
+
+#[test]
+fn damaged_copies_of_a_real_qtm_file_give_errors_not_panics() {
+    let Some(root) = root() else { return };
+    let bytes =
+        std::fs::read(root.join("datasets/qualisys/Guillaume_Nexus5_NoDist_Texting.mat")).unwrap();
+    let parse = |b: &[u8]| {
+        std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+            MatFile::from_bytes(b, "real.mat").map(|_| ())
+        }))
+        .expect("reader panicked")
+    };
+    // Cuts through the struct headers, the first arrays and the end.
+    for cut in (0..3000)
+        .step_by(7)
+        .chain([bytes.len() / 2, bytes.len() - 1])
+    {
+        let e = parse(&bytes[..cut]).unwrap_err().to_string();
+        assert!(e.starts_with("real.mat"), "{e}");
+    }
+    let mut seed = 7u64;
+    for _ in 0..150 {
+        seed = seed.wrapping_mul(6_364_136_223_846_793_005).wrapping_add(1);
+        let mut b = bytes.clone();
+        // The structure (tags, sizes, names) is in the first few kilobytes.
+        let at = 128 + (seed >> 33) as usize % 4000;
+        b[at] ^= 1 << ((seed >> 20) % 8);
+        if let Err(e) = parse(&b) {
+            assert!(e.to_string().starts_with("real.mat"), "{e}");
+        }
+    }
+}
+
+#[test]
+fn read_sequence_reads_a_single_part_tyrex_run_and_refuses_a_split_one() {
+    let Some(root) = root() else { return };
+    let android = root.join("datasets/android");
+    let opts = ridi_data::ReadOptions::default();
+    let whole = ridi_data::read_sequence(android.join("Guillaume_Nexus5_NoDist_Texting"), &opts)
+        .expect("a run without long gaps reads as one sequence");
+    assert_eq!(whole.placement(), Some("Texting"));
+    assert!(whole.ground_truth().is_some());
+    let err = ridi_data::read_sequence(android.join("Jakob_Nexus5_NoDist_Swinging"), &opts)
+        .unwrap_err()
+        .to_string();
+    assert!(
+        err.contains("usable parts") && err.contains("ridi convert"),
+        "{err}"
+    );
+}
