@@ -32,7 +32,14 @@ pub fn align_gravity(gravity: DeviceVec) -> StabFromDevice {
         return StabFromDevice::identity();
     }
     let axis = g.cross(&up);
-    let w = norm + g.dot(&up);
+    // w = |g| + g_y loses every digit to cancellation when g points nearly down; the
+    // algebraically equal (g_x^2 + g_z^2) / (|g| - g_y) keeps full precision there, so the
+    // near-opposite rotations stay accurate right up to the exactly opposite case.
+    let w = if g.y >= 0.0 {
+        norm + g.y
+    } else {
+        (g.x * g.x + g.z * g.z) / (norm - g.y)
+    };
     let q = Quaternion::from_parts(w, axis);
     if q.norm() <= norm * 1e-12 {
         return StabFromDevice::from_unit_quaternion(UnitQuaternion::from_axis_angle(

@@ -7,12 +7,29 @@
 //! - [`Device`] (I): the Android sensor frame (x right, y top of the device, z out of screen).
 //! - [`Stabilized`] (S): the device frame with pitch and roll removed by the smallest rotation
 //!   taking the measured gravity onto [`UP_S`] (+y, as in the original). Horizontal axes: S-x
-//!   and S-z (forward is -z).
+//!   (right) and S-z (back; forward is -z).
 //!
 //! [`Vec3<F>`] is a vector in frame `F`; [`Rot<To, From>`] a rotation that maps `Vec3<From>` to
 //! `Vec3<To>`. Rotations are Hamilton unit quaternions with `v_To = q v_From q*`; the device
 //! orientation is [`WorldFromDevice`]. Quaternion component order is never implicit: use
 //! [`Rot::from_wxyz`] or [`Rot::from_xyzw`] at file edges.
+//!
+//! # Gravity alignment
+//!
+//! [`align_gravity`] is the S-from-device rotation of one frame. It is the *smallest* rotation
+//! taking gravity onto S-up, so its axis is horizontal and heading is kept (no twist about the
+//! vertical). It is accurate right up to gravity pointing exactly down the S-up axis, where it
+//! is a proper half turn (the original C++ used a reflection there). Test-time world to S is
+//! [`stab_from_world`]`(q, g) = align(g) * q*`.
+//!
+//! # Orientation without a magnetometer
+//!
+//! [`estimate`] is a Mahony complementary filter on gyroscope and accelerometer
+//! ([`estimate_orientation`], gains in [`FilterConfig`]) for recordings without a usable
+//! orientation. It starts with heading 0 ([`initial_orientation`]). [`tilt_error`],
+//! [`heading_difference`] and [`orientation_errors`] compare any orientation track with a
+//! reference (e.g. motion capture): tilt error in the device frame, heading drift as the yaw of
+//! the relative rotation.
 //!
 //! # Example
 //!
@@ -30,13 +47,28 @@
 //! let v_w = ridi_frames::WorldVec::new(1.0, 0.0, 0.0);
 //! let v_s = stab_from_world(q, g) * v_w;
 //! assert!((v_s.norm() - 1.0).abs() < 1e-12);
+//!
+//! // A still phone tilted by 0.3 rad: the filter's tilt matches, heading starts at 0.
+//! use ridi_frames::{estimate_orientation, gravity_in_device, tilt_error, FilterConfig};
+//! let truth = WorldFromDevice::from_scaled_axis([0.3, 0.0, 0.0].into());
+//! let time: Vec<f64> = (0..400).map(|i| i as f64 / 200.0).collect();
+//! let gyro = vec![DeviceVec::ZERO; time.len()];
+//! let acce = vec![gravity_in_device(truth, 9.81); time.len()];
+//! let est = estimate_orientation(&time, &gyro, &acce, &FilterConfig::default()).unwrap();
+//! assert!(tilt_error(est[399], truth) < 1e-9);
 //! ```
 
+pub mod estimate;
 mod frame;
 mod gravity;
 mod rotation;
 mod vector;
 
+pub use estimate::{
+    EstimateError, FilterConfig, OrientationErrors, estimate_orientation,
+    estimate_orientation_from, heading_difference, initial_orientation, orientation_errors,
+    tilt_error,
+};
 pub use frame::{Device, Frame, Stabilized, World};
 pub use gravity::{
     STANDARD_GRAVITY, UP_S, UP_W, align_gravity, gravity_in_device, stab_from_world,

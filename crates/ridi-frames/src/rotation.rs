@@ -181,7 +181,12 @@ impl<To: Frame, From: Frame> Default for Rot<To, From> {
 impl<To: Frame, From: Frame> fmt::Debug for Rot<To, From> {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         let [w, x, y, z] = self.to_wxyz();
-        write!(f, "{}<-{}(w={w}, x={x}, y={y}, z={z})", To::NAME, From::NAME)
+        write!(
+            f,
+            "{}<-{}(w={w}, x={x}, y={y}, z={z})",
+            To::NAME,
+            From::NAME
+        )
     }
 }
 

@@ -1,0 +1,52 @@
+//! The error type of this crate.
+
+/// Why features, targets or a configuration were rejected. Every variant names the offending
+/// input so that a caller can point at the bad recording.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum FeatureError {
+    /// Inputs that must be parallel have different lengths.
+    #[error("{what} has {found} samples, expected {expected}")]
+    LengthMismatch {
+        /// Which input.
+        what: &'static str,
+        /// Length it should have.
+        expected: usize,
+        /// Length found.
+        found: usize,
+    },
+    /// A NaN or infinite value.
+    #[error("non-finite {what} at sample {index}")]
+    NonFinite {
+        /// Which input.
+        what: &'static str,
+        /// Sample index.
+        index: usize,
+    },
+    /// `time[index] <= time[index - 1]`: velocities need strictly increasing time.
+    #[error("time does not increase at sample {index}")]
+    TimeNotIncreasing {
+        /// Sample index.
+        index: usize,
+    },
+    /// A requested sample frame lies outside `[min, max]`.
+    #[error("sample frame {frame} outside the valid range [{min}, {max}]")]
+    FrameOutOfRange {
+        /// The frame asked for.
+        frame: usize,
+        /// Smallest valid frame.
+        min: usize,
+        /// Largest valid frame.
+        max: usize,
+    },
+    /// A row or vector has the wrong dimension.
+    #[error("dimension {found} where {expected} was expected")]
+    DimensionMismatch {
+        /// Dimension the configuration implies.
+        expected: usize,
+        /// Dimension found.
+        found: usize,
+    },
+    /// A configuration value is out of range.
+    #[error("invalid feature configuration: {0}")]
+    InvalidConfig(String),
+}
