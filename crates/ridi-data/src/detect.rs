@@ -39,10 +39,10 @@ fn locate(path: &Path) -> Result<(Format, PathBuf)> {
             .file_name()
             .map(|n| n.to_string_lossy().to_lowercase())
             .unwrap_or_default();
-        if name.ends_with(".csv") {
+        if name.ends_with(".csv") || name.ends_with(".csv.gz") {
             return Ok((Format::RidiCsv, path.to_path_buf()));
         }
-        if name.ends_with(".txt") {
+        if name.ends_with(".txt") || name.ends_with(".txt.gz") {
             return Ok((Format::RidiPlain, path.to_path_buf()));
         }
         return Err(DataError::format(
@@ -61,7 +61,9 @@ fn locate(path: &Path) -> Result<(Format, PathBuf)> {
     // what the published dataset ships, with the trimmed, synchronized timeline, so it wins.
     for (rel, format) in [
         ("processed/data.csv", Format::RidiCsv),
+        ("processed/data.csv.gz", Format::RidiCsv),
         ("data.csv", Format::RidiCsv),
+        ("data.csv.gz", Format::RidiCsv),
         ("processed/data_plain.txt", Format::RidiPlain),
         ("data_plain.txt", Format::RidiPlain),
     ] {
@@ -85,9 +87,10 @@ fn locate(path: &Path) -> Result<(Format, PathBuf)> {
 
 /// Detects the format of a file or folder.
 ///
-/// Files: `*.csv` is a RIDI processed csv, `*.txt` a `data_plain.txt`. Folders, first match
-/// wins: `processed/data.csv`, `data.csv`, `processed/data_plain.txt`, `data_plain.txt`, a RIDI
-/// raw folder (`gyro.txt` and `acce.txt`), a Tyrex folder (`accelerometer.txt` and
+/// Files: `*.csv` is a RIDI processed csv, `*.txt` a `data_plain.txt`; either may be
+/// gzip-compressed (`*.csv.gz`, `*.txt.gz`). Folders, first match wins: `processed/data.csv`
+/// (or `.csv.gz`), `data.csv` (or `.csv.gz`), `processed/data_plain.txt`, `data_plain.txt`, a
+/// RIDI raw folder (`gyro.txt` and `acce.txt`), a Tyrex folder (`accelerometer.txt` and
 /// `gyroscope-calibrated.txt`).
 pub fn detect(path: impl AsRef<Path>) -> Result<Format> {
     locate(path.as_ref()).map(|(f, _)| f)

@@ -82,4 +82,6 @@ pub use ridi_frames;
 pub use sequence::{
     GroundTruth, OrientationSource, Sequence, SequenceError, SequenceParts, Validation,
 };
-pub use write::{write_atomically, write_ridi_csv, write_ridi_plain};
+pub use write::{
+    Precision, write_atomically, write_ridi_csv, write_ridi_csv_with, write_ridi_plain,
+};

@@ -75,17 +75,16 @@ pub(crate) struct Table {
 }
 
 /// Sequence name from a file path: the capture folder for `<name>/processed/data.csv` and
-/// `<name>/data.csv` (also `data_plain.txt`), the file stem otherwise.
+/// `<name>/data.csv` (also `data_plain.txt`, and both gzipped), the file stem otherwise.
 pub(crate) fn name_from_path(path: &Path) -> String {
     let file_name = |p: &Path| p.file_name().map(|s| s.to_string_lossy().into_owned());
-    let stem = path
+    let full = file_name(path).unwrap_or_default();
+    let base = full.strip_suffix(".gz").unwrap_or(&full);
+    let stem = Path::new(base)
         .file_stem()
         .map(|s| s.to_string_lossy().into_owned())
         .unwrap_or_default();
-    if !matches!(
-        file_name(path).as_deref(),
-        Some("data.csv" | "data_plain.txt")
-    ) {
+    if !matches!(base, "data.csv" | "data_plain.txt") {
         return stem;
     }
     let Some(dir) = path.parent() else {

@@ -9,7 +9,25 @@ use crate::sequence::SequenceError;
 /// Reads a whole file; the readers parse from memory because one pass over a byte slice is much
 /// faster than buffered line reading with a `String` per line.
 pub(crate) fn read_file(path: &Path) -> Result<Vec<u8>> {
-    std::fs::read(path).map_err(|e| DataError::io(path, e))
+    let bytes = std::fs::read(path).map_err(|e| DataError::io(path, e))?;
+    gunzip_if_gzip(bytes, path)
+}
+
+/// Decompresses gzip data (recognized by its magic bytes, whatever the file name), so every
+/// text format can be stored compressed (`data.csv.gz`).
+pub(crate) fn gunzip_if_gzip(bytes: Vec<u8>, path: &Path) -> Result<Vec<u8>> {
+    if !bytes.starts_with(&[0x1f, 0x8b]) {
+        return Ok(bytes);
+    }
+    let mut out = Vec::with_capacity(bytes.len() * 4);
+    std::io::Read::read_to_end(&mut flate2::read::MultiGzDecoder::new(&bytes[..]), &mut out)
+        .map_err(|e| {
+            DataError::format(
+                Location::file(path),
+                format!("corrupt or truncated gzip data: {e}"),
+            )
+        })?;
+    Ok(out)
 }
 
 /// The bytes as UTF-8 text without a leading byte-order mark; the error names the first line
@@ -222,6 +240,19 @@ mod tests {
     fn lines_are_numbered_and_blank_ones_skipped() {
         let v: Vec<_> = lines("a\r\n\n  \nb\n").collect();
         assert_eq!(v, vec![(1, "a"), (4, "b")]);
+    }
+
+    #[test]
+    fn gzip_is_decompressed_and_corrupt_gzip_named() {
+        use std::io::Write;
+        let mut enc = flate2::write::GzEncoder::new(Vec::new(), flate2::Compression::fast());
+        enc.write_all(b"a,b\n1,2\n").unwrap();
+        let gz = enc.finish().unwrap();
+        assert_eq!(gunzip_if_gzip(gz.clone(), p()).unwrap(), b"a,b\n1,2\n");
+        assert_eq!(gunzip_if_gzip(b"plain".to_vec(), p()).unwrap(), b"plain");
+        let cut = gz[..gz.len() - 6].to_vec();
+        let e = gunzip_if_gzip(cut, p()).unwrap_err().to_string();
+        assert!(e.starts_with("f.csv: corrupt or truncated gzip"), "{e}");
     }
 
     #[test]

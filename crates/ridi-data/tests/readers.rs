@@ -610,3 +610,40 @@ fn writes_replace_atomically_and_leave_no_temporary_files() {
         &["data.csv"],
     );
 }
+
+#[test]
+fn gzipped_f32_files_are_written_and_read_back_transparently() {
+    let dir = tempfile::tempdir().unwrap();
+    let seq = sample_sequence("walk_gz", 50, true, true);
+    let folder = dir.path().join("walk_gz/processed");
+    std::fs::create_dir_all(&folder).unwrap();
+    let path = folder.join("data.csv.gz");
+    ridi_data::write_ridi_csv_with(&seq, &path, ridi_data::Precision::F32).unwrap();
+    let bytes = std::fs::read(&path).unwrap();
+    assert_eq!(&bytes[..2], &[0x1f, 0x8b], "not gzip");
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::PermissionsExt;
+        let mode = std::fs::metadata(&path).unwrap().permissions().mode();
+        assert_eq!(mode & 0o777, 0o644, "outputs must be readable by others");
+    }
+    assert_eq!(detect(dir.path().join("walk_gz")).unwrap(), Format::RidiCsv);
+    let back = read_sequence(dir.path().join("walk_gz"), &opts()).unwrap();
+    assert_eq!(back.name(), "walk_gz");
+    assert_eq!(back.len(), seq.len());
+    for (a, b) in back.gyro().iter().zip(seq.gyro()) {
+        assert!(
+            (*a - *b).norm() <= 1e-6 * b.norm().max(1.0),
+            "{a:?} vs {b:?}"
+        );
+    }
+    for (a, b) in back.time().iter().zip(seq.time()) {
+        assert_eq!(a, b, "time stays exact in integer nanoseconds");
+    }
+    // A cut gzip stream is an error naming the file, not a panic.
+    std::fs::write(&path, &bytes[..bytes.len() / 2]).unwrap();
+    let err = read_sequence(dir.path().join("walk_gz"), &opts())
+        .unwrap_err()
+        .to_string();
+    assert!(err.contains("data.csv.gz") && err.contains("gzip"), "{err}");
+}
