@@ -1,0 +1,82 @@
+//! Errors of the batch correction and of the streaming tracker.
+
+use thiserror::Error;
+
+/// Why a batch correction (or an integration) was refused.
+///
+/// Every check happens before any arithmetic, so an error never leaves a partly written result.
+#[derive(Debug, Clone, PartialEq, Error)]
+pub enum CorrectError {
+    /// The sequence has no frame.
+    #[error("the sequence is empty")]
+    Empty,
+    /// Two per-frame slices have different lengths.
+    #[error("{what} has {got} entries, expected {expected} (one per frame)")]
+    LengthMismatch {
+        /// Which input.
+        what: &'static str,
+        /// Number of frames (length of `time`).
+        expected: usize,
+        /// Length found.
+        got: usize,
+    },
+    /// A NaN or infinite value.
+    #[error("{what} is not finite at frame {frame}")]
+    NonFinite {
+        /// Which input.
+        what: &'static str,
+        /// Frame (or target) index.
+        frame: usize,
+    },
+    /// `time[frame] <= time[frame - 1]`.
+    #[error("time does not increase at frame {frame}")]
+    TimeNotIncreasing {
+        /// First frame whose time is not after its predecessor's.
+        frame: usize,
+    },
+    /// The time step before `frame` exceeds the configured maximum.
+    #[error("gap of {dt} s before frame {frame} exceeds max_dt = {max_dt} s")]
+    Gap {
+        /// First frame after the gap.
+        frame: usize,
+        /// The time step found, seconds.
+        dt: f64,
+        /// The configured limit, seconds.
+        max_dt: f64,
+    },
+    /// A velocity target refers to a frame outside the sequence.
+    #[error("target {index} is at frame {frame}, but the sequence has {len} frames")]
+    TargetOutOfRange {
+        /// Index of the target.
+        index: usize,
+        /// Its frame.
+        frame: usize,
+        /// Number of frames.
+        len: usize,
+    },
+    /// Target frames must be strictly increasing.
+    #[error("target {index} is not after target {}", index - 1)]
+    TargetsNotIncreasing {
+        /// Index of the first out-of-order target.
+        index: usize,
+    },
+    /// The initial velocity cannot be estimated without any velocity target.
+    #[error("estimating the initial velocity needs at least one velocity target")]
+    NoTargets,
+    /// A configuration value is out of its domain.
+    #[error("invalid configuration: {0}")]
+    InvalidConfig(&'static str),
+    /// At a target frame, the horizontal S rows and the world vertical are (nearly) linearly
+    /// dependent: gravity and orientation disagree by about 90 degrees.
+    #[error("inconsistent gravity and orientation at target frame {frame}")]
+    DegenerateFrame {
+        /// The target's frame.
+        frame: usize,
+    },
+    /// The reduced normal equations were not numerically positive definite (extreme weights).
+    #[error("the correction system is not numerically positive definite")]
+    NotPositiveDefinite,
+    /// Allocation of the factorization workspace failed.
+    #[error("out of memory while factorizing the correction system")]
+    OutOfMemory,
+}

@@ -1,0 +1,159 @@
+//! Knots of the piecewise-linear bias and the bias curve itself.
+
+use ridi_frames::DeviceVec;
+use serde::{Deserialize, Serialize};
+
+/// Knot placement over a sequence of `len` frames: frames `0, s, 2s, ...` (`s` the spacing)
+/// plus a final knot at the last frame when it is not already one, so that every frame,
+/// including the tail, lies between two knots (the original left the tail uncorrected).
+///
+/// Between two knots the bias is interpolated linearly in *time*, so irregular sampling does
+/// not distort it.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Knots {
+    spacing: usize,
+    frames: Vec<usize>,
+    times: Vec<f64>,
+}
+
+impl Knots {
+    /// Knots for the frames of `time` every `spacing` frames. `spacing` is clamped to at
+    /// least 1; an empty `time` gives no knot.
+    pub fn new(time: &[f64], spacing: usize) -> Self {
+        let spacing = spacing.max(1);
+        let n = time.len();
+        let mut frames: Vec<usize> = (0..n).step_by(spacing).collect();
+        if n > 0 && frames.last() != Some(&(n - 1)) {
+            frames.push(n - 1);
+        }
+        let times = frames.iter().map(|&f| time[f]).collect();
+        Self {
+            spacing,
+            frames,
+            times,
+        }
+    }
+
+    /// Number of knots.
+    pub fn len(&self) -> usize {
+        self.frames.len()
+    }
+
+    /// `true` when there is no knot (empty sequence).
+    pub fn is_empty(&self) -> bool {
+        self.frames.is_empty()
+    }
+
+    /// Frame index of each knot.
+    pub fn frames(&self) -> &[usize] {
+        &self.frames
+    }
+
+    /// Time of each knot, seconds.
+    pub fn times(&self) -> &[f64] {
+        &self.times
+    }
+
+    /// Knot spacing in frames.
+    pub fn spacing(&self) -> usize {
+        self.spacing
+    }
+
+    /// The knot at or before `frame` and the weight of the next knot: the bias at `frame` is
+    /// `(1 - w) x[k] + w x[k + 1]` (`w = 0` exactly on a knot, and for the last knot).
+    /// `time` is the frame's timestamp. Frames past the last knot are clamped to it.
+    #[inline]
+    pub fn locate(&self, frame: usize, time: f64) -> (usize, f64) {
+        let last = self.frames.len().saturating_sub(1);
+        let k = (frame / self.spacing).min(last);
+        if k == last || self.frames[k] == frame {
+            return (k, 0.0);
+        }
+        // Only the final knot can sit off the regular grid.
+        if self.frames[k + 1] == frame {
+            return (k + 1, 0.0);
+        }
+        let (t0, t1) = (self.times[k], self.times[k + 1]);
+        (k, (time - t0) / (t1 - t0))
+    }
+
+    /// Index of the last knot whose support contains `frame`: `k` if `frame` is a knot,
+    /// else `k + 1`. It depends on indices only, so the sparsity of the system does too.
+    #[inline]
+    pub(crate) fn upper(&self, frame: usize) -> usize {
+        let last = self.frames.len().saturating_sub(1);
+        let k = (frame / self.spacing).min(last);
+        if self.frames[k] == frame { k } else { k + 1 }
+    }
+}
+
+/// A piecewise-linear device-frame acceleration bias: one value per knot.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct BiasCurve {
+    /// Where the values sit.
+    pub knots: Knots,
+    /// Bias at each knot, device frame, m/s².
+    pub values: Vec<DeviceVec>,
+}
+
+impl BiasCurve {
+    /// The zero bias over `knots`.
+    pub fn zero(knots: Knots) -> Self {
+        let values = vec![DeviceVec::ZERO; knots.len()];
+        Self { knots, values }
+    }
+
+    /// Bias at `frame` (whose timestamp is `time`). Zero if there is no knot.
+    #[inline]
+    pub fn at(&self, frame: usize, time: f64) -> DeviceVec {
+        if self.values.is_empty() {
+            return DeviceVec::ZERO;
+        }
+        let (k, w) = self.knots.locate(frame, time);
+        if w == 0.0 {
+            self.values[k]
+        } else {
+            self.values[k] * (1.0 - w) + self.values[k + 1] * w
+        }
+    }
+
+    /// Bias at the last knot (the end of the covered frames), zero if there is no knot.
+    pub fn last(&self) -> DeviceVec {
+        self.values.last().copied().unwrap_or(DeviceVec::ZERO)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn knots_cover_the_tail_and_interpolate_in_time() {
+        let time: Vec<f64> = (0..12).map(|i| i as f64 * 0.5).collect();
+        let k = Knots::new(&time, 5);
+        assert_eq!(k.frames(), &[0, 5, 10, 11]);
+        assert_eq!(k.locate(0, 0.0), (0, 0.0));
+        assert_eq!(k.locate(5, 2.5), (1, 0.0));
+        let (i, w) = k.locate(7, 3.5);
+        assert_eq!(i, 1);
+        assert!((w - 0.4).abs() < 1e-12);
+        assert_eq!(k.locate(11, 5.5), (3, 0.0));
+        assert_eq!(k.upper(7), 2);
+        assert_eq!(k.upper(10), 2);
+        // Aligned length: no extra knot.
+        assert_eq!(Knots::new(&time[..11], 5).frames(), &[0, 5, 10]);
+    }
+
+    #[test]
+    fn curve_is_linear_between_knots() {
+        let time: Vec<f64> = (0..11).map(|i| i as f64).collect();
+        let knots = Knots::new(&time, 10);
+        let curve = BiasCurve {
+            knots,
+            values: vec![DeviceVec::new(0.0, 1.0, 2.0), DeviceVec::new(1.0, 1.0, 0.0)],
+        };
+        let mid = curve.at(5, 5.0);
+        assert!((mid - DeviceVec::new(0.5, 1.0, 1.0)).norm() < 1e-12);
+        assert_eq!(curve.last(), DeviceVec::new(1.0, 1.0, 0.0));
+    }
+}

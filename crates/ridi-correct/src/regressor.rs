@@ -1,0 +1,85 @@
+//! The interface between the tracker and a velocity regressor.
+
+use ridi_frames::{DeviceVec, WorldFromDevice};
+
+/// A view of the most recent frames of the stream, oldest first, one entry per frame in
+/// each slice. The last frame is the one to regress.
+#[derive(Debug, Clone, Copy)]
+pub struct FrameWindow<'a> {
+    /// Stream index of the first frame of the view (frames are counted from 0 since the
+    /// tracker was created, across restarts).
+    pub first_frame: u64,
+    /// Timestamps, seconds.
+    pub time: &'a [f64],
+    /// Angular rate, device frame, rad/s.
+    pub gyro: &'a [DeviceVec],
+    /// Linear acceleration, device frame, m/s².
+    pub linacce: &'a [DeviceVec],
+    /// Gravity (pointing up), device frame, m/s².
+    pub gravity: &'a [DeviceVec],
+    /// Device orientation, world-from-device.
+    pub orientation: &'a [WorldFromDevice],
+}
+
+impl FrameWindow<'_> {
+    /// Number of frames in the view.
+    pub fn len(&self) -> usize {
+        self.time.len()
+    }
+
+    /// `true` when the view holds no frame.
+    pub fn is_empty(&self) -> bool {
+        self.time.is_empty()
+    }
+
+    /// Stream index of the last frame (the one to regress).
+    pub fn last_frame(&self) -> u64 {
+        self.first_frame + self.len().saturating_sub(1) as u64
+    }
+}
+
+/// A regressed velocity with the placement it was regressed for.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Regression {
+    /// Horizontal velocity in the stabilized frame S, `[S-x, S-z]`, m/s.
+    pub velocity: [f64; 2],
+    /// Placement class id (e.g. leg, bag, hand, body), if the regressor classifies; used by
+    /// the placement-change filter.
+    pub label: Option<u32>,
+}
+
+/// The error type a regressor may return.
+pub type RegressError = Box<dyn std::error::Error + Send + Sync>;
+
+/// A source of regressed velocities for the [`Tracker`](crate::Tracker): the SVR cascade in
+/// production, test doubles in tests.
+pub trait VelocityRegressor {
+    /// How many of the most recent frames [`regress`](Self::regress) needs. The tracker only
+    /// asks for a regression once a segment holds that many frames, and always passes exactly
+    /// that many, the last being the frame regressed. RIDI's features use the 200 frames
+    /// *before* the sample frame: such a regressor asks for 201 and ignores the last one.
+    fn window_len(&self) -> usize;
+
+    /// The velocity at the last frame of `frames`. `Ok(None)` means "no estimate here" (the
+    /// frame is skipped silently); an error is reported in the tracker's update and the frame
+    /// is skipped too.
+    fn regress(&mut self, frames: &FrameWindow<'_>) -> Result<Option<Regression>, RegressError>;
+}
+
+impl<R: VelocityRegressor + ?Sized> VelocityRegressor for Box<R> {
+    fn window_len(&self) -> usize {
+        (**self).window_len()
+    }
+    fn regress(&mut self, frames: &FrameWindow<'_>) -> Result<Option<Regression>, RegressError> {
+        (**self).regress(frames)
+    }
+}
+
+impl<R: VelocityRegressor + ?Sized> VelocityRegressor for &mut R {
+    fn window_len(&self) -> usize {
+        (**self).window_len()
+    }
+    fn regress(&mut self, frames: &FrameWindow<'_>) -> Result<Option<Regression>, RegressError> {
+        (**self).regress(frames)
+    }
+}
