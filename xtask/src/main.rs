@@ -4,6 +4,10 @@ use std::process::ExitCode;
 use anyhow::Result;
 use clap::{Parser, Subcommand};
 
+mod eval_orientation;
+mod eval_tyrex;
+mod sample;
+
 use xtask::checksum;
 use xtask::fetch::{self, Outcome};
 use xtask::manifest::Manifest;
@@ -44,6 +48,40 @@ enum Task {
     /// Print the sha256sum list of every file under a folder (sorted), e.g. to regenerate
     /// datasets/<name>.sha256.
     Checksums { folder: PathBuf },
+    /// The accuracy protocol: leave-one-subject-out on the 24 Tyrex Nexus 5 runs, every method,
+    /// and one variant per open choice of the paper; writes docs/bench-accuracy.md.
+    EvalTyrex {
+        /// Tyrex root [default: <workspace>/../shared/data/raw/tyrex-attitude-smartphones].
+        #[arg(long, value_name = "DIR")]
+        data: Option<PathBuf>,
+        /// Report to write [default: <workspace>/docs/bench-accuracy.md].
+        #[arg(long, value_name = "FILE")]
+        out: Option<PathBuf>,
+        /// Only the reference variant.
+        #[arg(long)]
+        quick: bool,
+    },
+    /// Rebuild the bundled sample (datasets/sample) from the Tyrex data: 24 s of every Nexus 5
+    /// run, RIDI processed layout, gzip + f32, with list files.
+    Sample {
+        /// Tyrex root [default: <workspace>/../shared/data/raw/tyrex-attitude-smartphones].
+        #[arg(long, value_name = "DIR")]
+        data: Option<PathBuf>,
+        /// Output folder [default: <workspace>/datasets/sample].
+        #[arg(long, value_name = "DIR")]
+        out: Option<PathBuf>,
+    },
+    /// Compare the gyro + accelerometer orientation estimator (default gains and a kp/ki
+    /// sweep) and the Android rotation vector with the Tyrex motion capture, and write a
+    /// markdown report.
+    EvalOrientation {
+        /// Tyrex root [default: <workspace>/../shared/data/raw/tyrex-attitude-smartphones].
+        #[arg(long, value_name = "DIR")]
+        data: Option<PathBuf>,
+        /// Report to write [default: <workspace>/docs/bench-orientation.md].
+        #[arg(long, value_name = "FILE")]
+        out: Option<PathBuf>,
+    },
 }
 
 fn main() -> ExitCode {
@@ -106,6 +144,22 @@ fn run(cli: Cli) -> Result<()> {
         Task::Checksums { folder } => {
             let list = checksum::list_tree(&folder)?;
             print!("{}", checksum::format_list(&list));
+        }
+        Task::EvalTyrex { data, out, quick } => {
+            let out = eval_tyrex::run(data, out, quick)?;
+            println!("wrote {}", out.display());
+        }
+        Task::Sample { data, out } => {
+            let root = xtask::workspace_root();
+            let data =
+                data.unwrap_or_else(|| root.join("../shared/data/raw/tyrex-attitude-smartphones"));
+            let out = out.unwrap_or_else(|| root.join("datasets/sample"));
+            sample::build(&data, &out)?;
+            println!("wrote {}", out.display());
+        }
+        Task::EvalOrientation { data, out } => {
+            let out = eval_orientation::run(data, out)?;
+            println!("wrote {}", out.display());
         }
     }
     Ok(())

@@ -1,1 +1,593 @@
-fn main() {}
+//! The `ridi` command line. Thin: parsing, printing and exit codes; the work is in the `ridi`
+//! crate.
+
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+
+use anyhow::{Context, Result, bail};
+use clap::{Parser, Subcommand, ValueEnum};
+use indicatif::{ProgressBar, ProgressStyle};
+
+use ridi::data::{Format, ReadOptions, Sequence};
+use ridi::regress::{Cascade, ProgressEvent, Stage, model_file};
+use ridi::{EvalOptions, GridChoice, Method, PlacementMap, TrackOptions, TrainOptions};
+
+#[derive(Parser)]
+#[command(
+    name = "ridi",
+    version,
+    about = "Robust IMU Double Integration: pedestrian trajectories from a phone's IMU",
+    long_about = None,
+)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Describe a recording: format, duration, rate, gravity, ground truth, warnings.
+    #[command(after_help = "Examples:\n  \
+        ridi inspect datasets/sample/Jakob_Nexus5_NoDist_Texting\n  \
+        ridi inspect path/to/ridi/dan_body1/processed/data.csv --json\n  \
+        ridi inspect ../shared/data/raw/tyrex-attitude-smartphones/datasets/android/Guillaume_Nexus5_NoDist_AR")]
+    Inspect {
+        /// A RIDI data.csv, data_plain.txt, RIDI raw folder, or Tyrex sequence folder.
+        sequence: PathBuf,
+        /// Print JSON instead of text.
+        #[arg(long)]
+        json: bool,
+    },
+    /// Convert recordings to the RIDI processed layout, with list files.
+    #[command(after_help = "Examples:\n  \
+        ridi convert ../shared/data/raw/tyrex-attitude-smartphones --out converted\n  \
+        ridi convert my_capture/ --from ridi-raw --out converted\n\n\
+        Writes <out>/<name>/processed/data.csv per sequence and list files \
+        (`path,placement` per line): for a Tyrex root, list_<subject>.txt per person and list_all.txt.")]
+    Convert {
+        /// A sequence (file or folder), a folder of sequences, or a Tyrex dataset root.
+        source: PathBuf,
+        /// Output folder.
+        #[arg(long)]
+        out: PathBuf,
+        /// Source format (detected when omitted).
+        #[arg(long, value_enum)]
+        from: Option<FromFormat>,
+    },
+
+    /// Train the placement classifier and velocity regressors on labelled recordings.
+    #[command(after_help = "Examples:\n  \
+        ridi train --list datasets/sample/list_train.txt --out model.ridi --grid small \
+        --placement-map tyrex4\n  \
+        ridi train --list ridi/list_train_publish_v2.txt --out ridi.model --grid paper --jobs 2\n\n\
+        Every sequence needs ground truth and a placement (the list's second column).")]
+    Train {
+        /// List files (`path,placement` per line); several are concatenated.
+        #[arg(long, required = true, num_args = 1..)]
+        list: Vec<PathBuf>,
+        /// Model file to write.
+        #[arg(long)]
+        out: PathBuf,
+        /// Regressor hyper-parameter search.
+        #[arg(long, value_enum, default_value = "paper")]
+        grid: Grid,
+        /// Group placement labels: `tyrex4` (hand, swing, pocket, running) or a file of
+        /// `label,class` lines.
+        #[arg(long)]
+        placement_map: Option<String>,
+        /// Train on raw features (the original RIDI) instead of standardized ones.
+        #[arg(long)]
+        no_standardize: bool,
+        /// Classifier C (paper: 10).
+        #[arg(long, default_value_t = 10.0)]
+        classifier_c: f64,
+        /// Worker threads (default: all cores).
+        #[arg(long)]
+        jobs: Option<usize>,
+    },
+    /// Track a recording with a trained model: one pose per frame.
+    #[command(after_help = "Examples:\n  \
+        ridi track datasets/sample/Thibaud_Nexus5_NoDist_Texting --model model.ridi --out traj.csv \
+        --plot traj.png\n  \
+        ridi track capture/ --model model.ridi --out traj.csv --online\n\n\
+        The CSV has time,pos_x,pos_y,pos_z,vel_x,vel_y,vel_z,placement,bias_x,bias_y,bias_z \
+        (world frame of the device orientation, metres from the start).")]
+    Track {
+        /// A RIDI data.csv, data_plain.txt, raw folder, or Tyrex run.
+        sequence: PathBuf,
+        /// Model file from `ridi train`.
+        #[arg(long)]
+        model: PathBuf,
+        /// Trajectory CSV to write.
+        #[arg(long)]
+        out: PathBuf,
+        /// Streaming mode: correction every 200 frames over the latest 1000.
+        #[arg(long)]
+        online: bool,
+        /// Also draw the trajectory (and ground truth if any) to a .png or .svg file.
+        #[arg(long)]
+        plot: Option<PathBuf>,
+        /// Frames between regressions.
+        #[arg(long, default_value_t = 50)]
+        regress_every: usize,
+        /// Weight of the bias prior (paper: 0.1).
+        #[arg(long, default_value_t = 0.1)]
+        lambda: f64,
+        /// Estimate the initial velocity instead of assuming the walk starts at rest.
+        #[arg(long)]
+        estimate_initial_velocity: bool,
+    },
+    /// Evaluate RIDI and the baselines on labelled recordings: report.json, report.md, plots.
+    #[command(after_help = "Examples:\n  \
+        ridi eval --list datasets/sample/list_test.txt --model model.ridi --out report \
+        --placement-map tyrex4\n  \
+        ridi eval --list test.txt --model model.ridi --out report --methods ridi,pdr,still\n\n\
+        Methods: ridi, raw, pdr, ridi_mag, ridi_ori, velocity, still.")]
+    Eval {
+        /// List files of the sequences to evaluate (ground truth required).
+        #[arg(long, required = true, num_args = 1..)]
+        list: Vec<PathBuf>,
+        /// Model file from `ridi train`.
+        #[arg(long)]
+        model: PathBuf,
+        /// Output folder.
+        #[arg(long)]
+        out: PathBuf,
+        /// Methods to compare (comma-separated).
+        #[arg(
+            long,
+            value_delimiter = ',',
+            default_value = "ridi,raw,pdr,ridi_mag,ridi_ori,velocity,still"
+        )]
+        methods: Vec<String>,
+        /// Group placement labels as at training (`tyrex4` or a `label,class` file).
+        #[arg(long)]
+        placement_map: Option<String>,
+        /// Plot format, or `none`.
+        #[arg(long, value_enum, default_value = "png")]
+        plots: Plots,
+        /// Worker threads (default: all cores).
+        #[arg(long)]
+        jobs: Option<usize>,
+    },
+    /// Train on the bundled sample (two people) and evaluate on the held-out person.
+    #[command(after_help = "Example:\n  ridi demo --out demo-out\n\n\
+        Uses datasets/sample (list_train.txt, list_test.txt) with the four Tyrex placement \
+        groups; writes the model, report.json, report.md and plots into --out.")]
+    Demo {
+        /// Output folder.
+        #[arg(long, default_value = "demo-out")]
+        out: PathBuf,
+        /// The bundled sample folder (default: datasets/sample of this checkout).
+        #[arg(long)]
+        data: Option<PathBuf>,
+        /// Regressor hyper-parameter search.
+        #[arg(long, value_enum, default_value = "none")]
+        grid: Grid,
+        /// Plot format, or `none`.
+        #[arg(long, value_enum, default_value = "png")]
+        plots: Plots,
+    },
+}
+
+#[derive(Clone, Copy, ValueEnum)]
+enum Grid {
+    /// C in {0.1, 1, 10, 100} x epsilon in {0.001, 0.01, 0.1, 1}, 3 folds by sequence.
+    Paper,
+    /// C in {1, 10} x epsilon in {0.01, 0.1}, 3 folds.
+    Small,
+    /// C = 10, epsilon = 0.01.
+    None,
+}
+
+impl From<Grid> for GridChoice {
+    fn from(g: Grid) -> GridChoice {
+        match g {
+            Grid::Paper => GridChoice::Paper,
+            Grid::Small => GridChoice::Small,
+            Grid::None => GridChoice::None,
+        }
+    }
+}
+
+#[derive(Clone, Copy, PartialEq, ValueEnum)]
+enum Plots {
+    Png,
+    Svg,
+    None,
+}
+
+#[derive(Clone, Copy, ValueEnum)]
+enum FromFormat {
+    /// RIDI raw recorder folder (gyro.txt, acce.txt, ..., pose.txt).
+    RidiRaw,
+    /// RIDI processed data.csv (or data_plain.txt).
+    RidiCsv,
+    /// Tyrex smartphone benchmark (a sequence folder or the dataset root).
+    Tyrex,
+}
+
+impl From<FromFormat> for Format {
+    fn from(f: FromFormat) -> Format {
+        match f {
+            FromFormat::RidiRaw => Format::RidiRaw,
+            FromFormat::RidiCsv => Format::RidiCsv,
+            FromFormat::Tyrex => Format::Tyrex,
+        }
+    }
+}
+
+fn run(cli: Cli) -> Result<()> {
+    match cli.command {
+        Command::Inspect { sequence, json } => {
+            let opts = ReadOptions::default();
+            let loaded = ridi::read_any(&sequence, None, &opts)?;
+            for w in &loaded.warnings {
+                eprintln!("warning: {w}");
+            }
+            for seq in &loaded.sequences {
+                let report = ridi::inspect::inspect(seq, loaded.format);
+                if json {
+                    println!("{}", serde_json::to_string_pretty(&report)?);
+                } else {
+                    print!("{report}");
+                }
+            }
+        }
+        Command::Convert { source, out, from } => {
+            let summary = ridi::convert::convert(
+                &source,
+                &out,
+                from.map(Format::from),
+                &ReadOptions::default(),
+            )?;
+            for w in &summary.warnings {
+                eprintln!("warning: {w}");
+            }
+            for c in &summary.sequences {
+                println!(
+                    "{}  {}",
+                    c.path.display(),
+                    c.placement.as_deref().unwrap_or("-")
+                );
+            }
+            for l in &summary.lists {
+                println!("list: {}", l.display());
+            }
+        }
+        Command::Train {
+            list,
+            out,
+            grid,
+            placement_map,
+            no_standardize,
+            classifier_c,
+            jobs,
+        } => {
+            set_jobs(jobs)?;
+            let seqs = load_lists(&list, placement_map.as_deref())?;
+            let mut opts = TrainOptions {
+                standardize: !no_standardize,
+                ..TrainOptions::default()
+            };
+            opts.cascade.classifier_c = classifier_c;
+            opts.cascade.regressors = GridChoice::from(grid).regressors();
+            let model = train_with_progress(&seqs, &opts)?;
+            print_training(&model);
+            model_file::save(&model, &out)
+                .with_context(|| format!("cannot write {}", out.display()))?;
+            println!("model: {}", out.display());
+        }
+        Command::Track {
+            sequence,
+            model,
+            out,
+            online,
+            plot,
+            regress_every,
+            lambda,
+            estimate_initial_velocity,
+        } => {
+            let model = load_model(&model)?;
+            let loaded = ridi::read_any(&sequence, None, &ReadOptions::default())?;
+            for w in &loaded.warnings {
+                eprintln!("warning: {w}");
+            }
+            let [seq] = &loaded.sequences[..] else {
+                bail!(
+                    "{} holds {} sequences; convert it with `ridi convert` and track each",
+                    sequence.display(),
+                    loaded.sequences.len()
+                );
+            };
+            let mut opts = TrackOptions {
+                regress_every,
+                online,
+                ..TrackOptions::default()
+            };
+            opts.correction.lambda = lambda;
+            if estimate_initial_velocity {
+                opts.correction.initial_velocity = ridi::correct::InitialVelocity::Estimate;
+            }
+            let track = ridi::track(seq, &model, &opts)?;
+            track.write_csv(&out)?;
+            println!(
+                "{}: {} frames, {} regressions -> {}",
+                seq.name(),
+                track.time.len(),
+                track.regressions.len(),
+                out.display()
+            );
+            if let Some(plot) = plot {
+                plot_track(seq, &track, &plot)?;
+                println!("plot: {}", plot.display());
+            }
+        }
+        Command::Eval {
+            list,
+            model,
+            out,
+            methods,
+            placement_map,
+            plots,
+            jobs,
+        } => {
+            set_jobs(jobs)?;
+            let model = load_model(&model)?;
+            let seqs = load_lists(&list, placement_map.as_deref())?;
+            let methods = methods
+                .iter()
+                .map(|m| m.parse::<Method>().map_err(anyhow::Error::msg))
+                .collect::<Result<Vec<_>>>()?;
+            evaluate_and_write(&seqs, &model, methods, &out, plots)?;
+        }
+        Command::Demo {
+            out,
+            data,
+            grid,
+            plots,
+        } => demo(&out, data, grid, plots)?,
+    }
+    Ok(())
+}
+
+fn set_jobs(jobs: Option<usize>) -> Result<()> {
+    if let Some(n) = jobs {
+        rayon::ThreadPoolBuilder::new()
+            .num_threads(n.max(1))
+            .build_global()
+            .context("cannot set up the worker threads")?;
+    }
+    Ok(())
+}
+
+fn load_lists(lists: &[PathBuf], map: Option<&str>) -> Result<Vec<Sequence>> {
+    let mut seqs = Vec::new();
+    for l in lists {
+        seqs.extend(ridi::data::load_list(l, &ReadOptions::default())?);
+    }
+    if let Some(map) = map {
+        PlacementMap::from_arg(map)?.apply(&mut seqs);
+    }
+    Ok(seqs)
+}
+
+fn load_model(path: &Path) -> Result<Cascade> {
+    model_file::load(path).with_context(|| format!("cannot load model {}", path.display()))
+}
+
+fn bar(len: u64) -> ProgressBar {
+    let bar = ProgressBar::new(len);
+    bar.set_style(
+        ProgressStyle::with_template("{prefix:>24} [{bar:30}] {pos}/{len} {elapsed}")
+            .unwrap_or_else(|_| ProgressStyle::default_bar())
+            .progress_chars("=> "),
+    );
+    bar
+}
+
+fn train_with_progress(seqs: &[Sequence], opts: &TrainOptions) -> Result<Cascade> {
+    let bar = bar(0);
+    let mut progress = |e: &ProgressEvent<'_>| {
+        let stage = match e.stage {
+            Stage::Classifier => "placement classifier".to_string(),
+            Stage::Grid { placement } => format!("grid {placement}"),
+            Stage::Regressors { placement } => format!("regressors {placement}"),
+        };
+        bar.set_prefix(stage);
+        bar.set_length(e.total as u64);
+        bar.set_position(e.done as u64);
+        true
+    };
+    let model = ridi::train(seqs, opts, &mut progress)?;
+    bar.finish_and_clear();
+    Ok(model)
+}
+
+fn print_training(model: &Cascade) {
+    println!("placements: {}", model.placements().join(", "));
+    for (p, name) in model.placements().iter().enumerate() {
+        if let Some([x, z]) = model.regressor_params(p) {
+            println!(
+                "  {name:<12} {:>6} samples  S-x: C={} eps={}  S-z: C={} eps={}",
+                model.stored_samples(p),
+                x.0,
+                x.1,
+                z.0,
+                z.1
+            );
+        }
+    }
+    let rows = model.grid_results();
+    if !rows.is_empty() {
+        println!("cross-validation (MSE, (m/s)^2, mean over folds):");
+        println!(
+            "  {:<12} {:>7} {:>8} {:>8} {:>10}",
+            "placement", "channel", "C", "epsilon", "MSE"
+        );
+        for r in rows {
+            println!(
+                "  {:<12} {:>7} {:>8} {:>8} {:>10.5}",
+                r.placement,
+                if r.channel == 0 { "S-x" } else { "S-z" },
+                r.c,
+                r.epsilon,
+                r.mse
+            );
+        }
+    }
+}
+
+fn plot_track(seq: &Sequence, track: &ridi::Track, path: &Path) -> Result<()> {
+    use ridi::plot::{Trajectory, TrajectoryOptions, TrajectoryPlot, plot_trajectories};
+    let est = track.horizontal();
+    let gt: Option<Vec<[f64; 2]>> = seq.ground_truth().map(|gt| {
+        let gt2: Vec<[f64; 2]> = gt.position.iter().map(|p| [p.x(), p.y()]).collect();
+        gt2
+    });
+    // With ground truth, show the estimate aligned on the first 10 s, as evaluations do.
+    let shown = match &gt {
+        Some(gt) => ridi::eval::align_trajectory(seq.time(), &est, gt, Default::default())?.1,
+        None => est,
+    };
+    let estimates = [Trajectory {
+        name: "ridi",
+        points: &shown,
+    }];
+    plot_trajectories(
+        path,
+        &TrajectoryPlot {
+            title: seq.name(),
+            ground_truth: gt.as_deref().map(|points| Trajectory {
+                name: "ground truth",
+                points,
+            }),
+            estimates: &estimates,
+        },
+        &TrajectoryOptions::default(),
+    )?;
+    Ok(())
+}
+
+fn evaluate_and_write(
+    seqs: &[Sequence],
+    model: &Cascade,
+    methods: Vec<Method>,
+    out: &Path,
+    plots: Plots,
+) -> Result<ridi::Report> {
+    let opts = EvalOptions {
+        methods,
+        ..EvalOptions::default()
+    };
+    let spinner = ProgressBar::new_spinner();
+    spinner.set_message(format!("evaluating {} sequences", seqs.len()));
+    spinner.enable_steady_tick(std::time::Duration::from_millis(200));
+    let (report, traces) = ridi::evaluate(seqs, model, &opts)?;
+    spinner.finish_and_clear();
+    let mut written = report.write(out)?;
+    let ext = match plots {
+        Plots::Png => Some("png"),
+        Plots::Svg => Some("svg"),
+        Plots::None => None,
+    };
+    if let Some(ext) = ext {
+        let dir = out.join("plots");
+        std::fs::create_dir_all(&dir)
+            .with_context(|| format!("cannot create {}", dir.display()))?;
+        for t in &traces {
+            written.extend(t.plot(&dir, ext)?);
+        }
+    }
+    print_summary(&report);
+    println!(
+        "wrote {} files into {} (report.md, report.json{})",
+        written.len(),
+        out.display(),
+        if ext.is_some() { ", plots/" } else { "" }
+    );
+    Ok(report)
+}
+
+fn print_summary(report: &ridi::Report) {
+    println!(
+        "\n{} sequences; velocity MSE S-x {:.3} S-z {:.3} (m/s)^2; placement accuracy {}",
+        report.sequences.len(),
+        report.velocity_mse[0],
+        report.velocity_mse[1],
+        report
+            .placement_accuracy
+            .map_or("-".into(), |a| format!("{a:.3}"))
+    );
+    println!(
+        "{:<10} {:>9} {:>9} {:>9} {:>9} {:>11}",
+        "method", "RTE 5s m", "ATE m", "RTE m", "MPE m", "path ratio"
+    );
+    let opt = |v: Option<f64>| v.map_or("-".to_string(), |v| format!("{v:.3}"));
+    for key in &report.methods {
+        if let Some(m) = report.summary.get(key) {
+            println!(
+                "{key:<10} {:>9.3} {:>9.3} {:>9.3} {:>9.3} {:>11}",
+                m.rte_5s_m,
+                m.ate_m,
+                m.rte_m,
+                m.mpe_m,
+                opt(m.path_length_ratio)
+            );
+        }
+    }
+}
+
+fn demo(out: &Path, data: Option<PathBuf>, grid: Grid, plots: Plots) -> Result<()> {
+    let data = match data {
+        Some(d) => d,
+        None => {
+            let here = PathBuf::from("datasets/sample");
+            if here.join("list_train.txt").is_file() {
+                here
+            } else {
+                Path::new(env!("CARGO_MANIFEST_DIR")).join("../../datasets/sample")
+            }
+        }
+    };
+    let train_list = data.join("list_train.txt");
+    if !train_list.is_file() {
+        bail!(
+            "no bundled sample at {} (give its folder with --data)",
+            data.display()
+        );
+    }
+    let map = Some("tyrex4");
+    let train = load_lists(&[train_list], map)?;
+    let test = load_lists(&[data.join("list_test.txt")], map)?;
+    println!(
+        "demo: training on {} sequences ({:.0} s), testing on {} held-out sequences",
+        train.len(),
+        train.iter().map(|s| s.duration()).sum::<f64>(),
+        test.len()
+    );
+    let mut opts = TrainOptions::default();
+    opts.cascade.regressors = GridChoice::from(grid).regressors();
+    let started = std::time::Instant::now();
+    let model = train_with_progress(&train, &opts)?;
+    println!("trained in {:.1} s", started.elapsed().as_secs_f64());
+    print_training(&model);
+    std::fs::create_dir_all(out).with_context(|| format!("cannot create {}", out.display()))?;
+    let model_path = out.join("model.ridi");
+    model_file::save(&model, &model_path)
+        .with_context(|| format!("cannot write {}", model_path.display()))?;
+    evaluate_and_write(&test, &model, Method::ALL.to_vec(), out, plots)?;
+    Ok(())
+}
+
+fn main() -> ExitCode {
+    match run(Cli::parse()) {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            // One line: the outermost context and every cause, as users asked for.
+            let causes: Vec<String> = e.chain().map(|c| c.to_string()).collect();
+            eprintln!("error: {}", causes.join(": "));
+            ExitCode::FAILURE
+        }
+    }
+}

@@ -123,7 +123,7 @@ impl Metric {
         }
     }
 
-    fn format(self, v: Option<f64>) -> String {
+    pub fn format(self, v: Option<f64>) -> String {
         match (self, v) {
             (_, None) => "n/a".to_owned(),
             (Self::MpePct, Some(v)) => format!("{v:.2}"),

@@ -1,1 +1,109 @@
 //! Cascaded placement classification and velocity regression for RIDI.
+//!
+//! RIDI classifies the phone placement with an RBF C-SVC and regresses the two horizontal
+//! velocity components in the stabilized frame S with one RBF epsilon-SVR per placement and
+//! component. This crate holds its own SMO solver instead of using linfa-svm, whose solver
+//! builds the full `n × n` kernel with a scalar loop and only handles binary classification.
+//!
+//! # Solver
+//!
+//! [`smo`] is libsvm's solver: WSS3 second-order working-set selection, shrinking with
+//! unshrinking and gradient reconstruction, epsilon-SVR as the 2l-variable dual, `rho` with
+//! libsvm's sign (`f(x) = Σ coef K(sv, x) - rho`). Kernel values are `f32` and come from
+//! blocked GEMM (faer) with precomputed squared norms, `K_ij = exp(-γ(|x_i|² + |x_j|² -
+//! 2 x_i·x_j))`, either as a full matrix computed once in parallel (when it fits in
+//! [`SolverConfig::kernel_memory`]) or as a bounded LRU row cache that computes missing rows in
+//! batches. Gradients and dual variables are `f64`.
+//!
+//! # Reuse
+//!
+//! All fits of a placement index one kernel over its samples: the two velocity channels, every
+//! grid point and every cross-validation fold ([`grid`]). Fits along the `C` axis start from
+//! the previous solution scaled by `C_new / C_old`. A trained [`Cascade`] stores each
+//! placement's samples once; at prediction one distance pass per placement feeds the classifier
+//! and is reused by the regressors ([`Cascade::predict`] batches with GEMM,
+//! [`Cascade::predict_one`] serves a single query).
+//!
+//! # Small or degenerate placements
+//!
+//! - A placement name without samples, or with fewer than
+//!   [`CascadeParams::min_class_samples`] (default 10), fails with
+//!   [`RegressError::NotEnoughData`] naming the placement.
+//! - Grid search needs at least 2 sequences in a placement. A placement with fewer sequences
+//!   than folds uses one fold per sequence. A placement with a single sequence fails with
+//!   `NotEnoughData`.
+//! - With one placement the classifier is skipped, and every query gets placement 0.
+//!
+//! # Model files
+//!
+//! [`model_file`]: magic number, format version, CRC32, bincode 2 payload including the
+//! [`ridi_features::FeatureConfig`]; atomic writes, deterministic bytes.
+//!
+//! # Example
+//!
+//! ```
+//! use ridi_features::FeatureConfig;
+//! use ridi_regress::{Cascade, CascadeParams, MatrixRef, NoProgress, RegressorChoice, TrainingSet, model_file};
+//!
+//! // A tiny feature config: a 2-frame window of one channel gives 6 values per sample.
+//! let config = FeatureConfig { window: 2, channels: vec![ridi_features::Channel::Gyro], ..FeatureConfig::default() };
+//! // Two placements; the velocity depends on the features, the placement on their sign.
+//! let mut x = Vec::new();
+//! let (mut y, mut placement, mut group) = (Vec::new(), Vec::new(), Vec::new());
+//! for i in 0..60 {
+//!     let t = i as f32 / 60.0;
+//!     let p = i % 2;
+//!     let s = if p == 0 { 1.0 } else { -1.0 };
+//!     x.extend([s + t, s - t, t, 0.5 * t, s, -t]);
+//!     y.push([t, 1.0 - t]);
+//!     placement.push(p);
+//!     group.push((i / 10) as u64);
+//! }
+//! let names = vec!["handheld".to_string(), "bag".to_string()];
+//! let data = TrainingSet {
+//!     features: MatrixRef::new(&x, 6)?,
+//!     targets: &y,
+//!     placements: &placement,
+//!     placement_names: &names,
+//!     groups: &group,
+//!     feature_config: &config,
+//! };
+//! let params = CascadeParams {
+//!     regressors: RegressorChoice::Fixed { c: 10.0, epsilon: 0.01 },
+//!     ..CascadeParams::default()
+//! };
+//! let model = Cascade::train(&data, &params, &mut NoProgress)?;
+//! let p = model.predict_one(&x[6..12])?;
+//! assert_eq!(p.placement, 1);
+//! assert!((p.velocity[0] - 1.0 / 60.0).abs() < 0.1);
+//!
+//! let bytes = model_file::to_bytes(&model)?;
+//! assert_eq!(model_file::from_bytes(&bytes)?, model);
+//! # Ok::<(), ridi_regress::RegressError>(())
+//! ```
+
+pub(crate) mod cache;
+pub mod cascade;
+pub mod config;
+pub mod error;
+pub(crate) mod expansion;
+pub mod grid;
+pub mod kernel;
+pub mod linfa_impl;
+pub mod matrix;
+pub mod model_file;
+pub mod progress;
+pub mod smo;
+pub mod svc;
+pub mod svr;
+
+pub use cascade::{Cascade, CascadeParams, Gamma, Prediction, RegressorChoice, TrainingSet};
+pub use config::{Precompute, SolverConfig};
+pub use error::RegressError;
+pub use grid::{GridRow, GridSpec};
+pub use kernel::Rbf;
+pub use matrix::{Matrix, MatrixRef};
+pub use progress::{NoProgress, Progress, ProgressEvent, Stage};
+pub use smo::SmoSettings;
+pub use svc::{Svc, SvcParams};
+pub use svr::{FitInfo, Svr, SvrParams};

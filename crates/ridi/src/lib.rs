@@ -1,4 +1,18 @@
 //! RIDI in Rust: the layers of ridi-rs re-exported, and the end-to-end pipeline.
+//!
+//! Each stage is its own crate and can be used alone; this crate ties them together:
+//!
+//! | module | crate | what |
+//! | --- | --- | --- |
+//! | [`frames`] | `ridi-frames` | frames W, I, S; typed vectors and rotations; gravity alignment |
+//! | [`data`] | `ridi-data` | the `Sequence` model, dataset readers and writers |
+//! | [`features`] | `ridi-features` | smoothing, feature windows, velocity targets |
+//! | [`regress`] | `ridi-regress` | placement SVM and velocity SVRs |
+//! | [`correct`] | `ridi-correct` | bias correction, integration, streaming tracker |
+//! | [`eval`] | `ridi-eval` | alignment, MPE/ATE/RTE, reports |
+//!
+//! Pipeline modules: [`source`] reads any supported layout, [`convert`] writes the RIDI
+//! layout with list files, [`inspect`] summarizes a recording.
 
 pub use ridi_correct as correct;
 pub use ridi_data as data;
@@ -6,3 +20,22 @@ pub use ridi_eval as eval;
 pub use ridi_features as features;
 pub use ridi_frames as frames;
 pub use ridi_regress as regress;
+
+pub mod baselines;
+pub mod convert;
+mod error;
+pub mod evaluate;
+pub mod inspect;
+pub mod placement;
+pub mod plot;
+pub mod source;
+pub mod track;
+pub mod train;
+
+pub use baselines::Method;
+pub use error::{PipelineError, Result};
+pub use evaluate::{EvalOptions, Report, evaluate};
+pub use placement::PlacementMap;
+pub use source::{Loaded, read_any};
+pub use track::{Track, TrackOptions, track};
+pub use train::{GridChoice, TrainOptions, train};

@@ -1,0 +1,164 @@
+//! The `ridi` binary as a user runs it: outputs, exit codes and one-line errors.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+fn ridi(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_ridi"))
+        .args(args)
+        .output()
+        .expect("run ridi")
+}
+
+fn sample() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../../datasets/sample")
+}
+
+fn s(p: &Path) -> &str {
+    p.to_str().unwrap()
+}
+
+fn stderr(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stderr).into_owned()
+}
+
+#[test]
+fn inspect_prints_text_and_json() {
+    let seq = sample().join("Jakob_Nexus5_NoDist_Texting");
+    let out = ridi(&["inspect", s(&seq)]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let text = String::from_utf8(out.stdout).unwrap();
+    assert!(
+        text.contains("RIDI processed csv") && text.contains("200.00 Hz"),
+        "{text}"
+    );
+    let out = ridi(&["inspect", s(&seq), "--json"]);
+    let json: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(json["frames"], 4800);
+    assert_eq!(json["placement"], serde_json::Value::Null);
+    assert!(json["path_length_m"].as_f64().unwrap() > 5.0);
+}
+
+#[test]
+fn errors_are_one_line_with_a_non_zero_exit() {
+    let dir = tempfile::tempdir().unwrap();
+    let missing = dir.path().join("nope");
+    let out = ridi(&["inspect", s(&missing)]);
+    assert!(!out.status.success());
+    let err = stderr(&out);
+    assert_eq!(err.lines().count(), 1, "{err}");
+    assert!(err.starts_with("error: ") && err.contains("nope"), "{err}");
+
+    // A corrupt csv names file, line and field.
+    let bad = dir.path().join("bad.csv");
+    std::fs::write(&bad, ",time,gyro_x\n0,1,x\n").unwrap();
+    let out = ridi(&["inspect", s(&bad)]);
+    let err = stderr(&out);
+    assert!(!out.status.success() && err.contains("bad.csv"), "{err}");
+
+    // A model file that is not one.
+    let model = dir.path().join("m.ridi");
+    std::fs::write(&model, b"not a model").unwrap();
+    let seq = sample().join("Jakob_Nexus5_NoDist_Texting");
+    let csv = dir.path().join("t.csv");
+    let out = ridi(&["track", s(&seq), "--model", s(&model), "--out", s(&csv)]);
+    let err = stderr(&out);
+    assert!(!out.status.success() && err.contains("m.ridi"), "{err}");
+    assert!(!csv.exists(), "no output on failure");
+}
+
+#[test]
+fn convert_train_track_and_eval() {
+    let dir = tempfile::tempdir().unwrap();
+    let conv = dir.path().join("conv");
+    let seq = sample().join("Guillaume_Nexus5_NoDist_Swinging");
+    let out = ridi(&["convert", s(&seq), "--out", s(&conv)]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert!(
+        conv.join("Guillaume_Nexus5_NoDist_Swinging/processed/data.csv")
+            .is_file()
+    );
+    assert!(conv.join("list_all.txt").is_file());
+
+    let model = dir.path().join("m.ridi");
+    let list = sample().join("list_Guillaume.txt");
+    let out = ridi(&[
+        "train",
+        "--list",
+        s(&list),
+        "--out",
+        s(&model),
+        "--grid",
+        "none",
+        "--placement-map",
+        "tyrex4",
+    ]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert!(
+        String::from_utf8_lossy(&out.stdout).contains("placements: hand, pocket, running, swing")
+    );
+
+    let csv = dir.path().join("t.csv");
+    let png = dir.path().join("t.png");
+    let test_seq = sample().join("Jakob_Nexus5_NoDist_Texting");
+    let out = ridi(&[
+        "track",
+        s(&test_seq),
+        "--model",
+        s(&model),
+        "--out",
+        s(&csv),
+        "--online",
+        "--plot",
+        s(&png),
+    ]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert_eq!(std::fs::read_to_string(&csv).unwrap().lines().count(), 4801);
+    assert!(std::fs::read(&png).unwrap().starts_with(b"\x89PNG"));
+
+    let report = dir.path().join("report");
+    let test_list = sample().join("list_Jakob.txt");
+    let out = ridi(&[
+        "eval",
+        "--list",
+        s(&test_list),
+        "--model",
+        s(&model),
+        "--out",
+        s(&report),
+        "--methods",
+        "ridi,raw,still",
+        "--placement-map",
+        "tyrex4",
+        "--plots",
+        "svg",
+    ]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(report.join("report.json")).unwrap())
+            .unwrap();
+    assert_eq!(json["methods"], serde_json::json!(["ridi", "raw", "still"]));
+    assert!(
+        report
+            .join("plots/Jakob_Nexus5_NoDist_Texting.trajectory.svg")
+            .is_file()
+    );
+
+    let out = ridi(&[
+        "eval",
+        "--list",
+        s(&test_list),
+        "--model",
+        s(&model),
+        "--out",
+        s(&report),
+        "--methods",
+        "ridi,magic",
+    ]);
+    assert!(!out.status.success());
+    assert!(
+        stderr(&out).contains("unknown method `magic`"),
+        "{}",
+        stderr(&out)
+    );
+}

@@ -1,0 +1,66 @@
+//! Criterion benchmarks on synthetic IMU-like data (`benches/synth.rs`). Long runs (17k-sample
+//! fits, full grid, scikit-learn comparison) are in `examples/svr_timing.rs` and
+//! `docs/bench-regress.md`.
+
+mod synth;
+
+use criterion::{Criterion, criterion_group, criterion_main};
+use ridi_features::FeatureConfig;
+use ridi_regress::{
+    Cascade, CascadeParams, MatrixRef, NoProgress, RegressorChoice, Svc, SvcParams, Svr, SvrParams,
+    TrainingSet, kernel,
+};
+
+fn benches(c: &mut Criterion) {
+    let data = synth::generate(2000, 4, 150, 42);
+    let x = MatrixRef::new(&data.x, data.dim).unwrap();
+    let gamma = 1.0 / data.dim as f32;
+    let mut g = c.benchmark_group("regress");
+    g.sample_size(10);
+
+    let norms = kernel::sq_norms(x);
+    g.bench_function("gram_2000x1200", |b| {
+        b.iter(|| kernel::gram(x, &norms, gamma))
+    });
+
+    let y: Vec<f32> = data.y.iter().map(|v| v[1]).collect();
+    g.bench_function("svr_fit_2000_c10_eps0.01", |b| {
+        b.iter(|| Svr::fit(x, &y, &SvrParams::new(10.0, 0.01, gamma)).unwrap())
+    });
+    g.bench_function("svc_fit_2000_4class_c10", |b| {
+        b.iter(|| Svc::fit(x, &data.placement, &SvcParams::new(10.0, gamma)).unwrap())
+    });
+
+    let names: Vec<String> = (0..4).map(|p| format!("p{p}")).collect();
+    let config = FeatureConfig::default();
+    let set = TrainingSet {
+        features: x,
+        targets: &data.y,
+        placements: &data.placement,
+        placement_names: &names,
+        groups: &data.group,
+        feature_config: &config,
+    };
+    let params = CascadeParams {
+        regressors: RegressorChoice::Fixed {
+            c: 10.0,
+            epsilon: 0.001,
+        },
+        ..CascadeParams::default()
+    };
+    let model = Cascade::train(&set, &params, &mut NoProgress).unwrap();
+    g.bench_function("cascade_predict_one", |b| {
+        let mut i = 0;
+        b.iter(|| {
+            i = (i + 1) % 2000;
+            model.predict_one(x.row(i)).unwrap()
+        })
+    });
+    g.bench_function("cascade_predict_batch_2000", |b| {
+        b.iter(|| model.predict(x).unwrap())
+    });
+    g.finish();
+}
+
+criterion_group!(regress, benches);
+criterion_main!(regress);

@@ -1,0 +1,229 @@
+//! Timing runs on synthetic IMU-like data (see `benches/synth.rs`), too long for criterion.
+//!
+//! ```text
+//! cargo run --release -p ridi-regress --example svr_timing -- <task> <n> [options]
+//!   tasks: svr | svc | grid | cascade | query | export <dir>
+//!   options: --c C --eps E --placements K --mem-mb M --never-precompute
+//! ```
+//! `RAYON_NUM_THREADS=1` gives one-core numbers. Peak memory is the process's VmHWM.
+
+#[path = "../benches/synth.rs"]
+mod synth;
+
+use std::time::Instant;
+
+use ridi_features::FeatureConfig;
+use ridi_regress::{
+    Cascade, CascadeParams, GridSpec, MatrixRef, Precompute, ProgressEvent, RegressorChoice,
+    SolverConfig, Svc, SvcParams, Svr, SvrParams, TrainingSet,
+};
+
+fn peak_mb() -> f64 {
+    std::fs::read_to_string("/proc/self/status")
+        .ok()
+        .and_then(|s| {
+            s.lines()
+                .find(|l| l.starts_with("VmHWM"))
+                .and_then(|l| l.split_whitespace().nth(1)?.parse::<f64>().ok())
+        })
+        .map_or(f64::NAN, |kb| kb / 1024.0)
+}
+
+fn arg<T: std::str::FromStr>(args: &[String], name: &str, default: T) -> T {
+    args.iter()
+        .position(|a| a == name)
+        .and_then(|i| args.get(i + 1)?.parse().ok())
+        .unwrap_or(default)
+}
+
+fn main() -> Result<(), Box<dyn std::error::Error>> {
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    let task = args.first().cloned().unwrap_or_else(|| "svr".into());
+    let n: usize = args.get(1).and_then(|s| s.parse().ok()).unwrap_or(2000);
+    let c: f64 = arg(&args, "--c", 10.0);
+    let eps: f64 = arg(&args, "--eps", 0.01);
+    let k: usize = arg(&args, "--placements", 4);
+    let mem_mb: u64 = arg(&args, "--mem-mb", 2048);
+    let mut solver = SolverConfig {
+        kernel_memory: mem_mb << 20,
+        ..SolverConfig::default()
+    };
+    if args.iter().any(|a| a == "--never-precompute") {
+        solver.regressor_kernel = Precompute::Never;
+    }
+    if args.iter().any(|a| a == "--precompute-classifier") {
+        solver.classifier_kernel = Precompute::Auto;
+    }
+    let t = Instant::now();
+    let data = synth::generate(n, k, 150, 42);
+    let x = MatrixRef::new(&data.x, data.dim)?;
+    eprintln!("generated {n} x {} in {:.2?}", data.dim, t.elapsed());
+    let gamma = 1.0 / data.dim as f32;
+    let threads = rayon::current_num_threads();
+    match task.as_str() {
+        "svr" => {
+            let y: Vec<f32> = data.y.iter().map(|v| v[1]).collect();
+            let p = SvrParams {
+                c,
+                epsilon: eps,
+                gamma,
+                solver,
+            };
+            let t = Instant::now();
+            let m = Svr::fit(x, &y, &p)?;
+            let fit = t.elapsed();
+            let pred = m.predict(x)?;
+            let mse = pred
+                .iter()
+                .zip(&y)
+                .map(|(a, b)| ((a - b) as f64).powi(2))
+                .sum::<f64>()
+                / n as f64;
+            println!(
+                "svr n={n} C={c} eps={eps} threads={threads}: fit {:.2} s, {} iterations, {} SV, train MSE {mse:.5}, peak {:.0} MB",
+                fit.as_secs_f64(),
+                m.info().iterations,
+                m.info().n_support,
+                peak_mb()
+            );
+        }
+        "svc" => {
+            let p = SvcParams { c, gamma, solver };
+            let t = Instant::now();
+            let m = Svc::fit(x, &data.placement, &p)?;
+            let fit = t.elapsed();
+            let pred = m.predict(x)?;
+            let acc = pred
+                .iter()
+                .zip(&data.placement)
+                .filter(|(a, b)| a == b)
+                .count() as f64
+                / n as f64;
+            let iters: usize = m.info().iter().map(|i| i.iterations).sum();
+            println!(
+                "svc n={n} k={k} C={c} threads={threads}: fit {:.2} s, {iters} iterations, {} SV, train accuracy {acc:.4}, peak {:.0} MB",
+                fit.as_secs_f64(),
+                m.n_support(),
+                peak_mb()
+            );
+        }
+        "grid" | "cascade" | "query" => {
+            let names: Vec<String> = (0..k).map(|p| format!("p{p}")).collect();
+            let config = FeatureConfig::default();
+            let set = TrainingSet {
+                features: x,
+                targets: &data.y,
+                placements: &data.placement,
+                placement_names: &names,
+                groups: &data.group,
+                feature_config: &config,
+            };
+            let regressors = if task == "query" {
+                RegressorChoice::Fixed { c, epsilon: eps }
+            } else {
+                RegressorChoice::Grid(GridSpec::default())
+            };
+            let params = CascadeParams {
+                regressors,
+                solver,
+                ..CascadeParams::default()
+            };
+            let t = Instant::now();
+            let mut last = String::new();
+            let mut progress = |e: &ProgressEvent<'_>| {
+                let s = format!("{:?}", e.stage);
+                if s != last {
+                    eprintln!(
+                        "[{:7.1} s] {s} ({} steps)",
+                        t.elapsed().as_secs_f64(),
+                        e.total
+                    );
+                    last = s;
+                }
+                true
+            };
+            let model = Cascade::train(&set, &params, &mut progress)?;
+            let train = t.elapsed().as_secs_f64();
+            println!(
+                "cascade n={n} k={k} threads={threads}: train {train:.1} s, peak {:.0} MB",
+                peak_mb()
+            );
+            for (p, name) in names.iter().enumerate() {
+                let rp = model.regressor_params(p).unwrap_or_default();
+                let best: Vec<f64> = (0..2)
+                    .map(|ch| {
+                        model
+                            .grid_results()
+                            .iter()
+                            .filter(|r| &r.placement == name && r.channel as usize == ch)
+                            .map(|r| r.mse)
+                            .fold(f64::INFINITY, f64::min)
+                    })
+                    .collect();
+                println!(
+                    "  {}: {} stored samples, chosen {rp:?}, CV MSE {best:?}",
+                    names[p],
+                    model.stored_samples(p)
+                );
+            }
+            let q = 200.min(n);
+            let t = Instant::now();
+            for i in 0..q {
+                std::hint::black_box(model.predict_one(x.row(i))?);
+            }
+            let one = t.elapsed().as_secs_f64() / q as f64;
+            let t = Instant::now();
+            let batch = model.predict(x)?;
+            let bt = t.elapsed().as_secs_f64();
+            let acc = batch
+                .iter()
+                .zip(&data.placement)
+                .filter(|(a, b)| a.placement == **b)
+                .count() as f64
+                / n as f64;
+            println!(
+                "  predict_one {:.3} ms/query; batch {n} in {bt:.2} s = {:.0} queries/s; train placement accuracy {acc:.4}",
+                one * 1e3,
+                n as f64 / bt
+            );
+        }
+        "export" => {
+            let dir = std::path::PathBuf::from(args.get(2).cloned().unwrap_or_else(|| ".".into()));
+            std::fs::create_dir_all(&dir)?;
+            let bytes = |v: &[f32]| v.iter().flat_map(|f| f.to_le_bytes()).collect::<Vec<u8>>();
+            std::fs::write(dir.join("x.f32"), bytes(&data.x))?;
+            let y: Vec<f32> = data.y.iter().flat_map(|v| *v).collect();
+            std::fs::write(dir.join("y.f32"), bytes(&y))?;
+            let lab: Vec<u8> = data
+                .placement
+                .iter()
+                .flat_map(|&p| (p as u32).to_le_bytes())
+                .collect();
+            std::fs::write(dir.join("placement.u32"), lab)?;
+            let grp: Vec<u8> = data
+                .group
+                .iter()
+                .flat_map(|&g| (g as u32).to_le_bytes())
+                .collect();
+            std::fs::write(dir.join("group.u32"), grp)?;
+            // The cross-validation folds the cascade uses (per placement, default grid seed),
+            // so that scikit-learn can be scored on identical splits.
+            let mut fold = vec![0u32; n];
+            for p in 0..k {
+                let idx: Vec<usize> = (0..n).filter(|&i| data.placement[i] == p).collect();
+                let groups: Vec<u64> = idx.iter().map(|&i| data.group[i]).collect();
+                let spec = GridSpec::default();
+                let (f, _) = ridi_regress::grid::assign_folds(&groups, spec.folds, spec.seed)?;
+                for (&i, &fi) in idx.iter().zip(&f) {
+                    fold[i] = fi as u32;
+                }
+            }
+            let fb: Vec<u8> = fold.iter().flat_map(|f| f.to_le_bytes()).collect();
+            std::fs::write(dir.join("fold.u32"), fb)?;
+            std::fs::write(dir.join("shape.txt"), format!("{n} {}\n", data.dim))?;
+            println!("exported {n} x {} to {}", data.dim, dir.display());
+        }
+        other => return Err(format!("unknown task {other}").into()),
+    }
+    Ok(())
+}

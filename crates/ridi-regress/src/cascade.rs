@@ -1,0 +1,670 @@
+//! The RIDI cascade: a placement classifier, then two epsilon-SVRs per placement for the two
+//! horizontal velocity components in the stabilized frame S.
+//!
+//! Storage: each placement keeps its samples once, ordered so that the classifier's support
+//! vectors of that placement come first, followed by the other samples that either regressor
+//! uses. Prediction computes the squared distances of a query block to the classifier part of
+//! every placement with one GEMM per placement, classifies, and then reuses those distances for
+//! the regressors of the predicted placement (a second GEMM covers only its remaining samples).
+
+use rayon::prelude::*;
+use ridi_features::FeatureConfig;
+use serde::{Deserialize, Serialize};
+
+use crate::config::{self, SolverConfig};
+use crate::error::RegressError;
+use crate::expansion::weighted_sums;
+use crate::grid::{self, GridRow, GridSpec};
+use crate::kernel;
+use crate::matrix::{Matrix, MatrixRef};
+use crate::progress::{Progress, ProgressEvent, Stage};
+use crate::svc::{self, PairDual, SvcParams};
+use crate::svr::{self, FitInfo};
+
+/// Queries per block in batched prediction (bounds temporaries to a few MB).
+const QUERY_BLOCK: usize = 256;
+
+/// How the RBF width is chosen.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub enum Gamma {
+    /// `1 / dim` (the paper's 1/1200).
+    InverseDim,
+    /// `1 / (dim · var(X))` over all training feature values (scikit-learn's `"scale"`;
+    /// equals `1 / dim` on standardized features).
+    Scale,
+    /// A fixed value.
+    Value(f32),
+}
+
+impl Gamma {
+    fn resolve(self, x: MatrixRef<'_>) -> Result<f32, RegressError> {
+        let d = x.dim() as f64;
+        let g = match self {
+            Gamma::InverseDim => 1.0 / d,
+            Gamma::Value(g) => g as f64,
+            Gamma::Scale => {
+                let v = x.as_slice();
+                let n = v.len() as f64;
+                let mean = v.iter().map(|&a| a as f64).sum::<f64>() / n;
+                let var = v.iter().map(|&a| (a as f64 - mean).powi(2)).sum::<f64>() / n;
+                if var > 0.0 { 1.0 / (d * var) } else { 1.0 / d }
+            }
+        };
+        let g = g as f32;
+        if !(g.is_finite() && g > 0.0) {
+            return Err(RegressError::InvalidParam(format!("gamma {g}")));
+        }
+        Ok(g)
+    }
+}
+
+/// Hyper-parameters of the regressors.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub enum RegressorChoice {
+    /// The same `C` and epsilon for every placement and channel.
+    Fixed {
+        /// Box constraint.
+        c: f64,
+        /// Tube width.
+        epsilon: f64,
+    },
+    /// Cross-validated grid search per placement and channel (lowest mean fold MSE).
+    Grid(GridSpec),
+}
+
+/// Training settings of the cascade. [`Default`] is the paper with its regressor grid.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct CascadeParams {
+    /// Classifier `C` (paper: 10).
+    pub classifier_c: f64,
+    /// Classifier RBF width.
+    pub classifier_gamma: Gamma,
+    /// Regressor RBF width.
+    pub regressor_gamma: Gamma,
+    /// Regressor `C` / epsilon selection.
+    pub regressors: RegressorChoice,
+    /// Solver, memory and kernel strategy.
+    pub solver: SolverConfig,
+    /// Placements with fewer training samples are rejected with
+    /// [`RegressError::NotEnoughData`] (default 10).
+    pub min_class_samples: usize,
+}
+
+impl Default for CascadeParams {
+    fn default() -> Self {
+        Self {
+            classifier_c: 10.0,
+            classifier_gamma: Gamma::InverseDim,
+            regressor_gamma: Gamma::InverseDim,
+            regressors: RegressorChoice::Grid(GridSpec::default()),
+            solver: SolverConfig::default(),
+            min_class_samples: 10,
+        }
+    }
+}
+
+/// Training data: one row per sample.
+#[derive(Debug, Clone, Copy)]
+pub struct TrainingSet<'a> {
+    /// Feature matrix (`n × dim`).
+    pub features: MatrixRef<'a>,
+    /// Velocity targets in S (two horizontal components).
+    pub targets: &'a [[f32; 2]],
+    /// Placement of each sample, an index into `placement_names`.
+    pub placements: &'a [usize],
+    /// Placement names; every name needs samples.
+    pub placement_names: &'a [String],
+    /// Sequence id of each sample: cross-validation folds never split a sequence.
+    pub groups: &'a [u64],
+    /// Feature configuration the rows were computed with (stored in the model).
+    pub feature_config: &'a FeatureConfig,
+}
+
+/// Output for one query.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Prediction {
+    /// Placement index (into [`Cascade::placements`]).
+    pub placement: usize,
+    /// Velocity in S (same components as the targets).
+    pub velocity: [f32; 2],
+}
+
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub(crate) struct ClassifierHead {
+    pub gamma: f32,
+    pub c: f64,
+    pub pairs: Vec<(u32, u32)>,
+    pub rho: Vec<f64>,
+    pub info: Vec<FitInfo>,
+}
+
+/// One placement: samples stored once, shared by the classifier (first `n_classifier` rows)
+/// and both regressors.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub(crate) struct ClassModel {
+    pub samples: Matrix,
+    pub norms: Vec<f32>,
+    pub n_classifier: usize,
+    /// `n_classifier × pairs` row-major.
+    pub clf_coef: Vec<f64>,
+    /// `samples × 2` row-major.
+    pub reg_coef: Vec<f64>,
+    pub reg_rho: [f64; 2],
+    /// `(C, epsilon)` per channel.
+    pub reg_params: [(f64, f64); 2],
+    pub reg_info: [FitInfo; 2],
+    pub n_train: usize,
+}
+
+/// A trained cascade (what the model file holds).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Cascade {
+    pub(crate) feature_config: FeatureConfig,
+    pub(crate) dim: usize,
+    pub(crate) placements: Vec<String>,
+    pub(crate) classifier: Option<ClassifierHead>,
+    pub(crate) regressor_gamma: f32,
+    pub(crate) classes: Vec<ClassModel>,
+    pub(crate) grid: Vec<GridRow>,
+}
+
+fn report(
+    progress: &mut dyn Progress,
+    stage: Stage<'_>,
+    done: usize,
+    total: usize,
+) -> Result<(), RegressError> {
+    if progress.report(&ProgressEvent { stage, done, total }) {
+        Ok(())
+    } else {
+        Err(RegressError::Cancelled)
+    }
+}
+
+fn check_training_set(
+    data: &TrainingSet<'_>,
+    params: &CascadeParams,
+) -> Result<Vec<Vec<usize>>, RegressError> {
+    let n = data.features.rows();
+    if data.targets.len() != n || data.placements.len() != n || data.groups.len() != n {
+        return Err(RegressError::Shape(format!(
+            "{n} feature rows, {} targets, {} placements, {} group ids",
+            data.targets.len(),
+            data.placements.len(),
+            data.groups.len()
+        )));
+    }
+    if data.placement_names.is_empty() {
+        return Err(RegressError::NotEnoughData("no placements".into()));
+    }
+    let fd = data.feature_config.feature_dim();
+    if fd != data.features.dim() {
+        return Err(RegressError::Shape(format!(
+            "feature config describes {fd} values per row, features have {}",
+            data.features.dim()
+        )));
+    }
+    if let Some(i) = data
+        .targets
+        .iter()
+        .position(|t| !t.iter().all(|v| v.is_finite()))
+    {
+        return Err(RegressError::NonFinite(format!("target of sample {i}")));
+    }
+    let k = data.placement_names.len();
+    let mut members = vec![Vec::new(); k];
+    for (i, &p) in data.placements.iter().enumerate() {
+        if p >= k {
+            return Err(RegressError::Shape(format!(
+                "sample {i} has placement {p}, only {k} names"
+            )));
+        }
+        members[p].push(i);
+    }
+    for (c, m) in members.iter().enumerate() {
+        if m.len() < params.min_class_samples.max(1) {
+            return Err(RegressError::NotEnoughData(format!(
+                "placement '{}' has {} training samples, at least {} are required",
+                data.placement_names[c],
+                m.len(),
+                params.min_class_samples.max(1)
+            )));
+        }
+    }
+    svr::check_c_gamma(params.classifier_c, 1.0)?;
+    svr::check_smo(&params.solver.smo)?;
+    match &params.regressors {
+        RegressorChoice::Fixed { c, epsilon } => {
+            svr::SvrParams::new(*c, *epsilon, 1.0).validate()?;
+        }
+        RegressorChoice::Grid(g) => g.validate()?,
+    }
+    Ok(members)
+}
+
+impl Cascade {
+    /// Trains the classifier (skipped when there is a single placement) and the regressors.
+    pub fn train(
+        data: &TrainingSet<'_>,
+        params: &CascadeParams,
+        progress: &mut dyn Progress,
+    ) -> Result<Self, RegressError> {
+        let members = check_training_set(data, params)?;
+        let k = members.len();
+        let x = data.features;
+        let gamma_c = params.classifier_gamma.resolve(x)?;
+        let gamma_r = params.regressor_gamma.resolve(x)?;
+
+        let (classifier, pair_duals) = if k >= 2 {
+            let total = k * (k - 1) / 2;
+            report(progress, Stage::Classifier, 0, total)?;
+            let svc_params = SvcParams {
+                c: params.classifier_c,
+                gamma: gamma_c,
+                solver: params.solver,
+            };
+            let mut on_pair = |done, total| {
+                progress.report(&ProgressEvent {
+                    stage: Stage::Classifier,
+                    done,
+                    total,
+                })
+            };
+            let duals = svc::fit_ovo(x, data.placements, k, &svc_params, &mut on_pair)?;
+            let head = ClassifierHead {
+                gamma: gamma_c,
+                c: params.classifier_c,
+                pairs: duals.iter().map(|d| (d.a as u32, d.b as u32)).collect(),
+                rho: duals.iter().map(|d| d.rho).collect(),
+                info: duals.iter().map(|d| d.info).collect(),
+            };
+            (Some(head), duals)
+        } else {
+            (None, Vec::new())
+        };
+
+        let mut classes = Vec::with_capacity(k);
+        let mut grid_rows = Vec::new();
+        for (c, idx) in members.iter().enumerate() {
+            let name = data.placement_names[c].as_str();
+            let xc = x.select(idx);
+            let rows = config::kernel_rows(
+                xc.view(),
+                gamma_r,
+                params.solver.kernel_memory,
+                params.solver.regressor_kernel,
+            );
+            let targets: Vec<Vec<f64>> = (0..2)
+                .map(|ch| idx.iter().map(|&i| data.targets[i][ch] as f64).collect())
+                .collect();
+            let chosen: Vec<(f64, f64)> = match &params.regressors {
+                RegressorChoice::Fixed { c, epsilon } => vec![(*c, *epsilon); 2],
+                RegressorChoice::Grid(spec) => {
+                    let groups: Vec<u64> = idx.iter().map(|&i| data.groups[i]).collect();
+                    let table = grid::search(
+                        rows.as_ref(),
+                        &targets,
+                        &groups,
+                        spec,
+                        &params.solver.smo,
+                        name,
+                        progress,
+                    )
+                    .map_err(|e| match e {
+                        RegressError::NotEnoughData(m) => {
+                            RegressError::NotEnoughData(format!("placement '{name}': {m}"))
+                        }
+                        other => other,
+                    })?;
+                    let best = grid::best(&table, 2);
+                    grid_rows.extend(table);
+                    best
+                }
+            };
+            report(progress, Stage::Regressors { placement: name }, 0, 2)?;
+            let local: Vec<usize> = (0..idx.len()).collect();
+            let smo = &params.solver.smo;
+            let rows_ref = rows.as_ref();
+            let fit = |ch: usize| {
+                svr::solve_svr(
+                    rows_ref,
+                    &local,
+                    &targets[ch],
+                    chosen[ch].0,
+                    chosen[ch].1,
+                    None,
+                    smo,
+                )
+            };
+            // In parallel only over a precomputed kernel (see `grid::search` on determinism).
+            let (d0, d1) = if rows_ref.batch_size() == 0 {
+                rayon::join(|| fit(0), || fit(1))
+            } else {
+                (fit(0), fit(1))
+            };
+            drop(rows);
+            report(progress, Stage::Regressors { placement: name }, 2, 2)?;
+            classes.push(build_class(
+                c,
+                idx,
+                xc.view(),
+                &pair_duals,
+                [&d0, &d1],
+                [chosen[0], chosen[1]],
+            ));
+        }
+        Ok(Self {
+            feature_config: data.feature_config.clone(),
+            dim: x.dim(),
+            placements: data.placement_names.to_vec(),
+            classifier,
+            regressor_gamma: gamma_r,
+            classes,
+            grid: grid_rows,
+        })
+    }
+
+    /// Placement names, in class-index order.
+    pub fn placements(&self) -> &[String] {
+        &self.placements
+    }
+
+    /// Feature configuration the model was trained with.
+    pub fn feature_config(&self) -> &FeatureConfig {
+        &self.feature_config
+    }
+
+    /// Feature dimension.
+    pub fn dim(&self) -> usize {
+        self.dim
+    }
+
+    /// Grid-search results table (empty when the regressor parameters were fixed).
+    pub fn grid_results(&self) -> &[GridRow] {
+        &self.grid
+    }
+
+    /// Chosen `(C, epsilon)` of the two regressors of placement `p`.
+    pub fn regressor_params(&self, p: usize) -> Option<[(f64, f64); 2]> {
+        self.classes.get(p).map(|c| c.reg_params)
+    }
+
+    /// Stored samples of placement `p` (shared by its classifier part and both regressors).
+    pub fn stored_samples(&self, p: usize) -> usize {
+        self.classes.get(p).map_or(0, |c| c.samples.rows())
+    }
+
+    /// Classifies and regresses one query (the online path).
+    pub fn predict_one(&self, q: &[f32]) -> Result<Prediction, RegressError> {
+        let m = MatrixRef::new(q, self.dim.max(1))?;
+        if m.rows() != 1 || q.len() != self.dim {
+            return Err(RegressError::Shape(format!(
+                "query has {} values, model expects {}",
+                q.len(),
+                self.dim
+            )));
+        }
+        let mut out = [Prediction {
+            placement: 0,
+            velocity: [0.0; 2],
+        }];
+        self.predict_block(m, None, &mut out);
+        Ok(out[0])
+    }
+
+    /// Classifies and regresses every row of `x` (batched GEMM path).
+    pub fn predict(&self, x: MatrixRef<'_>) -> Result<Vec<Prediction>, RegressError> {
+        self.check_dim(x)?;
+        let mut out = vec![
+            Prediction {
+                placement: 0,
+                velocity: [0.0; 2]
+            };
+            x.rows()
+        ];
+        out.par_chunks_mut(QUERY_BLOCK)
+            .enumerate()
+            .for_each(|(b, o)| {
+                let r0 = b * QUERY_BLOCK;
+                self.predict_block(x.rows_range(r0, r0 + o.len()), None, o);
+            });
+        Ok(out)
+    }
+
+    /// Regresses every row of `x` with the regressors of a known placement (skips the
+    /// classifier), e.g. to evaluate regressors on ground-truth placements.
+    pub fn predict_with_placement(
+        &self,
+        x: MatrixRef<'_>,
+        placement: usize,
+    ) -> Result<Vec<[f32; 2]>, RegressError> {
+        self.check_dim(x)?;
+        if placement >= self.classes.len() {
+            return Err(RegressError::Shape(format!(
+                "placement {placement} of {}",
+                self.classes.len()
+            )));
+        }
+        let mut out = vec![
+            Prediction {
+                placement,
+                velocity: [0.0; 2]
+            };
+            x.rows()
+        ];
+        out.par_chunks_mut(QUERY_BLOCK)
+            .enumerate()
+            .for_each(|(b, o)| {
+                let r0 = b * QUERY_BLOCK;
+                self.predict_block(x.rows_range(r0, r0 + o.len()), Some(placement), o);
+            });
+        Ok(out.into_iter().map(|p| p.velocity).collect())
+    }
+
+    fn check_dim(&self, x: MatrixRef<'_>) -> Result<(), RegressError> {
+        if x.dim() != self.dim {
+            return Err(RegressError::Shape(format!(
+                "queries have {} features, model expects {}",
+                x.dim(),
+                self.dim
+            )));
+        }
+        Ok(())
+    }
+
+    fn predict_block(&self, q: MatrixRef<'_>, forced: Option<usize>, out: &mut [Prediction]) {
+        let m = q.rows();
+        let qn = kernel::sq_norms(q);
+        // Squared distances to the classifier part of each placement.
+        let dists: Vec<Vec<f32>> = self
+            .classes
+            .iter()
+            .map(|cl| {
+                let mut d = vec![0.0f32; m * cl.n_classifier];
+                if forced.is_none() && cl.n_classifier > 0 {
+                    kernel::cross_sq_dist(
+                        q,
+                        &qn,
+                        cl.samples.view().rows_range(0, cl.n_classifier),
+                        &cl.norms[..cl.n_classifier],
+                        &mut d,
+                    );
+                }
+                d
+            })
+            .collect();
+        match (forced, &self.classifier) {
+            (Some(p), _) => out.iter_mut().for_each(|o| o.placement = p),
+            (None, None) => out.iter_mut().for_each(|o| o.placement = 0),
+            (None, Some(head)) => {
+                let np = head.pairs.len();
+                let mut dec = vec![0.0f64; m * np];
+                let mut tmp = vec![0.0f64; m * np];
+                for (cl, d) in self.classes.iter().zip(&dists) {
+                    if cl.n_classifier == 0 {
+                        continue;
+                    }
+                    let mut kv = vec![0.0f32; d.len()];
+                    kernel::exp_neg_scaled(d, head.gamma, &mut kv);
+                    weighted_sums(&kv, &cl.clf_coef, np, &mut tmp);
+                    dec.iter_mut().zip(&tmp).for_each(|(a, b)| *a += b);
+                }
+                let mut votes = vec![0u32; self.classes.len()];
+                for (i, o) in out.iter_mut().enumerate() {
+                    let row = &mut dec[i * np..(i + 1) * np];
+                    row.iter_mut().zip(&head.rho).for_each(|(v, r)| *v -= r);
+                    o.placement = svc::vote(row, &head.pairs, self.classes.len(), &mut votes);
+                }
+            }
+        }
+        for (p, cl) in self.classes.iter().enumerate() {
+            let sel: Vec<usize> = (0..m).filter(|&i| out[i].placement == p).collect();
+            if sel.is_empty() {
+                continue;
+            }
+            let ns = cl.samples.rows();
+            let nc = cl.n_classifier;
+            let mut kv = vec![0.0f32; sel.len() * ns];
+            // Classifier rows: reuse the distances.
+            if nc > 0 && forced.is_none() {
+                for (r, &i) in sel.iter().enumerate() {
+                    kernel::exp_neg_scaled(
+                        &dists[p][i * nc..(i + 1) * nc],
+                        self.regressor_gamma,
+                        &mut kv[r * ns..r * ns + nc],
+                    );
+                }
+            }
+            let start = if forced.is_none() { nc } else { 0 };
+            if start < ns {
+                let qs = if sel.len() == m {
+                    None
+                } else {
+                    Some(q.select(&sel))
+                };
+                let qv = qs.as_ref().map_or(q, |s| s.view());
+                let qsn: Vec<f32> = sel.iter().map(|&i| qn[i]).collect();
+                let mut block = vec![0.0f32; sel.len() * (ns - start)];
+                kernel::cross_kernel(
+                    qv,
+                    &qsn,
+                    cl.samples.view().rows_range(start, ns),
+                    &cl.norms[start..],
+                    self.regressor_gamma,
+                    &mut block,
+                );
+                for r in 0..sel.len() {
+                    kv[r * ns + start..(r + 1) * ns]
+                        .copy_from_slice(&block[r * (ns - start)..(r + 1) * (ns - start)]);
+                }
+            }
+            let mut v = vec![0.0f64; sel.len() * 2];
+            weighted_sums(&kv, &cl.reg_coef, 2, &mut v);
+            for (r, &i) in sel.iter().enumerate() {
+                out[i].velocity = [
+                    (v[2 * r] - cl.reg_rho[0]) as f32,
+                    (v[2 * r + 1] - cl.reg_rho[1]) as f32,
+                ];
+            }
+        }
+    }
+
+    /// Consistency checks after decoding (the checksum only guards against corruption, not
+    /// against a well-formed but inconsistent payload).
+    pub(crate) fn check(&self) -> Result<(), RegressError> {
+        let bad = |m: &str| Err(RegressError::Decode(m.to_string()));
+        self.feature_config
+            .validate()
+            .map_err(|e| RegressError::Decode(format!("feature config: {e}")))?;
+        if self.feature_config.feature_dim() != self.dim {
+            return bad("feature config and model dimension disagree");
+        }
+        let k = self.placements.len();
+        if k == 0 || self.classes.len() != k {
+            return bad("placement count");
+        }
+        if !(self.regressor_gamma.is_finite() && self.regressor_gamma > 0.0) {
+            return bad("regressor gamma");
+        }
+        let np = match &self.classifier {
+            None if k == 1 => 0,
+            None => return bad("missing classifier"),
+            Some(h) => {
+                if h.pairs.len() != k * (k - 1) / 2
+                    || h.rho.len() != h.pairs.len()
+                    || h.pairs
+                        .iter()
+                        .any(|&(a, b)| a as usize >= k || b as usize >= k)
+                    || !(h.gamma.is_finite() && h.gamma > 0.0)
+                {
+                    return bad("classifier pairs");
+                }
+                h.pairs.len()
+            }
+        };
+        for cl in &self.classes {
+            cl.samples.check()?;
+            let ns = cl.samples.rows();
+            if cl.samples.dim() != self.dim
+                || cl.norms.len() != ns
+                || cl.n_classifier > ns
+                || cl.clf_coef.len() != cl.n_classifier * np
+                || cl.reg_coef.len() != ns * 2
+            {
+                return bad("class sample store sizes");
+            }
+        }
+        Ok(())
+    }
+}
+
+fn build_class(
+    c: usize,
+    idx: &[usize],
+    xc: MatrixRef<'_>,
+    pairs: &[PairDual],
+    duals: [&svr::SvrDual; 2],
+    chosen: [(f64, f64); 2],
+) -> ClassModel {
+    let n = idx.len();
+    let np = pairs.len();
+    // Classifier coefficients of this class's samples, by local index.
+    let mut clf: Vec<Option<Vec<f64>>> = vec![None; n];
+    for (p, d) in pairs.iter().enumerate() {
+        if d.a != c && d.b != c {
+            continue;
+        }
+        for (&g, &a) in d.sv.iter().zip(&d.coef) {
+            if let Ok(s) = idx.binary_search(&g) {
+                clf[s].get_or_insert_with(|| vec![0.0; np])[p] = a;
+            }
+        }
+    }
+    let mut order: Vec<usize> = (0..n).filter(|&s| clf[s].is_some()).collect();
+    let n_classifier = order.len();
+    order.extend(
+        (0..n)
+            .filter(|&s| clf[s].is_none() && (duals[0].coef[s] != 0.0 || duals[1].coef[s] != 0.0)),
+    );
+    let samples = xc.select(&order);
+    let norms = kernel::sq_norms(samples.view());
+    let clf_coef = order[..n_classifier]
+        .iter()
+        .flat_map(|&s| clf[s].clone().unwrap_or_default())
+        .collect();
+    let reg_coef = order
+        .iter()
+        .flat_map(|&s| [duals[0].coef[s], duals[1].coef[s]])
+        .collect();
+    ClassModel {
+        samples,
+        norms,
+        n_classifier,
+        clf_coef,
+        reg_coef,
+        reg_rho: [duals[0].rho, duals[1].rho],
+        reg_params: chosen,
+        reg_info: [duals[0].info(), duals[1].info()],
+        n_train: n,
+    }
+}

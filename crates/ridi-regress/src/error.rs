@@ -1,0 +1,64 @@
+//! Error type of the crate.
+
+use thiserror::Error;
+
+/// Everything that can go wrong while training, predicting or reading a model.
+#[derive(Debug, Error)]
+pub enum RegressError {
+    /// Inconsistent dimensions between inputs.
+    #[error("shape mismatch: {0}")]
+    Shape(String),
+    /// NaN or infinite input.
+    #[error("non-finite input: {0}")]
+    NonFinite(String),
+    /// A hyper-parameter outside its valid range.
+    #[error("invalid parameter: {0}")]
+    InvalidParam(String),
+    /// Not enough data to train what was asked (e.g. a placement class with too few samples).
+    #[error("not enough data: {0}")]
+    NotEnoughData(String),
+    /// The training was cancelled by the progress callback.
+    #[error("training cancelled")]
+    Cancelled,
+    /// The file does not start with the model magic number.
+    #[error("not a ridi-regress model file (bad magic number)")]
+    BadMagic,
+    /// The file was written by a newer (or unknown) format version.
+    #[error("unsupported model file version {found} (this build reads version {supported})")]
+    UnsupportedVersion {
+        /// Version in the file.
+        found: u32,
+        /// Version this build writes and reads.
+        supported: u32,
+    },
+    /// The file ends before the length its header announces.
+    #[error("model file truncated: expected {expected} bytes, found {found}")]
+    Truncated {
+        /// Bytes announced by the header (header included).
+        expected: u64,
+        /// Bytes present.
+        found: u64,
+    },
+    /// Payload checksum mismatch: the file is corrupt.
+    #[error("model file corrupt: checksum {found:#010x}, expected {expected:#010x}")]
+    Checksum {
+        /// CRC32 stored in the header.
+        expected: u32,
+        /// CRC32 of the payload read.
+        found: u32,
+    },
+    /// The payload passed the checksum but does not decode into a consistent model.
+    #[error("model file invalid: {0}")]
+    Decode(String),
+    /// Encoding failure.
+    #[error("model encoding failed: {0}")]
+    Encode(String),
+    /// Filesystem error.
+    #[error("i/o error on {path}: {source}")]
+    Io {
+        /// File concerned.
+        path: std::path::PathBuf,
+        /// Underlying error.
+        source: std::io::Error,
+    },
+}

@@ -1,0 +1,298 @@
+//! Grid search over `C` and epsilon with k-fold cross-validation by groups (whole sequences).
+//!
+//! All fits of a class index one kernel over the class's samples: both channels, every grid
+//! point and every fold (a fold's training set is a subset of the base samples). Along the `C`
+//! axis each fit starts from the previous solution scaled by `C_new / C_old`.
+
+use std::sync::Mutex;
+use std::sync::atomic::{AtomicBool, Ordering};
+
+use rayon::prelude::*;
+use serde::{Deserialize, Serialize};
+
+use crate::cache::KernelRows;
+use crate::error::RegressError;
+use crate::progress::{Progress, ProgressEvent, Stage};
+use crate::smo::SmoSettings;
+use crate::svr::{self, SvrDual};
+
+/// Grid and folds. [`Default`] is the paper: `C ∈ {0.1, 1, 10, 100}`,
+/// `ε ∈ {0.001, 0.01, 0.1, 1}`, 3 folds.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct GridSpec {
+    /// Values of `C` (any order; searched ascending for warm starts).
+    pub c: Vec<f64>,
+    /// Values of epsilon.
+    pub epsilon: Vec<f64>,
+    /// Number of folds; a class with fewer sequences uses one fold per sequence (at least 2).
+    pub folds: usize,
+    /// Seed of the sequence-to-fold shuffle.
+    pub seed: u64,
+}
+
+impl Default for GridSpec {
+    fn default() -> Self {
+        Self {
+            c: vec![0.1, 1.0, 10.0, 100.0],
+            epsilon: vec![0.001, 0.01, 0.1, 1.0],
+            folds: 3,
+            seed: 0,
+        }
+    }
+}
+
+impl GridSpec {
+    pub(crate) fn validate(&self) -> Result<(), RegressError> {
+        if self.c.is_empty() || self.epsilon.is_empty() {
+            return Err(RegressError::InvalidParam("empty grid".into()));
+        }
+        for &c in &self.c {
+            svr::check_c_gamma(c, 1.0)?;
+        }
+        if let Some(e) = self.epsilon.iter().find(|e| !(e.is_finite() && **e >= 0.0)) {
+            return Err(RegressError::InvalidParam(format!("epsilon {e} in grid")));
+        }
+        if self.folds < 2 {
+            return Err(RegressError::InvalidParam(
+                "cross-validation needs at least 2 folds".into(),
+            ));
+        }
+        Ok(())
+    }
+}
+
+/// One line of the results table: a grid point of one placement and channel.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct GridRow {
+    /// Placement name.
+    pub placement: String,
+    /// Velocity channel (0: S-x, 1: S-z).
+    pub channel: u8,
+    /// `C` of this grid point.
+    pub c: f64,
+    /// Epsilon of this grid point.
+    pub epsilon: f64,
+    /// Mean over folds of the validation MSE (scikit-learn's `GridSearchCV` convention).
+    pub mse: f64,
+    /// Validation MSE of each fold.
+    pub fold_mse: Vec<f64>,
+    /// SMO iterations summed over folds.
+    pub iterations: usize,
+}
+
+/// Assigns whole groups to folds: groups are shuffled with `seed`, then each goes to the fold
+/// with the fewest samples so far. Returns the fold of every sample and the number of folds.
+pub fn assign_folds(
+    groups: &[u64],
+    folds: usize,
+    seed: u64,
+) -> Result<(Vec<usize>, usize), RegressError> {
+    let mut distinct: Vec<u64> = groups.to_vec();
+    distinct.sort_unstable();
+    distinct.dedup();
+    if distinct.len() < 2 {
+        return Err(RegressError::NotEnoughData(format!(
+            "cross-validation by sequence needs at least 2 sequences, found {}",
+            distinct.len()
+        )));
+    }
+    let k = folds.min(distinct.len());
+    let mut counts: Vec<usize> = distinct
+        .iter()
+        .map(|g| groups.iter().filter(|x| *x == g).count())
+        .collect();
+    // Fisher-Yates with SplitMix64: deterministic across platforms and library versions.
+    let mut state = seed;
+    let mut next = || {
+        state = state.wrapping_add(0x9E37_79B9_7F4A_7C15);
+        let mut z = state;
+        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+        z ^ (z >> 31)
+    };
+    let mut order: Vec<usize> = (0..distinct.len()).collect();
+    for i in (1..order.len()).rev() {
+        let j = (next() % (i as u64 + 1)) as usize;
+        order.swap(i, j);
+    }
+    let mut fold_size = vec![0usize; k];
+    let mut fold_of_group = vec![0usize; distinct.len()];
+    for (rank, &g) in order.iter().enumerate() {
+        // The first k groups seed distinct folds so that no fold stays empty.
+        let f = if rank < k {
+            rank
+        } else {
+            (0..k).min_by_key(|&f| (fold_size[f], f)).unwrap_or(0)
+        };
+        fold_of_group[g] = f;
+        fold_size[f] += counts[g];
+    }
+    counts.clear();
+    let fold = groups
+        .iter()
+        .map(|g| fold_of_group[distinct.binary_search(g).unwrap_or(0)])
+        .collect();
+    Ok((fold, k))
+}
+
+/// Best `(C, epsilon)` of each channel from a results table (lowest MSE; ties to the first
+/// row, i.e. smaller `C`, then smaller epsilon).
+pub(crate) fn best(rows: &[GridRow], channels: usize) -> Vec<(f64, f64)> {
+    (0..channels)
+        .map(|ch| {
+            rows.iter()
+                .filter(|r| r.channel as usize == ch)
+                .fold(None::<&GridRow>, |b, r| match b {
+                    Some(b) if b.mse <= r.mse => Some(b),
+                    _ => Some(r),
+                })
+                .map_or((1.0, 0.1), |r| (r.c, r.epsilon))
+        })
+        .collect()
+}
+
+/// Runs the grid for every channel of `targets` (`targets[ch][s]` for base sample `s`) and
+/// returns the table in `(channel, C, epsilon)` order.
+pub(crate) fn search(
+    rows: &dyn KernelRows,
+    targets: &[Vec<f64>],
+    groups: &[u64],
+    spec: &GridSpec,
+    smo: &SmoSettings,
+    placement: &str,
+    progress: &mut dyn Progress,
+) -> Result<Vec<GridRow>, RegressError> {
+    spec.validate()?;
+    let (fold, k) = assign_folds(groups, spec.folds, spec.seed)?;
+    let mut cs = spec.c.clone();
+    cs.sort_by(f64::total_cmp);
+    cs.dedup();
+    let eps = spec.epsilon.clone();
+    let channels = targets.len();
+    let total = k * channels * eps.len() * cs.len();
+    let stage = Stage::Grid { placement };
+    if !progress.report(&ProgressEvent {
+        stage,
+        done: 0,
+        total,
+    }) {
+        return Err(RegressError::Cancelled);
+    }
+    let split: Vec<(Vec<usize>, Vec<usize>)> = (0..k)
+        .map(|f| {
+            let train = (0..fold.len()).filter(|&s| fold[s] != f).collect();
+            let val = (0..fold.len()).filter(|&s| fold[s] == f).collect();
+            (train, val)
+        })
+        .collect();
+    let ne = eps.len();
+    let tasks: Vec<(usize, usize, usize)> = (0..k)
+        .flat_map(|f| (0..channels).flat_map(move |ch| (0..ne).map(move |e| (f, ch, e))))
+        .collect();
+    let done = Mutex::new((0usize, progress));
+    let cancelled = AtomicBool::new(false);
+    // Per task: (sse per C, iterations per C).
+    let run = |&(f, ch, e): &(usize, usize, usize)| {
+        let (train, val) = &split[f];
+        let y: Vec<f64> = train.iter().map(|&s| targets[ch][s]).collect();
+        let mut prev: Option<(f64, SvrDual)> = None;
+        let mut out = Vec::with_capacity(cs.len());
+        for &c in &cs {
+            if cancelled.load(Ordering::Relaxed) {
+                break;
+            }
+            let alpha0 = prev
+                .as_ref()
+                .map(|(c_old, d)| svr::warm_start(&d.alpha, *c_old, c));
+            let dual = svr::solve_svr(rows, train, &y, c, eps[e], alpha0, smo);
+            let sv: Vec<(usize, f64)> = train
+                .iter()
+                .zip(&dual.coef)
+                .filter(|(_, a)| **a != 0.0)
+                .map(|(&s, &a)| (s, a))
+                .collect();
+            let mut sse = 0.0;
+            for &v in val {
+                let row = rows.row(v);
+                let f: f64 = sv.iter().map(|&(s, a)| a * row[s] as f64).sum::<f64>() - dual.rho;
+                sse += (targets[ch][v] - f).powi(2);
+            }
+            out.push((sse / val.len().max(1) as f64, dual.iterations));
+            prev = Some((c, dual));
+            let mut guard = done.lock().unwrap_or_else(|p| p.into_inner());
+            guard.0 += 1;
+            let n = guard.0;
+            if !guard.1.report(&ProgressEvent {
+                stage,
+                done: n,
+                total,
+            }) {
+                cancelled.store(true, Ordering::Relaxed);
+            }
+        }
+        out
+    };
+    // Rows computed on demand depend (in the last bits) on which batch computed them, so tasks
+    // sharing a row cache run in order to keep models reproducible; with a precomputed kernel
+    // they run in parallel.
+    let results: Vec<Vec<(f64, usize)>> = if rows.batch_size() == 0 {
+        tasks.par_iter().map(run).collect()
+    } else {
+        tasks.iter().map(run).collect()
+    };
+    if cancelled.load(Ordering::Relaxed) {
+        return Err(RegressError::Cancelled);
+    }
+    let mut table = Vec::with_capacity(channels * cs.len() * eps.len());
+    for ch in 0..channels {
+        for (ci, &c) in cs.iter().enumerate() {
+            for (e, &epsilon) in eps.iter().enumerate() {
+                let per_fold: Vec<(f64, usize)> = (0..k)
+                    .map(|f| {
+                        let t = tasks.iter().position(|&x| x == (f, ch, e)).unwrap_or(0);
+                        results[t].get(ci).copied().unwrap_or((f64::NAN, 0))
+                    })
+                    .collect();
+                let fold_mse: Vec<f64> = per_fold.iter().map(|p| p.0).collect();
+                table.push(GridRow {
+                    placement: placement.to_string(),
+                    channel: ch as u8,
+                    c,
+                    epsilon,
+                    mse: fold_mse.iter().sum::<f64>() / k as f64,
+                    fold_mse,
+                    iterations: per_fold.iter().map(|p| p.1).sum(),
+                });
+            }
+        }
+    }
+    Ok(table)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn folds_keep_groups_whole_and_balanced() {
+        let groups: Vec<u64> = (0..100).map(|i| (i / 10) as u64 * 7).collect();
+        let (fold, k) = assign_folds(&groups, 3, 42).unwrap();
+        assert_eq!(k, 3);
+        for g in 0..10 {
+            let f = fold[g * 10];
+            assert!(fold[g * 10..g * 10 + 10].iter().all(|&x| x == f));
+        }
+        let sizes: Vec<usize> = (0..3)
+            .map(|f| fold.iter().filter(|&&x| x == f).count())
+            .collect();
+        assert!(sizes.iter().all(|&s| (30..=40).contains(&s)), "{sizes:?}");
+        assert_eq!(assign_folds(&groups, 3, 42).unwrap().0, fold);
+        // Fewer sequences than folds: one fold per sequence.
+        let (_, k) = assign_folds(&[1, 1, 2, 2], 3, 0).unwrap();
+        assert_eq!(k, 2);
+        assert!(matches!(
+            assign_folds(&[5, 5, 5], 3, 0),
+            Err(RegressError::NotEnoughData(_))
+        ));
+    }
+}

@@ -1,0 +1,148 @@
+//! Model file codec.
+//!
+//! Layout (little-endian):
+//!
+//! | bytes | content                                   |
+//! |-------|-------------------------------------------|
+//! | 8     | magic `b"RIDIREG\0"`                      |
+//! | 4     | format version ([`FORMAT_VERSION`])       |
+//! | 8     | payload length in bytes                   |
+//! | 4     | CRC32 of the payload                      |
+//! | n     | payload: bincode 2 (standard config, serde) of the [`Cascade`] |
+//!
+//! The header is checked before the payload is decoded, so a newer version, a truncated file
+//! or a corrupt payload each give their own error. Encoding is deterministic (no maps, no
+//! timestamps), so the same model always gives the same bytes. Writing goes to a temporary
+//! file in the target directory, is flushed to disk, then renamed over the target.
+
+use std::io::Write;
+use std::path::{Path, PathBuf};
+
+use crate::cascade::Cascade;
+use crate::error::RegressError;
+
+/// File magic number.
+pub const MAGIC: [u8; 8] = *b"RIDIREG\0";
+/// Format version written and read by this build.
+pub const FORMAT_VERSION: u32 = 1;
+const HEADER: usize = 8 + 4 + 8 + 4;
+/// Refuses to allocate for absurd payload lengths from a corrupt header.
+const MAX_PAYLOAD: u64 = 1 << 40;
+
+fn bincode_config() -> impl bincode::config::Config {
+    bincode::config::standard().with_limit::<{ MAX_PAYLOAD as usize }>()
+}
+
+/// Encodes a model into file bytes.
+pub fn to_bytes(model: &Cascade) -> Result<Vec<u8>, RegressError> {
+    let payload = bincode::serde::encode_to_vec(model, bincode_config())
+        .map_err(|e| RegressError::Encode(e.to_string()))?;
+    let mut out = Vec::with_capacity(HEADER + payload.len());
+    out.extend_from_slice(&MAGIC);
+    out.extend_from_slice(&FORMAT_VERSION.to_le_bytes());
+    out.extend_from_slice(&(payload.len() as u64).to_le_bytes());
+    out.extend_from_slice(&crc32fast::hash(&payload).to_le_bytes());
+    out.extend_from_slice(&payload);
+    Ok(out)
+}
+
+/// Decodes file bytes into a model, checking magic, version, length, checksum and the
+/// model's internal consistency.
+pub fn from_bytes(bytes: &[u8]) -> Result<Cascade, RegressError> {
+    if bytes.len() < MAGIC.len() || bytes[..MAGIC.len()] != MAGIC {
+        return Err(if bytes.len() < MAGIC.len() && MAGIC.starts_with(bytes) {
+            RegressError::Truncated {
+                expected: HEADER as u64,
+                found: bytes.len() as u64,
+            }
+        } else {
+            RegressError::BadMagic
+        });
+    }
+    if bytes.len() < HEADER {
+        return Err(RegressError::Truncated {
+            expected: HEADER as u64,
+            found: bytes.len() as u64,
+        });
+    }
+    let word = |r: std::ops::Range<usize>| -> [u8; 8] {
+        let mut w = [0u8; 8];
+        w[..r.len()].copy_from_slice(&bytes[r]);
+        w
+    };
+    let version = u32::from_le_bytes(word(8..12)[..4].try_into().unwrap_or([0; 4]));
+    if version != FORMAT_VERSION {
+        return Err(RegressError::UnsupportedVersion {
+            found: version,
+            supported: FORMAT_VERSION,
+        });
+    }
+    let len = u64::from_le_bytes(word(12..20));
+    let crc = u32::from_le_bytes(word(20..24)[..4].try_into().unwrap_or([0; 4]));
+    let expected = (HEADER as u64).saturating_add(len);
+    if len > MAX_PAYLOAD || (bytes.len() as u64) < expected {
+        return Err(RegressError::Truncated {
+            expected,
+            found: bytes.len() as u64,
+        });
+    }
+    if (bytes.len() as u64) > expected {
+        return Err(RegressError::Decode(format!(
+            "{} trailing bytes after the payload",
+            bytes.len() as u64 - expected
+        )));
+    }
+    let payload = &bytes[HEADER..];
+    let found = crc32fast::hash(payload);
+    if found != crc {
+        return Err(RegressError::Checksum {
+            expected: crc,
+            found,
+        });
+    }
+    let (model, used): (Cascade, usize) =
+        bincode::serde::decode_from_slice(payload, bincode_config())
+            .map_err(|e| RegressError::Decode(e.to_string()))?;
+    if used != payload.len() {
+        return Err(RegressError::Decode("payload longer than the model".into()));
+    }
+    model.check()?;
+    Ok(model)
+}
+
+fn io_err(path: &Path) -> impl FnOnce(std::io::Error) -> RegressError + '_ {
+    move |source| RegressError::Io {
+        path: path.to_path_buf(),
+        source,
+    }
+}
+
+/// Writes the model atomically: temporary file in the same directory, `fsync`, rename.
+pub fn save(model: &Cascade, path: &Path) -> Result<(), RegressError> {
+    let bytes = to_bytes(model)?;
+    let dir = match path.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d.to_path_buf(),
+        _ => PathBuf::from("."),
+    };
+    let name = path
+        .file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_else(|| "model".into());
+    let tmp = dir.join(format!(".{name}.tmp{}", std::process::id()));
+    let result = (|| {
+        let mut f = std::fs::File::create(&tmp).map_err(io_err(&tmp))?;
+        f.write_all(&bytes).map_err(io_err(&tmp))?;
+        f.sync_all().map_err(io_err(&tmp))?;
+        std::fs::rename(&tmp, path).map_err(io_err(path))
+    })();
+    if result.is_err() {
+        let _ = std::fs::remove_file(&tmp);
+    }
+    result
+}
+
+/// Reads and validates a model file.
+pub fn load(path: &Path) -> Result<Cascade, RegressError> {
+    let bytes = std::fs::read(path).map_err(io_err(path))?;
+    from_bytes(&bytes)
+}

@@ -1,0 +1,306 @@
+//! Epsilon-SVR with an RBF kernel (libsvm's 2l-variable dual).
+
+use serde::{Deserialize, Serialize};
+
+use crate::cache::KernelRows;
+use crate::config::{self, SolverConfig};
+use crate::error::RegressError;
+use crate::expansion::Expansion;
+use crate::matrix::MatrixRef;
+use crate::smo::{self, SmoProblem, SmoSettings};
+
+/// Hyper-parameters of one epsilon-SVR.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct SvrParams {
+    /// Box constraint `C > 0`.
+    pub c: f64,
+    /// Width of the insensitive tube, `>= 0`.
+    pub epsilon: f64,
+    /// RBF width `gamma > 0`.
+    pub gamma: f32,
+    /// Solver settings.
+    pub solver: SolverConfig,
+}
+
+impl SvrParams {
+    /// Parameters with default solver settings.
+    pub fn new(c: f64, epsilon: f64, gamma: f32) -> Self {
+        Self {
+            c,
+            epsilon,
+            gamma,
+            solver: SolverConfig::default(),
+        }
+    }
+
+    pub(crate) fn validate(&self) -> Result<(), RegressError> {
+        check_c_gamma(self.c, self.gamma)?;
+        if !(self.epsilon.is_finite() && self.epsilon >= 0.0) {
+            return Err(RegressError::InvalidParam(format!(
+                "epsilon must be finite and >= 0, got {}",
+                self.epsilon
+            )));
+        }
+        check_smo(&self.solver.smo)
+    }
+}
+
+pub(crate) fn check_c_gamma(c: f64, gamma: f32) -> Result<(), RegressError> {
+    if !(c.is_finite() && c > 0.0) {
+        return Err(RegressError::InvalidParam(format!(
+            "C must be finite and > 0, got {c}"
+        )));
+    }
+    if !(gamma.is_finite() && gamma > 0.0) {
+        return Err(RegressError::InvalidParam(format!(
+            "gamma must be finite and > 0, got {gamma}"
+        )));
+    }
+    Ok(())
+}
+
+pub(crate) fn check_smo(s: &SmoSettings) -> Result<(), RegressError> {
+    if !(s.tol.is_finite() && s.tol > 0.0) {
+        return Err(RegressError::InvalidParam(format!(
+            "solver tolerance must be > 0, got {}",
+            s.tol
+        )));
+    }
+    Ok(())
+}
+
+/// Solver statistics of one fit.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct FitInfo {
+    /// SMO iterations.
+    pub iterations: usize,
+    /// Final dual objective (libsvm's `obj`).
+    pub objective: f64,
+    /// False when the iteration cap stopped the solver before the tolerance was met.
+    pub converged: bool,
+    /// Number of support vectors.
+    pub n_support: usize,
+}
+
+/// Dual solution of an SVR over a subset of a kernel's base samples.
+#[derive(Debug, Clone)]
+pub(crate) struct SvrDual {
+    /// `α_s - α*_s` for every sample of the subset.
+    pub coef: Vec<f64>,
+    /// The 2l dual variables (for warm starts).
+    pub alpha: Vec<f64>,
+    pub rho: f64,
+    pub obj: f64,
+    pub iterations: usize,
+    pub converged: bool,
+}
+
+impl SvrDual {
+    pub(crate) fn info(&self) -> FitInfo {
+        FitInfo {
+            iterations: self.iterations,
+            objective: self.obj,
+            converged: self.converged,
+            n_support: self.coef.iter().filter(|c| **c != 0.0).count(),
+        }
+    }
+}
+
+/// Solves the SVR dual on base samples `idx` of `rows` with targets `y` (one per `idx`).
+pub(crate) fn solve_svr(
+    rows: &dyn KernelRows,
+    idx: &[usize],
+    y: &[f64],
+    c: f64,
+    epsilon: f64,
+    alpha0: Option<Vec<f64>>,
+    settings: &SmoSettings,
+) -> SvrDual {
+    let m = idx.len();
+    let kidx: Vec<u32> = idx.iter().chain(idx).map(|&i| i as u32).collect();
+    let sign: Vec<f64> = (0..2 * m).map(|t| if t < m { 1.0 } else { -1.0 }).collect();
+    let p: Vec<f64> = (0..2 * m)
+        .map(|t| {
+            if t < m {
+                epsilon - y[t]
+            } else {
+                epsilon + y[t - m]
+            }
+        })
+        .collect();
+    let sol = smo::solve(
+        rows,
+        SmoProblem {
+            kidx,
+            y: sign,
+            p,
+            c,
+            alpha0,
+        },
+        settings,
+    );
+    let coef = (0..m).map(|s| sol.alpha[s] - sol.alpha[s + m]).collect();
+    SvrDual {
+        coef,
+        alpha: sol.alpha,
+        rho: sol.rho,
+        obj: sol.obj,
+        iterations: sol.iterations,
+        converged: sol.converged,
+    }
+}
+
+/// Scales a previous solution to a new `C`: multiplying every α by `C_new / C_old` keeps the
+/// equality constraint and the box, so it is a feasible (and usually close) warm start.
+pub(crate) fn warm_start(alpha: &[f64], c_old: f64, c_new: f64) -> Vec<f64> {
+    let r = c_new / c_old;
+    alpha.iter().map(|a| (a * r).clamp(0.0, c_new)).collect()
+}
+
+/// Trained epsilon-SVR: `f(x) = Σ_s coef_s K(sv_s, x) - rho`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Svr {
+    pub(crate) exp: Expansion,
+    pub(crate) rho: f64,
+    pub(crate) params: SvrParams,
+    pub(crate) info: FitInfo,
+}
+
+pub(crate) fn check_xy(x: MatrixRef<'_>, n_targets: usize) -> Result<(), RegressError> {
+    if x.rows() != n_targets {
+        return Err(RegressError::Shape(format!(
+            "{} samples but {} targets",
+            x.rows(),
+            n_targets
+        )));
+    }
+    if x.rows() == 0 {
+        return Err(RegressError::NotEnoughData("no training samples".into()));
+    }
+    Ok(())
+}
+
+impl Svr {
+    /// Trains on rows of `x` with targets `y`.
+    pub fn fit(x: MatrixRef<'_>, y: &[f32], params: &SvrParams) -> Result<Self, RegressError> {
+        params.validate()?;
+        check_xy(x, y.len())?;
+        if let Some(i) = y.iter().position(|v| !v.is_finite()) {
+            return Err(RegressError::NonFinite(format!("target {i}")));
+        }
+        let rows = config::kernel_rows(
+            x,
+            params.gamma,
+            params.solver.kernel_memory,
+            params.solver.regressor_kernel,
+        );
+        let idx: Vec<usize> = (0..x.rows()).collect();
+        let yd: Vec<f64> = y.iter().map(|&v| v as f64).collect();
+        let dual = solve_svr(
+            rows.as_ref(),
+            &idx,
+            &yd,
+            params.c,
+            params.epsilon,
+            None,
+            &params.solver.smo,
+        );
+        Ok(Self::from_dual(x, &idx, &dual, *params))
+    }
+
+    pub(crate) fn from_dual(
+        x: MatrixRef<'_>,
+        idx: &[usize],
+        dual: &SvrDual,
+        params: SvrParams,
+    ) -> Self {
+        let keep: Vec<usize> = (0..idx.len()).filter(|&s| dual.coef[s] != 0.0).collect();
+        let sv_rows: Vec<usize> = keep.iter().map(|&s| idx[s]).collect();
+        let coef: Vec<f64> = keep.iter().map(|&s| dual.coef[s]).collect();
+        Self {
+            exp: Expansion::new(x.select(&sv_rows), coef, 1, params.gamma),
+            rho: dual.rho,
+            params,
+            info: dual.info(),
+        }
+    }
+
+    /// Predictions for every row of `x`.
+    pub fn predict(&self, x: MatrixRef<'_>) -> Result<Vec<f32>, RegressError> {
+        Ok(self
+            .exp
+            .eval(x)?
+            .into_iter()
+            .map(|s| (s - self.rho) as f32)
+            .collect())
+    }
+
+    /// Offset `rho` (libsvm sign convention: `f(x) = Σ coef K - rho`).
+    pub fn rho(&self) -> f64 {
+        self.rho
+    }
+
+    /// Dual coefficients `α_s - α*_s` of the support vectors.
+    pub fn dual_coef(&self) -> &[f64] {
+        &self.exp.coef
+    }
+
+    /// Support vectors (row-major).
+    pub fn support_vectors(&self) -> MatrixRef<'_> {
+        self.exp.sv.view()
+    }
+
+    /// Hyper-parameters used.
+    pub fn params(&self) -> &SvrParams {
+        &self.params
+    }
+
+    /// Solver statistics.
+    pub fn info(&self) -> &FitInfo {
+        &self.info
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::cache::FullKernel;
+    use crate::kernel;
+    use crate::matrix::Matrix;
+
+    #[test]
+    fn warm_started_fit_reaches_the_cold_solution() {
+        let n = 120;
+        let x: Vec<f32> = (0..n * 5).map(|k| ((k as f32) * 0.61).sin()).collect();
+        let x = Matrix::new(x, 5).unwrap();
+        let y: Vec<f64> = (0..n).map(|i| (i as f64 * 0.1).cos()).collect();
+        let full = FullKernel::new(x.view(), &kernel::sq_norms(x.view()), 0.3);
+        let settings = SmoSettings {
+            tol: 1e-6,
+            ..SmoSettings::default()
+        };
+        // A fold-like subset, to exercise indexing into the shared kernel.
+        let idx: Vec<usize> = (0..n).filter(|i| i % 3 != 0).collect();
+        let ys: Vec<f64> = idx.iter().map(|&i| y[i]).collect();
+        let low = solve_svr(&full, &idx, &ys, 1.0, 0.01, None, &settings);
+        let cold = solve_svr(&full, &idx, &ys, 10.0, 0.01, None, &settings);
+        let warm = solve_svr(
+            &full,
+            &idx,
+            &ys,
+            10.0,
+            0.01,
+            Some(warm_start(&low.alpha, 1.0, 10.0)),
+            &settings,
+        );
+        assert!(warm.converged && cold.converged);
+        assert!((warm.obj - cold.obj).abs() < 1e-6 * cold.obj.abs().max(1.0));
+        assert!((warm.rho - cold.rho).abs() < 1e-3);
+        assert!(
+            warm.iterations < cold.iterations,
+            "{} vs {}",
+            warm.iterations,
+            cold.iterations
+        );
+    }
+}

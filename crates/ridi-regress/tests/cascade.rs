@@ -1,0 +1,302 @@
+//! Cascade training and prediction, grid search, model file codec.
+
+mod common;
+
+use ridi_features::{Channel, FeatureConfig};
+use ridi_regress::{
+    Cascade, CascadeParams, GridSpec, MatrixRef, NoProgress, ProgressEvent, RegressError,
+    RegressorChoice, Stage, TrainingSet, model_file,
+};
+
+struct Data {
+    x: Vec<f32>,
+    y: Vec<[f32; 2]>,
+    placement: Vec<usize>,
+    group: Vec<u64>,
+    names: Vec<String>,
+    config: FeatureConfig,
+}
+
+impl Data {
+    fn set(&self) -> TrainingSet<'_> {
+        TrainingSet {
+            features: MatrixRef::new(&self.x, self.config.feature_dim()).unwrap(),
+            targets: &self.y,
+            placements: &self.placement,
+            placement_names: &self.names,
+            groups: &self.group,
+            feature_config: &self.config,
+        }
+    }
+}
+
+/// `placements` classes, `seqs` sequences each, `per_seq` samples per sequence; the
+/// placement shifts a feature pattern, the velocity is a smooth function of a latent state.
+fn make(placements: usize, seqs: usize, per_seq: usize, seed: u64) -> Data {
+    let config = FeatureConfig {
+        window: 4,
+        channels: vec![Channel::Gyro, Channel::LinearAcceleration],
+        ..FeatureConfig::default()
+    };
+    let d = config.feature_dim();
+    let mut rng = common::Rng(seed);
+    let mut data = Data {
+        x: Vec::new(),
+        y: Vec::new(),
+        placement: Vec::new(),
+        group: Vec::new(),
+        names: (0..placements).map(|p| format!("placement{p}")).collect(),
+        config,
+    };
+    for p in 0..placements {
+        for s in 0..seqs {
+            for _ in 0..per_seq {
+                let a = rng.uniform();
+                let b = rng.uniform();
+                for j in 0..d {
+                    let t = j as f64 / d as f64;
+                    let shift = if j % placements == p { 1.5 } else { 0.0 };
+                    data.x.push(
+                        (shift + a * (4.0 * t).sin() + b * (3.0 * t).cos() + 0.05 * rng.uniform())
+                            as f32,
+                    );
+                }
+                let gain = 1.0 + p as f64 * 0.3;
+                data.y
+                    .push([(gain * a) as f32, (0.5 * b * b - 0.3 * gain) as f32]);
+                data.placement.push(p);
+                data.group.push((p * 100 + s) as u64);
+            }
+        }
+    }
+    data
+}
+
+fn small_grid() -> CascadeParams {
+    CascadeParams {
+        regressors: RegressorChoice::Grid(GridSpec {
+            c: vec![1.0, 10.0],
+            epsilon: vec![0.01, 0.1],
+            folds: 3,
+            seed: 7,
+        }),
+        ..CascadeParams::default()
+    }
+}
+
+#[test]
+fn cascade_classifies_regresses_and_batches_consistently() {
+    let data = make(3, 4, 15, 1);
+    let mut events = Vec::new();
+    let mut progress = |e: &ProgressEvent<'_>| {
+        events.push((format!("{:?}", e.stage), e.done, e.total));
+        true
+    };
+    let model = Cascade::train(&data.set(), &small_grid(), &mut progress).unwrap();
+    assert_eq!(model.placements(), &data.names[..]);
+    // Grid table: 3 placements × 2 channels × 4 points.
+    assert_eq!(model.grid_results().len(), 24);
+    for p in 0..3 {
+        let chosen = model.regressor_params(p).unwrap();
+        for (ch, &(c, e)) in chosen.iter().enumerate() {
+            let best = model
+                .grid_results()
+                .iter()
+                .filter(|r| r.placement == data.names[p] && r.channel as usize == ch)
+                .min_by(|a, b| a.mse.total_cmp(&b.mse))
+                .unwrap();
+            assert_eq!((best.c, best.epsilon), (c, e));
+        }
+        assert!(model.stored_samples(p) <= 60);
+    }
+    assert!(
+        events
+            .iter()
+            .any(|e| e.0 == "Classifier" && e.1 == 3 && e.2 == 3)
+    );
+    assert!(
+        events
+            .iter()
+            .any(|e| e.0.starts_with("Grid") && e.1 == 24 && e.2 == 24)
+    );
+
+    // Held-out data from the same distribution.
+    let test = make(3, 1, 20, 99);
+    let xt = MatrixRef::new(&test.x, 24).unwrap();
+    let batch = model.predict(xt).unwrap();
+    let correct = batch
+        .iter()
+        .zip(&test.placement)
+        .filter(|(p, t)| p.placement == **t)
+        .count();
+    assert!(correct >= 57, "placement accuracy {correct}/60");
+    let mse: f64 = batch
+        .iter()
+        .zip(&test.y)
+        .map(|(p, t)| ((p.velocity[0] - t[0]).powi(2) + (p.velocity[1] - t[1]).powi(2)) as f64)
+        .sum::<f64>()
+        / 120.0;
+    assert!(mse < 0.01, "velocity MSE {mse}");
+    for (i, b) in batch.iter().enumerate() {
+        let one = model.predict_one(xt.row(i)).unwrap();
+        assert_eq!(one.placement, b.placement);
+        for ch in 0..2 {
+            let diff = (one.velocity[ch] - b.velocity[ch]).abs();
+            // GEMM blocking differs between one query and a block: f32 rounding only.
+            assert!(diff < 1e-4, "sample {i} channel {ch}: {diff}");
+        }
+        let forced = model
+            .predict_with_placement(xt.rows_range(i, i + 1), one.placement)
+            .unwrap();
+        for (f, o) in forced[0].iter().zip(&one.velocity) {
+            assert!((f - o).abs() < 1e-4);
+        }
+    }
+    assert!(model.predict_one(&test.x[..23]).is_err());
+}
+
+#[test]
+fn training_is_deterministic_and_model_files_round_trip() {
+    let data = make(2, 3, 12, 5);
+    let params = small_grid();
+    let a = Cascade::train(&data.set(), &params, &mut NoProgress).unwrap();
+    let b = Cascade::train(&data.set(), &params, &mut NoProgress).unwrap();
+    let bytes = model_file::to_bytes(&a).unwrap();
+    assert_eq!(bytes, model_file::to_bytes(&b).unwrap());
+    assert_eq!(&bytes[..8], b"RIDIREG\0");
+    let back = model_file::from_bytes(&bytes).unwrap();
+    assert_eq!(back, a);
+    assert_eq!(back.feature_config(), &data.config);
+
+    let dir = std::env::temp_dir().join(format!("ridi-regress-test-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join("model.ridi");
+    model_file::save(&a, &path).unwrap();
+    assert_eq!(model_file::load(&path).unwrap(), a);
+    assert_eq!(
+        std::fs::read_dir(&dir).unwrap().count(),
+        1,
+        "temporary file left behind"
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+
+    let mut corrupt = bytes.clone();
+    let mid = bytes.len() / 2;
+    corrupt[mid] ^= 0x40;
+    assert!(matches!(
+        model_file::from_bytes(&corrupt),
+        Err(RegressError::Checksum { .. })
+    ));
+    for cut in [0, 5, 20, bytes.len() - 1] {
+        assert!(
+            matches!(
+                model_file::from_bytes(&bytes[..cut]),
+                Err(RegressError::Truncated { .. })
+            ),
+            "cut at {cut}"
+        );
+    }
+    let mut newer = bytes.clone();
+    newer[8..12].copy_from_slice(&2u32.to_le_bytes());
+    assert!(matches!(
+        model_file::from_bytes(&newer),
+        Err(RegressError::UnsupportedVersion {
+            found: 2,
+            supported: 1
+        })
+    ));
+    let mut magic = bytes.clone();
+    magic[0] = b'X';
+    assert!(matches!(
+        model_file::from_bytes(&magic),
+        Err(RegressError::BadMagic)
+    ));
+    assert!(model_file::load(std::path::Path::new("/nonexistent/model.ridi")).is_err());
+}
+
+#[test]
+fn small_or_degenerate_placements_give_clear_errors_or_documented_fallbacks() {
+    // Too few samples: placement0 keeps 5 of its 30.
+    let fixed = CascadeParams {
+        regressors: RegressorChoice::Fixed {
+            c: 1.0,
+            epsilon: 0.1,
+        },
+        ..CascadeParams::default()
+    };
+    let mut few = make(2, 3, 10, 3);
+    for p in few.placement.iter_mut().take(25) {
+        *p = 1;
+    }
+    match Cascade::train(&few.set(), &fixed, &mut NoProgress) {
+        Err(RegressError::NotEnoughData(m)) => assert!(m.contains("placement0"), "{m}"),
+        other => panic!("expected NotEnoughData, got {other:?}"),
+    }
+    // A name without samples.
+    let mut empty = make(2, 3, 10, 3);
+    empty.names.push("leg".into());
+    assert!(matches!(
+        Cascade::train(&empty.set(), &fixed, &mut NoProgress),
+        Err(RegressError::NotEnoughData(m)) if m.contains("leg")
+    ));
+    // A placement recorded in a single sequence cannot be cross-validated by sequence.
+    let mut one_seq = make(2, 3, 10, 3);
+    for (g, p) in one_seq.group.iter_mut().zip(&one_seq.placement) {
+        if *p == 0 {
+            *g = 0;
+        }
+    }
+    match Cascade::train(&one_seq.set(), &small_grid(), &mut NoProgress) {
+        Err(RegressError::NotEnoughData(m)) => assert!(m.contains("placement0"), "{m}"),
+        other => panic!("expected NotEnoughData, got {other:?}"),
+    }
+    // A single placement: no classifier, every query gets placement 0.
+    let single = make(1, 3, 10, 4);
+    let model = Cascade::train(&single.set(), &fixed, &mut NoProgress).unwrap();
+    assert_eq!(model.predict_one(&single.x[..24]).unwrap().placement, 0);
+    let bytes = model_file::to_bytes(&model).unwrap();
+    assert_eq!(model_file::from_bytes(&bytes).unwrap(), model);
+    // Mismatched lengths and a feature config of another width.
+    let mut short = make(2, 3, 10, 3);
+    short.y.pop();
+    assert!(matches!(
+        Cascade::train(&short.set(), &fixed, &mut NoProgress),
+        Err(RegressError::Shape(_))
+    ));
+    let mut wide = make(2, 3, 10, 3);
+    wide.config.window = 5;
+    let set = wide.set_unchecked();
+    assert!(matches!(
+        Cascade::train(&set, &fixed, &mut NoProgress),
+        Err(RegressError::Shape(_))
+    ));
+}
+
+#[test]
+fn progress_callback_can_cancel() {
+    let data = make(2, 3, 10, 8);
+    let mut calls = 0;
+    let mut progress = |e: &ProgressEvent<'_>| {
+        calls += 1;
+        !matches!(e.stage, Stage::Grid { .. }) || e.done < 2
+    };
+    assert!(matches!(
+        Cascade::train(&data.set(), &small_grid(), &mut progress),
+        Err(RegressError::Cancelled)
+    ));
+    assert!(calls > 2);
+}
+
+impl Data {
+    /// Like `set` but without building the features view from the config width.
+    fn set_unchecked(&self) -> TrainingSet<'_> {
+        TrainingSet {
+            features: MatrixRef::new(&self.x, 24).unwrap(),
+            targets: &self.y,
+            placements: &self.placement,
+            placement_names: &self.names,
+            groups: &self.group,
+            feature_config: &self.config,
+        }
+    }
+}

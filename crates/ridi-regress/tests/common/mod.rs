@@ -1,0 +1,59 @@
+//! Deterministic synthetic data shared by the integration tests.
+#![allow(dead_code)]
+
+/// SplitMix64: tiny, deterministic, good enough for test data.
+pub struct Rng(pub u64);
+
+impl Rng {
+    pub fn next_u64(&mut self) -> u64 {
+        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
+        let mut z = self.0;
+        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+        z ^ (z >> 31)
+    }
+    /// Uniform in [-1, 1).
+    pub fn uniform(&mut self) -> f64 {
+        (self.next_u64() >> 11) as f64 / (1u64 << 52) as f64 - 1.0
+    }
+}
+
+/// `n × d` features with smooth structure and a nonlinear target.
+pub fn regression(n: usize, d: usize, seed: u64) -> (Vec<f32>, Vec<f32>) {
+    let mut rng = Rng(seed);
+    let mut x = Vec::with_capacity(n * d);
+    let mut y = Vec::with_capacity(n);
+    for _ in 0..n {
+        let a = rng.uniform();
+        let b = rng.uniform();
+        for j in 0..d {
+            let t = j as f64 / d as f64;
+            x.push((a * (3.0 * t).sin() + b * (5.0 * t + a).cos() + 0.1 * rng.uniform()) as f32);
+        }
+        y.push(((2.0 * a).sin() + 0.5 * b * b + 0.05 * rng.uniform()) as f32);
+    }
+    (x, y)
+}
+
+/// `k` Gaussian-ish blobs in `d` dimensions, `n_per` samples each; labels are `label_of[c]`.
+pub fn blobs(
+    n_per: usize,
+    d: usize,
+    label_of: &[usize],
+    spread: f64,
+    seed: u64,
+) -> (Vec<f32>, Vec<usize>) {
+    let mut rng = Rng(seed);
+    let mut x = Vec::new();
+    let mut y = Vec::new();
+    for (c, &label) in label_of.iter().enumerate() {
+        for _ in 0..n_per {
+            for j in 0..d {
+                let centre = if j % label_of.len() == c { 1.0 } else { 0.0 };
+                x.push((centre + spread * rng.uniform()) as f32);
+            }
+            y.push(label);
+        }
+    }
+    (x, y)
+}

@@ -1,0 +1,219 @@
+//! The methods every evaluation compares: RIDI and its baselines.
+//!
+//! | method | key | trajectory |
+//! | --- | --- | --- |
+//! | RIDI | `ridi` | regressed velocities, bias correction (lambda 0.1), double integration |
+//! | RAW | `raw` | plain double integration of the linear acceleration from rest |
+//! | PDR | `pdr` | steps from the accelerometer magnitude; step length = the sequence's mean ground-truth step length (as in the paper); heading = the device's forward direction (S -z) in the world |
+//! | RIDI-MAG | `ridi_mag` | RIDI with only the *magnitude* of each regressed velocity, pointed along the device's forward direction (S -z), as the original code's `mag_only` preset |
+//! | RIDI-ORI | `ridi_ori` | RIDI with only the *direction* of each regressed velocity, at a constant speed (the sequence's mean ground-truth speed), as the original's `ori_only` preset |
+//! | VELOCITY | `velocity` | the regressed velocities followed closely (lambda 1e-6: the bias absorbs any mismatch) |
+//! | STILL | `still` | stays at the start point: on short runs in a small room it can beat real methods on ATE, and a report must show that |
+//!
+//! PDR, RIDI-MAG and RIDI-ORI use ground truth (mean step length or speed), which flatters
+//! them; they are references, not competitors.
+
+use std::fmt;
+use std::str::FromStr;
+
+use ridi_correct::{CorrectionConfig, integrate, world_acceleration};
+use ridi_data::Sequence;
+use ridi_eval::{StepDetectorConfig, detect_steps, pdr_trajectory};
+use ridi_frames::{StabVec, WorldVec, stab_from_world};
+use serde::{Deserialize, Serialize};
+
+use crate::error::{PipelineError, Result};
+use crate::track::{Regressed, correct_with, imu_slices};
+
+/// A trajectory method.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Method {
+    /// RIDI itself.
+    Ridi,
+    /// Plain double integration.
+    Raw,
+    /// Step counting.
+    Pdr,
+    /// Regressed speed, device heading.
+    RidiMag,
+    /// Regressed direction, constant speed.
+    RidiOri,
+    /// Regressed velocities followed closely.
+    Velocity,
+    /// Standing still.
+    Still,
+}
+
+impl Method {
+    /// Every method, in report order.
+    pub const ALL: [Method; 7] = [
+        Method::Ridi,
+        Method::Raw,
+        Method::Pdr,
+        Method::RidiMag,
+        Method::RidiOri,
+        Method::Velocity,
+        Method::Still,
+    ];
+
+    /// The report key (`ridi`, `raw`, `pdr`, `ridi_mag`, `ridi_ori`, `velocity`, `still`).
+    pub fn key(self) -> &'static str {
+        match self {
+            Method::Ridi => "ridi",
+            Method::Raw => "raw",
+            Method::Pdr => "pdr",
+            Method::RidiMag => "ridi_mag",
+            Method::RidiOri => "ridi_ori",
+            Method::Velocity => "velocity",
+            Method::Still => "still",
+        }
+    }
+
+    /// Whether the method needs the regression model.
+    pub fn needs_model(self) -> bool {
+        matches!(
+            self,
+            Method::Ridi | Method::RidiMag | Method::RidiOri | Method::Velocity
+        )
+    }
+}
+
+impl fmt::Display for Method {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.key())
+    }
+}
+
+impl FromStr for Method {
+    type Err = String;
+    fn from_str(s: &str) -> std::result::Result<Self, String> {
+        let key = s.trim().to_ascii_lowercase().replace('-', "_");
+        Method::ALL
+            .into_iter()
+            .find(|m| m.key() == key)
+            .ok_or_else(|| {
+                let keys: Vec<&str> = Method::ALL.iter().map(|m| m.key()).collect();
+                format!("unknown method `{s}` (known: {})", keys.join(", "))
+            })
+    }
+}
+
+/// Heading (yaw, radians counter-clockwise from world +x) of the device's forward direction,
+/// S -z, at every frame.
+pub fn device_heading(seq: &Sequence) -> Vec<f64> {
+    let forward = StabVec::new(0.0, 0.0, -1.0);
+    seq.orientation()
+        .iter()
+        .zip(seq.gravity())
+        .map(|(&q, &g)| {
+            let f: WorldVec = stab_from_world(q, g).inverse() * forward;
+            f.y().atan2(f.x())
+        })
+        .collect()
+}
+
+fn horizontal(p: &[WorldVec]) -> Vec<[f64; 2]> {
+    p.iter().map(|p| [p.x(), p.y()]).collect()
+}
+
+/// Mean horizontal ground-truth speed, m/s.
+fn mean_speed(seq: &Sequence) -> Result<f64> {
+    let len = seq
+        .path_length()
+        .ok_or_else(|| PipelineError::sequence(seq.name(), "has no ground truth"))?;
+    Ok(len / seq.duration().max(f64::EPSILON))
+}
+
+/// The horizontal trajectory of `method` on `seq`, starting at the origin. `regressions` are
+/// the cascade's outputs (needed by the model-based methods); `config` is RIDI's correction.
+pub fn trajectory(
+    method: Method,
+    seq: &Sequence,
+    regressions: &[Regressed],
+    config: CorrectionConfig,
+) -> Result<Vec<[f64; 2]>> {
+    let with = |regs: Vec<Regressed>, config: CorrectionConfig| -> Result<Vec<[f64; 2]>> {
+        Ok(correct_with(seq, &regs, config, &[])?.horizontal())
+    };
+    match method {
+        Method::Ridi => with(regressions.to_vec(), config),
+        Method::Velocity => with(
+            regressions.to_vec(),
+            CorrectionConfig {
+                lambda: 1e-6,
+                ..config
+            },
+        ),
+        Method::RidiMag => with(
+            regressions
+                .iter()
+                .map(|r| Regressed {
+                    velocity: [0.0, -r.velocity[0].hypot(r.velocity[1])],
+                    ..*r
+                })
+                .collect(),
+            config,
+        ),
+        Method::RidiOri => {
+            let speed = mean_speed(seq)?;
+            with(
+                regressions
+                    .iter()
+                    .map(|r| {
+                        let n = r.velocity[0].hypot(r.velocity[1]);
+                        let v = if n > 1e-9 {
+                            [speed * r.velocity[0] / n, speed * r.velocity[1] / n]
+                        } else {
+                            [0.0, 0.0]
+                        };
+                        Regressed { velocity: v, ..*r }
+                    })
+                    .collect(),
+                config,
+            )
+        }
+        Method::Raw => {
+            let acc = world_acceleration(&imu_slices(seq));
+            let poses = integrate(seq.time(), &acc, WorldVec::ZERO, WorldVec::ZERO)?;
+            Ok(poses
+                .iter()
+                .map(|p| [p.position.x(), p.position.y()])
+                .collect())
+        }
+        Method::Pdr => {
+            let acce: Vec<[f64; 3]> = seq.acce().iter().map(|a| a.to_array()).collect();
+            let steps = detect_steps(seq.time(), &acce, &StepDetectorConfig::default())?;
+            let gt = seq
+                .ground_truth()
+                .ok_or_else(|| PipelineError::sequence(seq.name(), "has no ground truth"))?;
+            let path = ridi_eval::path_length(&horizontal(&gt.position))?;
+            let step_length = if steps.is_empty() {
+                0.0
+            } else {
+                path / steps.len() as f64
+            };
+            Ok(pdr_trajectory(
+                [0.0, 0.0],
+                &steps,
+                step_length,
+                &device_heading(seq),
+            )?)
+        }
+        Method::Still => Ok(vec![[0.0, 0.0]; seq.len()]),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn method_keys_round_trip() {
+        for m in Method::ALL {
+            assert_eq!(m.key().parse::<Method>(), Ok(m));
+        }
+        assert_eq!("RIDI-MAG".parse::<Method>(), Ok(Method::RidiMag));
+        assert!("nope".parse::<Method>().unwrap_err().contains("ridi_ori"));
+    }
+}

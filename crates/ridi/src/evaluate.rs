@@ -1,0 +1,466 @@
+//! Evaluation: every method on every sequence with ground truth, metrics, and the report files.
+//!
+//! `report.json` has, per sequence, `name`, `placement`, `path_length_m`,
+//! `placement_accuracy`, `velocity_mse` (`[S-x, S-z]`, (m/s)^2) and `methods.<key>` with the
+//! metric keys of [`ridi_eval::TrajectoryMetrics`] (`mpe_m`, `mpe_pct`, `ate_m`, `rte_m`,
+//! `ate_ronin_m`, `rte_ronin_m`, `rte_5s_m`, `path_length_ratio`); `summary.<key>` holds the
+//! means over sequences. Method keys are those of [`Method::key`].
+
+use std::collections::{BTreeMap, BTreeSet};
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+
+use rayon::prelude::*;
+use ridi_data::{Sequence, write_atomically};
+use ridi_eval::{
+    ConfusionMatrix, EvalConfig, MethodMetrics, Metric, SequenceReport, TrajectoryMetrics,
+    evaluate_trajectory, markdown_confusion, markdown_metric_table, summarize, velocity_mse,
+};
+use ridi_features::compute_targets;
+use ridi_regress::Cascade;
+use serde::Serialize;
+
+use crate::baselines::{Method, trajectory};
+use crate::error::{PipelineError, Result};
+use crate::track::{Regressed, TrackOptions, regress};
+use crate::train::ground_truth_view;
+
+/// What to evaluate and how.
+#[derive(Debug, Clone, PartialEq)]
+pub struct EvalOptions {
+    /// Methods, in report order.
+    pub methods: Vec<Method>,
+    /// Regression step and correction of the model-based methods.
+    pub track: TrackOptions,
+    /// Alignment and metric windows.
+    pub metrics: EvalConfig,
+}
+
+impl Default for EvalOptions {
+    fn default() -> Self {
+        Self {
+            methods: Method::ALL.to_vec(),
+            track: TrackOptions::default(),
+            metrics: EvalConfig::default(),
+        }
+    }
+}
+
+/// Results of one sequence.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct SequenceResult {
+    /// Sequence name.
+    pub name: String,
+    /// Placement label.
+    pub placement: Option<String>,
+    /// Horizontal ground-truth path length, metres.
+    pub path_length_m: f64,
+    /// Fraction of regressions whose predicted placement is the sequence's label.
+    pub placement_accuracy: Option<f64>,
+    /// Velocity regression MSE `[S-x, S-z]`, (m/s)^2, against the smoothed ground truth.
+    pub velocity_mse: [f64; 2],
+    /// Metrics per method key.
+    pub methods: BTreeMap<String, TrajectoryMetrics>,
+}
+
+/// Everything needed to draw the plots of one sequence.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Traces {
+    /// Sequence name.
+    pub name: String,
+    /// Ground-truth horizontal positions.
+    pub ground_truth: Vec<[f64; 2]>,
+    /// Aligned horizontal trajectory of each method.
+    pub methods: Vec<(Method, Vec<[f64; 2]>)>,
+    /// Times of the regressions, seconds.
+    pub regression_time: Vec<f64>,
+    /// Regressed velocities `[S-x, S-z]`.
+    pub regressed: Vec<[f64; 2]>,
+    /// Ground-truth velocities at the same frames.
+    pub true_velocity: Vec<[f64; 2]>,
+    /// Predicted placement names at the same frames.
+    pub placements: Vec<String>,
+}
+
+/// The whole evaluation.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Report {
+    /// Per-sequence results.
+    pub sequences: Vec<SequenceResult>,
+    /// Mean of each metric over sequences, per method key.
+    pub summary: BTreeMap<String, TrajectoryMetrics>,
+    /// Velocity MSE over all regressions of all sequences, (m/s)^2.
+    pub velocity_mse: [f64; 2],
+    /// Placement accuracy over all regressions.
+    pub placement_accuracy: Option<f64>,
+    /// Confusion matrix of the placement classifier (rows: truth, columns: prediction).
+    pub placement_confusion: Option<ConfusionMatrix>,
+    /// Alignment and metric settings.
+    pub config: EvalConfig,
+    /// Methods in report order.
+    pub methods: Vec<String>,
+}
+
+struct Evaluated {
+    result: SequenceResult,
+    traces: Traces,
+    truth_labels: Vec<String>,
+    squared_errors: Vec<[f64; 2]>,
+}
+
+fn evaluate_one(seq: &Sequence, model: &Cascade, opts: &EvalOptions) -> Result<Evaluated> {
+    let gt = seq
+        .ground_truth()
+        .ok_or_else(|| PipelineError::sequence(seq.name(), "has no ground truth to evaluate"))?;
+    let gt2: Vec<[f64; 2]> = gt.position.iter().map(|p| [p.x(), p.y()]).collect();
+    let regressions: Vec<Regressed> = if opts.methods.iter().any(|m| m.needs_model()) {
+        regress(seq, model, opts.track.regress_every)?
+    } else {
+        Vec::new()
+    };
+    let frames: Vec<usize> = regressions.iter().map(|r| r.frame).collect();
+    let targets = compute_targets(&ground_truth_view(seq)?, model.feature_config(), &frames)?;
+    let predicted: Vec<[f64; 2]> = regressions.iter().map(|r| r.velocity).collect();
+    let vel_mse = if predicted.is_empty() {
+        [f64::NAN; 2]
+    } else {
+        velocity_mse(&predicted, &targets.values)?
+    };
+    let names: Vec<String> = regressions
+        .iter()
+        .map(|r| {
+            model
+                .placements()
+                .get(r.placement)
+                .cloned()
+                .unwrap_or_default()
+        })
+        .collect();
+    let placement_accuracy = match (seq.placement(), names.is_empty()) {
+        (Some(p), false) => {
+            Some(names.iter().filter(|n| n.as_str() == p).count() as f64 / names.len() as f64)
+        }
+        _ => None,
+    };
+    let mut methods = BTreeMap::new();
+    let mut traced = Vec::new();
+    for &m in &opts.methods {
+        let est = trajectory(m, seq, &regressions, opts.track.correction)?;
+        let e = evaluate_trajectory(seq.time(), &est, &gt2, &opts.metrics)?;
+        methods.insert(m.key().to_string(), e.metrics);
+        traced.push((m, e.aligned));
+    }
+    Ok(Evaluated {
+        result: SequenceResult {
+            name: seq.name().to_string(),
+            placement: seq.placement().map(str::to_string),
+            path_length_m: ridi_eval::path_length(&gt2)?,
+            placement_accuracy,
+            velocity_mse: vel_mse,
+            methods,
+        },
+        truth_labels: seq
+            .placement()
+            .map(|p| vec![p.to_string(); names.len()])
+            .unwrap_or_default(),
+        squared_errors: predicted
+            .iter()
+            .zip(&targets.values)
+            .map(|(p, t)| [(p[0] - t[0]).powi(2), (p[1] - t[1]).powi(2)])
+            .collect(),
+        traces: Traces {
+            name: seq.name().to_string(),
+            ground_truth: gt2,
+            methods: traced,
+            regression_time: frames.iter().map(|&f| seq.time()[f]).collect(),
+            regressed: predicted,
+            true_velocity: targets.values,
+            placements: names,
+        },
+    })
+}
+
+/// Evaluates every method of `opts` on every sequence (ground truth required), in parallel.
+/// Returns the report and the traces for plots, in sequence order.
+pub fn evaluate(
+    seqs: &[Sequence],
+    model: &Cascade,
+    opts: &EvalOptions,
+) -> Result<(Report, Vec<Traces>)> {
+    let done: Vec<Evaluated> = seqs
+        .par_iter()
+        .map(|s| evaluate_one(s, model, opts))
+        .collect::<Result<_>>()?;
+    let reports = sequence_reports(done.iter().map(|e| &e.result));
+    let summary = summarize(&reports)
+        .into_iter()
+        .map(|s| (s.method, s.mean))
+        .collect();
+    let squared: Vec<[f64; 2]> = done
+        .iter()
+        .flat_map(|e| e.squared_errors.iter().copied())
+        .collect();
+    let velocity_mse = if squared.is_empty() {
+        [f64::NAN; 2]
+    } else {
+        let n = squared.len() as f64;
+        [
+            squared.iter().map(|s| s[0]).sum::<f64>() / n,
+            squared.iter().map(|s| s[1]).sum::<f64>() / n,
+        ]
+    };
+    let truth: Vec<&str> = done
+        .iter()
+        .flat_map(|e| e.truth_labels.iter().map(String::as_str))
+        .collect();
+    let predicted: Vec<&str> = done
+        .iter()
+        .filter(|e| !e.truth_labels.is_empty())
+        .flat_map(|e| e.traces.placements.iter().map(String::as_str))
+        .collect();
+    let (placement_accuracy, placement_confusion) = if truth.is_empty() {
+        (None, None)
+    } else {
+        let classes: BTreeSet<&str> = model
+            .placements()
+            .iter()
+            .map(String::as_str)
+            .chain(truth.iter().copied())
+            .collect();
+        let classes: Vec<&str> = classes.into_iter().collect();
+        let cm = ConfusionMatrix::from_names(&truth, &predicted, &classes)?;
+        (cm.accuracy(), Some(cm))
+    };
+    let (results, traces) = done.into_iter().map(|e| (e.result, e.traces)).unzip();
+    Ok((
+        Report {
+            sequences: results,
+            summary,
+            velocity_mse,
+            placement_accuracy,
+            placement_confusion,
+            config: opts.metrics,
+            methods: opts.methods.iter().map(|m| m.key().to_string()).collect(),
+        },
+        traces,
+    ))
+}
+
+fn sequence_reports<'a>(results: impl Iterator<Item = &'a SequenceResult>) -> Vec<SequenceReport> {
+    results
+        .map(|r| SequenceReport {
+            sequence: r.name.clone(),
+            placement: r.placement.clone(),
+            frames: 0,
+            methods: r
+                .methods
+                .iter()
+                .map(|(k, m)| MethodMetrics {
+                    method: k.clone(),
+                    metrics: *m,
+                })
+                .collect(),
+        })
+        .collect()
+}
+
+fn fmt_opt(v: Option<f64>) -> String {
+    v.map_or("-".into(), |v| format!("{v:.3}"))
+}
+
+impl Report {
+    /// The markdown report: overall summary, per placement, per sequence, velocity and
+    /// placement results.
+    pub fn to_markdown(&self) -> String {
+        let mut out = String::new();
+        let _ = writeln!(out, "# RIDI evaluation\n");
+        let _ = writeln!(
+            out,
+            "{} sequences; trajectories aligned on {} (2D rigid, no scale); RTE window {} s, short RTE {} s.\n",
+            self.sequences.len(),
+            match self.config.align {
+                ridi_eval::AlignWindow::Seconds(s) => format!("the first {s} s"),
+                ridi_eval::AlignWindow::Frames(n) => format!("the first {n} frames"),
+                ridi_eval::AlignWindow::All => "the whole trajectory".to_string(),
+            },
+            self.config.rte_window_s,
+            self.config.short_rte_window_s
+        );
+        let _ = writeln!(
+            out,
+            "Velocity MSE (all regressions): S-x {:.4}, S-z {:.4} (m/s)^2; placement accuracy {}.\n",
+            self.velocity_mse[0],
+            self.velocity_mse[1],
+            fmt_opt(self.placement_accuracy)
+        );
+        let _ = writeln!(out, "## Overall (mean over sequences)\n");
+        let mut head = "| method |".to_string();
+        let mut rule = "| --- |".to_string();
+        for m in Metric::ALL {
+            let _ = write!(head, " {} |", m.label());
+            rule.push_str(" --- |");
+        }
+        let _ = writeln!(out, "{head}\n{rule}");
+        for key in &self.methods {
+            if let Some(mean) = self.summary.get(key) {
+                let _ = write!(out, "| {key} |");
+                for m in Metric::ALL {
+                    let _ = write!(out, " {} |", m.format(m.value(mean)));
+                }
+                let _ = writeln!(out);
+            }
+        }
+        let reports = sequence_reports(self.sequences.iter());
+        let placements: BTreeSet<&str> = self
+            .sequences
+            .iter()
+            .filter_map(|s| s.placement.as_deref())
+            .collect();
+        if !placements.is_empty() {
+            let _ = writeln!(out, "\n## Per placement (mean RTE 5 s, m)\n");
+            let _ = write!(out, "| placement | sequences |");
+            for key in &self.methods {
+                let _ = write!(out, " {key} |");
+            }
+            let _ = writeln!(
+                out,
+                "\n| --- | --- |{}",
+                " --- |".repeat(self.methods.len())
+            );
+            for p in placements {
+                let subset: Vec<SequenceReport> = reports
+                    .iter()
+                    .filter(|r| r.placement.as_deref() == Some(p))
+                    .cloned()
+                    .collect();
+                let means: BTreeMap<String, TrajectoryMetrics> = summarize(&subset)
+                    .into_iter()
+                    .map(|s| (s.method, s.mean))
+                    .collect();
+                let _ = write!(out, "| {p} | {} |", subset.len());
+                for key in &self.methods {
+                    let v = means.get(key).map(|m| m.rte_5s_m);
+                    let _ = write!(out, " {} |", fmt_opt(v));
+                }
+                let _ = writeln!(out);
+            }
+        }
+        for metric in [
+            Metric::Rte5sM,
+            Metric::PathLengthRatio,
+            Metric::AteM,
+            Metric::MpeM,
+        ] {
+            let _ = writeln!(out, "\n## Per sequence: {}\n", metric.label());
+            out.push_str(&markdown_metric_table(&reports, metric));
+        }
+        let _ = writeln!(out, "\n## Velocity regression and placement per sequence\n");
+        let _ = writeln!(
+            out,
+            "| sequence | placement | path (m) | velocity MSE S-x | velocity MSE S-z | placement accuracy |\n| --- | --- | --- | --- | --- | --- |"
+        );
+        for s in &self.sequences {
+            let _ = writeln!(
+                out,
+                "| {} | {} | {:.1} | {:.4} | {:.4} | {} |",
+                s.name,
+                s.placement.as_deref().unwrap_or("-"),
+                s.path_length_m,
+                s.velocity_mse[0],
+                s.velocity_mse[1],
+                fmt_opt(s.placement_accuracy)
+            );
+        }
+        if let Some(cm) = &self.placement_confusion {
+            let _ = writeln!(out, "\n## Placement confusion (rows: truth)\n");
+            out.push_str(&markdown_confusion(cm));
+        }
+        out
+    }
+
+    /// Writes `report.json` and `report.md` into `dir` (created if needed), atomically.
+    pub fn write(&self, dir: &Path) -> Result<Vec<PathBuf>> {
+        std::fs::create_dir_all(dir).map_err(|e| PipelineError::File {
+            path: dir.to_path_buf(),
+            message: e.to_string(),
+        })?;
+        let json = serde_json::to_string_pretty(self).map_err(|e| PipelineError::File {
+            path: dir.join("report.json"),
+            message: e.to_string(),
+        })?;
+        let md = self.to_markdown();
+        let mut written = Vec::new();
+        for (name, text) in [("report.json", json), ("report.md", md)] {
+            let path = dir.join(name);
+            write_atomically(&path, |w| w.write_all(text.as_bytes()))?;
+            written.push(path);
+        }
+        Ok(written)
+    }
+}
+
+impl Traces {
+    /// Draws the trajectory plot (ground truth and every method, aligned) and the velocity plot
+    /// (regressed vs true, with predicted placements) of this sequence into `dir` as
+    /// `<name>.trajectory.<ext>` and `<name>.velocity.<ext>` (`ext`: `svg` or `png`).
+    pub fn plot(&self, dir: &Path, ext: &str) -> Result<Vec<PathBuf>> {
+        use crate::plot::{
+            Placements, Trajectory, TrajectoryOptions, TrajectoryPlot, VelocityOptions,
+            VelocityPlot, VelocityTrack, plot_trajectories, plot_velocity,
+        };
+        let traj_path = dir.join(format!("{}.trajectory.{ext}", self.name));
+        let estimates: Vec<Trajectory<'_>> = self
+            .methods
+            .iter()
+            .map(|(m, points)| Trajectory {
+                name: m.key(),
+                points,
+            })
+            .collect();
+        plot_trajectories(
+            &traj_path,
+            &TrajectoryPlot {
+                title: &self.name,
+                ground_truth: Some(Trajectory {
+                    name: "ground truth",
+                    points: &self.ground_truth,
+                }),
+                estimates: &estimates,
+            },
+            &TrajectoryOptions::default(),
+        )?;
+        let mut written = vec![traj_path];
+        if !self.regressed.is_empty() {
+            let col = |v: &[[f64; 2]], i: usize| v.iter().map(|p| p[i]).collect::<Vec<f64>>();
+            let (rx, rz) = (col(&self.regressed, 0), col(&self.regressed, 1));
+            let (tx, tz) = (col(&self.true_velocity, 0), col(&self.true_velocity, 1));
+            let labels: Vec<&str> = self.placements.iter().map(String::as_str).collect();
+            let vel_path = dir.join(format!("{}.velocity.{ext}", self.name));
+            plot_velocity(
+                &vel_path,
+                &VelocityPlot {
+                    title: &self.name,
+                    regressed: VelocityTrack {
+                        name: "regressed",
+                        t: &self.regression_time,
+                        x: &rx,
+                        z: &rz,
+                    },
+                    truth: Some(VelocityTrack {
+                        name: "ground truth",
+                        t: &self.regression_time,
+                        x: &tx,
+                        z: &tz,
+                    }),
+                    placements: Some(Placements {
+                        t: &self.regression_time,
+                        labels: &labels,
+                    }),
+                },
+                &VelocityOptions::default(),
+            )?;
+            written.push(vel_path);
+        }
+        Ok(written)
+    }
+}

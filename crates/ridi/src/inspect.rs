@@ -1,0 +1,199 @@
+//! What `ridi inspect` reports about a sequence.
+
+use ridi_data::{Format, Sequence};
+use serde::Serialize;
+
+/// Summary statistics of a scalar series.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct Stats {
+    /// Mean.
+    pub mean: f64,
+    /// Standard deviation (population).
+    pub std: f64,
+    /// Minimum.
+    pub min: f64,
+    /// Maximum.
+    pub max: f64,
+}
+
+impl Stats {
+    /// Statistics of `values` (all zero when empty).
+    pub fn of(values: impl Iterator<Item = f64> + Clone) -> Stats {
+        let (mut n, mut sum, mut min, mut max) = (0usize, 0.0, f64::INFINITY, f64::NEG_INFINITY);
+        for v in values.clone() {
+            n += 1;
+            sum += v;
+            min = min.min(v);
+            max = max.max(v);
+        }
+        if n == 0 {
+            return Stats {
+                mean: 0.0,
+                std: 0.0,
+                min: 0.0,
+                max: 0.0,
+            };
+        }
+        let mean = sum / n as f64;
+        let var = values.map(|v| (v - mean).powi(2)).sum::<f64>() / n as f64;
+        Stats {
+            mean,
+            std: var.sqrt(),
+            min,
+            max,
+        }
+    }
+}
+
+/// Everything `ridi inspect` prints, as JSON with `--json`.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Inspection {
+    /// Format detected.
+    pub format: String,
+    /// Sequence name.
+    pub name: String,
+    /// Placement label, if known.
+    pub placement: Option<String>,
+    /// Number of frames.
+    pub frames: usize,
+    /// First to last frame, seconds.
+    pub duration_s: f64,
+    /// Mean rate, Hz.
+    pub rate_hz: f64,
+    /// Longest interval between frames, seconds.
+    pub max_gap_s: f64,
+    /// Where the device orientation comes from.
+    pub orientation_source: Option<String>,
+    /// Gravity magnitude, m/s^2.
+    pub gravity_norm: Stats,
+    /// Accelerometer magnitude, m/s^2.
+    pub acce_norm: Stats,
+    /// Whether a magnetometer stream is present.
+    pub has_magnet: bool,
+    /// Whether a step counter is present.
+    pub has_steps: bool,
+    /// Fraction of frames with ground truth (0 or 1: sequences carry it on every frame or not
+    /// at all; readers trim or split where it is missing).
+    pub ground_truth_coverage: f64,
+    /// Horizontal ground-truth path length, metres.
+    pub path_length_m: Option<f64>,
+    /// Things a user should look at.
+    pub warnings: Vec<String>,
+}
+
+/// Inspects `seq`, read as `format`.
+pub fn inspect(seq: &Sequence, format: Format) -> Inspection {
+    let gravity_norm = Stats::of(seq.gravity().iter().map(|g| g.norm()));
+    let acce_norm = Stats::of(seq.acce().iter().map(|a| a.norm()));
+    let rate_hz = seq.rate_hz();
+    let max_gap_s = seq.max_gap();
+    let mut warnings = Vec::new();
+    if !(195.0..=205.0).contains(&rate_hz) {
+        warnings.push(format!(
+            "rate {rate_hz:.1} Hz: RIDI models are trained at about 200 Hz"
+        ));
+    }
+    if rate_hz > 0.0 && max_gap_s > 5.0 / rate_hz {
+        warnings.push(format!(
+            "longest gap {:.3} s is {:.0} frame intervals",
+            max_gap_s,
+            max_gap_s * rate_hz
+        ));
+    }
+    if (gravity_norm.mean - ridi_frames::STANDARD_GRAVITY).abs() > 0.3 {
+        warnings.push(format!(
+            "mean gravity magnitude {:.3} m/s^2 is far from 9.81: accelerometer scale error?",
+            gravity_norm.mean
+        ));
+    }
+    if (acce_norm.mean - gravity_norm.mean).abs() > 0.5 {
+        warnings.push(format!(
+            "accelerometer mean magnitude {:.3} m/s^2 differs from gravity's {:.3}",
+            acce_norm.mean, gravity_norm.mean
+        ));
+    }
+    if seq.duration() < 10.0 {
+        warnings.push("shorter than 10 s: too short for the paper's alignment".into());
+    }
+    if seq.ground_truth().is_none() {
+        warnings.push("no ground truth: usable for tracking, not for training".into());
+    }
+    Inspection {
+        format: format.to_string(),
+        name: seq.name().to_string(),
+        placement: seq.placement().map(str::to_string),
+        frames: seq.len(),
+        duration_s: seq.duration(),
+        rate_hz,
+        max_gap_s,
+        orientation_source: seq.orientation_source().map(|s| s.to_string()),
+        gravity_norm,
+        acce_norm,
+        has_magnet: seq.magnet().is_some(),
+        has_steps: seq.steps().is_some(),
+        ground_truth_coverage: if seq.ground_truth().is_some() {
+            1.0
+        } else {
+            0.0
+        },
+        path_length_m: seq.path_length(),
+        warnings,
+    }
+}
+
+impl std::fmt::Display for Inspection {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        writeln!(f, "name:         {}", self.name)?;
+        writeln!(f, "format:       {}", self.format)?;
+        writeln!(
+            f,
+            "placement:    {}",
+            self.placement.as_deref().unwrap_or("(none)")
+        )?;
+        writeln!(
+            f,
+            "frames:       {} over {:.2} s",
+            self.frames, self.duration_s
+        )?;
+        writeln!(
+            f,
+            "rate:         {:.2} Hz mean, worst gap {:.4} s",
+            self.rate_hz, self.max_gap_s
+        )?;
+        writeln!(
+            f,
+            "orientation:  {}",
+            self.orientation_source.as_deref().unwrap_or("(unknown)")
+        )?;
+        let g = &self.gravity_norm;
+        writeln!(
+            f,
+            "|gravity|:    mean {:.4}, std {:.4}, min {:.4}, max {:.4} m/s^2",
+            g.mean, g.std, g.min, g.max
+        )?;
+        let a = &self.acce_norm;
+        writeln!(
+            f,
+            "|acce|:       mean {:.4}, std {:.4}, min {:.4}, max {:.4} m/s^2",
+            a.mean, a.std, a.min, a.max
+        )?;
+        writeln!(
+            f,
+            "magnetometer: {}   step counter: {}",
+            if self.has_magnet { "yes" } else { "no" },
+            if self.has_steps { "yes" } else { "no" }
+        )?;
+        match self.path_length_m {
+            Some(len) => writeln!(
+                f,
+                "ground truth: {:.0} % of frames, path length {len:.2} m",
+                self.ground_truth_coverage * 100.0
+            )?,
+            None => writeln!(f, "ground truth: none")?,
+        }
+        for w in &self.warnings {
+            writeln!(f, "warning:      {w}")?;
+        }
+        Ok(())
+    }
+}

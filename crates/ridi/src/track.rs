@@ -1,0 +1,274 @@
+//! Tracking: regress velocities with a trained cascade, correct the accelerations, integrate.
+
+use std::path::Path;
+
+use ridi_correct::{
+    CorrectionConfig, FrameWindow, Regression, Sample, Tracker, TrackerConfig, VelocityRegressor,
+    VelocityTarget, correct,
+};
+use ridi_data::{Sequence, write_atomically};
+use ridi_features::{FeatureExtractor, ImuView, SampleSchedule};
+use ridi_frames::{DeviceVec, WorldVec};
+use ridi_regress::{Cascade, MatrixRef};
+use serde::{Deserialize, Serialize};
+
+use crate::error::{PipelineError, Result};
+use crate::train::imu_view;
+
+/// How to track.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct TrackOptions {
+    /// Frames between regressions (paper: 50, the residual frames of the correction).
+    pub regress_every: usize,
+    /// The correction objective (knots, lambda, weights, initial velocity).
+    pub correction: CorrectionConfig,
+    /// Streaming mode (paper's online variant): a 1000-frame window corrected every 200
+    /// frames, each frame's pose as known when it arrived. Otherwise one global correction.
+    pub online: bool,
+}
+
+impl Default for TrackOptions {
+    fn default() -> Self {
+        Self {
+            regress_every: 50,
+            correction: CorrectionConfig::default(),
+            online: false,
+        }
+    }
+}
+
+/// One regression: the cascade's output at a frame.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct Regressed {
+    /// Frame index.
+    pub frame: usize,
+    /// Placement index into the model's placement names.
+    pub placement: usize,
+    /// Velocity `[S-x, S-z]`, m/s.
+    pub velocity: [f64; 2],
+}
+
+/// A tracked sequence: one pose per frame, plus what produced it.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Track {
+    /// Timestamps, seconds.
+    pub time: Vec<f64>,
+    /// Position, world frame of the device orientation, metres, from the origin.
+    pub position: Vec<WorldVec>,
+    /// Velocity, world frame, m/s.
+    pub velocity: Vec<WorldVec>,
+    /// Estimated accelerometer bias, device frame, m/s^2.
+    pub bias: Vec<DeviceVec>,
+    /// The regressions used.
+    pub regressions: Vec<Regressed>,
+    /// Placement names of the model.
+    pub placement_names: Vec<String>,
+}
+
+impl Track {
+    /// The horizontal trajectory, `[x, y]` per frame.
+    pub fn horizontal(&self) -> Vec<[f64; 2]> {
+        self.position.iter().map(|p| [p.x(), p.y()]).collect()
+    }
+
+    /// Writes the trajectory CSV: `time,pos_x,pos_y,pos_z,vel_x,vel_y,vel_z,placement,
+    /// bias_x,bias_y,bias_z`, one row per frame (`placement` is the latest regression's, empty
+    /// before the first). Written atomically.
+    pub fn write_csv(&self, path: &Path) -> Result<()> {
+        let mut next = 0;
+        let mut current: Option<&str> = None;
+        write_atomically(path, |w| {
+            writeln!(
+                w,
+                "time,pos_x,pos_y,pos_z,vel_x,vel_y,vel_z,placement,bias_x,bias_y,bias_z"
+            )?;
+            for i in 0..self.time.len() {
+                while next < self.regressions.len() && self.regressions[next].frame <= i {
+                    current = self
+                        .placement_names
+                        .get(self.regressions[next].placement)
+                        .map(String::as_str);
+                    next += 1;
+                }
+                let (p, v, b) = (self.position[i], self.velocity[i], self.bias[i]);
+                writeln!(
+                    w,
+                    "{},{},{},{},{},{},{},{},{},{},{}",
+                    self.time[i],
+                    p.x(),
+                    p.y(),
+                    p.z(),
+                    v.x(),
+                    v.y(),
+                    v.z(),
+                    current.unwrap_or(""),
+                    b.x(),
+                    b.y(),
+                    b.z()
+                )?;
+            }
+            Ok(())
+        })?;
+        Ok(())
+    }
+}
+
+/// Regresses placement and velocity every `step` frames from the first full window, in one
+/// batched pass.
+pub fn regress(seq: &Sequence, model: &Cascade, step: usize) -> Result<Vec<Regressed>> {
+    let fx = FeatureExtractor::new(model.feature_config().clone())?;
+    let frames = SampleSchedule::every(fx.config(), step)?.frames(seq.len());
+    if frames.is_empty() {
+        return Ok(Vec::new());
+    }
+    let features = fx.features(&fx.stabilize(&imu_view(seq)?)?, &frames)?;
+    let predictions = model.predict(MatrixRef::new(features.as_slice(), features.cols())?)?;
+    Ok(frames
+        .iter()
+        .zip(predictions)
+        .map(|(&frame, p)| Regressed {
+            frame,
+            placement: p.placement,
+            velocity: [p.velocity[0] as f64, p.velocity[1] as f64],
+        })
+        .collect())
+}
+
+/// The inputs of a correction of `seq`.
+pub(crate) fn imu_slices(seq: &Sequence) -> ridi_correct::ImuSlices<'_> {
+    ridi_correct::ImuSlices {
+        time: seq.time(),
+        linacce: seq.linacce(),
+        orientation: seq.orientation(),
+        gravity: seq.gravity(),
+    }
+}
+
+/// Corrects and integrates `seq` so that its velocity follows `regressions` (batch: one
+/// global solve).
+pub fn correct_with(
+    seq: &Sequence,
+    regressions: &[Regressed],
+    config: CorrectionConfig,
+    placement_names: &[String],
+) -> Result<Track> {
+    let targets: Vec<VelocityTarget> = regressions
+        .iter()
+        .map(|r| VelocityTarget {
+            frame: r.frame,
+            velocity: r.velocity,
+        })
+        .collect();
+    let traj = correct(config, &imu_slices(seq), &targets)?;
+    let bias = &traj.correction.bias;
+    Ok(Track {
+        time: seq.time().to_vec(),
+        position: traj.poses.iter().map(|p| p.position).collect(),
+        velocity: traj.poses.iter().map(|p| p.velocity).collect(),
+        bias: (0..seq.len()).map(|i| bias.at(i, seq.time()[i])).collect(),
+        regressions: regressions.to_vec(),
+        placement_names: placement_names.to_vec(),
+    })
+}
+
+/// Tracks `seq` with `model`.
+pub fn track(seq: &Sequence, model: &Cascade, opts: &TrackOptions) -> Result<Track> {
+    if opts.online {
+        return track_online(seq, model, opts);
+    }
+    let regressions = regress(seq, model, opts.regress_every)?;
+    correct_with(seq, &regressions, opts.correction, model.placements())
+}
+
+/// The cascade as the streaming tracker's regressor: features of the latest window, one query.
+pub struct CascadeRegressor<'m> {
+    model: &'m Cascade,
+    extractor: FeatureExtractor,
+    row: Vec<f32>,
+    /// Every regression made, for reports.
+    pub made: Vec<Regressed>,
+}
+
+impl<'m> CascadeRegressor<'m> {
+    /// A regressor over `model`.
+    pub fn new(model: &'m Cascade) -> Result<Self> {
+        let extractor = FeatureExtractor::new(model.feature_config().clone())?;
+        let row = vec![0.0; extractor.dim()];
+        Ok(Self {
+            model,
+            extractor,
+            row,
+            made: Vec::new(),
+        })
+    }
+}
+
+impl VelocityRegressor for CascadeRegressor<'_> {
+    fn window_len(&self) -> usize {
+        // One more than the feature window: the feature of the regressed (last) frame covers
+        // the frames before it, as in batch tracking.
+        self.extractor.config().window + 1
+    }
+
+    fn regress(
+        &mut self,
+        frames: &FrameWindow<'_>,
+    ) -> std::result::Result<Option<Regression>, ridi_correct::RegressError> {
+        let imu = ImuView::new(frames.gyro, frames.linacce, frames.gravity)?;
+        let stab = self.extractor.stabilize(&imu)?;
+        let len = frames.len();
+        self.extractor.row_into(&stab, len - 1, &mut self.row)?;
+        let p = self.model.predict_one(&self.row)?;
+        let velocity = [p.velocity[0] as f64, p.velocity[1] as f64];
+        self.made.push(Regressed {
+            frame: frames.last_frame() as usize,
+            placement: p.placement,
+            velocity,
+        });
+        Ok(Some(Regression {
+            velocity,
+            label: Some(p.placement as u32),
+        }))
+    }
+}
+
+fn track_online(seq: &Sequence, model: &Cascade, opts: &TrackOptions) -> Result<Track> {
+    let config = TrackerConfig {
+        correction: opts.correction,
+        regress_every: opts.regress_every,
+        ..TrackerConfig::default()
+    };
+    let mut regressor = CascadeRegressor::new(model)?;
+    let mut tracker = Tracker::new(config, &mut regressor)
+        .map_err(|e| PipelineError::sequence(seq.name(), e.to_string()))?;
+    let n = seq.len();
+    let (mut position, mut velocity, mut bias) = (
+        Vec::with_capacity(n),
+        Vec::with_capacity(n),
+        Vec::with_capacity(n),
+    );
+    for i in 0..n {
+        let sample = Sample {
+            time: seq.time()[i],
+            gyro: seq.gyro()[i],
+            linacce: seq.linacce()[i],
+            gravity: seq.gravity()[i],
+            orientation: seq.orientation()[i],
+        };
+        let update = tracker
+            .push(&sample)
+            .map_err(|e| PipelineError::sequence(seq.name(), format!("frame {i}: {e}")))?;
+        position.push(update.pose.position);
+        velocity.push(update.pose.velocity);
+        bias.push(tracker.bias());
+    }
+    drop(tracker);
+    Ok(Track {
+        time: seq.time().to_vec(),
+        position,
+        velocity,
+        bias,
+        regressions: regressor.made,
+        placement_names: model.placements().to_vec(),
+    })
+}

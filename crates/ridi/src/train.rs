@@ -1,0 +1,197 @@
+//! Training: features and targets of labelled sequences, then the regression cascade.
+
+use std::collections::BTreeSet;
+
+use rayon::prelude::*;
+use ridi_data::Sequence;
+use ridi_features::{
+    FeatureConfig, FeatureExtractor, FeatureMatrix, GroundTruthView, ImuView, SampleSchedule,
+    Standardization, compute_targets,
+};
+use ridi_regress::{
+    Cascade, CascadeParams, GridSpec, MatrixRef, Progress, RegressorChoice, TrainingSet,
+};
+use serde::{Deserialize, Serialize};
+
+use crate::error::{PipelineError, Result};
+
+/// Which regressor hyper-parameters to search.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+pub enum GridChoice {
+    /// The paper's grid: C in {0.1, 1, 10, 100} x epsilon in {0.001, 0.01, 0.1, 1}, 3 folds.
+    Paper,
+    /// C in {1, 10} x epsilon in {0.01, 0.1}, 3 folds: a quick check.
+    Small,
+    /// No search: C = 10, epsilon = 0.01 for every placement and channel.
+    None,
+}
+
+impl GridChoice {
+    /// The regressor choice of this grid.
+    pub fn regressors(self) -> RegressorChoice {
+        match self {
+            GridChoice::Paper => RegressorChoice::Grid(GridSpec::default()),
+            GridChoice::Small => RegressorChoice::Grid(GridSpec {
+                c: vec![1.0, 10.0],
+                epsilon: vec![0.01, 0.1],
+                ..GridSpec::default()
+            }),
+            GridChoice::None => RegressorChoice::Fixed {
+                c: 10.0,
+                epsilon: 0.01,
+            },
+        }
+    }
+}
+
+/// How to train.
+#[derive(Debug, Clone, PartialEq)]
+pub struct TrainOptions {
+    /// Feature configuration (its `standardization` is filled in when `standardize` is set).
+    pub features: FeatureConfig,
+    /// Learn a per-dimension z-scoring on the training features (not in the paper; it made
+    /// the placement classifier markedly better on the Tyrex data).
+    pub standardize: bool,
+    /// Cascade hyper-parameters.
+    pub cascade: CascadeParams,
+}
+
+impl Default for TrainOptions {
+    fn default() -> Self {
+        Self {
+            features: FeatureConfig::default(),
+            standardize: true,
+            cascade: CascadeParams {
+                regressors: GridChoice::Paper.regressors(),
+                ..CascadeParams::default()
+            },
+        }
+    }
+}
+
+/// Features, targets and labels of a training set, one row per sample.
+#[derive(Debug, Clone, PartialEq)]
+pub struct TrainingData {
+    /// Features (`n x dim`), not standardized.
+    pub features: FeatureMatrix,
+    /// Targets `[S-x, S-z]`, m/s.
+    pub targets: Vec<[f32; 2]>,
+    /// Placement index of each sample into `placement_names`.
+    pub placements: Vec<usize>,
+    /// Placement names, sorted.
+    pub placement_names: Vec<String>,
+    /// Index of the sequence each sample comes from.
+    pub groups: Vec<u64>,
+}
+
+/// The IMU streams of `seq` as feature input.
+pub fn imu_view(seq: &Sequence) -> Result<ImuView<'_>> {
+    Ok(ImuView::new(seq.gyro(), seq.linacce(), seq.gravity())?)
+}
+
+/// Ground truth of `seq` as target input; an error names the sequence when it has none.
+pub fn ground_truth_view(seq: &Sequence) -> Result<GroundTruthView<'_>> {
+    let gt = seq
+        .ground_truth()
+        .ok_or_else(|| PipelineError::sequence(seq.name(), "has no ground truth"))?;
+    Ok(GroundTruthView {
+        time: seq.time(),
+        position: &gt.position,
+        orientation: &gt.orientation,
+        gravity: seq.gravity(),
+    })
+}
+
+/// Features and targets of every sequence at the training schedule of `config` (standardization
+/// in `config` is ignored: it is learned from this data).
+pub fn training_data(seqs: &[Sequence], config: &FeatureConfig) -> Result<TrainingData> {
+    let config = FeatureConfig {
+        standardization: None,
+        ..config.clone()
+    };
+    let names: BTreeSet<&str> = seqs
+        .iter()
+        .map(|s| {
+            s.placement().ok_or_else(|| {
+                PipelineError::sequence(
+                    s.name(),
+                    "has no placement label (give it in the list file)",
+                )
+            })
+        })
+        .collect::<Result<_>>()?;
+    let names: Vec<String> = names.into_iter().map(str::to_string).collect();
+    let schedule = SampleSchedule::training(&config)?;
+    let fx = FeatureExtractor::new(config.clone())?;
+    let per_seq: Vec<(FeatureMatrix, Vec<[f32; 2]>)> = seqs
+        .par_iter()
+        .map(|s| {
+            let frames = schedule.frames(s.len());
+            let features = fx.features(&fx.stabilize(&imu_view(s)?)?, &frames)?;
+            let targets = compute_targets(&ground_truth_view(s)?, &config, &frames)?;
+            let t = targets
+                .values
+                .iter()
+                .map(|v| [v[0] as f32, v[1] as f32])
+                .collect();
+            Ok((features, t))
+        })
+        .collect::<Result<_>>()?;
+    let mut data = TrainingData {
+        features: FeatureMatrix::zeros(0, fx.dim()),
+        targets: Vec::new(),
+        placements: Vec::new(),
+        placement_names: names,
+        groups: Vec::new(),
+    };
+    for (g, (seq, (features, targets))) in seqs.iter().zip(per_seq).enumerate() {
+        let p = data
+            .placement_names
+            .iter()
+            .position(|n| Some(n.as_str()) == seq.placement())
+            .unwrap_or_default();
+        data.features.append(&features)?;
+        data.placements
+            .extend(std::iter::repeat_n(p, targets.len()));
+        data.groups
+            .extend(std::iter::repeat_n(g as u64, targets.len()));
+        data.targets.extend(targets);
+    }
+    if data.targets.is_empty() {
+        return Err(PipelineError::sequence(
+            seqs.first().map(|s| s.name()).unwrap_or("(none)"),
+            format!(
+                "no training sample: every sequence is shorter than the {}-frame window",
+                config.window
+            ),
+        ));
+    }
+    Ok(data)
+}
+
+/// Trains the cascade on labelled sequences (placement and ground truth required).
+pub fn train(
+    seqs: &[Sequence],
+    opts: &TrainOptions,
+    progress: &mut dyn Progress,
+) -> Result<Cascade> {
+    let mut data = training_data(seqs, &opts.features)?;
+    let mut config = FeatureConfig {
+        standardization: None,
+        ..opts.features.clone()
+    };
+    if opts.standardize {
+        let s = Standardization::fit([&data.features])?;
+        s.apply(&mut data.features)?;
+        config.standardization = Some(s);
+    }
+    let set = TrainingSet {
+        features: MatrixRef::new(data.features.as_slice(), data.features.cols())?,
+        targets: &data.targets,
+        placements: &data.placements,
+        placement_names: &data.placement_names,
+        groups: &data.groups,
+        feature_config: &config,
+    };
+    Ok(Cascade::train(&set, &opts.cascade, progress)?)
+}

@@ -1,0 +1,170 @@
+//! End to end on the bundled sample: train, track (batch and online), evaluate.
+
+use std::path::{Path, PathBuf};
+
+use ridi::data::{ReadOptions, Sequence, load_list};
+use ridi::regress::{NoProgress, model_file};
+use ridi::{EvalOptions, GridChoice, Method, PlacementMap, TrackOptions, TrainOptions};
+
+fn sample() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../../datasets/sample")
+}
+
+fn load(list: &str) -> Vec<Sequence> {
+    let mut seqs = load_list(sample().join(list), &ReadOptions::default()).unwrap();
+    PlacementMap::tyrex_groups().apply(&mut seqs);
+    seqs
+}
+
+fn quick_model(seqs: &[Sequence]) -> ridi::regress::Cascade {
+    let mut opts = TrainOptions::default();
+    opts.cascade.regressors = GridChoice::None.regressors();
+    ridi::train(seqs, &opts, &mut NoProgress).unwrap()
+}
+
+#[test]
+fn train_track_and_evaluate_on_the_sample() {
+    let train = load("list_train.txt");
+    let test = load("list_test.txt");
+    assert_eq!((train.len(), test.len()), (16, 8));
+    let model = quick_model(&train);
+    assert_eq!(model.placements(), ["hand", "pocket", "running", "swing"]);
+
+    // The model file round-trips and keeps the feature configuration (with standardization).
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("m.ridi");
+    model_file::save(&model, &path).unwrap();
+    let back = model_file::load(&path).unwrap();
+    assert_eq!(back, model);
+    assert!(back.feature_config().standardization.is_some());
+
+    let (report, traces) = ridi::evaluate(&test, &model, &EvalOptions::default()).unwrap();
+    assert_eq!(report.sequences.len(), 8);
+    assert_eq!(traces.len(), 8);
+    let ridi = report.summary["ridi"];
+    let raw = report.summary["raw"];
+    let still = report.summary["still"];
+    // What the method is for: far better than double integration and than standing still on
+    // short-window drift, with velocities of the right size.
+    assert!(
+        ridi.rte_5s_m < 0.5 * raw.rte_5s_m,
+        "{ridi:?} vs raw {raw:?}"
+    );
+    assert!(
+        ridi.rte_5s_m < still.rte_5s_m,
+        "{ridi:?} vs still {still:?}"
+    );
+    let ratio = ridi.path_length_ratio.unwrap();
+    assert!((0.5..1.5).contains(&ratio), "path length ratio {ratio}");
+    assert!(
+        report.velocity_mse.iter().all(|m| *m < 0.5),
+        "{:?}",
+        report.velocity_mse
+    );
+    assert!(report.placement_accuracy.unwrap() > 0.6);
+
+    // Report files: the keys the issue names.
+    let written = report.write(dir.path()).unwrap();
+    assert_eq!(written.len(), 2);
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.path().join("report.json")).unwrap())
+            .unwrap();
+    let seq = &json["sequences"][0];
+    for key in [
+        "name",
+        "placement",
+        "path_length_m",
+        "placement_accuracy",
+        "velocity_mse",
+    ] {
+        assert!(!seq[key].is_null(), "missing {key}");
+    }
+    assert_eq!(seq["velocity_mse"].as_array().unwrap().len(), 2);
+    for m in Method::ALL {
+        let metrics = &seq["methods"][m.key()];
+        for key in [
+            "mpe_m",
+            "mpe_pct",
+            "ate_m",
+            "rte_m",
+            "ate_ronin_m",
+            "rte_ronin_m",
+            "rte_5s_m",
+            "path_length_ratio",
+        ] {
+            assert!(metrics.get(key).is_some(), "{} lacks {key}", m.key());
+        }
+        assert!(json["summary"][m.key()]["rte_5s_m"].is_number());
+    }
+    let md = std::fs::read_to_string(dir.path().join("report.md")).unwrap();
+    assert!(md.contains("## Per placement") && md.contains("| ridi |"));
+
+    // Plots of one sequence.
+    let files = traces[0].plot(dir.path(), "svg").unwrap();
+    assert_eq!(files.len(), 2);
+    assert!(
+        std::fs::read_to_string(&files[0])
+            .unwrap()
+            .contains("ground truth")
+    );
+}
+
+#[test]
+fn online_tracking_stays_close_to_batch_tracking() {
+    let train = load("list_Guillaume.txt");
+    let model = quick_model(&train);
+    let seq = &load("list_Jakob.txt")[7]; // Texting
+    let batch = ridi::track(seq, &model, &TrackOptions::default()).unwrap();
+    let online = ridi::track(
+        seq,
+        &model,
+        &TrackOptions {
+            online: true,
+            ..TrackOptions::default()
+        },
+    )
+    .unwrap();
+    assert_eq!(batch.time.len(), seq.len());
+    assert_eq!(online.time.len(), seq.len());
+    // Both regress at the same frames with the same features (batched GEMM and single-query
+    // kernels differ in f32 rounding only).
+    assert_eq!(batch.regressions.len(), online.regressions.len());
+    for (a, b) in batch.regressions.iter().zip(&online.regressions) {
+        assert_eq!(a.frame, b.frame);
+        assert!((a.velocity[0] - b.velocity[0]).abs() < 1e-3, "{a:?} {b:?}");
+        assert_eq!(a.placement, b.placement);
+    }
+    // The live trajectory differs from the global solve, but not wildly over 24 s.
+    let end = seq.len() - 1;
+    let gap = (batch.position[end] - online.position[end]).norm();
+    assert!(gap < 5.0, "online ends {gap} m from batch");
+    assert!(online.position.iter().all(|p| p.is_finite()));
+
+    let dir = tempfile::tempdir().unwrap();
+    let csv = dir.path().join("t.csv");
+    batch.write_csv(&csv).unwrap();
+    let text = std::fs::read_to_string(&csv).unwrap();
+    assert!(text.starts_with("time,pos_x,pos_y,pos_z,vel_x,vel_y,vel_z,placement,bias_x"));
+    assert_eq!(text.lines().count(), seq.len() + 1);
+}
+
+#[test]
+fn training_without_labels_or_ground_truth_names_the_sequence() {
+    let mut seqs = load("list_Thibaud.txt");
+    seqs[2].set_placement(None);
+    let name = seqs[2].name().to_string();
+    let err = ridi::train(&seqs, &TrainOptions::default(), &mut NoProgress)
+        .unwrap_err()
+        .to_string();
+    assert!(err.contains(&name) && err.contains("placement"), "{err}");
+
+    // A sequence too short for one window gives a clear error, not a panic.
+    let short: Vec<Sequence> = load("list_Thibaud.txt")
+        .iter()
+        .map(|s| s.slice(0..150))
+        .collect();
+    let err = ridi::train(&short, &TrainOptions::default(), &mut NoProgress)
+        .unwrap_err()
+        .to_string();
+    assert!(err.contains("window"), "{err}");
+}

@@ -1,0 +1,121 @@
+//! `cargo xtask sample`: the small real sample bundled in `datasets/sample`, cut from the Tyrex
+//! smartphone benchmark and converted to the RIDI processed layout.
+//!
+//! Every person and motion of the Nexus 5 runs, `SECONDS` seconds each from the longest usable
+//! part of the run (skipping its first `SKIP_S` seconds, where the mocap and the walker
+//! settle), written as gzip-compressed `data.csv.gz` with `f32` precision to stay under 15 MB.
+//! List files: one per person, `list_all.txt`, and the demo split `list_train.txt` (Guillaume,
+//! Jakob) / `list_test.txt` (Thibaud). Placements are the motion names.
+
+use std::path::Path;
+
+use anyhow::{Context, Result, bail};
+use ridi_data::tyrex::{self, TyrexOptions};
+use ridi_data::{Precision, write_atomically, write_ridi_csv_with};
+
+/// Seconds kept per run.
+pub const SECONDS: f64 = 24.0;
+/// Seconds skipped at the start of the chosen part.
+pub const SKIP_S: f64 = 5.0;
+/// People held out for the demo's test split.
+pub const TEST_PEOPLE: [&str; 1] = ["Thibaud"];
+
+/// One run of the sample, sorted by person then name.
+#[derive(Debug, PartialEq, Eq, PartialOrd, Ord)]
+struct Entry {
+    person: String,
+    name: String,
+    motion: String,
+}
+
+/// Builds the sample from the Tyrex root `data` into `out` (replacing its sequence folders and
+/// lists; other files such as the licence are left alone).
+pub fn build(data: &Path, out: &Path) -> Result<()> {
+    let runs = tyrex::list_sequences(data)?;
+    let mut lines: Vec<Entry> = Vec::new();
+    std::fs::create_dir_all(out).with_context(|| format!("creating {}", out.display()))?;
+    for dir in runs {
+        let name = dir
+            .file_name()
+            .unwrap_or_default()
+            .to_string_lossy()
+            .into_owned();
+        if !name.contains("_Nexus5_NoDist_") {
+            continue;
+        }
+        let read = tyrex::read(&dir, &TyrexOptions::default())?;
+        let Some(part) = read
+            .sequences
+            .iter()
+            .max_by(|a, b| a.duration().total_cmp(&b.duration()))
+        else {
+            bail!("{}: no usable part", dir.display());
+        };
+        let t0 = part.time()[0];
+        let skip = if part.duration() >= SKIP_S + SECONDS {
+            SKIP_S
+        } else {
+            0.0
+        };
+        let first = part.time().partition_point(|&t| t < t0 + skip);
+        let last = part.time().partition_point(|&t| t < t0 + skip + SECONDS);
+        if last <= first + 1 {
+            bail!("{}: part too short", dir.display());
+        }
+        let mut seq = part.slice(first..last);
+        seq.set_name(name.clone());
+        let folder = out.join(&name).join("processed");
+        std::fs::create_dir_all(&folder)?;
+        write_ridi_csv_with(&seq, folder.join("data.csv.gz"), Precision::F32)?;
+        let person = name.split('_').next().unwrap_or_default().to_string();
+        let motion = seq.placement().unwrap_or_default().to_string();
+        println!(
+            "{name}: {:.1} s from {:.1} s, {} frames",
+            seq.duration(),
+            skip,
+            seq.len()
+        );
+        lines.push(Entry {
+            person,
+            name,
+            motion,
+        });
+    }
+    lines.sort();
+    let people: std::collections::BTreeSet<&str> =
+        lines.iter().map(|l| l.person.as_str()).collect();
+    let mut lists: Vec<(String, Vec<&Entry>)> = vec![
+        ("all".into(), lines.iter().collect()),
+        (
+            "train".into(),
+            lines
+                .iter()
+                .filter(|l| !TEST_PEOPLE.contains(&l.person.as_str()))
+                .collect(),
+        ),
+        (
+            "test".into(),
+            lines
+                .iter()
+                .filter(|l| TEST_PEOPLE.contains(&l.person.as_str()))
+                .collect(),
+        ),
+    ];
+    for p in people {
+        lists.push((
+            p.to_string(),
+            lines.iter().filter(|l| l.person == p).collect(),
+        ));
+    }
+    for (key, entries) in lists {
+        let path = out.join(format!("list_{key}.txt"));
+        write_atomically(&path, |w| {
+            writeln!(w, "# written by `cargo xtask sample`: path,placement")?;
+            for e in entries {
+                writeln!(w, "{},{}", e.name, e.motion)?;
+            }
+            Ok(())
+        })?;
+    }
+    Ok(())
+}
