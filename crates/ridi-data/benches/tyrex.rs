@@ -1,6 +1,6 @@
 //! Reading the Tyrex benchmark from `../shared` (beside the checkout): one QTM `.mat`, one run
 //! (phone text files + `.mat` -> resampled 200 Hz sequence) and all 24 runs. Without the shared
-//! data it prints a note and measures nothing. Numbers: docs/bench-tyrex.md.
+//! data it prints a note and measures nothing. Numbers: docs/benchmarks.md.
 //!
 //! `cargo bench -p ridi-data --bench tyrex -- --warm-up-time 1 --measurement-time 5`
 

@@ -250,7 +250,7 @@ fn all_24_sequences_read_fast_with_plausible_content() {
     }
     let elapsed = started.elapsed();
     eprintln!("24 sequences read in {elapsed:.2?}");
-    // Seconds even in the test profile; release is much faster (docs/bench-tyrex.md).
+    // Seconds even in the test profile; release is much faster (docs/benchmarks.md).
     assert!(elapsed.as_secs_f64() < 30.0);
 }
 

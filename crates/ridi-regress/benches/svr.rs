@@ -1,6 +1,6 @@
 //! Criterion benchmarks on synthetic IMU-like data (`benches/synth.rs`). Long runs (17k-sample
 //! fits, full grid, scikit-learn comparison) are in `examples/svr_timing.rs` and
-//! `docs/bench-regress.md`.
+//! `docs/benchmarks.md`.
 
 mod synth;
 
