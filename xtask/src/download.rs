@@ -74,7 +74,7 @@ fn header<'a>(resp: &'a ureq::http::Response<ureq::Body>, name: &str) -> Option<
 pub struct Request<'a> {
     pub url: &'a str,
     pub part: &'a Path,
-    /// Identifies the content (see [`PartSource`]).
+    /// Identifies the content (see `PartSource`).
     pub key: String,
     pub expected_size: Option<u64>,
     pub progress: bool,
