@@ -4,6 +4,7 @@ use std::process::ExitCode;
 use anyhow::Result;
 use clap::{Parser, Subcommand};
 
+mod bench;
 mod eval_orientation;
 mod eval_tyrex;
 mod sample;
@@ -81,6 +82,19 @@ enum Task {
         /// Report to write [default: <workspace>/docs/bench-orientation.md].
         #[arg(long, value_name = "FILE")]
         out: Option<PathBuf>,
+    },
+    /// Run the benchmark set (criterion benches, correction latency, `ridi demo`), write a JSON
+    /// report and docs/bench-latest.md, and compare with benchmarks/baseline.json.
+    Bench {
+        /// Short measurement times and a subset of the benches.
+        #[arg(long)]
+        quick: bool,
+        /// Report to write [default: <target dir>/bench-report.json].
+        #[arg(long, value_name = "FILE")]
+        json: Option<PathBuf>,
+        /// Rewrite benchmarks/baseline.json from this run instead of comparing with it.
+        #[arg(long)]
+        update_baseline: bool,
     },
 }
 
@@ -161,6 +175,15 @@ fn run(cli: Cli) -> Result<()> {
             let out = eval_orientation::run(data, out)?;
             println!("wrote {}", out.display());
         }
+        Task::Bench {
+            quick,
+            json,
+            update_baseline,
+        } => bench::run(bench::Options {
+            quick,
+            json,
+            update_baseline,
+        })?,
     }
     Ok(())
 }
