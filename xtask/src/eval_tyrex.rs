@@ -141,13 +141,7 @@ fn oracle_rte(seq: &Sequence, opts: &EvalOptions) -> Result<f64> {
         })
         .collect();
     let est = trajectory(Method::Ridi, seq, &regs, opts.track.correction)?;
-    let gt = seq.ground_truth().map(|g| {
-        g.position
-            .iter()
-            .map(|p| [p.x(), p.y()])
-            .collect::<Vec<_>>()
-    });
-    let gt = gt.context("no ground truth")?;
+    let gt = seq.ground_truth().context("no ground truth")?.horizontal();
     Ok(
         evaluate_trajectory(seq.time(), &est, &gt, &EvalConfig::default())?
             .metrics

@@ -441,10 +441,7 @@ fn print_training(model: &Cascade) {
 fn plot_track(seq: &Sequence, track: &ridi::Track, path: &Path) -> Result<()> {
     use ridi::plot::{Trajectory, TrajectoryOptions, TrajectoryPlot, plot_trajectories};
     let est = track.horizontal();
-    let gt: Option<Vec<[f64; 2]>> = seq.ground_truth().map(|gt| {
-        let gt2: Vec<[f64; 2]> = gt.position.iter().map(|p| [p.x(), p.y()]).collect();
-        gt2
-    });
+    let gt = seq.ground_truth().map(|gt| gt.horizontal());
     // With ground truth, show the estimate aligned on the first 10 s, as evaluations do.
     let shown = match &gt {
         Some(gt) => ridi::eval::align_trajectory(seq.time(), &est, gt, Default::default())?.1,

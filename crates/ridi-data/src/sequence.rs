@@ -42,6 +42,13 @@ pub struct GroundTruth {
     pub orientation: Vec<WorldFromDevice>,
 }
 
+impl GroundTruth {
+    /// The horizontal path, `[x, y]` per frame: what trajectories are evaluated against.
+    pub fn horizontal(&self) -> Vec<[f64; 2]> {
+        self.position.iter().map(|p| [p.x(), p.y()]).collect()
+    }
+}
+
 /// Everything a [`Sequence`] is made of, before validation.
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct SequenceParts {

@@ -113,10 +113,6 @@ pub fn device_heading(seq: &Sequence) -> Vec<f64> {
         .collect()
 }
 
-fn horizontal(p: &[WorldVec]) -> Vec<[f64; 2]> {
-    p.iter().map(|p| [p.x(), p.y()]).collect()
-}
-
 /// Mean horizontal ground-truth speed, m/s.
 fn mean_speed(seq: &Sequence) -> Result<f64> {
     let len = seq
@@ -187,7 +183,7 @@ pub fn trajectory(
             let gt = seq
                 .ground_truth()
                 .ok_or_else(|| PipelineError::sequence(seq.name(), "has no ground truth"))?;
-            let path = ridi_eval::path_length(&horizontal(&gt.position))?;
+            let path = ridi_eval::path_length(&gt.horizontal())?;
             let step_length = if steps.is_empty() {
                 0.0
             } else {

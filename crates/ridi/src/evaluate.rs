@@ -112,7 +112,7 @@ fn evaluate_one(seq: &Sequence, model: &Cascade, opts: &EvalOptions) -> Result<E
     let gt = seq
         .ground_truth()
         .ok_or_else(|| PipelineError::sequence(seq.name(), "has no ground truth to evaluate"))?;
-    let gt2: Vec<[f64; 2]> = gt.position.iter().map(|p| [p.x(), p.y()]).collect();
+    let gt2 = gt.horizontal();
     let regressions: Vec<Regressed> = if opts.methods.iter().any(|m| m.needs_model()) {
         regress(seq, model, opts.track.regress_every)?
     } else {
