@@ -169,7 +169,7 @@ pub fn run(opts: Options) -> Result<()> {
 
     eprintln!("bench: ridi demo");
     cargo(&root, &["build", "--release", "-p", "ridi-cli"])?;
-    figures.extend(time_demo(&target.join("release/ridi"))?);
+    figures.extend(time_demo(&target.join("release/ridi"), &root, opts.quick)?);
 
     let mut command = String::from("cargo xtask bench");
     if opts.quick {
@@ -368,24 +368,98 @@ fn children_cpu_seconds() -> Option<f64> {
     Some((ticks(13)? + ticks(14)?) / 100.0)
 }
 
-/// Wall and CPU time of `ridi demo` on the bundled sample.
-fn time_demo(ridi: &Path) -> Result<Vec<Figure>> {
+/// Runs `cmd` to completion: wall seconds and peak resident memory (VmHWM, KiB, sampled every
+/// 5 ms from /proc while it runs; VmHWM only grows, so the last sample is the peak up to then).
+fn run_measured(cmd: &mut Command) -> Result<(f64, Option<f64>)> {
+    let t0 = Instant::now();
+    let mut child = cmd
+        .stdout(std::process::Stdio::null())
+        .spawn()
+        .context("starting a ridi command")?;
+    let status_file = format!("/proc/{}/status", child.id());
+    let mut peak = None;
+    let status = loop {
+        if let Some(kb) = std::fs::read_to_string(&status_file).ok().and_then(|s| {
+            s.lines()
+                .find_map(|l| l.strip_prefix("VmHWM:"))
+                .and_then(|v| v.trim().trim_end_matches("kB").trim().parse::<f64>().ok())
+        }) {
+            peak = Some(kb);
+        }
+        if let Some(status) = child.try_wait()? {
+            break status;
+        }
+        std::thread::sleep(std::time::Duration::from_millis(5));
+    };
+    if !status.success() {
+        bail!("{cmd:?} failed: {status}");
+    }
+    Ok((t0.elapsed().as_secs_f64(), peak))
+}
+
+/// End-to-end figures with the built `ridi` binary on the bundled sample: `ridi demo` (train
+/// 16 runs without grid search, evaluate 8), with `--grid small` in full mode, and tracking
+/// throughput, batch and streaming, with the demo's model on one 24 s run.
+fn time_demo(ridi: &Path, root: &Path, quick: bool) -> Result<Vec<Figure>> {
     let out = tempfile::tempdir()?;
     let c0 = children_cpu_seconds();
-    let t0 = Instant::now();
-    let status = Command::new(ridi)
-        .args(["demo", "--plots", "none", "--out"])
-        .arg(out.path())
-        .stdout(std::process::Stdio::null())
-        .status()
-        .with_context(|| format!("running {}", ridi.display()))?;
-    let wall = t0.elapsed().as_secs_f64();
-    if !status.success() {
-        bail!("ridi demo failed: {status}");
-    }
+    let (wall, peak) = run_measured(
+        Command::new(ridi)
+            .args(["demo", "--plots", "none", "--out"])
+            .arg(out.path()),
+    )?;
     let mut figures = vec![figure("e2e/demo_wall", wall, "s", false)];
     if let (Some(a), Some(b)) = (c0, children_cpu_seconds()) {
         figures.push(figure("e2e/demo_cpu", b - a, "s", true));
+    }
+    if let Some(kb) = peak {
+        figures.push(figure("e2e/demo_peak_rss", kb / 1024.0, "MiB", false));
+    }
+    if !quick {
+        let grid_out = tempfile::tempdir()?;
+        let (wall, peak) = run_measured(
+            Command::new(ridi)
+                .args(["demo", "--plots", "none", "--grid", "small", "--out"])
+                .arg(grid_out.path()),
+        )?;
+        figures.push(figure("e2e/demo_grid_small_wall", wall, "s", false));
+        if let Some(kb) = peak {
+            figures.push(figure(
+                "e2e/demo_grid_small_peak_rss",
+                kb / 1024.0,
+                "MiB",
+                false,
+            ));
+        }
+    }
+    let run = root.join("datasets/sample/Thibaud_Nexus5_NoDist_Texting");
+    let frames = 4800.0;
+    for (mode, extra) in [("batch", None), ("online", Some("--online"))] {
+        let mut cmd = Command::new(ridi);
+        cmd.arg("track")
+            .arg(&run)
+            .arg("--model")
+            .arg(out.path().join("model.ridi"))
+            .arg("--out")
+            .arg(out.path().join(format!("{mode}.csv")));
+        if let Some(flag) = extra {
+            cmd.arg(flag);
+        }
+        let (wall, peak) = run_measured(&mut cmd)?;
+        figures.push(figure(
+            &format!("e2e/track_{mode}_frames_per_s"),
+            frames / wall,
+            "frames/s",
+            false,
+        ));
+        if let Some(kb) = peak {
+            figures.push(figure(
+                &format!("e2e/track_{mode}_peak_rss"),
+                kb / 1024.0,
+                "MiB",
+                false,
+            ));
+        }
     }
     Ok(figures)
 }
