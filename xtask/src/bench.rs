@@ -171,6 +171,15 @@ pub fn run(opts: Options) -> Result<()> {
     cargo(&root, &["build", "--release", "-p", "ridi-cli"])?;
     figures.extend(time_demo(&target.join("release/ridi"), &root, opts.quick)?);
 
+    // The accuracy protocol's reference variant, where the Tyrex data are present (full mode).
+    let shared = root.join("../shared/data/raw/tyrex-attitude-smartphones");
+    if !opts.quick && shared.is_dir() {
+        eprintln!("bench: accuracy protocol (eval-tyrex --quick)");
+        let out = target.join("bench-accuracy.md");
+        crate::eval_tyrex::run(Some(shared), Some(out.clone()), true)?;
+        eprintln!("bench: accuracy report in {}", out.display());
+    }
+
     let mut command = String::from("cargo xtask bench");
     if opts.quick {
         command.push_str(" --quick");
@@ -601,6 +610,34 @@ pub fn markdown(report: &Report, comparisons: &[Comparison]) -> String {
             vs
         );
     }
+    let value = |name: &str| {
+        report
+            .figures
+            .iter()
+            .find(|f| f.name == name)
+            .map_or("-".to_string(), |f| {
+                format!("{} {}", significant(f.value), f.unit)
+            })
+    };
+    let _ = writeln!(s, "\n## Beside the paper's figures (i7-4790)\n");
+    let _ = writeln!(s, "| what | paper | this run |\n| --- | --- | --- |");
+    let _ = writeln!(
+        s,
+        "| overall tracking throughput | 2,000 frames/s | {} batch, {} online (incl. reading the csv and the model) |",
+        value("e2e/track_batch_frames_per_s"),
+        value("e2e/track_online_frames_per_s")
+    );
+    let _ = writeln!(
+        s,
+        "| one online correction (1,000-frame window) | 15 ms | {} (CPU), p99 {} |",
+        value("correct/window_1000_cpu"),
+        value("correct/window_1000_p99_wall")
+    );
+    let _ = writeln!(
+        s,
+        "| one SVR regression | 19 ms | {} (whole cascade query, full mode only) |",
+        value("regress/cascade_predict_one_wall")
+    );
     s
 }
 
