@@ -351,6 +351,15 @@ pub fn parse_latency(out: &str) -> Result<Vec<Figure>> {
             if let Some(v) = number_after(line, "p99 ") {
                 figures.push(figure("correct/window_1000_p99_wall", v, "ms", false));
             }
+        } else if line.starts_with("update latency (inline)") {
+            // "correcting frames n=594 p50=0.0488 ms p99=0.0711 ms ...": the streaming update
+            // that includes a window correction, the one that matters for latency.
+            if let Some(v) = number_after(line, "p50=") {
+                figures.push(figure("correct/update_p50_wall", v, "ms", false));
+            }
+            if let Some(v) = number_after(line, "p99=") {
+                figures.push(figure("correct/update_p99_wall", v, "ms", false));
+            }
         } else if line.starts_with("one-hour stream (inline)") {
             let frames = number_after(line, "one-hour stream (inline): ");
             if let (Some(n), Some(cpu)) = (frames, number_after(line, "calling thread CPU ")) {
@@ -666,13 +675,16 @@ mod tests {
                    10-minute global solve: wall 5.950 ms, CPU 3.070 ms (mean of 300)\n\
                    10-minute global solve + integration: wall 9.000 ms, CPU 8.000 ms (mean of 100)\n\
                    1000-frame window solve: wall 0.0400 ms, CPU 0.0300 ms (mean of 20,000)\n\
-                   1000-frame window solve, wall per call: p50 0.0300 ms, p99 0.0340 ms, p99.9 0.1 ms\n";
+                   1000-frame window solve, wall per call: p50 0.0300 ms, p99 0.0340 ms, p99.9 0.1 ms\n\
+                   update latency (inline), 10 min stream: correcting frames n=594 p50=0.0488 ms p99=0.0711 ms max=0.0896 ms; other frames p50=0.00006 ms\n";
         let f = parse_latency(out).unwrap();
         let get = |n: &str| f.iter().find(|x| x.name == n).unwrap().value;
         assert_eq!(get("correct/global_10min_cpu"), 3.07);
         assert_eq!(get("correct/global_10min_wall"), 5.95);
         assert_eq!(get("correct/window_1000_cpu"), 0.03);
         assert_eq!(get("correct/window_1000_p99_wall"), 0.034);
+        assert_eq!(get("correct/update_p50_wall"), 0.0488);
+        assert_eq!(get("correct/update_p99_wall"), 0.0711);
         assert!((get("correct/stream_inline_cpu") - 0.22e9 / 720000.0).abs() < 1e-9);
         assert!(parse_latency("nothing").is_err());
     }
