@@ -74,6 +74,39 @@ pub(crate) struct Table {
     pub has_ground_truth: bool,
 }
 
+/// Parses one data line of the processed layout: `cells()` yields its cells, `column_of(c)`
+/// says which of the [`COLUMNS`] cell `c` holds (`None`: not read), `width` is how many cells a
+/// line must have and `width_error(n)` the error for a line with `n`. Columns no cell fills stay
+/// NaN. A cut line often ends in a partial cell, so a bad number on a line of the wrong width
+/// is reported as the wrong width.
+pub(crate) fn parse_row<'a, I: Iterator<Item = &'a str>>(
+    cells: impl Fn() -> I,
+    column_of: impl Fn(usize) -> Option<usize>,
+    width: usize,
+    width_error: impl Fn(usize) -> DataError,
+    path: &Path,
+    line: usize,
+) -> Result<[f64; 27]> {
+    let mut row = [f64::NAN; 27];
+    let mut fields = 0;
+    for (c, cell) in cells().enumerate() {
+        if let Some(k) = column_of(c) {
+            row[k] =
+                text::number(cell, path, line, COLUMNS[k], nan_policy(k)).map_err(
+                    |e| match cells().count() {
+                        n if n != width => width_error(n),
+                        _ => e,
+                    },
+                )?;
+        }
+        fields = c + 1;
+    }
+    if fields != width {
+        return Err(width_error(fields));
+    }
+    Ok(row)
+}
+
 /// Sequence name from a file path: the capture folder for `<name>/processed/data.csv` and
 /// `<name>/data.csv` (also `data_plain.txt`, and both gzipped), the file stem otherwise.
 pub(crate) fn name_from_path(path: &Path) -> String {

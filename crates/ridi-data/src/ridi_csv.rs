@@ -112,24 +112,14 @@ fn parse_table(text: &str, path: &Path) -> Result<Table> {
             )
         };
         // Columns that are not in the file stay NaN; assemble never reads them.
-        let mut row = [f64::NAN; 27];
-        let mut fields = 0;
-        for (c, cell) in text::cells(content, b',').enumerate() {
-            if let Some(&Some(k)) = header.slots.get(c) {
-                let policy = processed::nan_policy(k);
-                row[k] = text::number(cell, path, line, COLUMNS[k], policy).map_err(|e| {
-                    // A cut line often ends in a partial cell: say so rather than blame it.
-                    match text::cells(content, b',').count() {
-                        n if n != width => width_error(n),
-                        _ => e,
-                    }
-                })?;
-            }
-            fields = c + 1;
-        }
-        if fields != width {
-            return Err(width_error(fields));
-        }
+        let row = processed::parse_row(
+            || text::cells(content, b','),
+            |c| header.slots.get(c).copied().flatten(),
+            width,
+            width_error,
+            path,
+            line,
+        )?;
         rows.push(row);
         row_lines.push(line);
     }

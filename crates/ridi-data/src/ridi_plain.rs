@@ -80,24 +80,14 @@ fn parse_table(text: &str, path: &Path) -> Result<Table> {
                 ),
             )
         };
-        let mut row = [f64::NAN; 27];
-        let mut fields = 0;
-        for (k, cell) in content.split_ascii_whitespace().enumerate() {
-            if let Some(slot) = row.get_mut(k) {
-                let policy = processed::nan_policy(k);
-                *slot = text::number(cell, path, line, COLUMNS[k], policy).map_err(|e| {
-                    // A cut line often ends in a partial cell: say so rather than blame it.
-                    match content.split_ascii_whitespace().count() {
-                        n if n != width => width_error(n),
-                        _ => e,
-                    }
-                })?;
-            }
-            fields = k + 1;
-        }
-        if fields != width {
-            return Err(width_error(fields));
-        }
+        let row = processed::parse_row(
+            || content.split_ascii_whitespace(),
+            |k| (k < COLUMNS.len()).then_some(k),
+            width,
+            width_error,
+            path,
+            line,
+        )?;
         rows.push(row);
         row_lines.push(line);
         last_line = line;

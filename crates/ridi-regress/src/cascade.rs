@@ -415,9 +415,15 @@ impl Cascade {
     /// Classifies and regresses every row of `x` (batched GEMM path).
     pub fn predict(&self, x: MatrixRef<'_>) -> Result<Vec<Prediction>, RegressError> {
         self.check_dim(x)?;
+        Ok(self.predict_blocks(x, None))
+    }
+
+    /// Predictions of every row, `QUERY_BLOCK` rows per GEMM, blocks in parallel; `placement`
+    /// skips the classifier.
+    fn predict_blocks(&self, x: MatrixRef<'_>, placement: Option<usize>) -> Vec<Prediction> {
         let mut out = vec![
             Prediction {
-                placement: 0,
+                placement: placement.unwrap_or(0),
                 velocity: [0.0; 2]
             };
             x.rows()
@@ -426,9 +432,9 @@ impl Cascade {
             .enumerate()
             .for_each(|(b, o)| {
                 let r0 = b * QUERY_BLOCK;
-                self.predict_block(x.rows_range(r0, r0 + o.len()), None, o);
+                self.predict_block(x.rows_range(r0, r0 + o.len()), placement, o);
             });
-        Ok(out)
+        out
     }
 
     /// Regresses every row of `x` with the regressors of a known placement (skips the
@@ -445,20 +451,11 @@ impl Cascade {
                 self.classes.len()
             )));
         }
-        let mut out = vec![
-            Prediction {
-                placement,
-                velocity: [0.0; 2]
-            };
-            x.rows()
-        ];
-        out.par_chunks_mut(QUERY_BLOCK)
-            .enumerate()
-            .for_each(|(b, o)| {
-                let r0 = b * QUERY_BLOCK;
-                self.predict_block(x.rows_range(r0, r0 + o.len()), Some(placement), o);
-            });
-        Ok(out.into_iter().map(|p| p.velocity).collect())
+        Ok(self
+            .predict_blocks(x, Some(placement))
+            .into_iter()
+            .map(|p| p.velocity)
+            .collect())
     }
 
     fn check_dim(&self, x: MatrixRef<'_>) -> Result<(), RegressError> {

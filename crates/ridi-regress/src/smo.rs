@@ -769,20 +769,11 @@ mod hot {
         masked_max_neg_generic(v, mask)
     }
 
+    /// Common end of both `masked_max_neg` kernels: reduce the vector lanes, take the scalar
+    /// tail from `k`, then find the first position of the maximum.
     #[inline(always)]
-    fn masked_max_neg_generic(v: &[f64], mask: &[f64]) -> (f64, usize) {
-        const L: usize = 8;
-        let n = v.len().min(mask.len());
-        let (v, mask) = (&v[..n], &mask[..n]);
-        let mut lanes = [f64::NEG_INFINITY; L];
-        let mut k = 0;
-        while k + L <= n {
-            for l in 0..L {
-                let m = mask[k + l] - v[k + l];
-                lanes[l] = if m > lanes[l] { m } else { lanes[l] };
-            }
-            k += L;
-        }
+    fn finish_masked_max(lanes: &[f64], v: &[f64], mask: &[f64], mut k: usize) -> (f64, usize) {
+        let n = v.len();
         let mut best = lanes
             .iter()
             .fold(f64::NEG_INFINITY, |a, &b| if b > a { b } else { a });
@@ -800,6 +791,23 @@ mod hot {
             .find(|&k| mask[k] - v[k] == best)
             .unwrap_or(usize::MAX);
         (best, pos)
+    }
+
+    #[inline(always)]
+    fn masked_max_neg_generic(v: &[f64], mask: &[f64]) -> (f64, usize) {
+        const L: usize = 8;
+        let n = v.len().min(mask.len());
+        let (v, mask) = (&v[..n], &mask[..n]);
+        let mut lanes = [f64::NEG_INFINITY; L];
+        let mut k = 0;
+        while k + L <= n {
+            for l in 0..L {
+                let m = mask[k + l] - v[k + l];
+                lanes[l] = if m > lanes[l] { m } else { lanes[l] };
+            }
+            k += L;
+        }
+        finish_masked_max(&lanes, v, mask, k)
     }
 
     #[cfg(target_arch = "x86_64")]
@@ -824,23 +832,7 @@ mod hot {
         let mut lanes = [0.0f64; 4];
         // SAFETY: `lanes` holds four f64.
         unsafe { _mm256_storeu_pd(lanes.as_mut_ptr(), acc) };
-        let mut best = lanes
-            .iter()
-            .fold(f64::NEG_INFINITY, |a, &b| if b > a { b } else { a });
-        while k < n {
-            let m = mask[k] - v[k];
-            if m > best {
-                best = m;
-            }
-            k += 1;
-        }
-        if best == f64::NEG_INFINITY {
-            return (best, usize::MAX);
-        }
-        let pos = (0..n)
-            .find(|&k| mask[k] - v[k] == best)
-            .unwrap_or(usize::MAX);
-        (best, pos)
+        finish_masked_max(&lanes, v, mask, k)
     }
 
     #[cfg(target_arch = "x86_64")]

@@ -41,8 +41,9 @@ type Written = (Vec<Converted>, Vec<String>);
 /// The sources under `source`: one sequence, the runs of a Tyrex root, or the sequences one
 /// level below a folder (a RIDI dataset folder).
 fn sources(source: &Path, from: Option<Format>) -> Result<Vec<PathBuf>, DataError> {
+    let detected = detect(source).ok();
     if from.is_none_or(|f| f == Format::Tyrex) {
-        if detect(source).is_ok_and(|f| f == Format::Tyrex) {
+        if detected == Some(Format::Tyrex) {
             return Ok(vec![source.to_path_buf()]);
         }
         if let Ok(runs) = tyrex::list_sequences(source) {
@@ -52,7 +53,7 @@ fn sources(source: &Path, from: Option<Format>) -> Result<Vec<PathBuf>, DataErro
             return tyrex::list_sequences(source);
         }
     }
-    if detect(source).is_ok() {
+    if detected.is_some() {
         return Ok(vec![source.to_path_buf()]);
     }
     let entries = std::fs::read_dir(source).map_err(|e| DataError::io(source, e))?;

@@ -37,12 +37,15 @@ pub fn read_any(
             })
         }
         _ => {
-            let found = detect(path)?;
-            if found != format {
-                return Err(DataError::format(
-                    ridi_data::Location::file(path),
-                    format!("expected a {format}, found a {found}"),
-                ));
+            // A forced format must match what is there; a detected one does by construction.
+            if from.is_some() {
+                let found = detect(path)?;
+                if found != format {
+                    return Err(DataError::format(
+                        ridi_data::Location::file(path),
+                        format!("expected a {format}, found a {found}"),
+                    ));
+                }
             }
             Ok(Loaded {
                 format,
