@@ -3,8 +3,14 @@
 //! ```text
 //! cargo run --release -p ridi-regress --example svr_timing -- <task> <n> [options]
 //!   tasks: svr | svc | grid | cascade | query | export <dir>
+//!          | load-query <path>
 //!   options: --c C --eps E --placements K --mem-mb M --never-precompute
+//!            --save <path> (grid, cascade, query: save the trained model)
+//!            --queries Q (load-query: held-out queries, default 2000)
 //! ```
+//! `query <n> --save <path>` trains the cascade with fixed `C`/epsilon (no grid) and saves it;
+//! `load-query <n> <path>` loads it and times prediction on one core and batched, on the
+//! held-out sequences generated after the `n` training rows.
 //! `RAYON_NUM_THREADS=1` gives one-core numbers. Peak memory is the process's VmHWM.
 
 #[path = "../benches/synth.rs"]
@@ -53,6 +59,9 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     }
     if args.iter().any(|a| a == "--precompute-classifier") {
         solver.classifier_kernel = Precompute::Auto;
+    }
+    if task == "load-query" {
+        return load_query(&args, n, k);
     }
     let t = Instant::now();
     let data = synth::generate(n, k, 150, 42);
@@ -144,8 +153,18 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             };
             let model = Cascade::train(&set, &params, &mut progress)?;
             let train = t.elapsed().as_secs_f64();
+            if let Some(path) = args
+                .iter()
+                .position(|a| a == "--save")
+                .and_then(|i| args.get(i + 1))
+            {
+                ridi_regress::model_file::save(&model, std::path::Path::new(path))?;
+                let mb = std::fs::metadata(path)?.len() as f64 / 1e6;
+                println!("saved {path}: {mb:.1} MB");
+            }
+            let grid_iterations: usize = model.grid_results().iter().map(|r| r.iterations).sum();
             println!(
-                "cascade n={n} k={k} threads={threads}: train {train:.1} s, peak {:.0} MB",
+                "cascade n={n} k={k} threads={threads}: train {train:.1} s, peak {:.0} MB, {grid_iterations} grid iterations",
                 peak_mb()
             );
             for (p, name) in names.iter().enumerate() {
@@ -225,5 +244,106 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         }
         other => return Err(format!("unknown task {other}").into()),
     }
+    Ok(())
+}
+
+/// CPU time of the calling thread, seconds (`/proc/thread-self/schedstat`).
+fn thread_cpu_s() -> f64 {
+    std::fs::read_to_string("/proc/thread-self/schedstat")
+        .ok()
+        .and_then(|s| s.split_whitespace().next()?.parse::<f64>().ok())
+        .map_or(f64::NAN, |ns| ns * 1e-9)
+}
+
+/// Times `predict_one` over `rows` (in that order) on the calling thread: (wall, CPU) seconds
+/// per query.
+fn time_one(model: &Cascade, q: MatrixRef<'_>, rows: &[usize]) -> Result<(f64, f64), String> {
+    let (t, c) = (Instant::now(), thread_cpu_s());
+    for &i in rows {
+        std::hint::black_box(model.predict_one(q.row(i)).map_err(|e| e.to_string())?);
+    }
+    let n = rows.len() as f64;
+    Ok((t.elapsed().as_secs_f64() / n, (thread_cpu_s() - c) / n))
+}
+
+fn load_query(args: &[String], n: usize, k: usize) -> Result<(), Box<dyn std::error::Error>> {
+    let path = args.get(2).ok_or("load-query needs a model path")?;
+    let nq: usize = arg(args, "--queries", 2000);
+    let t = Instant::now();
+    let model = ridi_regress::model_file::load(std::path::Path::new(path))?;
+    let stored: Vec<usize> = (0..k).map(|p| model.stored_samples(p)).collect();
+    println!(
+        "{path}: {:.1} MB, loaded in {:.2} s; stored samples {stored:?}",
+        std::fs::metadata(path)?.len() as f64 / 1e6,
+        t.elapsed().as_secs_f64()
+    );
+    // Held-out sequences: the ones the generator makes after the `n` training rows (same
+    // placement signatures). Stream order: consecutive queries mostly share a placement, as
+    // when tracking; the shuffled order changes placement at random.
+    let all = synth::generate(n + nq, k, 150, 42);
+    let dim = all.dim;
+    let held_x = all.x[n * dim..].to_vec();
+    let held_p = all.placement[n..].to_vec();
+    drop(all);
+    // Peak memory from here on: the model and the queries, not the generator's data.
+    std::fs::write("/proc/self/clear_refs", "5")?;
+    let q = MatrixRef::new(&held_x, dim)?;
+    let stream: Vec<usize> = (0..nq).collect();
+    let mut shuffled = stream.clone();
+    let mut s = 0x2545_f491_4f6c_dd1du64;
+    for i in (1..nq).rev() {
+        s ^= s << 13;
+        s ^= s >> 7;
+        s ^= s << 17;
+        shuffled.swap(i, (s % (i as u64 + 1)) as usize);
+    }
+    let one = rayon::ThreadPoolBuilder::new().num_threads(1).build()?;
+    let (warm, cold, batch1) = one.install(|| -> Result<_, String> {
+        time_one(&model, q, &stream[..nq.min(200)])?;
+        let warm = time_one(&model, q, &stream)?;
+        let cold = time_one(&model, q, &shuffled)?;
+        let (t, c) = (Instant::now(), thread_cpu_s());
+        model.predict(q).map_err(|e| e.to_string())?;
+        Ok((warm, cold, (t.elapsed().as_secs_f64(), thread_cpu_s() - c)))
+    })?;
+    let t = Instant::now();
+    let batch = model.predict(q)?;
+    let bt = t.elapsed().as_secs_f64();
+    let acc = batch
+        .iter()
+        .zip(&held_p)
+        .filter(|(a, b)| a.placement == **b)
+        .count() as f64
+        / nq as f64;
+    println!(
+        "predict_one, one thread, {nq} held-out queries: stream order {:.3} ms wall / {:.3} ms CPU, \
+         shuffled {:.3} ms wall / {:.3} ms CPU per query",
+        warm.0 * 1e3,
+        warm.1 * 1e3,
+        cold.0 * 1e3,
+        cold.1 * 1e3
+    );
+    println!(
+        "batched: one thread {:.0} queries/s wall ({:.0} CPU); {} threads {:.0} queries/s wall; \
+         placement accuracy {acc:.4}; peak {:.0} MB",
+        nq as f64 / batch1.0,
+        nq as f64 / batch1.1,
+        rayon::current_num_threads(),
+        nq as f64 / bt,
+        peak_mb()
+    );
+    let train = synth::generate(n, k, 150, 42);
+    let t = Instant::now();
+    let r = model.rounding_effect(MatrixRef::new(&train.x, dim)?, q)?;
+    println!(
+        "half-precision samples vs exact f32 rows ({:.1} s): placement agreement {:.4}, \
+         max |dv| {:.2e} / {:.2e}, mean |dv| {:.2e} / {:.2e} m/s",
+        t.elapsed().as_secs_f64(),
+        r.placement_agreement,
+        r.max_velocity_diff[0],
+        r.max_velocity_diff[1],
+        r.mean_velocity_diff[0],
+        r.mean_velocity_diff[1]
+    );
     Ok(())
 }

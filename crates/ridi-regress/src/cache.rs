@@ -5,6 +5,8 @@ use std::ops::Deref;
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::{Arc, Mutex};
 
+use rayon::prelude::*;
+
 use crate::kernel;
 use crate::matrix::MatrixRef;
 
@@ -55,6 +57,17 @@ impl FullKernel {
             n: x.rows(),
             data: kernel::gram(x, norms, gamma),
         }
+    }
+
+    /// The block of `rows` at base samples `idx` (rows and columns), as a kernel of its own.
+    pub(crate) fn block(rows: &dyn KernelRows, idx: &[usize]) -> Self {
+        let m = idx.len();
+        let mut data = vec![0.0f32; m * m];
+        let cols: Vec<u32> = idx.iter().map(|&i| i as u32).collect();
+        data.par_chunks_mut(m.max(1))
+            .zip(idx)
+            .for_each(|(out, &i)| crate::smo::gather(&rows.row(i), &cols, out));
+        Self { n: m, data }
     }
 
     /// Bytes needed for `n` samples.
@@ -271,5 +284,21 @@ mod tests {
         // The prefetch is capped at a quarter of the capacity (rows 0 and 1); then 0 and the
         // repeated 3s hit, the other five rows are computed.
         assert_eq!((hits, computed), (3, 7));
+    }
+
+    #[test]
+    fn block_is_the_sub_matrix() {
+        let v: Vec<f32> = (0..30 * 4).map(|k| (k as f32 * 0.3).sin()).collect();
+        let x = Matrix::new(v, 4).unwrap();
+        let full = FullKernel::new(x.view(), &kernel::sq_norms(x.view()), 0.5);
+        let idx = [29, 3, 4, 17, 0];
+        let block = FullKernel::block(&full, &idx);
+        assert_eq!(block.len(), idx.len());
+        for (a, &i) in idx.iter().enumerate() {
+            let (r, f) = (block.row(a), full.row(i));
+            for (b, &j) in idx.iter().enumerate() {
+                assert_eq!(r[b], f[j]);
+            }
+        }
     }
 }

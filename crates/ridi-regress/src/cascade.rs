@@ -1,11 +1,18 @@
 //! The RIDI cascade: a placement classifier, then two epsilon-SVRs per placement for the two
 //! horizontal velocity components in the stabilized frame S.
 //!
-//! Storage: each placement keeps its samples once, ordered so that the classifier's support
-//! vectors of that placement come first, followed by the other samples that either regressor
-//! uses. Prediction computes the squared distances of a query block to the classifier part of
-//! every placement with one GEMM per placement, classifies, and then reuses those distances for
-//! the regressors of the predicted placement (a second GEMM covers only its remaining samples).
+//! Storage: each placement keeps its samples once, in half precision (IEEE binary16: a query
+//! is bound by the bytes it streams), ordered so that the classifier's support vectors of
+//! that placement come first, followed by the other samples that either regressor uses.
+//! Prediction computes the squared distances of a query to the classifier part of every
+//! placement, classifies, and then reuses those distances for the regressors of the predicted
+//! placement, so every stored row is read once. Batches go through GEMM (rows widened to `f32`
+//! a tile at a time); a single query streams the rows once with a fused half-precision GEMV
+//! and reuses thread-local buffers.
+
+use std::cell::RefCell;
+use std::collections::HashMap;
+use std::hash::{DefaultHasher, Hash, Hasher};
 
 use rayon::prelude::*;
 use ridi_features::FeatureConfig;
@@ -14,6 +21,7 @@ use serde::{Deserialize, Serialize};
 use crate::config::{self, SolverConfig};
 use crate::error::RegressError;
 use crate::expansion::weighted_sums;
+use crate::f16mat::{F16_MAX, F16Matrix};
 use crate::grid::{self, GridRow, GridSpec};
 use crate::kernel;
 use crate::matrix::{Matrix, MatrixRef};
@@ -23,6 +31,10 @@ use crate::svr::{self, FitInfo};
 
 /// Queries per block in batched prediction (bounds temporaries to a few MB).
 const QUERY_BLOCK: usize = 256;
+
+/// Stored rows widened to `f32` per GEMM call in batched prediction (a 9.8 MB temporary at
+/// dim 1200; two column tiles of `cross_kernel`, so both cores get work on a small batch).
+const WIDEN_ROWS: usize = 2048;
 
 /// How the RBF width is chosen.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -142,7 +154,9 @@ pub(crate) struct ClassifierHead {
 /// and both regressors.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub(crate) struct ClassModel {
-    pub samples: Matrix,
+    pub samples: F16Matrix,
+    /// Squared norms of the rounded samples: recomputed on load, not stored.
+    #[serde(skip)]
     pub norms: Vec<f32>,
     pub n_classifier: usize,
     /// `n_classifier × pairs` row-major.
@@ -154,6 +168,44 @@ pub(crate) struct ClassModel {
     pub reg_params: [(f64, f64); 2],
     pub reg_info: [FitInfo; 2],
     pub n_train: usize,
+}
+
+/// How far the half-precision sample storage moves predictions: the stored model against the
+/// same model evaluated with the exact `f32` training rows ([`Cascade::rounding_effect`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct RoundingEffect {
+    /// Queries compared.
+    pub queries: usize,
+    /// Share of the queries given the same placement by both.
+    pub placement_agreement: f64,
+    /// Largest absolute velocity difference per channel (queries with the same placement).
+    pub max_velocity_diff: [f32; 2],
+    /// Mean absolute velocity difference per channel (queries with the same placement).
+    pub mean_velocity_diff: [f64; 2],
+}
+
+/// Where the batched path reads a placement's sample rows as `f32`.
+#[derive(Clone, Copy)]
+enum Rows<'a> {
+    /// The stored half-precision rows, widened a tile at a time.
+    Stored,
+    /// Exact rows in the stored order with their squared norms (reference evaluation).
+    Exact(&'a [(Matrix, Vec<f32>)]),
+}
+
+/// Buffers of the single-query path, kept per thread so that a query allocates nothing.
+#[derive(Default)]
+struct Scratch {
+    /// Squared distances to the classifier rows of every placement, one after the other.
+    dist: Vec<f32>,
+    kv: Vec<f32>,
+    dec: Vec<f64>,
+    tmp: Vec<f64>,
+    votes: Vec<u32>,
+}
+
+thread_local! {
+    static SCRATCH: RefCell<Scratch> = RefCell::default();
 }
 
 /// A trained cascade (what the model file holds).
@@ -202,6 +254,21 @@ fn check_training_set(
         return Err(RegressError::Shape(format!(
             "feature config describes {fd} values per row, features have {}",
             data.features.dim()
+        )));
+    }
+    if let Some(pos) = data
+        .features
+        .as_slice()
+        .iter()
+        .position(|v| v.abs() > F16_MAX)
+    {
+        let d = data.features.dim();
+        return Err(RegressError::NonFinite(format!(
+            "feature value {} at row {}, column {} exceeds the half-precision range of the \
+             model (±{F16_MAX}); standardize the features",
+            data.features.as_slice()[pos],
+            pos / d,
+            pos % d
         )));
     }
     if let Some(i) = data
@@ -306,7 +373,7 @@ impl Cascade {
                         &targets,
                         &groups,
                         spec,
-                        &params.solver.smo,
+                        &params.solver,
                         name,
                         progress,
                     )
@@ -404,23 +471,84 @@ impl Cascade {
                 self.dim
             )));
         }
-        let mut out = [Prediction {
-            placement: 0,
-            velocity: [0.0; 2],
-        }];
-        self.predict_block(m, None, &mut out);
-        Ok(out[0])
+        Ok(SCRATCH.with(|s| self.predict_single(q, &mut s.borrow_mut())))
+    }
+
+    /// The single-query path: one streaming pass over the classifier rows of every placement
+    /// and the remaining rows of the chosen one. Same arithmetic as [`Self::predict_block`]
+    /// except for the summation order inside the dot products.
+    fn predict_single(&self, q: &[f32], s: &mut Scratch) -> Prediction {
+        let qn = kernel::dot(q, q);
+        let k = self.classes.len();
+        let offsets: Vec<usize> = self
+            .classes
+            .iter()
+            .scan(0, |o, cl| {
+                let start = *o;
+                *o += cl.n_classifier;
+                Some(start)
+            })
+            .collect();
+        let total: usize = self.classes.iter().map(|cl| cl.n_classifier).sum();
+        s.dist.resize(total, 0.0);
+        let placement = match &self.classifier {
+            None => 0,
+            Some(head) => {
+                let np = head.pairs.len();
+                s.dec.clear();
+                s.dec.resize(np, 0.0);
+                for (cl, &off) in self.classes.iter().zip(&offsets) {
+                    let nc = cl.n_classifier;
+                    let d = &mut s.dist[off..off + nc];
+                    cl.samples.dots(q, 0, d);
+                    kernel::dist_from_dots(d, qn, &cl.norms[..nc]);
+                    s.kv.resize(nc, 0.0);
+                    kernel::exp_neg_scaled(d, head.gamma, &mut s.kv);
+                    s.tmp.resize(np, 0.0);
+                    weighted_sum(&s.kv, &cl.clf_coef, &mut s.tmp);
+                    s.dec.iter_mut().zip(&s.tmp).for_each(|(a, b)| *a += b);
+                }
+                s.dec.iter_mut().zip(&head.rho).for_each(|(v, r)| *v -= r);
+                s.votes.resize(k, 0);
+                svc::vote(&s.dec, &head.pairs, k, &mut s.votes)
+            }
+        };
+        let cl = &self.classes[placement];
+        let ns = cl.samples.rows();
+        // Without a classifier no distance was computed yet.
+        let reuse = if self.classifier.is_some() {
+            cl.n_classifier
+        } else {
+            0
+        };
+        let off = offsets[placement];
+        s.kv.resize(ns, 0.0);
+        let (head, rest) = s.kv.split_at_mut(reuse);
+        kernel::exp_neg_scaled(&s.dist[off..off + reuse], self.regressor_gamma, head);
+        cl.samples.dots(q, reuse, rest);
+        kernel::rbf_from_dots(rest, qn, &cl.norms[reuse..], self.regressor_gamma);
+        let mut v = [0.0f64; 2];
+        weighted_sum(&s.kv, &cl.reg_coef, &mut v);
+        Prediction {
+            placement,
+            velocity: [(v[0] - cl.reg_rho[0]) as f32, (v[1] - cl.reg_rho[1]) as f32],
+        }
     }
 
     /// Classifies and regresses every row of `x` (batched GEMM path).
     pub fn predict(&self, x: MatrixRef<'_>) -> Result<Vec<Prediction>, RegressError> {
         self.check_dim(x)?;
-        Ok(self.predict_blocks(x, None))
+        Ok(self.predict_blocks(Rows::Stored, x, None))
     }
 
     /// Predictions of every row, `QUERY_BLOCK` rows per GEMM, blocks in parallel; `placement`
     /// skips the classifier.
-    fn predict_blocks(&self, x: MatrixRef<'_>, placement: Option<usize>) -> Vec<Prediction> {
+    fn predict_blocks(
+        &self,
+        rows: Rows<'_>,
+        x: MatrixRef<'_>,
+        placement: Option<usize>,
+    ) -> Vec<Prediction> {
         let mut out = vec![
             Prediction {
                 placement: placement.unwrap_or(0),
@@ -432,7 +560,7 @@ impl Cascade {
             .enumerate()
             .for_each(|(b, o)| {
                 let r0 = b * QUERY_BLOCK;
-                self.predict_block(x.rows_range(r0, r0 + o.len()), placement, o);
+                self.predict_block(rows, x.rows_range(r0, r0 + o.len()), placement, o);
             });
         out
     }
@@ -452,7 +580,7 @@ impl Cascade {
             )));
         }
         Ok(self
-            .predict_blocks(x, Some(placement))
+            .predict_blocks(Rows::Stored, x, Some(placement))
             .into_iter()
             .map(|p| p.velocity)
             .collect())
@@ -469,23 +597,132 @@ impl Cascade {
         Ok(())
     }
 
-    fn predict_block(&self, q: MatrixRef<'_>, forced: Option<usize>, out: &mut [Prediction]) {
+    /// Compares [`Self::predict`] with the same model evaluated with exact `f32` samples: each
+    /// stored row is matched to the row of `training` (the rows the model was trained on)
+    /// that rounds to it. Fails when a stored row has no match.
+    pub fn rounding_effect(
+        &self,
+        training: MatrixRef<'_>,
+        queries: MatrixRef<'_>,
+    ) -> Result<RoundingEffect, RegressError> {
+        self.check_dim(training)?;
+        self.check_dim(queries)?;
+        let key = |bits: &[u16]| {
+            let mut h = DefaultHasher::new();
+            bits.hash(&mut h);
+            h.finish()
+        };
+        let rounded = |i: usize| F16Matrix::from_rows(training, &[i]);
+        let mut by_key: HashMap<u64, Vec<usize>> = HashMap::new();
+        for i in 0..training.rows() {
+            by_key
+                .entry(key(rounded(i).row_bits(0)))
+                .or_default()
+                .push(i);
+        }
+        let mut exact = Vec::with_capacity(self.classes.len());
+        for (p, cl) in self.classes.iter().enumerate() {
+            let idx = (0..cl.samples.rows())
+                .map(|j| {
+                    let bits = cl.samples.row_bits(j);
+                    by_key
+                        .get(&key(bits))
+                        .and_then(|c| c.iter().find(|&&i| rounded(i).row_bits(0) == bits))
+                        .copied()
+                        .ok_or_else(|| {
+                            RegressError::Shape(format!(
+                                "stored sample {j} of placement {p} is not a training row"
+                            ))
+                        })
+                })
+                .collect::<Result<Vec<usize>, _>>()?;
+            let m = training.select(&idx);
+            let norms = kernel::sq_norms(m.view());
+            exact.push((m, norms));
+        }
+        let stored = self.predict_blocks(Rows::Stored, queries, None);
+        let reference = self.predict_blocks(Rows::Exact(&exact), queries, None);
+        let mut same = 0usize;
+        let mut max = [0.0f32; 2];
+        let mut sum = [0.0f64; 2];
+        for (a, b) in stored.iter().zip(&reference) {
+            if a.placement != b.placement {
+                continue;
+            }
+            same += 1;
+            for ch in 0..2 {
+                let d = (a.velocity[ch] - b.velocity[ch]).abs();
+                max[ch] = max[ch].max(d);
+                sum[ch] += d as f64;
+            }
+        }
+        let n = stored.len();
+        Ok(RoundingEffect {
+            queries: n,
+            placement_agreement: same as f64 / n.max(1) as f64,
+            max_velocity_diff: max,
+            mean_velocity_diff: sum.map(|s| s / same.max(1) as f64),
+        })
+    }
+
+    /// `out (q.rows() × (r1 - r0))`: squared distances (`gamma` `None`) or kernel values from
+    /// the queries to sample rows `r0..r1` of placement `p`.
+    #[allow(clippy::too_many_arguments)]
+    fn class_block(
+        &self,
+        rows: Rows<'_>,
+        p: usize,
+        q: MatrixRef<'_>,
+        qn: &[f32],
+        (r0, r1): (usize, usize),
+        gamma: Option<f32>,
+        out: &mut [f32],
+    ) {
+        let run = |b: MatrixRef<'_>, nb: &[f32], o: &mut [f32]| match gamma {
+            Some(g) => kernel::cross_kernel(q, qn, b, nb, g, o),
+            None => kernel::cross_sq_dist(q, qn, b, nb, o),
+        };
+        let cl = &self.classes[p];
+        let (m, w) = (q.rows(), r1 - r0);
+        match rows {
+            Rows::Exact(ex) => run(ex[p].0.view().rows_range(r0, r1), &ex[p].1[r0..r1], out),
+            Rows::Stored => {
+                let mut wide = Vec::new();
+                let mut tile = Vec::new();
+                for t0 in (r0..r1).step_by(WIDEN_ROWS) {
+                    let t1 = (t0 + WIDEN_ROWS).min(r1);
+                    cl.samples.rows_f32(t0, t1, &mut wide);
+                    let b = MatrixRef::trusted(&wide, self.dim);
+                    if t1 - t0 == w {
+                        run(b, &cl.norms[t0..t1], out);
+                        continue;
+                    }
+                    tile.resize(m * (t1 - t0), 0.0);
+                    run(b, &cl.norms[t0..t1], &mut tile);
+                    for (o, t) in out.chunks_exact_mut(w).zip(tile.chunks_exact(t1 - t0)) {
+                        o[t0 - r0..t1 - r0].copy_from_slice(t);
+                    }
+                }
+            }
+        }
+    }
+
+    fn predict_block(
+        &self,
+        rows: Rows<'_>,
+        q: MatrixRef<'_>,
+        forced: Option<usize>,
+        out: &mut [Prediction],
+    ) {
         let m = q.rows();
         let qn = kernel::sq_norms(q);
         // Squared distances to the classifier part of each placement.
-        let dists: Vec<Vec<f32>> = self
-            .classes
-            .iter()
-            .map(|cl| {
-                let mut d = vec![0.0f32; m * cl.n_classifier];
-                if forced.is_none() && cl.n_classifier > 0 {
-                    kernel::cross_sq_dist(
-                        q,
-                        &qn,
-                        cl.samples.view().rows_range(0, cl.n_classifier),
-                        &cl.norms[..cl.n_classifier],
-                        &mut d,
-                    );
+        let dists: Vec<Vec<f32>> = (0..self.classes.len())
+            .map(|p| {
+                let nc = self.classes[p].n_classifier;
+                let mut d = vec![0.0f32; m * nc];
+                if forced.is_none() && nc > 0 {
+                    self.class_block(rows, p, q, &qn, (0, nc), None, &mut d);
                 }
                 d
             })
@@ -542,12 +779,13 @@ impl Cascade {
                 let qv = qs.as_ref().map_or(q, |s| s.view());
                 let qsn: Vec<f32> = sel.iter().map(|&i| qn[i]).collect();
                 let mut block = vec![0.0f32; sel.len() * (ns - start)];
-                kernel::cross_kernel(
+                self.class_block(
+                    rows,
+                    p,
                     qv,
                     &qsn,
-                    cl.samples.view().rows_range(start, ns),
-                    &cl.norms[start..],
-                    self.regressor_gamma,
+                    (start, ns),
+                    Some(self.regressor_gamma),
                     &mut block,
                 );
                 for r in 0..sel.len() {
@@ -564,6 +802,15 @@ impl Cascade {
                 ];
             }
         }
+    }
+
+    /// Recomputes what the model file does not store (the norms of the rounded samples),
+    /// then checks consistency.
+    pub(crate) fn finish_decode(&mut self) -> Result<(), RegressError> {
+        for cl in &mut self.classes {
+            cl.norms = cl.samples.sq_norms();
+        }
+        self.check()
     }
 
     /// Consistency checks after decoding (the checksum only guards against corruption, not
@@ -643,8 +890,8 @@ fn build_class(
         (0..n)
             .filter(|&s| clf[s].is_none() && (duals[0].coef[s] != 0.0 || duals[1].coef[s] != 0.0)),
     );
-    let samples = xc.select(&order);
-    let norms = kernel::sq_norms(samples.view());
+    let samples = F16Matrix::from_rows(xc, &order);
+    let norms = samples.sq_norms();
     let clf_coef = order[..n_classifier]
         .iter()
         .flat_map(|&s| clf[s].clone().unwrap_or_default())
@@ -663,5 +910,16 @@ fn build_class(
         reg_params: chosen,
         reg_info: [duals[0].info(), duals[1].info()],
         n_train: n,
+    }
+}
+
+/// `out (k) = kvals (n) · coef (n × k)`, accumulated in f64 in the order of
+/// [`weighted_sums`] (one query: no parallel split).
+fn weighted_sum(kvals: &[f32], coef: &[f64], out: &mut [f64]) {
+    let k = out.len();
+    out.fill(0.0);
+    for (&kv, c) in kvals.iter().zip(coef.chunks_exact(k)) {
+        let kv = kv as f64;
+        out.iter_mut().zip(c).for_each(|(o, c)| *o += kv * c);
     }
 }

@@ -23,8 +23,12 @@ pub enum RegressError {
     /// The file does not start with the model magic number.
     #[error("not a ridi-regress model file (bad magic number)")]
     BadMagic,
-    /// The file was written by a newer (or unknown) format version.
-    #[error("unsupported model file version {found} (this build reads version {supported})")]
+    /// The file was written by another format version: an older one (retrain the model) or a
+    /// newer or unknown one.
+    #[error(
+        "unsupported model file version {found}: this build reads version {supported} only \
+         (retrain a model from an older build; a newer one needs a newer build)"
+    )]
     UnsupportedVersion {
         /// Version in the file.
         found: u32,

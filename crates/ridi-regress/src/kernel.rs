@@ -82,7 +82,7 @@ pub(crate) fn rbf_from_dots(out: &mut [f32], na: f32, nb: &[f32], gamma: f32) {
 }
 
 /// `out[j] = max(0, na + nb[j] - 2 out[j])`.
-fn dist_from_dots(out: &mut [f32], na: f32, nb: &[f32]) {
+pub(crate) fn dist_from_dots(out: &mut [f32], na: f32, nb: &[f32]) {
     for (o, &b) in out.iter_mut().zip(nb) {
         *o = (na + b - 2.0 * *o).max(0.0);
     }
@@ -349,11 +349,12 @@ pub(crate) fn kernel_rows(
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
     use crate::matrix::Matrix;
 
-    fn data(n: usize, d: usize) -> Matrix {
+    /// Smooth test rows of magnitude up to about 3 (shared with other modules' tests).
+    pub(crate) fn data(n: usize, d: usize) -> Matrix {
         let v: Vec<f32> = (0..n * d)
             .map(|k| ((k as f32) * 0.37).sin() * 2.0 + ((k / d) as f32 * 0.1).cos())
             .collect();

@@ -20,9 +20,10 @@
 //! All fits of a placement index one kernel over its samples: the two velocity channels, every
 //! grid point and every cross-validation fold ([`grid`]). Fits along the `C` axis start from
 //! the previous solution scaled by `C_new / C_old`. A trained [`Cascade`] stores each
-//! placement's samples once; at prediction one distance pass per placement feeds the classifier
-//! and is reused by the regressors ([`Cascade::predict`] batches with GEMM,
-//! [`Cascade::predict_one`] serves a single query).
+//! placement's samples once, in half precision (prediction is bound by the bytes it streams;
+//! [`Cascade::rounding_effect`] measures what the rounding costs); at prediction one distance
+//! pass per placement feeds the classifier and is reused by the regressors
+//! ([`Cascade::predict`] batches with GEMM, [`Cascade::predict_one`] streams the rows once).
 //!
 //! # Small or degenerate placements
 //!
@@ -87,6 +88,7 @@ pub mod cascade;
 pub mod config;
 pub mod error;
 pub(crate) mod expansion;
+pub(crate) mod f16mat;
 pub mod grid;
 pub mod kernel;
 pub mod linfa_impl;
@@ -97,7 +99,9 @@ pub mod smo;
 pub mod svc;
 pub mod svr;
 
-pub use cascade::{Cascade, CascadeParams, Gamma, Prediction, RegressorChoice, TrainingSet};
+pub use cascade::{
+    Cascade, CascadeParams, Gamma, Prediction, RegressorChoice, RoundingEffect, TrainingSet,
+};
 pub use config::{Precompute, SolverConfig};
 pub use error::RegressError;
 pub use grid::{GridRow, GridSpec};

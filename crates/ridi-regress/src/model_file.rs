@@ -10,6 +10,11 @@
 //! | 4     | CRC32 of the payload                      |
 //! | n     | payload: bincode 2 (standard config, serde) of the [`Cascade`] |
 //!
+//! Version 2 stores each placement's samples as little-endian IEEE binary16 in one byte string
+//! (version 1 stored `f32`, twice the size) and no longer stores their squared norms, which
+//! are recomputed from the rounded values on load. Version 1 files are refused with
+//! [`RegressError::UnsupportedVersion`]: retrain the model.
+//!
 //! The header is checked before the payload is decoded, so a newer version, a truncated file
 //! or a corrupt payload each give their own error. Encoding is deterministic (no maps, no
 //! timestamps), so the same model always gives the same bytes. Writing goes to a temporary
@@ -24,7 +29,7 @@ use crate::error::RegressError;
 /// File magic number.
 pub const MAGIC: [u8; 8] = *b"RIDIREG\0";
 /// Format version written and read by this build.
-pub const FORMAT_VERSION: u32 = 1;
+pub const FORMAT_VERSION: u32 = 2;
 const HEADER: usize = 8 + 4 + 8 + 4;
 /// Refuses to allocate for absurd payload lengths from a corrupt header.
 const MAX_PAYLOAD: u64 = 1 << 40;
@@ -100,13 +105,13 @@ pub fn from_bytes(bytes: &[u8]) -> Result<Cascade, RegressError> {
             found,
         });
     }
-    let (model, used): (Cascade, usize) =
+    let (mut model, used): (Cascade, usize) =
         bincode::serde::decode_from_slice(payload, bincode_config())
             .map_err(|e| RegressError::Decode(e.to_string()))?;
     if used != payload.len() {
         return Err(RegressError::Decode("payload longer than the model".into()));
     }
-    model.check()?;
+    model.finish_decode()?;
     Ok(model)
 }
 

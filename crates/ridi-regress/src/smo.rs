@@ -10,7 +10,7 @@
 //! lets the 2l variables of epsilon-SVR share l kernel rows and lets any subset of a class
 //! (a fold, a class pair) index one shared kernel.
 
-use crate::cache::KernelRows;
+use crate::cache::{KernelRows, Row};
 
 const TAU: f64 = 1e-12;
 
@@ -67,60 +67,136 @@ pub(crate) struct SmoSolution {
     pub iterations: usize,
     /// False when the iteration cap stopped the solver.
     pub converged: bool,
+    /// How often the compact kernel was built, and re-compacted after shrinking.
+    #[cfg_attr(not(test), allow(dead_code))]
+    pub compactions: (usize, usize),
 }
 
-/// Solver state. Gradients are kept as `yG_t = y_t G_t`, which makes every update sign-free:
-/// `yG_t = y_t p_t + Σ_i (y_i α_i) K_it` and `yḠ_t = C Σ_{i at upper bound} y_i K_it`.
-/// The active (unshrunk) variables are copied into compact arrays so that the two hot loops
-/// (working-set selection, gradient update) run over contiguous memory.
+/// Largest compact kernel, in values (1 GiB of `f32`).
+const COMPACT_MAX: usize = 1 << 28;
+
+/// The active list is rebuilt when shrinking leaves at most this many tenths of it.
+const RELIST_FRACTION_TENTHS: usize = 7;
+
+const NONE: u32 = u32::MAX;
+
+/// Solver state, organized by kernel base rather than by variable: the variables of one base
+/// (two for epsilon-SVR, one for C-SVC) share `yG_t - y_t p_t = Σ_i y_i α_i K_{i,t}`, so
+/// the hot loops (working-set selection, gradient update) run over the distinct active bases,
+/// with `yG` of the best member of each side folded into the masks `aup` / `alow`.
+///
+/// Kernel values at the active bases come from, in order of preference: a compact kernel over
+/// the active bases (built once the gathers it saves have cost as much as building it, and
+/// kept contiguous under shrinking by moving tail rows and columns into the holes, as libsvm's
+/// swapping does), the provider's rows as they are (when the active bases are exactly rows
+/// `0..len`), or a gather from the provider's rows.
 struct Solver<'r> {
     rows: &'r dyn KernelRows,
     c: f64,
     tol: f64,
     // Per variable, in problem order.
-    kidx: Vec<u32>,
     y: Vec<f64>,
     p: Vec<f64>,
     alpha: Vec<f64>,
     status: Vec<Status>,
-    /// `y G`, exact for inactive variables only after `sync`.
-    yg: Vec<f64>,
-    ygbar: Vec<f64>,
+    /// Base of every variable.
+    vb: Vec<u32>,
+    var_active: Vec<bool>,
+    // Per base.
+    /// Kernel row of every base.
+    pb: Vec<u32>,
+    /// The variables of every base (`NONE` when absent).
+    slots: Vec<[u32; 2]>,
+    /// `Σ_i y_i α_i K(x_i, x_b)`, so `yG_t = y_t p_t + s[vb[t]]`; exact for active bases,
+    /// for the others only after `reconstruct_gradient`.
+    s: Vec<f64>,
+    /// `C Σ_{i at upper bound} y_i K(x_i, x_b)`.
+    sbar: Vec<f64>,
+    /// `pb` is `0..rows.len()`.
+    pb_direct: bool,
     // Compact active set, by position.
     act: Vec<u32>,
     ak: Vec<u32>,
-    ayg: Vec<f64>,
-    /// 0 for members of `I_up` / `I_low`, -inf otherwise: masks as arithmetic, so the hot
-    /// loops have no branches and vectorize.
+    av: Vec<f64>,
+    /// `max -y_t p_t` over the base's active members of `I_up`, `-inf` when there is none, so
+    /// that `aup - av` is the best `-yG` of the base; `alow + av` likewise the best `yG` of
+    /// `I_low`. Arithmetic masks keep the hot loops branch-free.
     aup: Vec<f64>,
     alow: Vec<f64>,
+    /// The active bases are exactly kernel rows `0..rows.len()`, in order.
+    direct: bool,
+    /// Kernel among the active bases (row `q`, column `r` at `q * kc_stride + r`); empty when
+    /// not built.
+    kc: Vec<f32>,
+    kc_stride: usize,
+    /// Values gathered since the compact kernel was last built or dropped.
+    rent: usize,
+    compactions: (usize, usize),
+    compact_max: usize,
     /// `max_{I_up} -yG` and its position, computed by the previous gradient update.
     next_gmax: Option<(f64, usize)>,
     unshrink: bool,
-    /// Scratch: kernel values gathered at the active positions, selection scores.
+    /// Active position whose gathered row `buf_i` holds.
+    buf_i_pos: Option<usize>,
     buf_i: Vec<f32>,
     buf_j: Vec<f32>,
-    scores: Vec<f32>,
+    buf_full: Vec<f32>,
 }
 
-/// Mask value: 0 for members, -inf for non-members.
-fn pen(member: bool) -> f64 {
-    if member { 0.0 } else { f64::NEG_INFINITY }
+/// Kernel values of one row at the active bases.
+enum ActiveRow<'a> {
+    Slice(&'a [f32]),
+    Row(Row<'a>),
+}
+
+impl std::ops::Deref for ActiveRow<'_> {
+    type Target = [f32];
+    fn deref(&self) -> &[f32] {
+        match self {
+            ActiveRow::Slice(s) => s,
+            ActiveRow::Row(r) => r,
+        }
+    }
+}
+
+/// Positions `0..m` in a new order after removing the positions not in `keep`: kept positions
+/// below the new size stay, the holes take the kept positions above it (ascending). Only the
+/// moved positions change, which keeps re-compacting the kernel proportional to the moves.
+fn fill_holes(keep: &[bool]) -> Vec<usize> {
+    let m2 = keep.iter().filter(|&&k| k).count();
+    let mut tail = (m2..keep.len()).filter(|&q| keep[q]);
+    (0..m2)
+        .map(|q| if keep[q] { q } else { tail.next().unwrap_or(q) })
+        .collect()
+}
+
+/// The [`RowSrc`] of a solver, borrowing only its row-source fields (a method would borrow the
+/// whole solver, and the hot loops write other fields while the rows are in use).
+macro_rules! row_src {
+    ($s:expr) => {
+        RowSrc {
+            rows: $s.rows,
+            kc: &$s.kc,
+            kc_stride: $s.kc_stride,
+            direct: $s.direct,
+            ak: &$s.ak,
+        }
+    };
+}
+
+fn status_of(a: f64, c: f64) -> Status {
+    if a >= c {
+        Status::Upper
+    } else if a <= 0.0 {
+        Status::Lower
+    } else {
+        Status::Free
+    }
 }
 
 impl Solver<'_> {
     fn l(&self) -> usize {
         self.alpha.len()
-    }
-
-    fn status_of(&self, a: f64) -> Status {
-        if a >= self.c {
-            Status::Upper
-        } else if a <= 0.0 {
-            Status::Lower
-        } else {
-            Status::Free
-        }
     }
 
     /// Member of `I_up`: `α_t` can move in the direction that increases `y_t α_t`.
@@ -141,33 +217,81 @@ impl Solver<'_> {
         }
     }
 
+    fn yg(&self, t: usize) -> f64 {
+        self.y[t] * self.p[t] + self.s[self.vb[t] as usize]
+    }
+
+    /// Best active member of `I_up` (`low == false`) or `I_low` of base `b` and its mask value
+    /// (`(NONE, -inf)` when there is none); ties go to the first slot.
+    fn best_member(&self, b: usize, low: bool) -> (u32, f64) {
+        let mut best = (NONE, f64::NEG_INFINITY);
+        for t in self.slots[b] {
+            if t == NONE || !self.var_active[t as usize] {
+                continue;
+            }
+            let t_ = t as usize;
+            let v = self.y[t_] * self.p[t_];
+            let (ok, v) = if low {
+                (self.low_ok(t_), v)
+            } else {
+                (self.up_ok(t_), -v)
+            };
+            if ok && (best.0 == NONE || v > best.1) {
+                best = (t, v);
+            }
+        }
+        best
+    }
+
+    fn refresh_masks(&mut self, pos: usize) {
+        let b = self.act[pos] as usize;
+        self.aup[pos] = self.best_member(b, false).1;
+        self.alow[pos] = self.best_member(b, true).1;
+    }
+
     fn set_active(&mut self, list: Vec<u32>) {
-        self.ak = list.iter().map(|&t| self.kidx[t as usize]).collect();
-        self.ayg = list.iter().map(|&t| self.yg[t as usize]).collect();
-        self.aup = list.iter().map(|&t| pen(self.up_ok(t as usize))).collect();
-        self.alow = list.iter().map(|&t| pen(self.low_ok(t as usize))).collect();
+        self.ak = list.iter().map(|&b| self.pb[b as usize]).collect();
+        self.av = list.iter().map(|&b| self.s[b as usize]).collect();
         self.act = list;
+        let m = self.act.len();
+        self.aup = vec![0.0; m];
+        self.alow = vec![0.0; m];
+        for pos in 0..m {
+            self.refresh_masks(pos);
+        }
+        self.direct =
+            m == self.rows.len() && self.ak.iter().enumerate().all(|(q, &k)| k as usize == q);
         self.next_gmax = None;
+        self.buf_i_pos = None;
     }
 
     fn sync(&mut self) {
-        for (pos, &t) in self.act.iter().enumerate() {
-            self.yg[t as usize] = self.ayg[pos];
+        for (pos, &b) in self.act.iter().enumerate() {
+            self.s[b as usize] = self.av[pos];
         }
     }
 
-    /// `yG` and `yḠ` from scratch, grouped by kernel row so that a warm start with both
-    /// variables of an SVR sample nonzero still reads each row once.
+    /// Kernel row `k` at every base, into `buf_full` unless the bases are the provider's rows.
+    fn full_row(&mut self, k: usize) -> ActiveRow<'_> {
+        let row = self.rows.row(k);
+        if self.pb_direct {
+            return ActiveRow::Row(row);
+        }
+        self.buf_full.resize(self.pb.len(), 0.0);
+        hot::gather(&row, &self.pb, &mut self.buf_full);
+        ActiveRow::Slice(&self.buf_full)
+    }
+
+    /// `s` and `sbar` from scratch, one kernel row per base with a nonzero coefficient.
     fn init_gradient(&mut self) {
-        let l = self.l();
-        let nb = self.rows.len();
-        self.yg = (0..l).map(|t| self.y[t] * self.p[t]).collect();
-        self.ygbar = vec![0.0; l];
+        let nb = self.pb.len();
+        self.s = vec![0.0; nb];
+        self.sbar = vec![0.0; nb];
         let mut w = vec![0.0f64; nb];
         let mut u = vec![0.0f64; nb];
-        for t in 0..l {
+        for t in 0..self.l() {
             if self.status[t] != Status::Lower {
-                let b = self.kidx[t] as usize;
+                let b = self.vb[t] as usize;
                 w[b] += self.y[t] * self.alpha[t];
                 if self.status[t] == Status::Upper {
                     u[b] += self.y[t] * self.c;
@@ -178,21 +302,24 @@ impl Solver<'_> {
         let chunk = self.rows.batch_size().max(1);
         for part in used.chunks(chunk) {
             if chunk > 1 {
-                self.rows.prefetch(part);
+                let ks: Vec<usize> = part.iter().map(|&b| self.pb[b] as usize).collect();
+                self.rows.prefetch(&ks);
             }
             for &b in part {
-                let row = self.rows.row(b);
                 let (wb, ub) = (w[b], u[b]);
-                for t in 0..l {
-                    let k = row[self.kidx[t] as usize] as f64;
-                    self.yg[t] += wb * k;
-                    self.ygbar[t] += ub * k;
-                }
+                let mut s = std::mem::take(&mut self.s);
+                let mut sbar = std::mem::take(&mut self.sbar);
+                let row = self.full_row(self.pb[b] as usize);
+                hot::axpy1(&mut s, wb, &row);
+                hot::axpy1(&mut sbar, ub, &row);
+                drop(row);
+                self.s = s;
+                self.sbar = sbar;
             }
         }
     }
 
-    /// Prefetches the rows of the variables most likely to be picked next (largest first-order
+    /// Prefetches the rows of the bases most likely to be picked next (largest first-order
     /// violations on both sides), so that the cache computes them in one GEMM pass.
     fn prefetch_around(&self, first: usize) {
         let batch = self.rows.batch_size();
@@ -202,11 +329,11 @@ impl Solver<'_> {
         let mut up: Vec<(f64, u32)> = Vec::new();
         let mut low: Vec<(f64, u32)> = Vec::new();
         for pos in 0..self.act.len() {
-            if self.aup[pos] == 0.0 {
-                up.push((-self.ayg[pos], self.ak[pos]));
+            if self.aup[pos] > f64::NEG_INFINITY {
+                up.push((self.aup[pos] - self.av[pos], self.ak[pos]));
             }
-            if self.alow[pos] == 0.0 {
-                low.push((self.ayg[pos], self.ak[pos]));
+            if self.alow[pos] > f64::NEG_INFINITY {
+                low.push((self.av[pos] + self.alow[pos], self.ak[pos]));
             }
         }
         let half = batch / 2;
@@ -223,136 +350,141 @@ impl Solver<'_> {
         self.rows.prefetch(&want);
     }
 
+    /// Builds the compact kernel over the active bases.
+    fn build_compact(&mut self) {
+        let m = self.ak.len();
+        let mut kc = vec![0.0f32; m * m];
+        let chunk = self.rows.batch_size().max(1);
+        for (ci, part) in self.ak.chunks(chunk).enumerate() {
+            if chunk > 1 {
+                let ks: Vec<usize> = part.iter().map(|&k| k as usize).collect();
+                self.rows.prefetch(&ks);
+            }
+            for (o, &k) in part.iter().enumerate() {
+                let q = ci * chunk + o;
+                hot::gather(
+                    &self.rows.row(k as usize),
+                    &self.ak,
+                    &mut kc[q * m..(q + 1) * m],
+                );
+            }
+        }
+        self.kc = kc;
+        self.kc_stride = m;
+        self.compactions.0 += 1;
+        self.rent = 0;
+        self.buf_i_pos = None;
+    }
+
+    /// Reorders the compact kernel after shrinking: new position `q` holds old position
+    /// `order[q]`; only rows and columns that move are touched.
+    fn permute_compact(&mut self, order: &[usize]) {
+        let st = self.kc_stride;
+        let moves: Vec<(usize, usize)> = order
+            .iter()
+            .enumerate()
+            .filter(|&(q, &o)| q != o)
+            .map(|(q, &o)| (q, o))
+            .collect();
+        for (q, &o) in order.iter().enumerate() {
+            if q == o {
+                let row = &mut self.kc[q * st..(q + 1) * st];
+                for &(h, src) in &moves {
+                    row[h] = row[src];
+                }
+            } else {
+                // Row `o` lies beyond the new size, so no new row overwrites it.
+                let (head, tail) = self.kc.split_at_mut(o * st);
+                let src = &tail[..st];
+                let dst = &mut head[q * st..(q + 1) * st];
+                for (d, &oc) in dst.iter_mut().zip(order) {
+                    *d = src[oc];
+                }
+            }
+        }
+    }
+
     fn gmax(&self) -> (f64, usize) {
-        hot::masked_max_neg(&self.ayg, &self.aup)
+        hot::masked_max_neg(&self.av, &self.aup)
     }
 
-    /// WSS3 over the active set; returns active positions, `None` when optimal within `tol`.
-    fn select_working_set(&mut self) -> Option<(usize, usize)> {
+    /// WSS3 over the active bases; returns the variables `(i, j)` with their active positions
+    /// and `K_ij`, `None` when optimal within `tol`.
+    fn select_working_set(&mut self) -> Option<([(usize, usize); 2], f64)> {
+        let m = self.act.len();
+        if self.kc.is_empty() && !self.direct && self.rent >= m * m && m * m <= self.compact_max {
+            self.build_compact();
+        }
         let (gmax, pi) = self.next_gmax.take().unwrap_or_else(|| self.gmax());
-        let row_i = if pi != usize::MAX {
-            self.prefetch_around(self.ak[pi] as usize);
-            Some(self.rows.row(self.ak[pi] as usize))
-        } else {
-            None
-        };
-        let mut gmax2 = f64::NEG_INFINITY;
-        let mut pj = usize::MAX;
-        let n = self.ayg.len();
-        match &row_i {
-            Some(ri) => {
-                self.buf_i.resize(n, 0.0);
-                self.scores.resize(n, 0.0);
-                hot::gather(ri, &self.ak, &mut self.buf_i);
-                gmax2 = hot::wss_scores(&self.ayg, &self.alow, &self.buf_i, gmax, &mut self.scores);
-                if let Some(k) = hot::argmax_positive(&self.scores) {
-                    pj = k;
-                }
-            }
-            None => {
-                for k in 0..n {
-                    gmax2 = gmax2.max(self.ayg[k] + self.alow[k]);
-                }
-            }
+        if pi == usize::MAX {
+            return None;
         }
-        if gmax + gmax2 < self.tol || pj == usize::MAX {
-            None
-        } else {
-            Some((pi, pj))
+        self.prefetch_around(self.ak[pi] as usize);
+        let src = row_src!(self);
+        let (ri, rent) = src.fetch(pi, &mut self.buf_i, false);
+        let (gmax2, pj) = hot::wss_select(&self.av, &self.alow, &ri, gmax);
+        let kij = pj.map(|pj| ri[pj] as f64);
+        drop(ri);
+        self.rent += rent;
+        self.buf_i_pos = Some(pi);
+        let (pj, kij) = (pj?, kij?);
+        if gmax + gmax2 < self.tol {
+            return None;
         }
+        let i = self.best_member(self.act[pi] as usize, false).0 as usize;
+        let j = self.best_member(self.act[pj] as usize, true).0 as usize;
+        Some(([(i, pi), (j, pj)], kij))
     }
 
-    fn update_pair(&mut self, pi: usize, pj: usize) {
-        let (i, j) = (self.act[pi] as usize, self.act[pj] as usize);
-        let row_i = self.rows.row(self.kidx[i] as usize);
-        let row_j = self.rows.row(self.kidx[j] as usize);
+    /// Takes the step on pair `(i, j)` (`kij = K_ij`, from the selection's row).
+    fn update_pair(&mut self, [(i, pi), (j, pj)]: [(usize, usize); 2], kij: f64) {
         let c = self.c;
-        let kij = row_i[self.kidx[j] as usize] as f64;
         let quad = 2.0 - 2.0 * kij;
         let quad = if quad <= 0.0 { TAU } else { quad };
-        let (gi, gj) = (self.y[i] * self.ayg[pi], self.y[j] * self.ayg[pj]);
+        debug_assert!(self.act[pi] == self.vb[i] && self.act[pj] == self.vb[j]);
+        let ygi = self.y[i] * self.p[i] + self.av[pi];
+        let ygj = self.y[j] * self.p[j] + self.av[pj];
+        let (gi, gj) = (self.y[i] * ygi, self.y[j] * ygj);
         let (old_i, old_j) = (self.alpha[i], self.alpha[j]);
-        let (mut ai, mut aj) = (old_i, old_j);
-        if self.y[i] != self.y[j] {
-            let delta = (-gi - gj) / quad;
-            let diff = ai - aj;
-            ai += delta;
-            aj += delta;
-            if diff > 0.0 {
-                if aj < 0.0 {
-                    aj = 0.0;
-                    ai = diff;
-                }
-            } else if ai < 0.0 {
-                ai = 0.0;
-                aj = -diff;
-            }
-            if diff > 0.0 {
-                if ai > c {
-                    ai = c;
-                    aj = c - diff;
-                }
-            } else if aj > c {
-                aj = c;
-                ai = c + diff;
-            }
-        } else {
-            let delta = (gi - gj) / quad;
-            let sum = ai + aj;
-            ai -= delta;
-            aj += delta;
-            if sum > c {
-                if ai > c {
-                    ai = c;
-                    aj = sum - c;
-                }
-            } else if aj < 0.0 {
-                aj = 0.0;
-                ai = sum;
-            }
-            if sum > c {
-                if aj > c {
-                    aj = c;
-                    ai = sum - c;
-                }
-            } else if ai < 0.0 {
-                ai = 0.0;
-                aj = sum;
-            }
-        }
+        let (ai, aj) = pair_step(self.y[i] != self.y[j], old_i, old_j, gi, gj, quad, c);
         self.alpha[i] = ai;
         self.alpha[j] = aj;
-        for (t, pos, row) in [(i, pi, &row_i), (j, pj, &row_j)] {
+        for t in [i, j] {
             let was_upper = self.status[t] == Status::Upper;
-            self.status[t] = self.status_of(self.alpha[t]);
-            self.aup[pos] = pen(self.up_ok(t));
-            self.alow[pos] = pen(self.low_ok(t));
+            self.status[t] = status_of(self.alpha[t], c);
             if was_upper != (self.status[t] == Status::Upper) {
                 let s = if was_upper { -c } else { c } * self.y[t];
-                for (gb, &b) in self.ygbar.iter_mut().zip(&self.kidx) {
-                    *gb += s * row[b as usize] as f64;
+                let row = self.rows.row(self.pb[self.vb[t] as usize] as usize);
+                if self.pb_direct {
+                    hot::axpy1(&mut self.sbar, s, &row);
+                } else {
+                    self.buf_full.resize(self.pb.len(), 0.0);
+                    hot::gather(&row, &self.pb, &mut self.buf_full);
+                    hot::axpy1(&mut self.sbar, s, &self.buf_full);
                 }
             }
         }
+        // The pair's masks change before the fused maximum reads them.
+        self.refresh_masks(pi);
+        self.refresh_masks(pj);
         // Gradient update, then the first half of the next selection.
         let dyi = (ai - old_i) * self.y[i];
         let dyj = (aj - old_j) * self.y[j];
-        let n = self.ayg.len();
-        self.buf_i.resize(n, 0.0);
-        self.buf_j.resize(n, 0.0);
-        hot::gather(&row_i, &self.ak, &mut self.buf_i);
-        hot::gather(&row_j, &self.ak, &mut self.buf_j);
-        hot::axpy2(&mut self.ayg, dyi, &self.buf_i, dyj, &self.buf_j);
-        let (gmax, gpos) = hot::masked_max_neg(&self.ayg, &self.aup);
-        self.next_gmax = Some((gmax, gpos));
+        let reuse_i = self.buf_i_pos == Some(pi);
+        let src = row_src!(self);
+        let (ri, rent_i) = src.fetch(pi, &mut self.buf_i, reuse_i);
+        let (rj, rent_j) = src.fetch(pj, &mut self.buf_j, false);
+        let next = hot::update_gmax(&mut self.av, (dyi, &ri), (dyj, &rj), &self.aup);
+        drop((ri, rj));
+        self.rent += rent_i + rent_j;
+        self.next_gmax = Some(next);
     }
 
     fn do_shrinking(&mut self) {
-        let mut gmax1 = f64::NEG_INFINITY;
+        let (gmax1, _) = self.gmax();
         let mut gmax2 = f64::NEG_INFINITY;
         for k in 0..self.act.len() {
-            gmax1 = gmax1.max(-self.ayg[k] + self.aup[k]);
-            gmax2 = gmax2.max(self.ayg[k] + self.alow[k]);
+            gmax2 = gmax2.max(self.av[k] + self.alow[k]);
         }
         self.sync();
         if !self.unshrink && gmax1 + gmax2 <= self.tol * 10.0 {
@@ -361,80 +493,123 @@ impl Solver<'_> {
         }
         // A bounded variable is dropped when it violates nothing by a margin: members of
         // I_up only when yG > max_{I_low} yG, members of I_low only when -yG > max_{I_up} -yG.
-        let keep: Vec<u32> = self
-            .act
-            .iter()
-            .copied()
-            .filter(|&t| {
+        // A base leaves the active set with its last variable.
+        let mut changed = false;
+        let mut keep = vec![false; self.act.len()];
+        for (pos, kp) in keep.iter_mut().enumerate() {
+            let b = self.act[pos] as usize;
+            for t in self.slots[b] {
                 let t = t as usize;
-                match (self.up_ok(t), self.low_ok(t)) {
-                    (true, true) => true,
-                    (true, false) => self.yg[t] <= gmax2,
-                    (false, true) => -self.yg[t] <= gmax1,
-                    (false, false) => true,
+                if t == NONE as usize || !self.var_active[t] {
+                    continue;
                 }
-            })
-            .collect();
-        if keep.len() != self.act.len() {
-            self.set_active(keep);
+                let yg = self.yg(t);
+                let stay = match (self.up_ok(t), self.low_ok(t)) {
+                    (true, true) | (false, false) => true,
+                    (true, false) => yg <= gmax2,
+                    (false, true) => -yg <= gmax1,
+                };
+                if stay {
+                    *kp = true;
+                } else {
+                    self.var_active[t] = false;
+                    changed = true;
+                }
+            }
         }
-    }
-
-    /// Restores the exact gradient of shrunk variables from `yḠ` plus the free variables'
-    /// contributions, then reactivates everything.
-    fn reconstruct_gradient(&mut self) {
-        let l = self.l();
-        self.sync();
-        if self.act.len() == l {
+        if !changed {
             return;
         }
-        let mut is_active = vec![false; l];
-        for &t in &self.act {
-            is_active[t as usize] = true;
-        }
-        let inactive: Vec<usize> = (0..l).filter(|&t| !is_active[t]).collect();
-        for &t in &inactive {
-            self.yg[t] = self.y[t] * self.p[t] + self.ygbar[t];
-        }
-        let free: Vec<usize> = self
-            .act
-            .iter()
-            .map(|&t| t as usize)
-            .filter(|&t| self.status[t] == Status::Free)
-            .collect();
-        // Read whichever set of rows is smaller (free variables' or inactive variables').
-        let chunk = self.rows.batch_size().max(1);
-        let rows_of =
-            |set: &[usize]| -> Vec<usize> { set.iter().map(|&t| self.kidx[t] as usize).collect() };
-        if free.len() <= inactive.len() {
-            for part in free.chunks(chunk) {
-                if chunk > 1 {
-                    self.rows.prefetch(&rows_of(part));
-                }
-                for &i in part {
-                    let row = self.rows.row(self.kidx[i] as usize);
-                    let ay = self.alpha[i] * self.y[i];
-                    for &t in &inactive {
-                        self.yg[t] += ay * row[self.kidx[t] as usize] as f64;
-                    }
-                }
+        // Positions of shrunk bases stay (masked, their `s` kept exact) until enough are gone
+        // to make a shorter list pay for re-listing.
+        let kept = keep.iter().filter(|&&k| k).count();
+        if kept * 10 > keep.len() * RELIST_FRACTION_TENTHS {
+            for pos in 0..keep.len() {
+                self.refresh_masks(pos);
             }
+            self.next_gmax = None;
+            return;
+        }
+        let order: Vec<usize> = if self.kc.is_empty() {
+            (0..keep.len()).filter(|&q| keep[q]).collect()
         } else {
-            for part in inactive.chunks(chunk) {
-                if chunk > 1 {
-                    self.rows.prefetch(&rows_of(part));
+            let order = fill_holes(&keep);
+            self.permute_compact(&order);
+            self.compactions.1 += 1;
+            order
+        };
+        let list = order.iter().map(|&q| self.act[q]).collect();
+        self.set_active(list);
+    }
+
+    /// Restores the exact `s` of inactive bases from `sbar` plus the free variables'
+    /// contributions, then reactivates everything.
+    fn reconstruct_gradient(&mut self) {
+        self.sync();
+        let nb = self.pb.len();
+        if self.act.len() == nb {
+            if !self.var_active.iter().all(|&a| a) {
+                self.var_active.fill(true);
+                for pos in 0..nb {
+                    self.refresh_masks(pos);
                 }
-                for &t in part {
-                    let row = self.rows.row(self.kidx[t] as usize);
-                    let s: f64 = free
+                self.next_gmax = None;
+            }
+            return;
+        }
+        let mut base_active = vec![false; nb];
+        for &b in &self.act {
+            base_active[b as usize] = true;
+        }
+        let inactive: Vec<usize> = (0..nb).filter(|&b| !base_active[b]).collect();
+        for &b in &inactive {
+            self.s[b] = self.sbar[b];
+        }
+        // Free variables are never shrunk, so their bases are active.
+        let mut w = vec![0.0f64; nb];
+        for t in 0..self.l() {
+            if self.status[t] == Status::Free {
+                w[self.vb[t] as usize] += self.alpha[t] * self.y[t];
+            }
+        }
+        let free: Vec<usize> = (0..nb).filter(|&b| w[b] != 0.0).collect();
+        // Read whichever set of rows is smaller (free bases' or inactive bases').
+        let chunk = self.rows.batch_size().max(1);
+        let (outer, inner) = if free.len() <= inactive.len() {
+            (&free, &inactive)
+        } else {
+            (&inactive, &free)
+        };
+        let mut acc = vec![0.0f64; outer.len()];
+        for (ci, part) in outer.chunks(chunk).enumerate() {
+            if chunk > 1 {
+                let ks: Vec<usize> = part.iter().map(|&b| self.pb[b] as usize).collect();
+                self.rows.prefetch(&ks);
+            }
+            for (o, &b) in part.iter().enumerate() {
+                let row = self.rows.row(self.pb[b] as usize);
+                if free.len() <= inactive.len() {
+                    let wb = w[b];
+                    for &t in inner {
+                        self.s[t] += wb * row[self.pb[t] as usize] as f64;
+                    }
+                } else {
+                    acc[ci * chunk + o] = inner
                         .iter()
-                        .map(|&i| self.alpha[i] * self.y[i] * row[self.kidx[i] as usize] as f64)
+                        .map(|&f| w[f] * row[self.pb[f] as usize] as f64)
                         .sum();
-                    self.yg[t] += s;
                 }
             }
         }
-        self.set_active((0..l as u32).collect());
+        if free.len() > inactive.len() {
+            for (&b, a) in inactive.iter().zip(&acc) {
+                self.s[b] += a;
+            }
+        }
+        self.var_active.fill(true);
+        self.kc = Vec::new();
+        self.rent = 0;
+        self.set_active((0..nb as u32).collect());
     }
 
     fn rho(&self) -> f64 {
@@ -443,7 +618,7 @@ impl Solver<'_> {
         let mut nr_free = 0usize;
         let mut sum_free = 0.0;
         for t in 0..self.l() {
-            let yg = self.yg[t];
+            let yg = self.yg(t);
             let pos = self.y[t] > 0.0;
             match self.status[t] {
                 Status::Upper => {
@@ -480,44 +655,195 @@ impl Solver<'_> {
     }
 }
 
+/// Where the kernel values at the active bases come from (fields of `Solver`, borrowed
+/// separately from the vectors the hot loops write).
+struct RowSrc<'a> {
+    rows: &'a dyn KernelRows,
+    kc: &'a [f32],
+    kc_stride: usize,
+    direct: bool,
+    ak: &'a [u32],
+}
+
+impl<'a> RowSrc<'a> {
+    /// Row of active position `pos` at the active bases, and how many values were gathered;
+    /// `reuse` says `buf` already holds it.
+    fn fetch<'b>(&self, pos: usize, buf: &'b mut Vec<f32>, reuse: bool) -> (ActiveRow<'b>, usize)
+    where
+        'a: 'b,
+    {
+        let m = self.ak.len();
+        if !self.kc.is_empty() {
+            let st = self.kc_stride;
+            return (ActiveRow::Slice(&self.kc[pos * st..pos * st + m]), 0);
+        }
+        let row = self.rows.row(self.ak[pos] as usize);
+        if self.direct {
+            return (ActiveRow::Row(row), 0);
+        }
+        if reuse && buf.len() == m {
+            return (ActiveRow::Slice(buf), 0);
+        }
+        buf.resize(m, 0.0);
+        hot::gather(&row, self.ak, buf);
+        (ActiveRow::Slice(buf), m)
+    }
+}
+
+/// The two-variable subproblem of libsvm (`Solver::solve`, the `y_i != y_j` and `y_i == y_j`
+/// cases): new `(α_i, α_j)` clipped to the box along the equality constraint.
+fn pair_step(
+    opposite: bool,
+    mut ai: f64,
+    mut aj: f64,
+    gi: f64,
+    gj: f64,
+    quad: f64,
+    c: f64,
+) -> (f64, f64) {
+    if opposite {
+        let delta = (-gi - gj) / quad;
+        let diff = ai - aj;
+        ai += delta;
+        aj += delta;
+        if diff > 0.0 {
+            if aj < 0.0 {
+                aj = 0.0;
+                ai = diff;
+            }
+        } else if ai < 0.0 {
+            ai = 0.0;
+            aj = -diff;
+        }
+        if diff > 0.0 {
+            if ai > c {
+                ai = c;
+                aj = c - diff;
+            }
+        } else if aj > c {
+            aj = c;
+            ai = c + diff;
+        }
+    } else {
+        let delta = (gi - gj) / quad;
+        let sum = ai + aj;
+        (ai, aj) = clip_sum(ai - delta, aj + delta, sum, c);
+        (aj, ai) = clip_sum(aj, ai, sum, c);
+    }
+    (ai, aj)
+}
+
+/// One half of libsvm's clipping along `a + b = sum`: `a` against the upper bound when the
+/// sum exceeds `C`, otherwise `b` against zero.
+fn clip_sum(mut a: f64, mut b: f64, sum: f64, c: f64) -> (f64, f64) {
+    if sum > c {
+        if a > c {
+            a = c;
+            b = sum - c;
+        }
+    } else if b < 0.0 {
+        b = 0.0;
+        a = sum;
+    }
+    (a, b)
+}
+
+pub(crate) use hot::gather;
+
 /// Solves one dual problem.
 pub(crate) fn solve(
     rows: &dyn KernelRows,
     problem: SmoProblem,
     settings: &SmoSettings,
 ) -> SmoSolution {
+    solve_with(rows, problem, settings, COMPACT_MAX)
+}
+
+/// [`solve`] with a cap on the compact kernel (values; 0 disables it).
+pub(crate) fn solve_with(
+    rows: &dyn KernelRows,
+    problem: SmoProblem,
+    settings: &SmoSettings,
+    compact_max: usize,
+) -> SmoSolution {
     let l = problem.y.len();
+    let nk = rows.len();
+    // The vectorized gathers rely on this; the crate builds every problem from valid indices.
+    assert!(
+        problem.kidx.iter().all(|&b| (b as usize) < nk),
+        "kernel index out of range"
+    );
+    // Bases in order of first use; at most two variables each (SVR: α and α*).
+    let mut base_of = vec![NONE; nk];
+    let mut pb = Vec::new();
+    let mut slots: Vec<[u32; 2]> = Vec::new();
+    let mut vb = Vec::with_capacity(l);
+    for (t, &k) in problem.kidx.iter().enumerate() {
+        let b = match base_of[k as usize] {
+            NONE => {
+                base_of[k as usize] = pb.len() as u32;
+                pb.push(k);
+                slots.push([t as u32, NONE]);
+                pb.len() - 1
+            }
+            b => {
+                let b = b as usize;
+                assert!(
+                    slots[b][1] == NONE,
+                    "more than two variables share a kernel row"
+                );
+                slots[b][1] = t as u32;
+                b
+            }
+        };
+        vb.push(b as u32);
+    }
+    drop(base_of);
+    let pb_direct = pb.len() == nk && pb.iter().enumerate().all(|(b, &k)| k as usize == b);
     let alpha = problem.alpha0.unwrap_or_else(|| vec![0.0; l]);
     let mut s = Solver {
         rows,
         c: problem.c,
         tol: settings.tol,
-        kidx: problem.kidx,
         y: problem.y,
         p: problem.p,
-        status: Vec::new(),
         alpha,
-        yg: Vec::new(),
-        ygbar: Vec::new(),
+        status: Vec::new(),
+        vb,
+        var_active: vec![true; l],
+        pb,
+        slots,
+        s: Vec::new(),
+        sbar: Vec::new(),
+        pb_direct,
         act: Vec::new(),
         ak: Vec::new(),
-        ayg: Vec::new(),
+        av: Vec::new(),
         aup: Vec::new(),
         alow: Vec::new(),
+        direct: false,
+        kc: Vec::new(),
+        kc_stride: 0,
+        rent: 0,
+        compactions: (0, 0),
+        // Only over precomputed rows: on a row cache, building it would compute rows that
+        // the solve may never need. At most a quarter of the provider's size on top of it
+        // (on 17,000 samples a half was no faster and took 270 MB more).
+        compact_max: if rows.batch_size() == 0 {
+            compact_max.min(nk * nk / 4)
+        } else {
+            0
+        },
         next_gmax: None,
         unshrink: false,
+        buf_i_pos: None,
         buf_i: Vec::new(),
         buf_j: Vec::new(),
-        scores: Vec::new(),
+        buf_full: Vec::new(),
     };
-    // The vectorized gathers rely on this; the crate builds every problem from valid indices.
-    assert!(
-        s.kidx.iter().all(|&b| (b as usize) < rows.len()),
-        "kernel index out of range"
-    );
-    s.status = s.alpha.iter().map(|&a| s.status_of(a)).collect();
+    s.status = s.alpha.iter().map(|&a| status_of(a, s.c)).collect();
     s.init_gradient();
-    s.set_active((0..l as u32).collect());
+    s.set_active((0..s.pb.len() as u32).collect());
 
     let max_iter = settings
         .max_iter
@@ -556,7 +882,7 @@ pub(crate) fn solve(
     s.reconstruct_gradient();
     let rho = s.rho();
     let obj = (0..l)
-        .map(|t| s.alpha[t] * (s.y[t] * s.yg[t] + s.p[t]))
+        .map(|t| s.alpha[t] * (s.y[t] * s.yg(t) + s.p[t]))
         .sum::<f64>()
         / 2.0;
     SmoSolution {
@@ -565,6 +891,7 @@ pub(crate) fn solve(
         obj,
         iterations: iter,
         converged,
+        compactions: s.compactions,
     }
 }
 
@@ -573,7 +900,7 @@ pub(crate) fn solve(
 mod hot {
     /// `out[k] = row[idx[k]]`; every index must be below `row.len()` (checked once per
     /// problem in `solve`).
-    pub(super) fn gather(row: &[f32], idx: &[u32], out: &mut [f32]) {
+    pub(crate) fn gather(row: &[f32], idx: &[u32], out: &mut [f32]) {
         #[cfg(target_arch = "x86_64")]
         if avx2() && row.len() < i32::MAX as usize {
             // SAFETY: AVX2 is available; indices are in bounds (caller contract) and fit i32.
@@ -605,236 +932,6 @@ mod hot {
         }
     }
 
-    /// First position where `s[k] == target`, 8 lanes at a time.
-    #[cfg(target_arch = "x86_64")]
-    #[target_feature(enable = "avx2,fma")]
-    unsafe fn find_f32_avx2(s: &[f32], target: f32) -> Option<usize> {
-        use std::arch::x86_64::*;
-        let t = _mm256_set1_ps(target);
-        let mut k = 0;
-        while k + 8 <= s.len() {
-            // SAFETY: k + 8 <= s.len().
-            let eq = unsafe { _mm256_cmp_ps::<_CMP_EQ_OQ>(_mm256_loadu_ps(s.as_ptr().add(k)), t) };
-            let bits = _mm256_movemask_ps(eq);
-            if bits != 0 {
-                return Some(k + bits.trailing_zeros() as usize);
-            }
-            k += 8;
-        }
-        s[k..].iter().position(|&v| v == target).map(|p| p + k)
-    }
-
-    /// Second-order gains `(gmax + yG_j)² / (2 - 2 K_ij)` of the `I_low` members with a
-    /// positive first-order gain (0 elsewhere), in `f32` (they only rank candidates); returns
-    /// `max_{I_low} yG`. `low` is the 0 / -inf membership mask.
-    pub(super) fn wss_scores(
-        ayg: &[f64],
-        low: &[f64],
-        kv: &[f32],
-        gmax: f64,
-        out: &mut [f32],
-    ) -> f64 {
-        #[cfg(target_arch = "x86_64")]
-        if avx2() {
-            // SAFETY: AVX2 and FMA are available (checked at run time).
-            return unsafe { wss_scores_avx2(ayg, low, kv, gmax, out) };
-        }
-        wss_scores_generic(ayg, low, kv, gmax, out)
-    }
-
-    #[inline(always)]
-    fn wss_scores_generic(ayg: &[f64], low: &[f64], kv: &[f32], gmax: f64, out: &mut [f32]) -> f64 {
-        const L: usize = 8;
-        let n = out.len();
-        let (ayg, low, kv) = (&ayg[..n], &low[..n], &kv[..n]);
-        let mut lanes = [f64::NEG_INFINITY; L];
-        let mut k = 0;
-        while k + L <= n {
-            for l in 0..L {
-                let m = ayg[k + l] + low[k + l];
-                lanes[l] = if m > lanes[l] { m } else { lanes[l] };
-                let gd = (gmax + m) as f32;
-                let q = 2.0 - 2.0 * kv[k + l];
-                let q = if q > 1e-12 { q } else { 1e-12 };
-                let sc = gd * gd / q;
-                out[k + l] = if gd > 0.0 { sc } else { 0.0 };
-            }
-            k += L;
-        }
-        let mut best = lanes
-            .iter()
-            .fold(f64::NEG_INFINITY, |a, &b| if b > a { b } else { a });
-        while k < n {
-            let m = ayg[k] + low[k];
-            if m > best {
-                best = m;
-            }
-            let gd = (gmax + m) as f32;
-            let q = 2.0 - 2.0 * kv[k];
-            let q = if q > 1e-12 { q } else { 1e-12 };
-            out[k] = if gd > 0.0 { gd * gd / q } else { 0.0 };
-            k += 1;
-        }
-        best
-    }
-
-    /// Position of the largest positive score (first on ties).
-    pub(super) fn argmax_positive(s: &[f32]) -> Option<usize> {
-        #[cfg(target_arch = "x86_64")]
-        if avx2() {
-            // SAFETY: AVX2 and FMA are available (checked at run time).
-            return unsafe { argmax_positive_avx2(s) };
-        }
-        argmax_positive_generic(s)
-    }
-
-    #[cfg(target_arch = "x86_64")]
-    #[target_feature(enable = "avx2,fma")]
-    unsafe fn argmax_positive_avx2(s: &[f32]) -> Option<usize> {
-        use std::arch::x86_64::*;
-        let n = s.len();
-        let mut acc = _mm256_setzero_ps();
-        let mut k = 0;
-        while k + 8 <= n {
-            // SAFETY: k + 8 <= n.
-            acc = _mm256_max_ps(acc, unsafe { _mm256_loadu_ps(s.as_ptr().add(k)) });
-            k += 8;
-        }
-        let mut lanes = [0.0f32; 8];
-        // SAFETY: `lanes` holds eight f32.
-        unsafe { _mm256_storeu_ps(lanes.as_mut_ptr(), acc) };
-        let mut best = lanes.iter().fold(0.0f32, |a, &b| if b > a { b } else { a });
-        for &v in &s[k..] {
-            if v > best {
-                best = v;
-            }
-        }
-        if best > 0.0 {
-            // SAFETY: AVX2 is enabled in this function.
-            unsafe { find_f32_avx2(s, best) }
-        } else {
-            None
-        }
-    }
-
-    #[inline(always)]
-    fn argmax_positive_generic(s: &[f32]) -> Option<usize> {
-        const L: usize = 16;
-        let mut lanes = [0.0f32; L];
-        let mut chunks = s.chunks_exact(L);
-        for c in &mut chunks {
-            for l in 0..L {
-                lanes[l] = if c[l] > lanes[l] { c[l] } else { lanes[l] };
-            }
-        }
-        let mut best = lanes.iter().fold(0.0f32, |a, &b| if b > a { b } else { a });
-        for &v in chunks.remainder() {
-            if v > best {
-                best = v;
-            }
-        }
-        if best > 0.0 {
-            s.iter().position(|&v| v == best)
-        } else {
-            None
-        }
-    }
-
-    /// `y[k] += a x[k] + b z[k]`.
-    pub(super) fn axpy2(y: &mut [f64], a: f64, x: &[f32], b: f64, z: &[f32]) {
-        #[cfg(target_arch = "x86_64")]
-        if avx2() {
-            // SAFETY: AVX2 and FMA are available (checked at run time).
-            unsafe { axpy2_avx2(y, a, x, b, z) };
-            return;
-        }
-        axpy2_generic(y, a, x, b, z)
-    }
-
-    #[inline(always)]
-    fn axpy2_generic(y: &mut [f64], a: f64, x: &[f32], b: f64, z: &[f32]) {
-        for ((v, &xi), &zi) in y.iter_mut().zip(x).zip(z) {
-            *v += a * xi as f64 + b * zi as f64;
-        }
-    }
-
-    /// `max_{mask} -v` and its first position (`(-inf, usize::MAX)` when the mask is empty);
-    /// `mask` is 0 / -inf.
-    pub(super) fn masked_max_neg(v: &[f64], mask: &[f64]) -> (f64, usize) {
-        #[cfg(target_arch = "x86_64")]
-        if avx2() {
-            // SAFETY: AVX2 and FMA are available (checked at run time).
-            return unsafe { masked_max_neg_avx2(v, mask) };
-        }
-        masked_max_neg_generic(v, mask)
-    }
-
-    /// Common end of both `masked_max_neg` kernels: reduce the vector lanes, take the scalar
-    /// tail from `k`, then find the first position of the maximum.
-    #[inline(always)]
-    fn finish_masked_max(lanes: &[f64], v: &[f64], mask: &[f64], mut k: usize) -> (f64, usize) {
-        let n = v.len();
-        let mut best = lanes
-            .iter()
-            .fold(f64::NEG_INFINITY, |a, &b| if b > a { b } else { a });
-        while k < n {
-            let m = mask[k] - v[k];
-            if m > best {
-                best = m;
-            }
-            k += 1;
-        }
-        if best == f64::NEG_INFINITY {
-            return (best, usize::MAX);
-        }
-        let pos = (0..n)
-            .find(|&k| mask[k] - v[k] == best)
-            .unwrap_or(usize::MAX);
-        (best, pos)
-    }
-
-    #[inline(always)]
-    fn masked_max_neg_generic(v: &[f64], mask: &[f64]) -> (f64, usize) {
-        const L: usize = 8;
-        let n = v.len().min(mask.len());
-        let (v, mask) = (&v[..n], &mask[..n]);
-        let mut lanes = [f64::NEG_INFINITY; L];
-        let mut k = 0;
-        while k + L <= n {
-            for l in 0..L {
-                let m = mask[k + l] - v[k + l];
-                lanes[l] = if m > lanes[l] { m } else { lanes[l] };
-            }
-            k += L;
-        }
-        finish_masked_max(&lanes, v, mask, k)
-    }
-
-    #[cfg(target_arch = "x86_64")]
-    #[target_feature(enable = "avx2,fma")]
-    unsafe fn masked_max_neg_avx2(v: &[f64], mask: &[f64]) -> (f64, usize) {
-        use std::arch::x86_64::*;
-        let n = v.len().min(mask.len());
-        let (v, mask) = (&v[..n], &mask[..n]);
-        let mut acc = _mm256_set1_pd(f64::NEG_INFINITY);
-        let mut k = 0;
-        while k + 4 <= n {
-            // SAFETY: k + 4 <= n and both slices have length n.
-            unsafe {
-                let m = _mm256_sub_pd(
-                    _mm256_loadu_pd(mask.as_ptr().add(k)),
-                    _mm256_loadu_pd(v.as_ptr().add(k)),
-                );
-                acc = _mm256_max_pd(acc, m);
-            }
-            k += 4;
-        }
-        let mut lanes = [0.0f64; 4];
-        // SAFETY: `lanes` holds four f64.
-        unsafe { _mm256_storeu_pd(lanes.as_mut_ptr(), acc) };
-        finish_masked_max(&lanes, v, mask, k)
-    }
-
     #[cfg(target_arch = "x86_64")]
     fn avx2() -> bool {
         static FLAG: std::sync::OnceLock<bool> = std::sync::OnceLock::new();
@@ -844,65 +941,441 @@ mod hot {
         })
     }
 
-    #[cfg(target_arch = "x86_64")]
-    #[target_feature(enable = "avx2,fma")]
-    unsafe fn wss_scores_avx2(
-        ayg: &[f64],
-        low: &[f64],
-        kv: &[f32],
-        gmax: f64,
-        out: &mut [f32],
-    ) -> f64 {
-        use std::arch::x86_64::*;
-        let n = out.len();
-        let (ayg, low, kv) = (&ayg[..n], &low[..n], &kv[..n]);
-        let mut k = 0;
-        let vg = _mm256_set1_pd(gmax);
-        let two = _mm_set1_ps(2.0);
-        let tiny = _mm_set1_ps(1e-12);
-        let zero = _mm_setzero_ps();
-        let mut acc = _mm256_set1_pd(f64::NEG_INFINITY);
-        while k + 4 <= n {
-            // SAFETY: k + 4 <= n and every slice has length n.
-            unsafe {
-                let m = _mm256_add_pd(
-                    _mm256_loadu_pd(ayg.as_ptr().add(k)),
-                    _mm256_loadu_pd(low.as_ptr().add(k)),
-                );
-                acc = _mm256_max_pd(acc, m);
-                let gd = _mm256_cvtpd_ps(_mm256_add_pd(vg, m));
-                let kvv = _mm_loadu_ps(kv.as_ptr().add(k));
-                let q = _mm_max_ps(_mm_sub_ps(two, _mm_mul_ps(two, kvv)), tiny);
-                let sc = _mm_div_ps(_mm_mul_ps(gd, gd), q);
-                _mm_storeu_ps(
-                    out.as_mut_ptr().add(k),
-                    _mm_and_ps(sc, _mm_cmpgt_ps(gd, zero)),
-                );
-            }
-            k += 4;
+    /// `y[k] += a x[k]`.
+    pub(super) fn axpy1(y: &mut [f64], a: f64, x: &[f32]) {
+        for (v, &xi) in y.iter_mut().zip(x) {
+            *v += a * xi as f64;
         }
-        let mut lanes = [0.0f64; 4];
-        // SAFETY: `lanes` holds four f64.
-        unsafe { _mm256_storeu_pd(lanes.as_mut_ptr(), acc) };
-        let mut best = lanes
-            .iter()
-            .fold(f64::NEG_INFINITY, |a, &b| if b > a { b } else { a });
-        while k < n {
-            let m = ayg[k] + low[k];
-            if m > best {
-                best = m;
+    }
+
+    /// Largest lane value and the smallest index holding it (`(-inf, usize::MAX)` when every
+    /// value is `-inf`, or below `floor`): the reduction of per-lane "first maximum" trackers.
+    fn reduce_lanes<T: Copy + PartialOrd>(vals: &[T], idx: &[usize], floor: T) -> (T, usize) {
+        let mut best = (floor, usize::MAX);
+        for (&v, &i) in vals.iter().zip(idx) {
+            if v > best.0 || (v == best.0 && i < best.1 && v > floor) {
+                best = (v, i);
             }
-            let gd = (gmax + m) as f32;
-            let q = (2.0 - 2.0 * kv[k]).max(1e-12);
-            out[k] = if gd > 0.0 { gd * gd / q } else { 0.0 };
-            k += 1;
         }
         best
     }
 
+    /// `max_{mask} -v` and its first position (`(-inf, usize::MAX)` when the mask is empty);
+    /// `mask` is `-inf` for non-members.
+    pub(super) fn masked_max_neg(v: &[f64], mask: &[f64]) -> (f64, usize) {
+        #[cfg(target_arch = "x86_64")]
+        if avx2() {
+            // SAFETY: AVX2 and FMA are available (checked at run time).
+            return unsafe { masked_max_neg_avx2(v, mask) };
+        }
+        masked_max_neg_generic(v, mask)
+    }
+
+    /// Gradient update `v[k] += a x[k] + b z[k]` fused with the next `masked_max_neg(v, mask)`.
+    pub(super) fn update_gmax(
+        v: &mut [f64],
+        (a, x): (f64, &[f32]),
+        (b, z): (f64, &[f32]),
+        mask: &[f64],
+    ) -> (f64, usize) {
+        let n = v.len();
+        assert!(x.len() >= n && z.len() >= n && mask.len() >= n);
+        #[cfg(target_arch = "x86_64")]
+        if avx2() {
+            // SAFETY: AVX2 and FMA are available; lengths checked above.
+            return unsafe { max_pass::<true>(v.as_mut_ptr(), n, (a, x), (b, z), mask) };
+        }
+        update_gmax_generic_mut(v, (a, x), (b, z), mask)
+    }
+
+    fn masked_max_neg_generic(v: &[f64], mask: &[f64]) -> (f64, usize) {
+        let mut best = (f64::NEG_INFINITY, usize::MAX);
+        for (k, (&vk, &mk)) in v.iter().zip(mask).enumerate() {
+            let m = mk - vk;
+            if m > best.0 {
+                best = (m, k);
+            }
+        }
+        best
+    }
+
+    fn update_gmax_generic_mut(
+        v: &mut [f64],
+        (a, x): (f64, &[f32]),
+        (b, z): (f64, &[f32]),
+        mask: &[f64],
+    ) -> (f64, usize) {
+        for ((vk, &xk), &zk) in v.iter_mut().zip(x).zip(z) {
+            *vk += a * xk as f64 + b * zk as f64;
+        }
+        masked_max_neg_generic(v, mask)
+    }
+
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx2,fma")]
-    unsafe fn axpy2_avx2(y: &mut [f64], a: f64, x: &[f32], b: f64, z: &[f32]) {
-        axpy2_generic(y, a, x, b, z)
+    unsafe fn masked_max_neg_avx2(v: &[f64], mask: &[f64]) -> (f64, usize) {
+        let n = v.len().min(mask.len());
+        // SAFETY: AVX2 is enabled here; without the update `v` is only read.
+        unsafe { max_pass::<false>(v.as_ptr() as *mut f64, n, (0.0, &[]), (0.0, &[]), mask) }
+    }
+
+    /// `max_k mask[k] - v[k]` with the position of its first occurrence, after (with `UPDATE`)
+    /// `v[k] += a x[k] + b z[k]` in the same pass. Per-lane maxima and positions in two
+    /// independent sets of lanes (to overlap the compare-blend latency), then `reduce_lanes`.
+    ///
+    /// # Safety
+    /// AVX2 must be available; `v` and `mask` must hold `n` values, and so must `x` and `z`
+    /// with `UPDATE` (which writes `v`).
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2,fma")]
+    unsafe fn max_pass<const UPDATE: bool>(
+        v: *mut f64,
+        n: usize,
+        (a, x): (f64, &[f32]),
+        (b, z): (f64, &[f32]),
+        mask: &[f64],
+    ) -> (f64, usize) {
+        use std::arch::x86_64::*;
+        let (va, vb) = (_mm256_set1_pd(a), _mm256_set1_pd(b));
+        let mut best = [_mm256_set1_pd(f64::NEG_INFINITY); 2];
+        let mut bidx = [_mm256_set1_pd(0.0); 2];
+        let mut idx = [
+            _mm256_setr_pd(0.0, 1.0, 2.0, 3.0),
+            _mm256_setr_pd(4.0, 5.0, 6.0, 7.0),
+        ];
+        let eight = _mm256_set1_pd(8.0);
+        let mut k = 0;
+        while k + 8 <= n {
+            for h in 0..2 {
+                let o = k + 4 * h;
+                // SAFETY: o + 4 <= n, within every slice (caller contract).
+                unsafe {
+                    let mut cur = _mm256_loadu_pd(v.add(o));
+                    if UPDATE {
+                        let xv = _mm256_cvtps_pd(_mm_loadu_ps(x.as_ptr().add(o)));
+                        let zv = _mm256_cvtps_pd(_mm_loadu_ps(z.as_ptr().add(o)));
+                        let d = _mm256_add_pd(_mm256_mul_pd(va, xv), _mm256_mul_pd(vb, zv));
+                        cur = _mm256_add_pd(cur, d);
+                        _mm256_storeu_pd(v.add(o), cur);
+                    }
+                    let m = _mm256_sub_pd(_mm256_loadu_pd(mask.as_ptr().add(o)), cur);
+                    let gt = _mm256_cmp_pd::<_CMP_GT_OQ>(m, best[h]);
+                    best[h] = _mm256_blendv_pd(best[h], m, gt);
+                    bidx[h] = _mm256_blendv_pd(bidx[h], idx[h], gt);
+                }
+                idx[h] = _mm256_add_pd(idx[h], eight);
+            }
+            k += 8;
+        }
+        let (mut vals, mut pos) = ([0.0f64; 8], [0.0f64; 8]);
+        // SAFETY: both arrays hold eight f64.
+        unsafe {
+            for h in 0..2 {
+                _mm256_storeu_pd(vals.as_mut_ptr().add(4 * h), best[h]);
+                _mm256_storeu_pd(pos.as_mut_ptr().add(4 * h), bidx[h]);
+            }
+        }
+        let pos = pos.map(|p| p as usize);
+        let mut out = reduce_lanes(&vals, &pos, f64::NEG_INFINITY);
+        for t in k..n {
+            // SAFETY: t < n (caller contract).
+            let cur = unsafe {
+                if UPDATE {
+                    *v.add(t) += a * x[t] as f64 + b * z[t] as f64;
+                }
+                *v.add(t)
+            };
+            let m = mask[t] - cur;
+            if m > out.0 {
+                out = (m, t);
+            }
+        }
+        out
+    }
+
+    /// WSS3's second index: second-order gains `(gmax + yG_j)² / (2 - 2 K_ij)` of the `I_low`
+    /// members with a positive first-order gain, in `f32` (they only rank candidates).
+    /// Returns `max_{I_low} yG` (`yG_j = v[j] + low[j]`, `low` is `-inf` for non-members) and
+    /// the first position of the largest positive gain.
+    pub(super) fn wss_select(
+        v: &[f64],
+        low: &[f64],
+        kv: &[f32],
+        gmax: f64,
+    ) -> (f64, Option<usize>) {
+        let n = v.len();
+        assert!(low.len() >= n && kv.len() >= n);
+        #[cfg(target_arch = "x86_64")]
+        if avx2() {
+            // SAFETY: AVX2 and FMA are available; lengths checked above.
+            return unsafe { wss_select_avx2(v, low, kv, gmax) };
+        }
+        wss_select_generic(v, low, kv, gmax)
+    }
+
+    #[inline(always)]
+    fn wss_gain(gmax: f64, m: f64, kv: f32) -> f32 {
+        let gd = (gmax + m) as f32;
+        let q = (2.0 - 2.0 * kv).max(1e-12);
+        if gd > 0.0 { gd * gd / q } else { 0.0 }
+    }
+
+    fn wss_select_generic(v: &[f64], low: &[f64], kv: &[f32], gmax: f64) -> (f64, Option<usize>) {
+        let mut gmax2 = f64::NEG_INFINITY;
+        let mut best = (0.0f32, None);
+        for k in 0..v.len() {
+            let m = v[k] + low[k];
+            if m > gmax2 {
+                gmax2 = m;
+            }
+            let sc = wss_gain(gmax, m, kv[k]);
+            if sc > best.0 {
+                best = (sc, Some(k));
+            }
+        }
+        (gmax2, best.1)
+    }
+
+    /// Eight candidates per step: the `f64` sums in two halves, the `f32` gains in one vector.
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2,fma")]
+    unsafe fn wss_select_avx2(
+        v: &[f64],
+        low: &[f64],
+        kv: &[f32],
+        gmax: f64,
+    ) -> (f64, Option<usize>) {
+        use std::arch::x86_64::*;
+        let n = v.len();
+        let vg = _mm256_set1_pd(gmax);
+        let two = _mm256_set1_ps(2.0);
+        let tiny = _mm256_set1_ps(1e-12);
+        let zero = _mm256_setzero_ps();
+        let mut acc = [_mm256_set1_pd(f64::NEG_INFINITY); 2];
+        let mut best = _mm256_setzero_ps();
+        let mut bidx = _mm256_setzero_si256();
+        let mut idx = _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7);
+        let eight = _mm256_set1_epi32(8);
+        let mut k = 0;
+        while k + 8 <= n {
+            // SAFETY: k + 8 <= n <= every slice's length (checked by the caller).
+            unsafe {
+                let mut gd = [_mm_setzero_ps(); 2];
+                for h in 0..2 {
+                    let o = k + 4 * h;
+                    let m = _mm256_add_pd(
+                        _mm256_loadu_pd(v.as_ptr().add(o)),
+                        _mm256_loadu_pd(low.as_ptr().add(o)),
+                    );
+                    acc[h] = _mm256_max_pd(acc[h], m);
+                    gd[h] = _mm256_cvtpd_ps(_mm256_add_pd(vg, m));
+                }
+                let gd = _mm256_set_m128(gd[1], gd[0]);
+                let kvv = _mm256_loadu_ps(kv.as_ptr().add(k));
+                let q = _mm256_max_ps(_mm256_sub_ps(two, _mm256_mul_ps(two, kvv)), tiny);
+                let pos = _mm256_cmp_ps::<_CMP_GT_OQ>(gd, zero);
+                let sc = _mm256_and_ps(_mm256_div_ps(_mm256_mul_ps(gd, gd), q), pos);
+                let gt = _mm256_cmp_ps::<_CMP_GT_OQ>(sc, best);
+                best = _mm256_blendv_ps(best, sc, gt);
+                bidx = _mm256_blendv_epi8(bidx, idx, _mm256_castps_si256(gt));
+            }
+            idx = _mm256_add_epi32(idx, eight);
+            k += 8;
+        }
+        let (mut lanes, mut vals, mut pos) = ([0.0f64; 8], [0.0f32; 8], [0i32; 8]);
+        // SAFETY: the arrays hold eight lanes each.
+        unsafe {
+            _mm256_storeu_pd(lanes.as_mut_ptr(), acc[0]);
+            _mm256_storeu_pd(lanes.as_mut_ptr().add(4), acc[1]);
+            _mm256_storeu_ps(vals.as_mut_ptr(), best);
+            _mm256_storeu_si256(pos.as_mut_ptr() as *mut __m256i, bidx);
+        }
+        let pos = pos.map(|p| p as usize);
+        let mut out = reduce_lanes(&vals, &pos, 0.0f32);
+        // The tail, then the lanes: a later position wins only with a strictly larger gain.
+        let (tail_g2, tail_pos) = wss_select_generic(&v[k..], &low[k..], &kv[k..n], gmax);
+        if let Some(t) = tail_pos {
+            let sc = wss_gain(gmax, v[k + t] + low[k + t], kv[k + t]);
+            if sc > out.0 {
+                out = (sc, k + t);
+            }
+        }
+        let gmax2 = lanes
+            .iter()
+            .fold(tail_g2, |a, &b| if b > a { b } else { a });
+        (gmax2, (out.1 != usize::MAX).then_some(out.1))
+    }
+
+    #[cfg(all(test, target_arch = "x86_64"))]
+    mod tests {
+        use super::*;
+
+        #[test]
+        fn vector_kernels_match_the_scalar_ones() {
+            if !avx2() {
+                return;
+            }
+            for n in [0, 1, 3, 4, 7, 8, 33, 257] {
+                let v: Vec<f64> = (0..n)
+                    .map(|k| ((k * 37 % 11) as f64 - 5.0) * 0.25)
+                    .collect();
+                // Ties (repeated values) and non-members.
+                let mask: Vec<f64> = (0..n)
+                    .map(|k| {
+                        if k % 5 == 2 {
+                            f64::NEG_INFINITY
+                        } else {
+                            (k % 3) as f64 * 0.5
+                        }
+                    })
+                    .collect();
+                let kv: Vec<f32> = (0..n).map(|k| ((k * 13 % 7) as f32) / 7.0).collect();
+                let x: Vec<f32> = (0..n).map(|k| (k as f32 * 0.3).sin()).collect();
+                // SAFETY: AVX2 checked above.
+                let fast = unsafe { masked_max_neg_avx2(&v, &mask) };
+                assert_eq!(fast, masked_max_neg_generic(&v, &mask), "n = {n}");
+                for gmax in [-1.0, 0.0, 0.75, 3.0] {
+                    // SAFETY: AVX2 checked above.
+                    let fast = unsafe { wss_select_avx2(&v, &mask, &kv, gmax) };
+                    assert_eq!(fast, wss_select_generic(&v, &mask, &kv, gmax), "n = {n}");
+                }
+                let (mut v1, mut v2) = (v.clone(), v.clone());
+                // SAFETY: AVX2 checked above; all slices have length n.
+                let fast =
+                    unsafe { max_pass::<true>(v1.as_mut_ptr(), n, (0.5, &x), (-2.0, &kv), &mask) };
+                let slow = update_gmax_generic_mut(&mut v2, (0.5, &x), (-2.0, &kv), &mask);
+                assert_eq!((fast, &v1), (slow, &v2), "n = {n}");
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::cache::{CachedKernel, FullKernel};
+    use crate::kernel;
+    use crate::matrix::Matrix;
+
+    fn data(n: usize) -> Matrix {
+        let v: Vec<f32> = (0..n * 6)
+            .map(|k| ((k as f32) * 0.713).sin() + ((k / 6) as f32 * 0.05).cos())
+            .collect();
+        Matrix::new(v, 6).unwrap()
+    }
+
+    fn svr_problem(idx: &[usize], c: f64, eps: f64) -> SmoProblem {
+        let m = idx.len();
+        let z = |s: usize| (idx[s] as f64 * 0.37).sin() + 0.3 * (idx[s] as f64 * 1.7).cos();
+        SmoProblem {
+            kidx: idx.iter().chain(idx).map(|&i| i as u32).collect(),
+            y: (0..2 * m).map(|t| if t < m { 1.0 } else { -1.0 }).collect(),
+            p: (0..2 * m)
+                .map(|t| if t < m { eps - z(t) } else { eps + z(t - m) })
+                .collect(),
+            c,
+            alpha0: None,
+        }
+    }
+
+    /// Same objective and the same decision values at every base sample (the dual solution
+    /// itself need not be unique when the kernel matrix is nearly singular).
+    fn assert_same(full: &FullKernel, problem: &SmoProblem, a: &SmoSolution, b: &SmoSolution) {
+        assert!(a.converged && b.converged);
+        assert!(
+            (a.obj - b.obj).abs() < 1e-6 * a.obj.abs().max(1.0),
+            "{} vs {}",
+            a.obj,
+            b.obj
+        );
+        let coef = |sol: &SmoSolution| -> Vec<f64> {
+            let mut w = vec![0.0; full.len()];
+            for (t, &k) in problem.kidx.iter().enumerate() {
+                w[k as usize] += problem.y[t] * sol.alpha[t];
+            }
+            w
+        };
+        let (wa, wb) = (coef(a), coef(b));
+        let mut worst = 0.0f64;
+        for &k in &problem.kidx {
+            let row = full.row(k as usize);
+            let dec = |w: &[f64], rho: f64| -> f64 {
+                w.iter()
+                    .zip(row.iter())
+                    .map(|(w, &r)| w * r as f64)
+                    .sum::<f64>()
+                    - rho
+            };
+            worst = worst.max((dec(&wa, a.rho) - dec(&wb, b.rho)).abs());
+        }
+        assert!(worst < 1e-3, "largest decision value difference {worst}");
+    }
+
+    #[test]
+    fn compact_kernel_gives_the_uncompacted_solution() {
+        let x = data(700);
+        let full = FullKernel::new(x.view(), &kernel::sq_norms(x.view()), 0.2);
+        let settings = SmoSettings {
+            tol: 1e-7,
+            ..SmoSettings::default()
+        };
+        // A fold-like subset (rows gathered, then compacted) and all rows (used directly
+        // until shrinking, then compacted).
+        let fold: Vec<usize> = (0..700).filter(|i| i % 4 != 1).collect();
+        let all: Vec<usize> = (0..700).collect();
+        for idx in [&fold, &all] {
+            let with = solve(&full, svr_problem(idx, 10.0, 0.01), &settings);
+            let without = solve_with(&full, svr_problem(idx, 10.0, 0.01), &settings, 0);
+            assert!(
+                with.compactions.0 >= 1 && with.compactions.1 >= 1,
+                "{:?}",
+                with.compactions
+            );
+            assert_eq!(without.compactions, (0, 0));
+            assert_same(&full, &svr_problem(idx, 10.0, 0.01), &with, &without);
+        }
+    }
+
+    #[test]
+    fn classifier_problem_agrees_across_kernel_providers_and_compaction() {
+        let x = data(500);
+        let full = FullKernel::new(x.view(), &kernel::sq_norms(x.view()), 0.2);
+        let cached = CachedKernel::new(x.view(), 0.2, 64 * 500 * 4);
+        let idx: Vec<usize> = (0..500).filter(|i| i % 5 != 0).collect();
+        let problem = || SmoProblem {
+            kidx: idx.iter().map(|&i| i as u32).collect(),
+            y: idx
+                .iter()
+                // Labels that the kernel separates only partly: many iterations, many SV.
+                .map(|&i| {
+                    if x.row(i)[0] + 0.5 * x.row(i)[3] > 0.4 || i % 7 == 0 {
+                        1.0
+                    } else {
+                        -1.0
+                    }
+                })
+                .collect(),
+            p: vec![-1.0; idx.len()],
+            c: 10.0,
+            alpha0: None,
+        };
+        let settings = SmoSettings {
+            tol: 1e-7,
+            ..SmoSettings::default()
+        };
+        let a = solve(&full, problem(), &settings);
+        let b = solve_with(&full, problem(), &settings, 0);
+        let c = solve(&cached, problem(), &settings);
+        assert!(a.compactions.0 >= 1, "{:?}", a.compactions);
+        assert_eq!(c.compactions, (0, 0));
+        assert_same(&full, &problem(), &a, &b);
+        assert_same(&full, &problem(), &a, &c);
+    }
+
+    #[test]
+    fn hole_filling_moves_only_tail_positions() {
+        let keep = [true, false, true, false, true, true, false, true];
+        assert_eq!(fill_holes(&keep), vec![0, 5, 2, 7, 4]);
+        assert_eq!(fill_holes(&[false, false]), Vec::<usize>::new());
     }
 }

@@ -197,14 +197,26 @@ fn training_is_deterministic_and_model_files_round_trip() {
         );
     }
     let mut newer = bytes.clone();
-    newer[8..12].copy_from_slice(&2u32.to_le_bytes());
+    newer[8..12].copy_from_slice(&3u32.to_le_bytes());
     assert!(matches!(
         model_file::from_bytes(&newer),
         Err(RegressError::UnsupportedVersion {
-            found: 2,
-            supported: 1
+            found: 3,
+            supported: 2
         })
     ));
+    // Version 1 stored f32 samples: refused with advice, not misread as version 2.
+    let mut older = bytes.clone();
+    older[8..12].copy_from_slice(&1u32.to_le_bytes());
+    let err = model_file::from_bytes(&older).unwrap_err();
+    assert!(matches!(
+        err,
+        RegressError::UnsupportedVersion {
+            found: 1,
+            supported: 2
+        }
+    ));
+    assert!(err.to_string().contains("retrain"), "{err}");
     let mut magic = bytes.clone();
     magic[0] = b'X';
     assert!(matches!(
@@ -270,6 +282,69 @@ fn small_or_degenerate_placements_give_clear_errors_or_documented_fallbacks() {
         Cascade::train(&set, &fixed, &mut NoProgress),
         Err(RegressError::Shape(_))
     ));
+}
+
+#[test]
+fn half_precision_samples_stay_close_to_the_exact_model() {
+    let data = make(3, 4, 15, 1);
+    let params = CascadeParams {
+        regressors: RegressorChoice::Fixed {
+            c: 10.0,
+            epsilon: 0.01,
+        },
+        ..CascadeParams::default()
+    };
+    let model = Cascade::train(&data.set(), &params, &mut NoProgress).unwrap();
+    let test = make(3, 2, 20, 99);
+    let xt = MatrixRef::new(&test.x, 24).unwrap();
+    let r = model.rounding_effect(data.set().features, xt).unwrap();
+    assert_eq!(r.queries, 120);
+    assert_eq!(r.placement_agreement, 1.0);
+    // Features of magnitude up to about 3 lose at most 2^-12 relative to rounding; targets
+    // are of order 1 m/s: the stored model moves velocities by well under 1 cm/s.
+    for ch in 0..2 {
+        assert!(r.max_velocity_diff[ch] < 5e-3, "{r:?}");
+        assert!(r.mean_velocity_diff[ch] <= r.max_velocity_diff[ch] as f64);
+    }
+    assert!(
+        r.max_velocity_diff.iter().any(|&d| d > 0.0),
+        "rounding had no effect"
+    );
+    // Rows that are not the training rows cannot be matched.
+    assert!(matches!(
+        model.rounding_effect(xt, xt),
+        Err(RegressError::Shape(_))
+    ));
+    // The single-query path (half-precision GEMV) agrees with the batched GEMM path up to the
+    // summation order of the dot products (the distances cancel |q|² + |s|² - 2 q·s).
+    let batch = model.predict(xt).unwrap();
+    for (i, b) in batch.iter().enumerate() {
+        let one = model.predict_one(xt.row(i)).unwrap();
+        assert_eq!(one.placement, b.placement);
+        for ch in 0..2 {
+            assert!(
+                (one.velocity[ch] - b.velocity[ch]).abs() < 1e-4,
+                "query {i}"
+            );
+        }
+    }
+}
+
+#[test]
+fn features_beyond_the_half_precision_range_are_refused() {
+    let mut data = make(2, 3, 10, 3);
+    data.x[30] = 1.0e5;
+    let fixed = CascadeParams {
+        regressors: RegressorChoice::Fixed {
+            c: 1.0,
+            epsilon: 0.1,
+        },
+        ..CascadeParams::default()
+    };
+    match Cascade::train(&data.set(), &fixed, &mut NoProgress) {
+        Err(RegressError::NonFinite(m)) => assert!(m.contains("row 1, column 6"), "{m}"),
+        other => panic!("expected NonFinite, got {other:?}"),
+    }
 }
 
 #[test]
