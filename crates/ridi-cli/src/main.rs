@@ -8,6 +8,7 @@ use anyhow::{Context, Result, bail};
 use clap::{Parser, Subcommand, ValueEnum};
 use indicatif::{ProgressBar, ProgressStyle};
 
+use ridi::correct::PlacementSmoother;
 use ridi::data::{Format, ReadOptions, Sequence};
 use ridi::regress::{Cascade, ProgressEvent, Stage, model_file};
 use ridi::{EvalOptions, GridChoice, Method, PlacementMap, TrackOptions, TrainOptions};
@@ -116,6 +117,10 @@ enum Command {
         /// Estimate the initial velocity instead of assuming the walk starts at rest.
         #[arg(long)]
         estimate_initial_velocity: bool,
+        /// Placement majority window, seconds (batch): each regression takes the most frequent
+        /// placement label within it; 0 keeps each window's own label, as in the paper.
+        #[arg(long, value_name = "SECONDS", default_value_t = 10.0)]
+        placement_window: f64,
     },
     /// Evaluate RIDI and the baselines on labelled recordings: report.json, report.md, plots.
     #[command(after_help = "Examples:\n  \
@@ -149,6 +154,10 @@ enum Command {
         /// Worker threads (default: all cores).
         #[arg(long)]
         jobs: Option<usize>,
+        /// Placement majority window, seconds (batch): each regression takes the most frequent
+        /// placement label within it; 0 keeps each window's own label, as in the paper.
+        #[arg(long, value_name = "SECONDS", default_value_t = 10.0)]
+        placement_window: f64,
     },
     /// Train on the bundled sample (two people) and evaluate on the held-out person.
     #[command(after_help = "Example:\n  ridi demo --out demo-out\n\n\
@@ -287,6 +296,7 @@ fn run(cli: Cli) -> Result<()> {
             regress_every,
             lambda,
             estimate_initial_velocity,
+            placement_window,
         } => {
             let model = load_model(&model)?;
             let loaded = ridi::read_any(&sequence, None, &ReadOptions::default())?;
@@ -303,6 +313,7 @@ fn run(cli: Cli) -> Result<()> {
             let mut opts = TrackOptions {
                 regress_every,
                 online,
+                placement_smoothing: placement_smoothing(placement_window)?,
                 ..TrackOptions::default()
             };
             opts.correction.lambda = lambda;
@@ -331,6 +342,7 @@ fn run(cli: Cli) -> Result<()> {
             placement_map,
             plots,
             jobs,
+            placement_window,
         } => {
             set_jobs(jobs)?;
             let model = load_model(&model)?;
@@ -339,7 +351,11 @@ fn run(cli: Cli) -> Result<()> {
                 .iter()
                 .map(|m| m.parse::<Method>().map_err(anyhow::Error::msg))
                 .collect::<Result<Vec<_>>>()?;
-            evaluate_and_write(&seqs, &model, methods, &out, plots)?;
+            let track = TrackOptions {
+                placement_smoothing: placement_smoothing(placement_window)?,
+                ..TrackOptions::default()
+            };
+            evaluate_and_write(&seqs, &model, methods, track, &out, plots)?;
         }
         Command::Demo {
             out,
@@ -349,6 +365,14 @@ fn run(cli: Cli) -> Result<()> {
         } => demo(&out, data, grid, plots)?,
     }
     Ok(())
+}
+
+/// `--placement-window`: 0 turns the majority vote off.
+fn placement_smoothing(window_s: f64) -> Result<Option<PlacementSmoother>> {
+    if !(window_s.is_finite() && window_s >= 0.0) {
+        bail!("--placement-window must be a number of seconds >= 0, got {window_s}");
+    }
+    Ok((window_s > 0.0).then_some(PlacementSmoother { window_s }))
 }
 
 fn set_jobs(jobs: Option<usize>) -> Result<()> {
@@ -470,11 +494,13 @@ fn evaluate_and_write(
     seqs: &[Sequence],
     model: &Cascade,
     methods: Vec<Method>,
+    track: TrackOptions,
     out: &Path,
     plots: Plots,
 ) -> Result<ridi::Report> {
     let opts = EvalOptions {
         methods,
+        track,
         ..EvalOptions::default()
     };
     let spinner = ProgressBar::new_spinner();
@@ -573,7 +599,14 @@ fn demo(out: &Path, data: Option<PathBuf>, grid: Grid, plots: Plots) -> Result<(
     let model_path = out.join("model.ridi");
     model_file::save(&model, &model_path)
         .with_context(|| format!("cannot write {}", model_path.display()))?;
-    evaluate_and_write(&test, &model, Method::ALL.to_vec(), out, plots)?;
+    evaluate_and_write(
+        &test,
+        &model,
+        Method::ALL.to_vec(),
+        TrackOptions::default(),
+        out,
+        plots,
+    )?;
     Ok(())
 }
 

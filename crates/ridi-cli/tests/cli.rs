@@ -161,4 +161,33 @@ fn convert_train_track_and_eval() {
         "{}",
         stderr(&out)
     );
+
+    // The placement majority window: off with 0, refused when negative.
+    let plain = dir.path().join("plain.csv");
+    let out = ridi(&[
+        "track",
+        s(&test_seq),
+        "--model",
+        s(&model),
+        "--out",
+        s(&plain),
+        "--placement-window",
+        "0",
+    ]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let out = ridi(&[
+        "track",
+        s(&test_seq),
+        "--model",
+        s(&model),
+        "--out",
+        s(&plain),
+        "--placement-window=-1",
+    ]);
+    assert!(!out.status.success());
+    assert!(
+        stderr(&out).contains("--placement-window must be a number of seconds >= 0"),
+        "{}",
+        stderr(&out)
+    );
 }
