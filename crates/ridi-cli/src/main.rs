@@ -11,7 +11,9 @@ use indicatif::{ProgressBar, ProgressStyle};
 use ridi::correct::PlacementSmoother;
 use ridi::data::{Format, ReadOptions, Sequence};
 use ridi::regress::{Cascade, ProgressEvent, Stage, model_file};
-use ridi::{EvalOptions, GridChoice, Method, PlacementMap, TrackOptions, TrainOptions};
+use ridi::{
+    EvalOptions, GridChoice, Method, Orientation, PlacementMap, TrackOptions, TrainOptions,
+};
 
 #[derive(Parser)]
 #[command(
@@ -82,6 +84,10 @@ enum Command {
         /// Classifier C (paper: 10).
         #[arg(long, default_value_t = 10.0)]
         classifier_c: f64,
+        /// Orientation to track with: as recorded, or estimated from gyro + accelerometer
+        /// (straighter tracks where the recorded one uses the magnetometer indoors).
+        #[arg(long, value_enum, default_value = "recorded")]
+        orientation: OrientationArg,
         /// Worker threads (default: all cores).
         #[arg(long)]
         jobs: Option<usize>,
@@ -121,6 +127,10 @@ enum Command {
         /// placement label within it; 0 keeps each window's own label, as in the paper.
         #[arg(long, value_name = "SECONDS", default_value_t = 10.0)]
         placement_window: f64,
+        /// Orientation to track with: as recorded, or estimated from gyro + accelerometer
+        /// (straighter tracks where the recorded one uses the magnetometer indoors).
+        #[arg(long, value_enum, default_value = "recorded")]
+        orientation: OrientationArg,
     },
     /// Evaluate RIDI and the baselines on labelled recordings: report.json, report.md, plots.
     #[command(after_help = "Examples:\n  \
@@ -158,6 +168,10 @@ enum Command {
         /// placement label within it; 0 keeps each window's own label, as in the paper.
         #[arg(long, value_name = "SECONDS", default_value_t = 10.0)]
         placement_window: f64,
+        /// Orientation to track with: as recorded, or estimated from gyro + accelerometer
+        /// (straighter tracks where the recorded one uses the magnetometer indoors).
+        #[arg(long, value_enum, default_value = "recorded")]
+        orientation: OrientationArg,
     },
     /// Train on the bundled sample (two people) and evaluate on the held-out person.
     #[command(after_help = "Example:\n  ridi demo --out demo-out\n\n\
@@ -195,6 +209,23 @@ impl From<Grid> for GridChoice {
             Grid::Paper => GridChoice::Paper,
             Grid::Small => GridChoice::Small,
             Grid::None => GridChoice::None,
+        }
+    }
+}
+
+#[derive(Clone, Copy, PartialEq, ValueEnum)]
+enum OrientationArg {
+    /// As recorded in the file.
+    Recorded,
+    /// Estimated from gyro + accelerometer.
+    Estimated,
+}
+
+impl From<OrientationArg> for Orientation {
+    fn from(o: OrientationArg) -> Self {
+        match o {
+            OrientationArg::Recorded => Orientation::Recorded,
+            OrientationArg::Estimated => Orientation::Estimated,
         }
     }
 }
@@ -272,9 +303,10 @@ fn run(cli: Cli) -> Result<()> {
             no_standardize,
             classifier_c,
             jobs,
+            orientation,
         } => {
             set_jobs(jobs)?;
-            let seqs = load_lists(&list, placement_map.as_deref())?;
+            let seqs = load_lists(&list, placement_map.as_deref(), orientation.into())?;
             let mut opts = TrainOptions {
                 standardize: !no_standardize,
                 ..TrainOptions::default()
@@ -297,12 +329,14 @@ fn run(cli: Cli) -> Result<()> {
             lambda,
             estimate_initial_velocity,
             placement_window,
+            orientation,
         } => {
             let model = load_model(&model)?;
-            let loaded = ridi::read_any(&sequence, None, &ReadOptions::default())?;
+            let mut loaded = ridi::read_any(&sequence, None, &ReadOptions::default())?;
             for w in &loaded.warnings {
                 eprintln!("warning: {w}");
             }
+            Orientation::from(orientation).apply(&mut loaded.sequences)?;
             let [seq] = &loaded.sequences[..] else {
                 bail!(
                     "{} holds {} sequences; convert it with `ridi convert` and track each",
@@ -343,10 +377,11 @@ fn run(cli: Cli) -> Result<()> {
             plots,
             jobs,
             placement_window,
+            orientation,
         } => {
             set_jobs(jobs)?;
             let model = load_model(&model)?;
-            let seqs = load_lists(&list, placement_map.as_deref())?;
+            let seqs = load_lists(&list, placement_map.as_deref(), orientation.into())?;
             let methods = methods
                 .iter()
                 .map(|m| m.parse::<Method>().map_err(anyhow::Error::msg))
@@ -385,11 +420,16 @@ fn set_jobs(jobs: Option<usize>) -> Result<()> {
     Ok(())
 }
 
-fn load_lists(lists: &[PathBuf], map: Option<&str>) -> Result<Vec<Sequence>> {
+fn load_lists(
+    lists: &[PathBuf],
+    map: Option<&str>,
+    orientation: Orientation,
+) -> Result<Vec<Sequence>> {
     let mut seqs = Vec::new();
     for l in lists {
         seqs.extend(ridi::data::load_list(l, &ReadOptions::default())?);
     }
+    orientation.apply(&mut seqs)?;
     if let Some(map) = map {
         PlacementMap::from_arg(map)?.apply(&mut seqs);
     }
@@ -581,8 +621,8 @@ fn demo(out: &Path, data: Option<PathBuf>, grid: Grid, plots: Plots) -> Result<(
         );
     }
     let map = Some("tyrex4");
-    let train = load_lists(&[train_list], map)?;
-    let test = load_lists(&[data.join("list_test.txt")], map)?;
+    let train = load_lists(&[train_list], map, Orientation::Recorded)?;
+    let test = load_lists(&[data.join("list_test.txt")], map, Orientation::Recorded)?;
     println!(
         "demo: training on {} sequences ({:.0} s), testing on {} held-out sequences",
         train.len(),
