@@ -3,8 +3,10 @@
 //! Leave one subject out: train on two people, test on the third, three folds, so every run
 //! is tested once by a model that never saw its person. Runs split at long mocap or sensor gaps
 //! count as several test sequences; figures are means over all test sequences. Each variant
-//! changes one thing against the reference (4 placement groups, standardized features, gamma
-//! 1/1200, C = 10, epsilon = 0.01, the Android rotation vector as orientation, start at rest).
+//! changes one thing against the paper's configuration (4 placement groups, standardized
+//! features, gamma 1/1200, C = 10, epsilon = 0.01, the Android rotation vector as orientation,
+//! each window's own placement label, start at rest). Variants that differ only at test time
+//! share their trained models.
 
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
@@ -12,16 +14,16 @@ use std::time::Instant;
 
 use anyhow::{Context, Result};
 use ridi::baselines::{Method, trajectory};
-use ridi::correct::InitialVelocity;
+use ridi::correct::{InitialVelocity, PlacementSmoother};
 use ridi::data::tyrex::{self, TyrexOptions};
-use ridi::data::{OrientationSource, Sequence, write_atomically};
+use ridi::data::{Sequence, write_atomically};
 use ridi::eval::{EvalConfig, evaluate_trajectory};
+use ridi::evaluate::{SequenceResult, Traces};
 use ridi::features::{SampleSchedule, compute_targets};
-use ridi::frames::{FilterConfig, STANDARD_GRAVITY, estimate_orientation, gravity_in_device};
-use ridi::regress::{Gamma, NoProgress};
+use ridi::regress::{Cascade, Gamma, NoProgress};
 use ridi::track::Regressed;
 use ridi::train::ground_truth_view;
-use ridi::{EvalOptions, GridChoice, PlacementMap, TrackOptions, TrainOptions};
+use ridi::{EvalOptions, GridChoice, Orientation, PlacementMap, TrackOptions, TrainOptions};
 
 const PEOPLE: [&str; 3] = ["Guillaume", "Jakob", "Thibaud"];
 
@@ -32,52 +34,107 @@ struct Variant {
     groups: bool,
     standardize: bool,
     gamma: Gamma,
-    estimate_v0: bool,
     estimated_orientation: bool,
+    // Test time only.
+    estimate_v0: bool,
+    smoothing: bool,
 }
 
-const REFERENCE: Variant = Variant {
-    name: "reference: 4 groups",
+impl Variant {
+    /// Variants with equal keys train the same models.
+    fn train_key(&self) -> String {
+        format!(
+            "{} {} {:?} {}",
+            self.groups, self.standardize, self.gamma, self.estimated_orientation
+        )
+    }
+}
+
+const PAPER: Variant = Variant {
+    name: "paper: 4 groups, each window's own placement",
     groups: true,
     standardize: true,
     gamma: Gamma::InverseDim,
-    estimate_v0: false,
     estimated_orientation: false,
+    estimate_v0: false,
+    smoothing: false,
+};
+
+const SMOOTHED: Variant = Variant {
+    name: "placement majority over 10 s (ridi's default)",
+    smoothing: true,
+    ..PAPER
+};
+
+const RECOMMENDED: Variant = Variant {
+    name: "majority + orientation from gyro + accelerometer",
+    smoothing: true,
+    estimated_orientation: true,
+    ..PAPER
 };
 
 fn variants(quick: bool) -> Vec<Variant> {
-    let mut v = vec![REFERENCE];
     if quick {
-        return v;
+        return vec![PAPER, SMOOTHED];
     }
-    v.extend([
+    // Ordered so that variants sharing models are adjacent.
+    vec![
+        PAPER,
+        SMOOTHED,
+        Variant {
+            name: "initial velocity estimated",
+            estimate_v0: true,
+            ..PAPER
+        },
+        RECOMMENDED,
+        Variant {
+            name: "orientation from gyro + accelerometer",
+            estimated_orientation: true,
+            ..PAPER
+        },
         Variant {
             name: "8 motion names",
             groups: false,
-            ..REFERENCE
+            ..PAPER
         },
         Variant {
             name: "raw features (no standardization)",
             standardize: false,
-            ..REFERENCE
+            ..PAPER
         },
         Variant {
             name: "gamma 4/1200",
             gamma: Gamma::Value(4.0 / 1200.0),
-            ..REFERENCE
+            ..PAPER
         },
-        Variant {
-            name: "initial velocity estimated",
-            estimate_v0: true,
-            ..REFERENCE
-        },
-        Variant {
-            name: "orientation from gyro + accelerometer",
-            estimated_orientation: true,
-            ..REFERENCE
-        },
-    ]);
-    v
+    ]
+}
+
+/// One test sequence of one variant.
+#[derive(Debug, Clone)]
+struct SeqRow {
+    result: SequenceResult,
+    /// Mean regressed and mean true velocity `[S-x, S-z]`: the heading of the phone relative
+    /// to the walk that the regressors learned, against this person's.
+    mean_regressed: [f64; 2],
+    mean_true: [f64; 2],
+}
+
+impl SeqRow {
+    fn new(result: SequenceResult, traces: &Traces) -> Self {
+        let mean = |v: &[[f64; 2]]| {
+            let n = v.len().max(1) as f64;
+            [
+                v.iter().map(|x| x[0]).sum::<f64>() / n,
+                v.iter().map(|x| x[1]).sum::<f64>() / n,
+            ]
+        };
+        Self {
+            mean_regressed: mean(&traces.regressed),
+            mean_true: mean(&traces.true_velocity),
+            result,
+        }
+    }
 }
 
 /// Means over the test sequences of one variant.
@@ -91,24 +148,7 @@ struct Row {
     path_ratio: Vec<(String, f64)>,
     oracle_rte_5s: f64,
     train_s: f64,
-}
-
-fn with_estimated_orientation(seq: &Sequence) -> Result<Sequence> {
-    let q = estimate_orientation(seq.time(), seq.gyro(), seq.acce(), &FilterConfig::default())?;
-    let mut p = seq.clone().into_parts();
-    p.gravity = q
-        .iter()
-        .map(|&q| gravity_in_device(q, STANDARD_GRAVITY))
-        .collect();
-    p.linacce = p
-        .acce
-        .iter()
-        .zip(&p.gravity)
-        .map(|(&a, &g)| a - g)
-        .collect();
-    p.orientation = q;
-    p.orientation_source = Some(OrientationSource::Estimated);
-    Ok(Sequence::new(p)?)
+    per_sequence: Vec<SeqRow>,
 }
 
 fn load(data: &Path) -> Result<Vec<Sequence>> {
@@ -149,50 +189,79 @@ fn oracle_rte(seq: &Sequence, opts: &EvalOptions) -> Result<f64> {
     )
 }
 
-fn run_variant(all: &[Sequence], v: &Variant) -> Result<Row> {
-    let mut seqs: Vec<Sequence> = if v.estimated_orientation {
-        all.iter()
-            .map(with_estimated_orientation)
-            .collect::<Result<_>>()?
-    } else {
-        all.to_vec()
-    };
+/// The sequences a variant trains and tests on.
+fn prepare(all: &[Sequence], v: &Variant) -> Result<Vec<Sequence>> {
+    let mut seqs = all.to_vec();
+    if v.estimated_orientation {
+        Orientation::Estimated.apply(&mut seqs)?;
+    }
     if v.groups {
         PlacementMap::tyrex_groups().apply(&mut seqs);
     }
-    let mut train_opts = TrainOptions {
+    Ok(seqs)
+}
+
+/// One model per test person, and the training time of all three.
+fn train_folds(seqs: &[Sequence], v: &Variant) -> Result<(Vec<Cascade>, f64)> {
+    let mut opts = TrainOptions {
         standardize: v.standardize,
         ..TrainOptions::default()
     };
-    train_opts.cascade.regressors = GridChoice::None.regressors();
-    train_opts.cascade.classifier_gamma = v.gamma;
-    train_opts.cascade.regressor_gamma = v.gamma;
+    opts.cascade.regressors = GridChoice::None.regressors();
+    opts.cascade.classifier_gamma = v.gamma;
+    opts.cascade.regressor_gamma = v.gamma;
+    let started = Instant::now();
+    let models = PEOPLE
+        .iter()
+        .map(|&test_person| {
+            let train: Vec<Sequence> = seqs
+                .iter()
+                .filter(|s| person(s) != test_person)
+                .cloned()
+                .collect();
+            let model = ridi::train(&train, &opts, &mut NoProgress)?;
+            eprintln!("  {}: trained without {test_person}", v.name);
+            Ok(model)
+        })
+        .collect::<Result<_>>()?;
+    Ok((models, started.elapsed().as_secs_f64()))
+}
+
+fn run_variant(seqs: &[Sequence], models: &[Cascade], train_s: f64, v: &Variant) -> Result<Row> {
     let mut eval_opts = EvalOptions {
-        track: TrackOptions::default(),
+        track: TrackOptions {
+            placement_smoothing: v.smoothing.then(PlacementSmoother::default),
+            ..TrackOptions::default()
+        },
         ..EvalOptions::default()
     };
     if v.estimate_v0 {
         eval_opts.track.correction.initial_velocity = InitialVelocity::Estimate;
     }
-    let mut results = Vec::new();
+    let mut per_sequence = Vec::new();
     let mut oracle = Vec::new();
-    let mut train_s = 0.0;
-    for test_person in PEOPLE {
-        let (test, train): (Vec<Sequence>, Vec<Sequence>) =
-            seqs.iter().cloned().partition(|s| person(s) == test_person);
-        let t = Instant::now();
-        let model = ridi::train(&train, &train_opts, &mut NoProgress)?;
-        train_s += t.elapsed().as_secs_f64();
-        let (report, _) = ridi::evaluate(&test, &model, &eval_opts)?;
-        results.extend(report.sequences);
+    for (test_person, model) in PEOPLE.iter().zip(models) {
+        let test: Vec<Sequence> = seqs
+            .iter()
+            .filter(|s| person(s) == *test_person)
+            .cloned()
+            .collect();
+        let (report, traces) = ridi::evaluate(&test, model, &eval_opts)?;
+        per_sequence.extend(
+            report
+                .sequences
+                .into_iter()
+                .zip(&traces)
+                .map(|(r, t)| SeqRow::new(r, t)),
+        );
         for s in &test {
             oracle.push(oracle_rte(s, &eval_opts)?);
         }
-        eprintln!("  {}: fold {test_person} done", v.name);
     }
+    eprintln!("  {}: evaluated", v.name);
+    let results: Vec<&SequenceResult> = per_sequence.iter().map(|r| &r.result).collect();
     let n = results.len() as f64;
-    let mean =
-        |f: &dyn Fn(&ridi::evaluate::SequenceResult) -> f64| results.iter().map(f).sum::<f64>() / n;
+    let mean = |f: &dyn Fn(&SequenceResult) -> f64| results.iter().map(|r| f(r)).sum::<f64>() / n;
     let per_method = |f: fn(&ridi::eval::TrajectoryMetrics) -> f64| {
         Method::ALL
             .iter()
@@ -214,7 +283,80 @@ fn run_variant(all: &[Sequence], v: &Variant) -> Result<Row> {
         path_ratio: per_method(|m| m.path_length_ratio.unwrap_or(f64::NAN)),
         oracle_rte_5s: oracle.iter().sum::<f64>() / oracle.len() as f64,
         train_s,
+        per_sequence,
     })
+}
+
+/// Means per placement label of one variant's sequences.
+fn per_placement(md: &mut String, v: &Variant, r: &Row) {
+    let _ = writeln!(md, "\n## Per placement, {}\n", v.name);
+    let _ = writeln!(
+        md,
+        "| placement | sequences | velocity MSE S-x / S-z | placement accuracy | RTE 5 s (m) | ATE (m) | path length ratio |\n| --- | --- | --- | --- | --- | --- | --- |"
+    );
+    let mut labels: Vec<&str> = r
+        .per_sequence
+        .iter()
+        .filter_map(|s| s.result.placement.as_deref())
+        .collect();
+    labels.sort_unstable();
+    labels.dedup();
+    for label in labels {
+        let rows: Vec<&SequenceResult> = r
+            .per_sequence
+            .iter()
+            .map(|s| &s.result)
+            .filter(|s| s.placement.as_deref() == Some(label))
+            .collect();
+        let n = rows.len() as f64;
+        let m = |f: &dyn Fn(&SequenceResult) -> f64| rows.iter().map(|r| f(r)).sum::<f64>() / n;
+        let _ = writeln!(
+            md,
+            "| {label} | {} | {:.3} / {:.3} | {:.3} | {:.3} | {:.3} | {:.3} |",
+            rows.len(),
+            m(&|r| r.velocity_mse[0]),
+            m(&|r| r.velocity_mse[1]),
+            m(&|r| r.placement_accuracy.unwrap_or(0.0)),
+            m(&|r| r.methods["ridi"].rte_5s_m),
+            m(&|r| r.methods["ridi"].ate_m),
+            m(&|r| r.methods["ridi"].path_length_ratio.unwrap_or(f64::NAN)),
+        );
+    }
+}
+
+/// Every test sequence of one variant, with the mean velocity directions.
+fn per_sequence(md: &mut String, v: &Variant, r: &Row) {
+    let _ = writeln!(md, "\n## Per sequence, {}\n", v.name);
+    let _ = writeln!(
+        md,
+        "Mean true and mean regressed velocity in S show how the phone was held relative to the \
+         walk: a person who carries it turned against the training people gets velocities \
+         turned by the same angle.\n"
+    );
+    let _ = writeln!(
+        md,
+        "| sequence | placement | velocity MSE S-x / S-z | placement accuracy | mean true v (S-x, S-z) | mean regressed v | RTE 5 s (m) | path length ratio |\n| --- | --- | --- | --- | --- | --- | --- | --- |"
+    );
+    let mut rows: Vec<&SeqRow> = r.per_sequence.iter().collect();
+    rows.sort_by(|a, b| a.result.name.cmp(&b.result.name));
+    for s in rows {
+        let q = &s.result;
+        let _ = writeln!(
+            md,
+            "| {} | {} | {:.3} / {:.3} | {:.3} | ({:+.2}, {:+.2}) | ({:+.2}, {:+.2}) | {:.3} | {:.3} |",
+            q.name,
+            q.placement.as_deref().unwrap_or("-"),
+            q.velocity_mse[0],
+            q.velocity_mse[1],
+            q.placement_accuracy.unwrap_or(f64::NAN),
+            s.mean_true[0],
+            s.mean_true[1],
+            s.mean_regressed[0],
+            s.mean_regressed[1],
+            q.methods["ridi"].rte_5s_m,
+            q.methods["ridi"].path_length_ratio.unwrap_or(f64::NAN),
+        );
+    }
 }
 
 fn get(v: &[(String, f64)], key: &str) -> f64 {
@@ -231,8 +373,17 @@ pub fn run(data: Option<PathBuf>, out: Option<PathBuf>, quick: bool) -> Result<P
     let started = Instant::now();
     let all = load(&data).with_context(|| format!("reading Tyrex data in {}", data.display()))?;
     let mut rows = Vec::new();
+    // Models of the previous variant, kept while the next one shares them.
+    let mut trained: Option<(String, Vec<Cascade>, f64)> = None;
     for v in variants(quick) {
-        let row = run_variant(&all, &v)?;
+        let seqs = prepare(&all, &v)?;
+        if trained.as_ref().is_none_or(|t| t.0 != v.train_key()) {
+            drop(trained.take()); // free the previous models first
+            let (models, secs) = train_folds(&seqs, &v)?;
+            trained = Some((v.train_key(), models, secs));
+        }
+        let (_, models, secs) = trained.as_ref().context("models")?;
+        let row = run_variant(&seqs, models, *secs, &v)?;
         rows.push((v, row));
     }
     let mut md = String::new();
@@ -245,7 +396,8 @@ pub fn run(data: Option<PathBuf>, out: Option<PathBuf>, quick: bool) -> Result<P
         "Command: `cargo xtask eval-tyrex{}` ({:.0} s in all on a 2-core machine shared with other work). \
          {} test sequences (24 runs; runs split at long mocap or sensor gaps count once per part). \
          Train on two people, test on the third, three folds; C = 10, epsilon = 0.01, no grid search; \
-         trajectories aligned on the first 10 s; means over test sequences.\n",
+         trajectories aligned on the first 10 s; means over test sequences. Variants that differ \
+         only at test time share their models (and their training time).\n",
         if quick { " --quick" } else { "" },
         started.elapsed().as_secs_f64(),
         rows.first().map_or(0, |r| r.1.sequences)
@@ -286,6 +438,15 @@ pub fn run(data: Option<PathBuf>, out: Option<PathBuf>, quick: bool) -> Result<P
                 get(&r.path_ratio, m.key())
             );
         }
+    }
+    for (v, r) in rows
+        .iter()
+        .filter(|(v, _)| v.name == PAPER.name || v.name == RECOMMENDED.name)
+    {
+        per_placement(&mut md, v, r);
+    }
+    if let Some((v, r)) = rows.first() {
+        per_sequence(&mut md, v, r);
     }
     write_atomically(&out, |w| w.write_all(md.as_bytes()))?;
     print!("{md}");

@@ -8,9 +8,12 @@ use anyhow::{Context, Result, bail};
 use clap::{Parser, Subcommand, ValueEnum};
 use indicatif::{ProgressBar, ProgressStyle};
 
+use ridi::correct::PlacementSmoother;
 use ridi::data::{Format, ReadOptions, Sequence};
 use ridi::regress::{Cascade, ProgressEvent, Stage, model_file};
-use ridi::{EvalOptions, GridChoice, Method, PlacementMap, TrackOptions, TrainOptions};
+use ridi::{
+    EvalOptions, GridChoice, Method, Orientation, PlacementMap, TrackOptions, TrainOptions,
+};
 
 #[derive(Parser)]
 #[command(
@@ -81,6 +84,10 @@ enum Command {
         /// Classifier C (paper: 10).
         #[arg(long, default_value_t = 10.0)]
         classifier_c: f64,
+        /// Orientation to track with: as recorded, or estimated from gyro + accelerometer
+        /// (straighter tracks where the recorded one uses the magnetometer indoors).
+        #[arg(long, value_enum, default_value = "recorded")]
+        orientation: OrientationArg,
         /// Worker threads (default: all cores).
         #[arg(long)]
         jobs: Option<usize>,
@@ -116,6 +123,14 @@ enum Command {
         /// Estimate the initial velocity instead of assuming the walk starts at rest.
         #[arg(long)]
         estimate_initial_velocity: bool,
+        /// Placement majority window, seconds (batch): each regression takes the most frequent
+        /// placement label within it; 0 keeps each window's own label, as in the paper.
+        #[arg(long, value_name = "SECONDS", default_value_t = 10.0)]
+        placement_window: f64,
+        /// Orientation to track with: as recorded, or estimated from gyro + accelerometer
+        /// (straighter tracks where the recorded one uses the magnetometer indoors).
+        #[arg(long, value_enum, default_value = "recorded")]
+        orientation: OrientationArg,
     },
     /// Evaluate RIDI and the baselines on labelled recordings: report.json, report.md, plots.
     #[command(after_help = "Examples:\n  \
@@ -149,6 +164,14 @@ enum Command {
         /// Worker threads (default: all cores).
         #[arg(long)]
         jobs: Option<usize>,
+        /// Placement majority window, seconds (batch): each regression takes the most frequent
+        /// placement label within it; 0 keeps each window's own label, as in the paper.
+        #[arg(long, value_name = "SECONDS", default_value_t = 10.0)]
+        placement_window: f64,
+        /// Orientation to track with: as recorded, or estimated from gyro + accelerometer
+        /// (straighter tracks where the recorded one uses the magnetometer indoors).
+        #[arg(long, value_enum, default_value = "recorded")]
+        orientation: OrientationArg,
     },
     /// Train on the bundled sample (two people) and evaluate on the held-out person.
     #[command(after_help = "Example:\n  ridi demo --out demo-out\n\n\
@@ -186,6 +209,23 @@ impl From<Grid> for GridChoice {
             Grid::Paper => GridChoice::Paper,
             Grid::Small => GridChoice::Small,
             Grid::None => GridChoice::None,
+        }
+    }
+}
+
+#[derive(Clone, Copy, PartialEq, ValueEnum)]
+enum OrientationArg {
+    /// As recorded in the file.
+    Recorded,
+    /// Estimated from gyro + accelerometer.
+    Estimated,
+}
+
+impl From<OrientationArg> for Orientation {
+    fn from(o: OrientationArg) -> Self {
+        match o {
+            OrientationArg::Recorded => Orientation::Recorded,
+            OrientationArg::Estimated => Orientation::Estimated,
         }
     }
 }
@@ -263,9 +303,10 @@ fn run(cli: Cli) -> Result<()> {
             no_standardize,
             classifier_c,
             jobs,
+            orientation,
         } => {
             set_jobs(jobs)?;
-            let seqs = load_lists(&list, placement_map.as_deref())?;
+            let seqs = load_lists(&list, placement_map.as_deref(), orientation.into())?;
             let mut opts = TrainOptions {
                 standardize: !no_standardize,
                 ..TrainOptions::default()
@@ -287,12 +328,15 @@ fn run(cli: Cli) -> Result<()> {
             regress_every,
             lambda,
             estimate_initial_velocity,
+            placement_window,
+            orientation,
         } => {
             let model = load_model(&model)?;
-            let loaded = ridi::read_any(&sequence, None, &ReadOptions::default())?;
+            let mut loaded = ridi::read_any(&sequence, None, &ReadOptions::default())?;
             for w in &loaded.warnings {
                 eprintln!("warning: {w}");
             }
+            Orientation::from(orientation).apply(&mut loaded.sequences)?;
             let [seq] = &loaded.sequences[..] else {
                 bail!(
                     "{} holds {} sequences; convert it with `ridi convert` and track each",
@@ -303,6 +347,7 @@ fn run(cli: Cli) -> Result<()> {
             let mut opts = TrackOptions {
                 regress_every,
                 online,
+                placement_smoothing: placement_smoothing(placement_window)?,
                 ..TrackOptions::default()
             };
             opts.correction.lambda = lambda;
@@ -331,15 +376,21 @@ fn run(cli: Cli) -> Result<()> {
             placement_map,
             plots,
             jobs,
+            placement_window,
+            orientation,
         } => {
             set_jobs(jobs)?;
             let model = load_model(&model)?;
-            let seqs = load_lists(&list, placement_map.as_deref())?;
+            let seqs = load_lists(&list, placement_map.as_deref(), orientation.into())?;
             let methods = methods
                 .iter()
                 .map(|m| m.parse::<Method>().map_err(anyhow::Error::msg))
                 .collect::<Result<Vec<_>>>()?;
-            evaluate_and_write(&seqs, &model, methods, &out, plots)?;
+            let track = TrackOptions {
+                placement_smoothing: placement_smoothing(placement_window)?,
+                ..TrackOptions::default()
+            };
+            evaluate_and_write(&seqs, &model, methods, track, &out, plots)?;
         }
         Command::Demo {
             out,
@@ -349,6 +400,14 @@ fn run(cli: Cli) -> Result<()> {
         } => demo(&out, data, grid, plots)?,
     }
     Ok(())
+}
+
+/// `--placement-window`: 0 turns the majority vote off.
+fn placement_smoothing(window_s: f64) -> Result<Option<PlacementSmoother>> {
+    if !(window_s.is_finite() && window_s >= 0.0) {
+        bail!("--placement-window must be a number of seconds >= 0, got {window_s}");
+    }
+    Ok((window_s > 0.0).then_some(PlacementSmoother { window_s }))
 }
 
 fn set_jobs(jobs: Option<usize>) -> Result<()> {
@@ -361,11 +420,16 @@ fn set_jobs(jobs: Option<usize>) -> Result<()> {
     Ok(())
 }
 
-fn load_lists(lists: &[PathBuf], map: Option<&str>) -> Result<Vec<Sequence>> {
+fn load_lists(
+    lists: &[PathBuf],
+    map: Option<&str>,
+    orientation: Orientation,
+) -> Result<Vec<Sequence>> {
     let mut seqs = Vec::new();
     for l in lists {
         seqs.extend(ridi::data::load_list(l, &ReadOptions::default())?);
     }
+    orientation.apply(&mut seqs)?;
     if let Some(map) = map {
         PlacementMap::from_arg(map)?.apply(&mut seqs);
     }
@@ -470,11 +534,13 @@ fn evaluate_and_write(
     seqs: &[Sequence],
     model: &Cascade,
     methods: Vec<Method>,
+    track: TrackOptions,
     out: &Path,
     plots: Plots,
 ) -> Result<ridi::Report> {
     let opts = EvalOptions {
         methods,
+        track,
         ..EvalOptions::default()
     };
     let spinner = ProgressBar::new_spinner();
@@ -555,8 +621,8 @@ fn demo(out: &Path, data: Option<PathBuf>, grid: Grid, plots: Plots) -> Result<(
         );
     }
     let map = Some("tyrex4");
-    let train = load_lists(&[train_list], map)?;
-    let test = load_lists(&[data.join("list_test.txt")], map)?;
+    let train = load_lists(&[train_list], map, Orientation::Recorded)?;
+    let test = load_lists(&[data.join("list_test.txt")], map, Orientation::Recorded)?;
     println!(
         "demo: training on {} sequences ({:.0} s), testing on {} held-out sequences",
         train.len(),
@@ -573,7 +639,14 @@ fn demo(out: &Path, data: Option<PathBuf>, grid: Grid, plots: Plots) -> Result<(
     let model_path = out.join("model.ridi");
     model_file::save(&model, &model_path)
         .with_context(|| format!("cannot write {}", model_path.display()))?;
-    evaluate_and_write(&test, &model, Method::ALL.to_vec(), out, plots)?;
+    evaluate_and_write(
+        &test,
+        &model,
+        Method::ALL.to_vec(),
+        TrackOptions::default(),
+        out,
+        plots,
+    )?;
     Ok(())
 }
 

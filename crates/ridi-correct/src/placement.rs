@@ -1,4 +1,5 @@
-//! The placement-change filter of the original code.
+//! Placement labels over time: the placement-change filter of the original code, and a
+//! majority smoother for batch tracking.
 //!
 //! A phone that is being moved between placements (pocket to hand, say) confuses the
 //! placement classifier, whose label then flips back and forth; the regressed velocity of such
@@ -56,9 +57,108 @@ impl PlacementFilter {
     }
 }
 
+/// Majority vote over the placement labels of a time window (batch tracking).
+///
+/// The classifier labels each feature window alone, so a sequence held one way collects
+/// scattered wrong labels, and each one sends its window to the wrong placement's
+/// regressors. Phones change placement seldom: replacing every label by the most frequent
+/// label within `±window_s / 2` seconds removes the scatter and keeps real changes that last
+/// longer than half a window. Not in the paper (its online code only zeroes velocities during
+/// label flicker, see [`PlacementFilter`]).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct PlacementSmoother {
+    /// Width of the voting window, seconds (centred on each label).
+    pub window_s: f64,
+}
+
+impl Default for PlacementSmoother {
+    /// A 10 s window (±5 s).
+    fn default() -> Self {
+        Self { window_s: 10.0 }
+    }
+}
+
+impl PlacementSmoother {
+    /// The smoothed label of each entry of `labels` (indices below `classes`) observed at
+    /// `times` (seconds, non-decreasing). A tie keeps the label itself when it is among the
+    /// most frequent, else the lowest tied label: the result does not depend on anything but
+    /// the inputs.
+    ///
+    /// # Panics
+    /// If `times` and `labels` differ in length or a label is not below `classes`: both are
+    /// produced by the caller's own classifier, never read from user input.
+    pub fn smooth(&self, times: &[f64], labels: &[usize], classes: usize) -> Vec<usize> {
+        assert_eq!(times.len(), labels.len(), "one time per label");
+        let half = self.window_s / 2.0;
+        let mut counts = vec![0usize; classes];
+        let (mut lo, mut hi) = (0, 0);
+        let mut out = Vec::with_capacity(labels.len());
+        for (i, &t) in times.iter().enumerate() {
+            while hi < labels.len() && times[hi] <= t + half {
+                counts[labels[hi]] += 1;
+                hi += 1;
+            }
+            while times[lo] < t - half {
+                counts[labels[lo]] -= 1;
+                lo += 1;
+            }
+            let best = counts.iter().copied().max().unwrap_or(0);
+            out.push(if counts[labels[i]] == best {
+                labels[i]
+            } else {
+                counts.iter().position(|&c| c == best).unwrap_or(labels[i])
+            });
+        }
+        out
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn smoother_removes_scatter_and_keeps_lasting_changes() {
+        let s = PlacementSmoother { window_s: 2.0 };
+        let times: Vec<f64> = (0..40).map(|i| i as f64 * 0.25).collect();
+        // Class 0 for 5 s, then class 2 for 5 s, with isolated wrong labels in both halves.
+        let mut labels: Vec<usize> = (0..40).map(|i| if i < 20 { 0 } else { 2 }).collect();
+        labels[5] = 1;
+        labels[30] = 0;
+        let out = s.smooth(&times, &labels, 3);
+        let want: Vec<usize> = (0..40).map(|i| if i < 20 { 0 } else { 2 }).collect();
+        assert_eq!(out, want);
+        // A label tied with another for the most votes keeps itself; else the lowest wins.
+        let times = [0.0, 0.1, 0.2, 0.3];
+        assert_eq!(s.smooth(&times, &[1, 0, 1, 0], 2), vec![1, 0, 1, 0]);
+        assert_eq!(s.smooth(&times, &[2, 1, 0, 3], 4), vec![2, 1, 0, 3]);
+        assert_eq!(s.smooth(&times, &[2, 2, 1, 0], 3), vec![2, 2, 2, 2]);
+        assert!(s.smooth(&[], &[], 3).is_empty());
+    }
+
+    #[test]
+    fn smoother_agrees_with_a_plain_count() {
+        // Uneven times, several classes: compare with counting each window from scratch.
+        let s = PlacementSmoother { window_s: 1.3 };
+        let times: Vec<f64> = (0..200).map(|i| (i as f64 * 0.173).powf(1.1)).collect();
+        let labels: Vec<usize> = (0..200).map(|i| (i * i + 3 * i) % 7 % 4).collect();
+        let out = s.smooth(&times, &labels, 4);
+        for i in 0..200 {
+            let mut c = [0usize; 4];
+            for j in 0..200 {
+                if (times[j] - times[i]).abs() <= 0.65 {
+                    c[labels[j]] += 1;
+                }
+            }
+            let best = *c.iter().max().unwrap();
+            let want = if c[labels[i]] == best {
+                labels[i]
+            } else {
+                c.iter().position(|&x| x == best).unwrap()
+            };
+            assert_eq!(out[i], want, "entry {i}");
+        }
+    }
 
     #[test]
     fn flags_flipping_labels_only() {

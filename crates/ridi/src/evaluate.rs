@@ -114,7 +114,7 @@ fn evaluate_one(seq: &Sequence, model: &Cascade, opts: &EvalOptions) -> Result<E
         .ok_or_else(|| PipelineError::sequence(seq.name(), "has no ground truth to evaluate"))?;
     let gt2 = gt.horizontal();
     let regressions: Vec<Regressed> = if opts.methods.iter().any(|m| m.needs_model()) {
-        regress(seq, model, opts.track.regress_every)?
+        regress(seq, model, &opts.track)?
     } else {
         Vec::new()
     };

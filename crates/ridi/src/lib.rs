@@ -12,7 +12,8 @@
 //! | [`eval`] | `ridi-eval` | alignment, MPE/ATE/RTE, reports |
 //!
 //! Pipeline modules: [`source`] reads any supported layout, [`convert`] writes the RIDI
-//! layout with list files, [`inspect`] summarizes a recording.
+//! layout with list files, [`inspect`] summarizes a recording, [`orientation`] swaps in an
+//! orientation estimated from gyro and accelerometer.
 
 pub use ridi_correct as correct;
 pub use ridi_data as data;
@@ -26,6 +27,7 @@ pub mod convert;
 mod error;
 pub mod evaluate;
 pub mod inspect;
+pub mod orientation;
 pub mod placement;
 pub mod plot;
 pub mod source;
@@ -35,6 +37,7 @@ pub mod train;
 pub use baselines::Method;
 pub use error::{PipelineError, Result};
 pub use evaluate::{EvalOptions, Report, evaluate};
+pub use orientation::Orientation;
 pub use placement::PlacementMap;
 pub use source::{Loaded, read_any};
 pub use track::{Track, TrackOptions, track};

@@ -3,8 +3,8 @@
 use std::path::Path;
 
 use ridi_correct::{
-    CorrectionConfig, FrameWindow, Regression, Sample, Tracker, TrackerConfig, VelocityRegressor,
-    VelocityTarget, correct,
+    CorrectionConfig, FrameWindow, PlacementSmoother, Regression, Sample, Tracker, TrackerConfig,
+    VelocityRegressor, VelocityTarget, correct,
 };
 use ridi_data::{Sequence, write_atomically};
 use ridi_features::{FeatureExtractor, ImuView, SampleSchedule};
@@ -25,6 +25,11 @@ pub struct TrackOptions {
     /// Streaming mode (paper's online variant): a 1000-frame window corrected every 200
     /// frames, each frame's pose as known when it arrived. Otherwise one global correction.
     pub online: bool,
+    /// Batch only: each regression's placement becomes the majority label of a time window
+    /// around it, and its velocity comes from that placement's regressors. `None` keeps every
+    /// window's own label (the paper). The streaming tracker keeps the original code's
+    /// placement-change filter instead.
+    pub placement_smoothing: Option<PlacementSmoother>,
 }
 
 impl Default for TrackOptions {
@@ -33,6 +38,7 @@ impl Default for TrackOptions {
             regress_every: 50,
             correction: CorrectionConfig::default(),
             online: false,
+            placement_smoothing: Some(PlacementSmoother::default()),
         }
     }
 }
@@ -113,17 +119,17 @@ impl Track {
     }
 }
 
-/// Regresses placement and velocity every `step` frames from the first full window, in one
-/// batched pass.
-pub fn regress(seq: &Sequence, model: &Cascade, step: usize) -> Result<Vec<Regressed>> {
+/// Regresses placement and velocity every `opts.regress_every` frames from the first full
+/// window, in one batched pass, then smooths the placements if `opts.placement_smoothing` asks.
+pub fn regress(seq: &Sequence, model: &Cascade, opts: &TrackOptions) -> Result<Vec<Regressed>> {
     let fx = FeatureExtractor::new(model.feature_config().clone())?;
-    let frames = SampleSchedule::every(fx.config(), step)?.frames(seq.len());
+    let frames = SampleSchedule::every(fx.config(), opts.regress_every)?.frames(seq.len());
     if frames.is_empty() {
         return Ok(Vec::new());
     }
     let features = fx.features(&fx.stabilize(&imu_view(seq)?)?, &frames)?;
     let predictions = model.predict(MatrixRef::new(features.as_slice(), features.cols())?)?;
-    Ok(frames
+    let mut out: Vec<Regressed> = frames
         .iter()
         .zip(predictions)
         .map(|(&frame, p)| Regressed {
@@ -131,7 +137,32 @@ pub fn regress(seq: &Sequence, model: &Cascade, step: usize) -> Result<Vec<Regre
             placement: p.placement,
             velocity: [p.velocity[0] as f64, p.velocity[1] as f64],
         })
-        .collect())
+        .collect();
+    let Some(smoother) = opts.placement_smoothing else {
+        return Ok(out);
+    };
+    let times: Vec<f64> = frames.iter().map(|&f| seq.time()[f]).collect();
+    let labels: Vec<usize> = out.iter().map(|r| r.placement).collect();
+    let smoothed = smoother.smooth(&times, &labels, model.placements().len());
+    for p in 0..model.placements().len() {
+        let moved: Vec<usize> = (0..out.len())
+            .filter(|&i| smoothed[i] == p && labels[i] != p)
+            .collect();
+        if moved.is_empty() {
+            continue;
+        }
+        let rows: Vec<f32> = moved
+            .iter()
+            .flat_map(|&i| features.row(i).iter().copied())
+            .collect();
+        let velocities =
+            model.predict_with_placement(MatrixRef::new(&rows, features.cols())?, p)?;
+        for (&i, v) in moved.iter().zip(velocities) {
+            out[i].placement = p;
+            out[i].velocity = [v[0] as f64, v[1] as f64];
+        }
+    }
+    Ok(out)
 }
 
 /// The inputs of a correction of `seq`.
@@ -176,7 +207,7 @@ pub fn track(seq: &Sequence, model: &Cascade, opts: &TrackOptions) -> Result<Tra
     if opts.online {
         return track_online(seq, model, opts);
     }
-    let regressions = regress(seq, model, opts.regress_every)?;
+    let regressions = regress(seq, model, opts)?;
     correct_with(seq, &regressions, opts.correction, model.placements())
 }
 

@@ -110,11 +110,56 @@ fn train_track_and_evaluate_on_the_sample() {
 }
 
 #[test]
+fn placement_smoothing_takes_the_window_majority_and_its_regressors() {
+    let model = quick_model(&load("list_Guillaume.txt"));
+    let test = load("list_Jakob.txt");
+    let mut changed = 0;
+    for seq in &test {
+        let off = TrackOptions {
+            placement_smoothing: None,
+            ..TrackOptions::default()
+        };
+        let on = TrackOptions::default();
+        let smoother = on.placement_smoothing.unwrap();
+        let raw = ridi::track::regress(seq, &model, &off).unwrap();
+        let smoothed = ridi::track::regress(seq, &model, &on).unwrap();
+        let times: Vec<f64> = raw.iter().map(|r| seq.time()[r.frame]).collect();
+        let labels: Vec<usize> = raw.iter().map(|r| r.placement).collect();
+        let want = smoother.smooth(&times, &labels, model.placements().len());
+        assert_eq!(raw.len(), smoothed.len());
+        for ((a, b), w) in raw.iter().zip(&smoothed).zip(&want) {
+            assert_eq!(a.frame, b.frame);
+            assert_eq!(b.placement, *w);
+            if a.placement == b.placement {
+                assert_eq!(a.velocity, b.velocity);
+            } else {
+                changed += 1;
+                assert_ne!(a.velocity, b.velocity);
+            }
+        }
+        // Fewer label changes than before.
+        let flips = |r: &[ridi::track::Regressed]| {
+            r.windows(2)
+                .filter(|w| w[0].placement != w[1].placement)
+                .count()
+        };
+        assert!(flips(&smoothed) <= flips(&raw), "{}", seq.name());
+    }
+    // A model of one person mislabels some windows of another: the test must exercise that.
+    assert!(changed > 0);
+}
+
+#[test]
 fn online_tracking_stays_close_to_batch_tracking() {
     let train = load("list_Guillaume.txt");
     let model = quick_model(&train);
     let seq = &load("list_Jakob.txt")[7]; // Texting
-    let batch = ridi::track(seq, &model, &TrackOptions::default()).unwrap();
+    // The streaming tracker labels each window alone: compare with batch labels unsmoothed.
+    let unsmoothed = TrackOptions {
+        placement_smoothing: None,
+        ..TrackOptions::default()
+    };
+    let batch = ridi::track(seq, &model, &unsmoothed).unwrap();
     let online = ridi::track(
         seq,
         &model,
