@@ -123,8 +123,9 @@ enum Command {
         /// Estimate the initial velocity instead of assuming the walk starts at rest.
         #[arg(long)]
         estimate_initial_velocity: bool,
-        /// Placement majority window, seconds (batch): each regression takes the most frequent
-        /// placement label within it; 0 keeps each window's own label, as in the paper.
+        /// Placement majority window, seconds: each regression takes the most frequent placement
+        /// label within it (centred in batch, the seconds before it with --online); 0 keeps each
+        /// window's own label, as in the paper.
         #[arg(long, value_name = "SECONDS", default_value_t = 10.0)]
         placement_window: f64,
         /// Orientation to track with: as recorded, or estimated from gyro + accelerometer
@@ -164,8 +165,9 @@ enum Command {
         /// Worker threads (default: all cores).
         #[arg(long)]
         jobs: Option<usize>,
-        /// Placement majority window, seconds (batch): each regression takes the most frequent
-        /// placement label within it; 0 keeps each window's own label, as in the paper.
+        /// Placement majority window, seconds: each regression takes the most frequent placement
+        /// label within it (centred in batch, the seconds before it with --online); 0 keeps each
+        /// window's own label, as in the paper.
         #[arg(long, value_name = "SECONDS", default_value_t = 10.0)]
         placement_window: f64,
         /// Orientation to track with: as recorded, or estimated from gyro + accelerometer

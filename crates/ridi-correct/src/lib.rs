@@ -78,7 +78,7 @@ pub use error::CorrectError;
 pub use input::{ImuSlices, VelocityTarget};
 pub use integrate::{Integrator, Pose, corrected_acceleration, integrate, world_acceleration};
 pub use knots::{BiasCurve, Knots};
-pub use placement::{PlacementFilter, PlacementSmoother};
+pub use placement::{PlacementFilter, PlacementSmoother, TrailingMajority};
 pub use regressor::{FrameWindow, RegressError, Regression, VelocityRegressor};
 pub use solve::{Correction, Corrector, Trajectory, correct};
 pub use tracker::{

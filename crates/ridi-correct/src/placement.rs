@@ -6,6 +6,8 @@
 //! a moment is unreliable. The original zeroes a regressed velocity when more than two label
 //! changes happen within ±7 regressions of it.
 
+use std::collections::VecDeque;
+
 use serde::{Deserialize, Serialize};
 
 /// Parameters of the placement-change filter.
@@ -102,14 +104,58 @@ impl PlacementSmoother {
                 counts[labels[lo]] -= 1;
                 lo += 1;
             }
-            let best = counts.iter().copied().max().unwrap_or(0);
-            out.push(if counts[labels[i]] == best {
-                labels[i]
-            } else {
-                counts.iter().position(|&c| c == best).unwrap_or(labels[i])
-            });
+            out.push(majority(&counts, labels[i]));
         }
         out
+    }
+
+    /// The streaming form: each label against those of the `window_s` seconds before it.
+    pub fn trailing(&self, classes: usize) -> TrailingMajority {
+        TrailingMajority {
+            window_s: self.window_s,
+            seen: VecDeque::new(),
+            counts: vec![0; classes],
+        }
+    }
+}
+
+/// The most frequent label of `counts`; `own` when it is among the most frequent, else the
+/// lowest such label.
+fn majority(counts: &[usize], own: usize) -> usize {
+    let best = counts.iter().copied().max().unwrap_or(0);
+    if counts[own] == best {
+        own
+    } else {
+        counts.iter().position(|&c| c == best).unwrap_or(own)
+    }
+}
+
+/// Majority vote over the labels of the last `window_s` seconds, one label at a time (the
+/// streaming tracker cannot look ahead). Built by [`PlacementSmoother::trailing`].
+#[derive(Debug, Clone)]
+pub struct TrailingMajority {
+    window_s: f64,
+    seen: VecDeque<(f64, usize)>,
+    counts: Vec<usize>,
+}
+
+impl TrailingMajority {
+    /// Adds `label` seen at `time` (seconds, non-decreasing) and returns the majority label of
+    /// `[time - window_s, time]`, with the tie rule of [`PlacementSmoother::smooth`].
+    ///
+    /// # Panics
+    /// If `label` is not below the number of classes given at construction.
+    pub fn push(&mut self, time: f64, label: usize) -> usize {
+        self.seen.push_back((time, label));
+        self.counts[label] += 1;
+        while let Some(&(t, l)) = self.seen.front() {
+            if t >= time - self.window_s {
+                break;
+            }
+            self.counts[l] -= 1;
+            self.seen.pop_front();
+        }
+        majority(&self.counts, label)
     }
 }
 
@@ -134,6 +180,34 @@ mod tests {
         assert_eq!(s.smooth(&times, &[2, 1, 0, 3], 4), vec![2, 1, 0, 3]);
         assert_eq!(s.smooth(&times, &[2, 2, 1, 0], 3), vec![2, 2, 2, 2]);
         assert!(s.smooth(&[], &[], 3).is_empty());
+    }
+
+    #[test]
+    fn trailing_majority_counts_the_window_before_each_label() {
+        let s = PlacementSmoother { window_s: 1.0 };
+        let times: Vec<f64> = (0..300).map(|i| (i as f64 * 0.137).powf(1.05)).collect();
+        let labels: Vec<usize> = (0..300).map(|i| (i * 7 + i / 13) % 5 % 3).collect();
+        let mut live = s.trailing(3);
+        for i in 0..300 {
+            let mut c = [0usize; 3];
+            for j in 0..=i {
+                if times[j] >= times[i] - 1.0 {
+                    c[labels[j]] += 1;
+                }
+            }
+            assert_eq!(
+                live.push(times[i], labels[i]),
+                majority(&c, labels[i]),
+                "entry {i}"
+            );
+        }
+        // A lasting change takes over once it holds the majority of the window.
+        let mut live = s.trailing(2);
+        let out: Vec<usize> = (0..20)
+            .map(|i| live.push(i as f64 * 0.1, usize::from(i >= 10)))
+            .collect();
+        assert_eq!(&out[..10], &[0; 10]);
+        assert_eq!(&out[16..], &[1; 4]);
     }
 
     #[test]

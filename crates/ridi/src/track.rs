@@ -4,7 +4,7 @@ use std::path::Path;
 
 use ridi_correct::{
     CorrectionConfig, FrameWindow, PlacementSmoother, Regression, Sample, Tracker, TrackerConfig,
-    VelocityRegressor, VelocityTarget, correct,
+    TrailingMajority, VelocityRegressor, VelocityTarget, correct,
 };
 use ridi_data::{Sequence, write_atomically};
 use ridi_features::{FeatureExtractor, ImuView, SampleSchedule};
@@ -25,10 +25,9 @@ pub struct TrackOptions {
     /// Streaming mode (paper's online variant): a 1000-frame window corrected every 200
     /// frames, each frame's pose as known when it arrived. Otherwise one global correction.
     pub online: bool,
-    /// Batch only: each regression's placement becomes the majority label of a time window
-    /// around it, and its velocity comes from that placement's regressors. `None` keeps every
-    /// window's own label (the paper). The streaming tracker keeps the original code's
-    /// placement-change filter instead.
+    /// Each regression's placement becomes the majority label of a time window, and its
+    /// velocity comes from that placement's regressors: centred on it in batch, the window
+    /// before it when streaming. `None` keeps every window's own label (the paper).
     pub placement_smoothing: Option<PlacementSmoother>,
 }
 
@@ -216,19 +215,22 @@ pub struct CascadeRegressor<'m> {
     model: &'m Cascade,
     extractor: FeatureExtractor,
     row: Vec<f32>,
+    majority: Option<TrailingMajority>,
     /// Every regression made, for reports.
     pub made: Vec<Regressed>,
 }
 
 impl<'m> CascadeRegressor<'m> {
-    /// A regressor over `model`.
-    pub fn new(model: &'m Cascade) -> Result<Self> {
+    /// A regressor over `model`; with `smoothing`, each placement becomes the majority label of
+    /// the window's length of regressions before it (the streaming form of the batch vote).
+    pub fn new(model: &'m Cascade, smoothing: Option<PlacementSmoother>) -> Result<Self> {
         let extractor = FeatureExtractor::new(model.feature_config().clone())?;
         let row = vec![0.0; extractor.dim()];
         Ok(Self {
             model,
             extractor,
             row,
+            majority: smoothing.map(|s| s.trailing(model.placements().len())),
             made: Vec::new(),
         })
     }
@@ -249,7 +251,15 @@ impl VelocityRegressor for CascadeRegressor<'_> {
         let stab = self.extractor.stabilize(&imu)?;
         let len = frames.len();
         self.extractor.row_into(&stab, len - 1, &mut self.row)?;
-        let p = self.model.predict_one(&self.row)?;
+        let mut p = self.model.predict_one(&self.row)?;
+        if let Some(m) = &mut self.majority {
+            let label = m.push(frames.time[len - 1], p.placement);
+            if label != p.placement {
+                let row = MatrixRef::new(&self.row, self.row.len())?;
+                p.velocity = self.model.predict_with_placement(row, label)?[0];
+                p.placement = label;
+            }
+        }
         let velocity = [p.velocity[0] as f64, p.velocity[1] as f64];
         self.made.push(Regressed {
             frame: frames.last_frame() as usize,
@@ -269,7 +279,7 @@ fn track_online(seq: &Sequence, model: &Cascade, opts: &TrackOptions) -> Result<
         regress_every: opts.regress_every,
         ..TrackerConfig::default()
     };
-    let mut regressor = CascadeRegressor::new(model)?;
+    let mut regressor = CascadeRegressor::new(model, opts.placement_smoothing)?;
     let mut tracker = Tracker::new(config, &mut regressor)
         .map_err(|e| PipelineError::sequence(seq.name(), e.to_string()))?;
     let n = seq.len();

@@ -150,11 +150,38 @@ fn placement_smoothing_takes_the_window_majority_and_its_regressors() {
 }
 
 #[test]
+fn online_smoothing_takes_the_majority_of_the_labels_before() {
+    let model = quick_model(&load("list_Guillaume.txt"));
+    let seq = &load("list_Jakob.txt")[6]; // Swinging: many scattered labels
+    let online = |smoothing| TrackOptions {
+        online: true,
+        placement_smoothing: smoothing,
+        ..TrackOptions::default()
+    };
+    let smoother = TrackOptions::default().placement_smoothing.unwrap();
+    let raw = ridi::track(seq, &model, &online(None)).unwrap();
+    let smoothed = ridi::track(seq, &model, &online(Some(smoother))).unwrap();
+    let mut live = smoother.trailing(model.placements().len());
+    let mut changed = 0;
+    assert_eq!(raw.regressions.len(), smoothed.regressions.len());
+    for (a, b) in raw.regressions.iter().zip(&smoothed.regressions) {
+        assert_eq!(a.frame, b.frame);
+        assert_eq!(b.placement, live.push(seq.time()[a.frame], a.placement));
+        if a.placement == b.placement {
+            assert_eq!(a.velocity, b.velocity);
+        } else {
+            changed += 1;
+        }
+    }
+    assert!(changed > 0, "the test needs scattered labels");
+}
+
+#[test]
 fn online_tracking_stays_close_to_batch_tracking() {
     let train = load("list_Guillaume.txt");
     let model = quick_model(&train);
     let seq = &load("list_Jakob.txt")[7]; // Texting
-    // The streaming tracker labels each window alone: compare with batch labels unsmoothed.
+    // Batch votes over a centred window, streaming over the window before: compare unsmoothed.
     let unsmoothed = TrackOptions {
         placement_smoothing: None,
         ..TrackOptions::default()
@@ -165,7 +192,7 @@ fn online_tracking_stays_close_to_batch_tracking() {
         &model,
         &TrackOptions {
             online: true,
-            ..TrackOptions::default()
+            ..unsmoothed
         },
     )
     .unwrap();
