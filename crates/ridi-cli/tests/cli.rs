@@ -165,31 +165,24 @@ fn convert_train_track_and_eval() {
     // The placement majority window: off with 0, refused when negative. The estimated
     // orientation gives another trajectory from the same regressions' inputs.
     let plain = dir.path().join("plain.csv");
-    let out = ridi(&[
-        "track",
-        s(&test_seq),
-        "--model",
-        s(&model),
-        "--out",
-        s(&plain),
-        "--placement-window",
-        "0",
-        "--orientation",
-        "estimated",
-    ]);
+    let track_plain = |extra: &[&str]| {
+        let mut args = vec![
+            "track",
+            s(&test_seq),
+            "--model",
+            s(&model),
+            "--out",
+            s(&plain),
+        ];
+        args.extend_from_slice(extra);
+        ridi(&args)
+    };
+    let out = track_plain(&["--placement-window", "0", "--orientation", "estimated"]);
     assert!(out.status.success(), "{}", stderr(&out));
     let estimated = std::fs::read_to_string(&plain).unwrap();
     assert_eq!(estimated.lines().count(), 4801);
     assert_ne!(estimated, std::fs::read_to_string(&csv).unwrap());
-    let out = ridi(&[
-        "track",
-        s(&test_seq),
-        "--model",
-        s(&model),
-        "--out",
-        s(&plain),
-        "--placement-window=-1",
-    ]);
+    let out = track_plain(&["--placement-window=-1"]);
     assert!(!out.status.success());
     assert!(
         stderr(&out).contains("--placement-window must be a number of seconds >= 0"),
