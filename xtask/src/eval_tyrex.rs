@@ -373,17 +373,18 @@ pub fn run(data: Option<PathBuf>, out: Option<PathBuf>, quick: bool) -> Result<P
     let started = Instant::now();
     let all = load(&data).with_context(|| format!("reading Tyrex data in {}", data.display()))?;
     let mut rows = Vec::new();
-    // Models of the previous variant, kept while the next one shares them.
-    let mut trained: Option<(String, Vec<Cascade>, f64)> = None;
+    // Sequences and models of the previous variant, kept while the next one shares them
+    // (`prepare` depends only on what the training key holds).
+    let mut shared: Option<(String, Vec<Sequence>, Vec<Cascade>, f64)> = None;
     for v in variants(quick) {
-        let seqs = prepare(&all, &v)?;
-        if trained.as_ref().is_none_or(|t| t.0 != v.train_key()) {
-            drop(trained.take()); // free the previous models first
+        if shared.as_ref().is_none_or(|s| s.0 != v.train_key()) {
+            drop(shared.take()); // free the previous models first
+            let seqs = prepare(&all, &v)?;
             let (models, secs) = train_folds(&seqs, &v)?;
-            trained = Some((v.train_key(), models, secs));
+            shared = Some((v.train_key(), seqs, models, secs));
         }
-        let (_, models, secs) = trained.as_ref().context("models")?;
-        let row = run_variant(&seqs, models, *secs, &v)?;
+        let (_, seqs, models, secs) = shared.as_ref().context("models")?;
+        let row = run_variant(seqs, models, *secs, &v)?;
         rows.push((v, row));
     }
     let mut md = String::new();
