@@ -6,7 +6,7 @@ use std::path::{Path, PathBuf};
 use crate::error::{DataError, Location, Result};
 use crate::options::ReadOptions;
 use crate::sequence::Sequence;
-use crate::{ridi_csv, ridi_plain, ridi_raw};
+use crate::{ilc, ridi_csv, ridi_plain, ridi_raw};
 
 /// The dataset formats ridi-data knows.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
@@ -19,6 +19,8 @@ pub enum Format {
     RidiRaw,
     /// Tyrex smartphone benchmark folder (`accelerometer.txt` and `gyroscope-calibrated.txt`).
     Tyrex,
+    /// Indoor Location Competition 2.0 path file (see [`ilc`]).
+    Ilc,
 }
 
 impl fmt::Display for Format {
@@ -28,6 +30,7 @@ impl fmt::Display for Format {
             Format::RidiPlain => "RIDI data_plain.txt",
             Format::RidiRaw => "RIDI raw folder",
             Format::Tyrex => "Tyrex folder",
+            Format::Ilc => "Indoor Location Competition path file",
         })
     }
 }
@@ -43,11 +46,17 @@ fn locate(path: &Path) -> Result<(Format, PathBuf)> {
             return Ok((Format::RidiCsv, path.to_path_buf()));
         }
         if name.ends_with(".txt") || name.ends_with(".txt.gz") {
-            return Ok((Format::RidiPlain, path.to_path_buf()));
+            let format = if ilc::is_path_file(path) {
+                Format::Ilc
+            } else {
+                Format::RidiPlain
+            };
+            return Ok((format, path.to_path_buf()));
         }
         return Err(DataError::format(
             Location::file(path),
-            "unknown file type: expected a RIDI `.csv` or `data_plain.txt`",
+            "unknown file type: expected a RIDI `.csv` or `data_plain.txt`, or an Indoor \
+             Location Competition path `.txt`",
         ));
     }
     if !path.is_dir() {
@@ -87,7 +96,9 @@ fn locate(path: &Path) -> Result<(Format, PathBuf)> {
 
 /// Detects the format of a file or folder.
 ///
-/// Files: `*.csv` is a RIDI processed csv, `*.txt` a `data_plain.txt`; either may be
+/// Files: `*.csv` is a RIDI processed csv, `*.txt` an Indoor Location Competition path file when
+/// its first lines are `unix_ms<TAB>TYPE_...` records or a `#\tstartTime:` header (see
+/// [`ilc::looks_like_path_file`]) and a `data_plain.txt` otherwise; either may be
 /// gzip-compressed (`*.csv.gz`, `*.txt.gz`). Folders, first match wins: `processed/data.csv`
 /// (or `.csv.gz`), `data.csv` (or `.csv.gz`), `processed/data_plain.txt`, `data_plain.txt`, a
 /// RIDI raw folder (`gyro.txt` and `acce.txt`), a Tyrex folder (`accelerometer.txt` and
@@ -96,14 +107,17 @@ pub fn detect(path: impl AsRef<Path>) -> Result<Format> {
     locate(path.as_ref()).map(|(f, _)| f)
 }
 
-/// Reads a sequence of any detected RIDI format (see [`detect`]). Tyrex folders are detected
-/// but not read here: use [`tyrex::read`](crate::tyrex::read), which may return several parts.
+/// Reads a sequence of any detected format (see [`detect`]). A Tyrex run split into several
+/// parts is refused here: use [`tyrex::read`](crate::tyrex::read), which returns every part.
+/// An Indoor Location Competition path file is read with [`ilc::IlcOptions`] built from `opts`
+/// (placement `hand`).
 pub fn read_sequence(path: impl AsRef<Path>, opts: &ReadOptions) -> Result<Sequence> {
     let (format, file) = locate(path.as_ref())?;
     match format {
         Format::RidiCsv => ridi_csv::read(&file, opts),
         Format::RidiPlain => ridi_plain::read(&file, opts),
         Format::RidiRaw => ridi_raw::read(&file, opts),
+        Format::Ilc => Ok(ilc::read(&file, &ilc::IlcOptions::from(opts))?.sequence),
         Format::Tyrex => {
             let mut read = crate::tyrex::read(&file, &crate::tyrex::TyrexOptions::from(opts))?;
             match read.sequences.len() {

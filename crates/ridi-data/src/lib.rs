@@ -15,10 +15,12 @@
 //! | RIDI processed `data.csv`: pandas index, then the 27 [`processed::COLUMNS`], time in ns | [`ridi_csv::read`] | [`write_ridi_csv`] |
 //! | RIDI `data_plain.txt`: `N 27`, then N tab-separated rows | [`ridi_plain::read`] | [`write_ridi_plain`] |
 //! | RIDI raw recorder folder (`gyro.txt`, `acce.txt`, ..., `pose.txt`) | [`ridi_raw::read`] | |
+//! | Tyrex smartphone benchmark folder (Android text files, Qualisys `.mat` ground truth) | [`tyrex::read`] | |
+//! | Indoor Location Competition 2.0 path file (`unix_ms<TAB>TYPE_...` records, waypoints) | [`ilc::read`] | |
 //! | dataset list file (`path,placement` per line) | [`read_list`], [`load_list`] | |
 //!
-//! [`detect`] tells the format of a file or folder (Tyrex folders included) and
-//! [`read_sequence`] reads any RIDI one. [`ReadOptions`] holds the validation limits and the
+//! [`detect`] tells the format of a file or folder and [`read_sequence`] reads any of them
+//! (a Tyrex run only when it is not split into parts). [`ReadOptions`] holds the validation limits and the
 //! raw synchronization settings.
 //!
 //! Conventions at the file edges: time is nanoseconds in files and seconds (absolute, `f64`)
@@ -59,8 +61,10 @@
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
 
+mod android;
 mod detect;
 mod error;
+pub mod ilc;
 mod list;
 pub mod mat;
 mod options;

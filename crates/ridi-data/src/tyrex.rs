@@ -62,10 +62,9 @@
 use std::path::{Path, PathBuf};
 
 use ridi_frames::nalgebra::Matrix3;
-use ridi_frames::{
-    DeviceVec, QuatError, STANDARD_GRAVITY, WorldFromDevice, WorldVec, gravity_in_device,
-};
+use ridi_frames::{DeviceVec, STANDARD_GRAVITY, WorldFromDevice, WorldVec};
 
+use crate::android;
 use crate::error::{DataError, Location, Result};
 use crate::mat::{MatFile, MatValue, dims_text};
 use crate::options::ReadOptions;
@@ -434,20 +433,8 @@ fn read_vec_stream(path: &Path, names: &[&str]) -> Result<Stream<DeviceVec>> {
 fn read_rotation_vector(path: &Path) -> Result<Stream<WorldFromDevice>> {
     let names = ["t", "qx", "qy", "qz", "qw", "heading_accuracy"];
     read_stream(path, &names, &[4, 5, 6], |c, line| {
-        let w = match c.get(4) {
-            Some(&w) => w,
-            // Old Android versions give only x, y, z; w >= 0 is implied.
-            None => (1.0 - c[1] * c[1] - c[2] * c[2] - c[3] * c[3])
-                .max(0.0)
-                .sqrt(),
-        };
-        WorldFromDevice::from_xyzw([c[1], c[2], c[3], w]).map_err(|e| {
-            let message = match e {
-                QuatError::NotUnit { norm } => {
-                    format!("quaternion x,y,z,w has norm {norm:.4}, not 1")
-                }
-                other => other.to_string(),
-            };
+        // Old Android versions give only x, y, z.
+        android::rotation_vector([c[1], c[2], c[3]], c.get(4).copied()).map_err(|message| {
             DataError::format(Location::line(path, line).with_field("qw"), message)
         })
     })
@@ -672,11 +659,8 @@ pub fn read(dir: impl AsRef<Path>, options: &TyrexOptions) -> Result<TyrexRead> 
         let time = uniform_timeline(start, end, options.rate_hz);
         let orientation = interpolate_rot(&rv.time, &rv.values, &time);
         let acce_i = interpolate_vec3(&acce.time, &acce.values, &time);
-        let gravity: Vec<DeviceVec> = orientation
-            .iter()
-            .map(|&q| gravity_in_device(q, options.gravity))
-            .collect();
-        let linacce = acce_i.iter().zip(&gravity).map(|(&a, &g)| a - g).collect();
+        let (gravity, linacce) =
+            android::gravity_and_linacce(&orientation, &acce_i, options.gravity);
         let ground_truth = truth.as_ref().map(|(t, p, q)| GroundTruth {
             position: interpolate_vec3(t, p, &time),
             orientation: interpolate_rot(t, q, &time),

@@ -8,10 +8,30 @@ use std::sync::LazyLock;
 
 use common::*;
 use proptest::prelude::*;
+use ridi_data::ilc::{self, IlcOptions};
 use ridi_data::{ReadOptions, parse_list, ridi_csv, ridi_plain, ridi_raw};
 
 static CSV: LazyLock<Vec<u8>> = LazyLock::new(|| valid_csv(12));
 static PLAIN: LazyLock<Vec<u8>> = LazyLock::new(|| valid_plain(12));
+
+/// A valid Indoor Location Competition path file: three 50 Hz IMU records, two waypoints.
+const ILC: &[u8] = b"#\tstartTime:1574559495000\n\
+    1574559495000\tTYPE_WAYPOINT\t81.3\t93.3\n\
+    1574559495000\tTYPE_ACCELEROMETER\t-0.8\t1.8\t9.8\t2\n\
+    1574559495000\tTYPE_GYROSCOPE\t-0.3\t-0.07\t0.09\t3\n\
+    1574559495000\tTYPE_MAGNETIC_FIELD\t29.7\t6.4\t-30.0\t3\n\
+    1574559495000\tTYPE_ROTATION_VECTOR\t0.06\t0.07\t0.57\t3\n\
+    1574559495020\tTYPE_ACCELEROMETER\t-0.6\t1.8\t9.9\t2\n\
+    1574559495020\tTYPE_GYROSCOPE\t-0.5\t-0.2\t0.08\t3\n\
+    1574559495020\tTYPE_MAGNETIC_FIELD\t29.7\t5.0\t-27.3\t3\n\
+    1574559495020\tTYPE_ROTATION_VECTOR\t0.05\t0.07\t0.57\t3\n\
+    1574559494900\tTYPE_WIFI\tssid\t00:11:22:33:44:55\t-60\t5180\t1574559494900\n\
+    1574559495040\tTYPE_ACCELEROMETER\t-0.6\t1.9\t10.3\t2\n\
+    1574559495040\tTYPE_GYROSCOPE\t-0.6\t-0.1\t0.1\t3\n\
+    1574559495040\tTYPE_MAGNETIC_FIELD\t29.7\t3.6\t-28.7\t3\n\
+    1574559495040\tTYPE_ROTATION_VECTOR\t0.05\t0.07\t0.57\t3\n\
+    1574559495040\tTYPE_WAYPOINT\t81.4\t93.2\n\
+    #\tendTime:1574559495040\n";
 
 /// One edit of a byte string.
 #[derive(Debug, Clone)]
@@ -80,6 +100,7 @@ fn opts() -> ReadOptions {
 fn unmutated_fixtures_are_valid() {
     ridi_csv::parse(&CSV, Path::new("data.csv"), &opts()).unwrap();
     ridi_plain::parse(&PLAIN, Path::new("data_plain.txt"), &opts()).unwrap();
+    ilc::parse(ILC, Path::new("path.txt"), &IlcOptions::default()).unwrap();
 }
 
 proptest! {
@@ -100,6 +121,13 @@ proptest! {
         let _ = ridi_csv::parse(&bytes, Path::new("data.csv"), &opts());
         let _ = ridi_plain::parse(&bytes, Path::new("data_plain.txt"), &opts());
         let _ = parse_list(&bytes, Path::new("list.txt"));
+        let _ = ilc::parse(&bytes, Path::new("path.txt"), &IlcOptions::default());
+        let _ = ilc::looks_like_path_file(&bytes);
+    }
+
+    #[test]
+    fn ilc_reader_survives_mutations(edits in edits()) {
+        let _ = ilc::parse(&mutate(ILC, &edits), Path::new("path.txt"), &IlcOptions::default());
     }
 
     #[test]

@@ -1,6 +1,8 @@
 //! Checks against the real Tyrex data in `../shared` (beside the checkout). Each test returns
 //! early with a note when the data are not there; the CI script runs them where they are.
 
+mod common;
+
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
@@ -9,17 +11,7 @@ use ridi_data::ridi_frames::{WorldFromDevice, WorldVec};
 use ridi_data::tyrex::{self, TyrexOptions};
 
 fn root() -> Option<PathBuf> {
-    let p = Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../../../shared/data/raw/tyrex-attitude-smartphones");
-    if p.join("datasets/android").is_dir() {
-        Some(p)
-    } else {
-        eprintln!(
-            "note: {} not found: Tyrex shared-data checks skipped",
-            p.display()
-        );
-        None
-    }
+    common::shared_dataset("tyrex-attitude-smartphones", "datasets/android")
 }
 
 /// One row of `derived/groundtruth/<seq>.csv` (an independent scipy conversion).

@@ -6,6 +6,7 @@
 //!          | load-query <path>
 //!   options: --c C --eps E --placements K --mem-mb M --never-precompute
 //!            --save <path> (grid, cascade, query: save the trained model)
+//!            --storage half|projected (grid, cascade, query; default projected)
 //!            --queries Q (load-query: held-out queries, default 2000)
 //! ```
 //! `query <n> --save <path>` trains the cascade with fixed `C`/epsilon (no grid) and saves it;
@@ -15,13 +16,17 @@
 
 #[path = "../benches/synth.rs"]
 mod synth;
+#[path = "common/timing.rs"]
+mod timing;
+
+use timing::{thread_cpu_s, time_one};
 
 use std::time::Instant;
 
 use ridi_features::FeatureConfig;
 use ridi_regress::{
     Cascade, CascadeParams, GridSpec, MatrixRef, Precompute, ProgressEvent, RegressorChoice,
-    SolverConfig, Svc, SvcParams, Svr, SvrParams, TrainingSet,
+    SolverConfig, Storage, Svc, SvcParams, Svr, SvrParams, TrainingSet,
 };
 
 fn peak_mb() -> f64 {
@@ -132,9 +137,20 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             } else {
                 RegressorChoice::Grid(GridSpec::default())
             };
+            let storage = match args
+                .iter()
+                .position(|a| a == "--storage")
+                .and_then(|i| args.get(i + 1))
+                .map(String::as_str)
+            {
+                None | Some("projected") => Storage::DEFAULT,
+                Some("half") => Storage::Half,
+                Some(other) => return Err(format!("unknown storage {other}").into()),
+            };
             let params = CascadeParams {
                 regressors,
                 solver,
+                storage,
                 ..CascadeParams::default()
             };
             let t = Instant::now();
@@ -153,6 +169,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             };
             let model = Cascade::train(&set, &params, &mut progress)?;
             let train = t.elapsed().as_secs_f64();
+            println!("storage: {:?}", model.stored_as());
             if let Some(path) = args
                 .iter()
                 .position(|a| a == "--save")
@@ -247,25 +264,6 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     Ok(())
 }
 
-/// CPU time of the calling thread, seconds (`/proc/thread-self/schedstat`).
-fn thread_cpu_s() -> f64 {
-    std::fs::read_to_string("/proc/thread-self/schedstat")
-        .ok()
-        .and_then(|s| s.split_whitespace().next()?.parse::<f64>().ok())
-        .map_or(f64::NAN, |ns| ns * 1e-9)
-}
-
-/// Times `predict_one` over `rows` (in that order) on the calling thread: (wall, CPU) seconds
-/// per query.
-fn time_one(model: &Cascade, q: MatrixRef<'_>, rows: &[usize]) -> Result<(f64, f64), String> {
-    let (t, c) = (Instant::now(), thread_cpu_s());
-    for &i in rows {
-        std::hint::black_box(model.predict_one(q.row(i)).map_err(|e| e.to_string())?);
-    }
-    let n = rows.len() as f64;
-    Ok((t.elapsed().as_secs_f64() / n, (thread_cpu_s() - c) / n))
-}
-
 fn load_query(args: &[String], n: usize, k: usize) -> Result<(), Box<dyn std::error::Error>> {
     let path = args.get(2).ok_or("load-query needs a model path")?;
     let nq: usize = arg(args, "--queries", 2000);
@@ -273,9 +271,10 @@ fn load_query(args: &[String], n: usize, k: usize) -> Result<(), Box<dyn std::er
     let model = ridi_regress::model_file::load(std::path::Path::new(path))?;
     let stored: Vec<usize> = (0..k).map(|p| model.stored_samples(p)).collect();
     println!(
-        "{path}: {:.1} MB, loaded in {:.2} s; stored samples {stored:?}",
+        "{path}: {:.1} MB, loaded in {:.2} s; stored samples {stored:?}; {:?}",
         std::fs::metadata(path)?.len() as f64 / 1e6,
-        t.elapsed().as_secs_f64()
+        t.elapsed().as_secs_f64(),
+        model.stored_as()
     );
     // Held-out sequences: the ones the generator makes after the `n` training rows (same
     // placement signatures). Stream order: consecutive queries mostly share a placement, as
@@ -289,14 +288,7 @@ fn load_query(args: &[String], n: usize, k: usize) -> Result<(), Box<dyn std::er
     std::fs::write("/proc/self/clear_refs", "5")?;
     let q = MatrixRef::new(&held_x, dim)?;
     let stream: Vec<usize> = (0..nq).collect();
-    let mut shuffled = stream.clone();
-    let mut s = 0x2545_f491_4f6c_dd1du64;
-    for i in (1..nq).rev() {
-        s ^= s << 13;
-        s ^= s >> 7;
-        s ^= s << 17;
-        shuffled.swap(i, (s % (i as u64 + 1)) as usize);
-    }
+    let shuffled = timing::shuffled(nq);
     let one = rayon::ThreadPoolBuilder::new().num_threads(1).build()?;
     let (warm, cold, batch1) = one.install(|| -> Result<_, String> {
         time_one(&model, q, &stream[..nq.min(200)])?;
@@ -336,14 +328,8 @@ fn load_query(args: &[String], n: usize, k: usize) -> Result<(), Box<dyn std::er
     let t = Instant::now();
     let r = model.rounding_effect(MatrixRef::new(&train.x, dim)?, q)?;
     println!(
-        "half-precision samples vs exact f32 rows ({:.1} s): placement agreement {:.4}, \
-         max |dv| {:.2e} / {:.2e}, mean |dv| {:.2e} / {:.2e} m/s",
-        t.elapsed().as_secs_f64(),
-        r.placement_agreement,
-        r.max_velocity_diff[0],
-        r.max_velocity_diff[1],
-        r.mean_velocity_diff[0],
-        r.mean_velocity_diff[1]
+        "stored samples vs exact f32 rows ({:.1} s): {r}",
+        t.elapsed().as_secs_f64()
     );
     Ok(())
 }

@@ -1,13 +1,15 @@
 //! The RIDI cascade: a placement classifier, then two epsilon-SVRs per placement for the two
 //! horizontal velocity components in the stabilized frame S.
 //!
-//! Storage: each placement keeps its samples once, in half precision (IEEE binary16: a query
+//! Storage: each placement keeps its samples once, as `f32` coordinates on the leading
+//! principal directions of the training features or in half precision ([`Storage`]: a query
 //! is bound by the bytes it streams), ordered so that the classifier's support vectors of
 //! that placement come first, followed by the other samples that either regressor uses.
 //! Prediction computes the squared distances of a query to the classifier part of every
 //! placement, classifies, and then reuses those distances for the regressors of the predicted
-//! placement, so every stored row is read once. Batches go through GEMM (rows widened to `f32`
-//! a tile at a time); a single query streams the rows once with a fused half-precision GEMV
+//! placement, so every stored row is read once. A query is projected first when the samples
+//! are. Batches go through GEMM (half-precision rows widened to `f32` a tile at a time); a
+//! single query streams the rows once (a fused half-precision GEMV for half-precision rows)
 //! and reuses thread-local buffers.
 
 use std::cell::RefCell;
@@ -21,11 +23,13 @@ use serde::{Deserialize, Serialize};
 use crate::config::{self, SolverConfig};
 use crate::error::RegressError;
 use crate::expansion::weighted_sums;
-use crate::f16mat::{F16_MAX, F16Matrix};
+use crate::f16mat::F16_MAX;
 use crate::grid::{self, GridRow, GridSpec};
 use crate::kernel;
 use crate::matrix::{Matrix, MatrixRef};
 use crate::progress::{Progress, ProgressEvent, Stage};
+use crate::projection::Projection;
+use crate::store::SampleRows;
 use crate::svc::{self, PairDual, SvcParams};
 use crate::svr::{self, FitInfo};
 
@@ -70,6 +74,57 @@ impl Gamma {
     }
 }
 
+/// How a trained model stores its samples for prediction.
+///
+/// A query streams every stored sample it needs, so its time is set by their bytes. RIDI's
+/// features are Gaussian-smoothed windows whose variance lies almost entirely in a few hundred
+/// of the 1200 directions. Writing a sample as `μ + Uᵀz + r` (`U`: the leading principal
+/// directions of the training features, `r`: the residual),
+/// `|a − b|² = |a − μ|² + |b − μ|² − 2 z_a·z_b − 2 r_a·r_b`; a projected model keeps `z` and
+/// the exact `|s − μ|²` of each sample, so every distance is right except for the product of
+/// two small residuals. [`Cascade::rounding_effect`] measures what either storage changes.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub enum Storage {
+    /// Every feature value in half precision.
+    Half,
+    /// `f32` coordinates on the leading principal directions of the training features that
+    /// hold at least `energy` of their variance, plus each sample's exact residual norm.
+    /// Falls back to [`Storage::Half`] when that would not save bytes (features without
+    /// low-dimensional structure, or fewer than 32 values per row).
+    Projected {
+        /// Share of the variance to keep, in `(0, 1]`.
+        energy: f64,
+    },
+}
+
+impl Storage {
+    /// The default: [`Storage::Projected`] keeping 99.99 % of the variance (304 of 1200
+    /// directions on standardized Tyrex features; the velocity moves by about as much as
+    /// half-precision rounding moves it, measured in docs/benchmarks.md). At 99.95 % (256
+    /// directions) the largest change was 3-6x that of half precision.
+    pub const DEFAULT: Self = Self::Projected { energy: 0.9999 };
+}
+
+impl Default for Storage {
+    fn default() -> Self {
+        Self::DEFAULT
+    }
+}
+
+/// How a trained model stores its samples ([`Cascade::stored_as`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum StoredAs {
+    /// Every feature value in half precision.
+    Half,
+    /// Principal-component coordinates.
+    Projected {
+        /// Coordinates per sample.
+        components: usize,
+        /// Share of the training variance they hold.
+        energy: f64,
+    },
+}
+
 /// Hyper-parameters of the regressors.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub enum RegressorChoice {
@@ -100,6 +155,9 @@ pub struct CascadeParams {
     /// Placements with fewer training samples are rejected with
     /// [`RegressError::NotEnoughData`] (default 10).
     pub min_class_samples: usize,
+    /// Sample storage of the trained model (prediction speed against a small, measured
+    /// change of the predictions).
+    pub storage: Storage,
 }
 
 impl Default for CascadeParams {
@@ -111,6 +169,7 @@ impl Default for CascadeParams {
             regressors: RegressorChoice::Grid(GridSpec::default()),
             solver: SolverConfig::default(),
             min_class_samples: 10,
+            storage: Storage::DEFAULT,
         }
     }
 }
@@ -154,8 +213,9 @@ pub(crate) struct ClassifierHead {
 /// and both regressors.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub(crate) struct ClassModel {
-    pub samples: F16Matrix,
-    /// Squared norms of the rounded samples: recomputed on load, not stored.
+    pub samples: SampleRows,
+    /// Squared norms as the distances need them ([`SampleRows::norms`]): recomputed on load,
+    /// not stored.
     #[serde(skip)]
     pub norms: Vec<f32>,
     pub n_classifier: usize,
@@ -170,8 +230,9 @@ pub(crate) struct ClassModel {
     pub n_train: usize,
 }
 
-/// How far the half-precision sample storage moves predictions: the stored model against the
-/// same model evaluated with the exact `f32` training rows ([`Cascade::rounding_effect`]).
+/// How far the compact sample storage (half precision or projection, [`Storage`]) moves
+/// predictions: the stored model against the same model evaluated with the exact `f32`
+/// training rows ([`Cascade::rounding_effect`]).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct RoundingEffect {
     /// Queries compared.
@@ -182,6 +243,22 @@ pub struct RoundingEffect {
     pub max_velocity_diff: [f32; 2],
     /// Mean absolute velocity difference per channel (queries with the same placement).
     pub mean_velocity_diff: [f64; 2],
+}
+
+impl std::fmt::Display for RoundingEffect {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(
+            f,
+            "{} queries: same placement {:.4}, max |dv| {:.2e} / {:.2e} m/s, mean |dv| {:.2e} / \
+             {:.2e} m/s",
+            self.queries,
+            self.placement_agreement,
+            self.max_velocity_diff[0],
+            self.max_velocity_diff[1],
+            self.mean_velocity_diff[0],
+            self.mean_velocity_diff[1]
+        )
+    }
 }
 
 /// Where the batched path reads a placement's sample rows as `f32`.
@@ -196,6 +273,9 @@ enum Rows<'a> {
 /// Buffers of the single-query path, kept per thread so that a query allocates nothing.
 #[derive(Default)]
 struct Scratch {
+    /// Projected query and centring buffer (projected models).
+    z: Vec<f32>,
+    centred: Vec<f32>,
     /// Squared distances to the classifier rows of every placement, one after the other.
     dist: Vec<f32>,
     kv: Vec<f32>,
@@ -218,6 +298,8 @@ pub struct Cascade {
     pub(crate) regressor_gamma: f32,
     pub(crate) classes: Vec<ClassModel>,
     pub(crate) grid: Vec<GridRow>,
+    /// Principal directions the samples are stored on (`None`: half-precision features).
+    pub(crate) projection: Option<Projection>,
 }
 
 fn report(
@@ -230,6 +312,20 @@ fn report(
         Ok(())
     } else {
         Err(RegressError::Cancelled)
+    }
+}
+
+/// Half-precision storage cannot hold feature values beyond ±65504.
+fn check_f16_range(x: MatrixRef<'_>) -> Result<(), RegressError> {
+    match x.as_slice().iter().position(|v| v.abs() > F16_MAX) {
+        None => Ok(()),
+        Some(pos) => Err(RegressError::NonFinite(format!(
+            "feature value {} at row {}, column {} exceeds the half-precision range of the \
+             model (±{F16_MAX}); standardize the features",
+            x.as_slice()[pos],
+            pos / x.dim(),
+            pos % x.dim()
+        ))),
     }
 }
 
@@ -254,21 +350,6 @@ fn check_training_set(
         return Err(RegressError::Shape(format!(
             "feature config describes {fd} values per row, features have {}",
             data.features.dim()
-        )));
-    }
-    if let Some(pos) = data
-        .features
-        .as_slice()
-        .iter()
-        .position(|v| v.abs() > F16_MAX)
-    {
-        let d = data.features.dim();
-        return Err(RegressError::NonFinite(format!(
-            "feature value {} at row {}, column {} exceeds the half-precision range of the \
-             model (±{F16_MAX}); standardize the features",
-            data.features.as_slice()[pos],
-            pos / d,
-            pos % d
         )));
     }
     if let Some(i) = data
@@ -321,6 +402,13 @@ impl Cascade {
         let x = data.features;
         let gamma_c = params.classifier_gamma.resolve(x)?;
         let gamma_r = params.regressor_gamma.resolve(x)?;
+        let projection = match params.storage {
+            Storage::Half => None,
+            Storage::Projected { energy } => Projection::fit(x, energy)?,
+        };
+        if projection.is_none() {
+            check_f16_range(x)?;
+        }
 
         let (classifier, pair_duals) = if k >= 2 {
             let total = k * (k - 1) / 2;
@@ -418,6 +506,7 @@ impl Cascade {
                 &pair_duals,
                 [&d0, &d1],
                 [chosen[0], chosen[1]],
+                projection.as_ref(),
             ));
         }
         Ok(Self {
@@ -428,6 +517,7 @@ impl Cascade {
             regressor_gamma: gamma_r,
             classes,
             grid: grid_rows,
+            projection,
         })
     }
 
@@ -456,6 +546,17 @@ impl Cascade {
         self.classes.get(p).map(|c| c.reg_params)
     }
 
+    /// How the samples are stored.
+    pub fn stored_as(&self) -> StoredAs {
+        match &self.projection {
+            None => StoredAs::Half,
+            Some(p) => StoredAs::Projected {
+                components: p.dim(),
+                energy: p.energy(),
+            },
+        }
+    }
+
     /// Stored samples of placement `p` (shared by its classifier part and both regressors).
     pub fn stored_samples(&self, p: usize) -> usize {
         self.classes.get(p).map_or(0, |c| c.samples.rows())
@@ -471,14 +572,25 @@ impl Cascade {
                 self.dim
             )));
         }
-        Ok(SCRATCH.with(|s| self.predict_single(q, &mut s.borrow_mut())))
+        Ok(SCRATCH.with(|s| {
+            let s = &mut *s.borrow_mut();
+            let Some(p) = &self.projection else {
+                return self.predict_single(q, kernel::dot(q, q), s);
+            };
+            let mut z = std::mem::take(&mut s.z);
+            z.resize(p.dim(), 0.0);
+            let qn = p.project_one(q, &mut s.centred, &mut z);
+            let out = self.predict_single(&z, qn, s);
+            s.z = z;
+            out
+        }))
     }
 
     /// The single-query path: one streaming pass over the classifier rows of every placement
     /// and the remaining rows of the chosen one. Same arithmetic as [`Self::predict_block`]
-    /// except for the summation order inside the dot products.
-    fn predict_single(&self, q: &[f32], s: &mut Scratch) -> Prediction {
-        let qn = kernel::dot(q, q);
+    /// except for the summation order inside the dot products. `q` is in the stored form
+    /// (projected when the samples are) and `qn` its squared norm as the distances need it.
+    fn predict_single(&self, q: &[f32], qn: f32, s: &mut Scratch) -> Prediction {
         let k = self.classes.len();
         let offsets: Vec<usize> = self
             .classes
@@ -597,9 +709,10 @@ impl Cascade {
         Ok(())
     }
 
-    /// Compares [`Self::predict`] with the same model evaluated with exact `f32` samples: each
-    /// stored row is matched to the row of `training` (the rows the model was trained on)
-    /// that rounds to it. Fails when a stored row has no match.
+    /// Compares [`Self::predict`] with the same model evaluated with the exact `f32` training
+    /// rows in full dimension: each stored row is matched to the row of `training` (the rows
+    /// the model was trained on) whose stored form (rounded, or projected) it is. Measures
+    /// what the [`Storage`] changes. Fails when a stored row has no match.
     pub fn rounding_effect(
         &self,
         training: MatrixRef<'_>,
@@ -607,27 +720,26 @@ impl Cascade {
     ) -> Result<RoundingEffect, RegressError> {
         self.check_dim(training)?;
         self.check_dim(queries)?;
-        let key = |bits: &[u16]| {
+        let key = |bytes: &[u8]| {
             let mut h = DefaultHasher::new();
-            bits.hash(&mut h);
+            bytes.hash(&mut h);
             h.finish()
         };
-        let rounded = |i: usize| F16Matrix::from_rows(training, &[i]);
+        let stored =
+            |i: usize| SampleRows::from_rows(training, &[i], self.projection.as_ref()).row_bytes(0);
+        let forms: Vec<Vec<u8>> = (0..training.rows()).into_par_iter().map(stored).collect();
         let mut by_key: HashMap<u64, Vec<usize>> = HashMap::new();
-        for i in 0..training.rows() {
-            by_key
-                .entry(key(rounded(i).row_bits(0)))
-                .or_default()
-                .push(i);
+        for (i, f) in forms.iter().enumerate() {
+            by_key.entry(key(f)).or_default().push(i);
         }
         let mut exact = Vec::with_capacity(self.classes.len());
         for (p, cl) in self.classes.iter().enumerate() {
             let idx = (0..cl.samples.rows())
                 .map(|j| {
-                    let bits = cl.samples.row_bits(j);
+                    let bytes = cl.samples.row_bytes(j);
                     by_key
-                        .get(&key(bits))
-                        .and_then(|c| c.iter().find(|&&i| rounded(i).row_bits(0) == bits))
+                        .get(&key(&bytes))
+                        .and_then(|c| c.iter().find(|&&i| forms[i] == bytes))
                         .copied()
                         .ok_or_else(|| {
                             RegressError::Shape(format!(
@@ -691,8 +803,10 @@ impl Cascade {
                 let mut tile = Vec::new();
                 for t0 in (r0..r1).step_by(WIDEN_ROWS) {
                     let t1 = (t0 + WIDEN_ROWS).min(r1);
-                    cl.samples.rows_f32(t0, t1, &mut wide);
-                    let b = MatrixRef::trusted(&wide, self.dim);
+                    let b = MatrixRef::trusted(
+                        cl.samples.rows_f32(t0, t1, &mut wide),
+                        cl.samples.dim(),
+                    );
                     if t1 - t0 == w {
                         run(b, &cl.norms[t0..t1], out);
                         continue;
@@ -715,7 +829,14 @@ impl Cascade {
         out: &mut [Prediction],
     ) {
         let m = q.rows();
-        let qn = kernel::sq_norms(q);
+        let projected = match (rows, &self.projection) {
+            (Rows::Stored, Some(p)) => Some(p.project(q)),
+            _ => None,
+        };
+        let (q, qn) = match projected {
+            Some((ref z, ref n)) => (z.view(), n.clone()),
+            None => (q, kernel::sq_norms(q)),
+        };
         // Squared distances to the classifier part of each placement.
         let dists: Vec<Vec<f32>> = (0..self.classes.len())
             .map(|p| {
@@ -808,7 +929,7 @@ impl Cascade {
     /// then checks consistency.
     pub(crate) fn finish_decode(&mut self) -> Result<(), RegressError> {
         for cl in &mut self.classes {
-            cl.norms = cl.samples.sq_norms();
+            cl.norms = cl.samples.norms();
         }
         self.check()
     }
@@ -846,10 +967,25 @@ impl Cascade {
                 h.pairs.len()
             }
         };
+        let stored_dim = match &self.projection {
+            None => self.dim,
+            Some(p) => {
+                p.check()?;
+                if p.input_dim() != self.dim {
+                    return bad("projection dimension");
+                }
+                p.dim()
+            }
+        };
         for cl in &self.classes {
             cl.samples.check()?;
             let ns = cl.samples.rows();
-            if cl.samples.dim() != self.dim
+            let form_ok = matches!(
+                (&cl.samples, &self.projection),
+                (SampleRows::Half(_), None) | (SampleRows::Projected { .. }, Some(_))
+            );
+            if !form_ok
+                || cl.samples.dim() != stored_dim
                 || cl.norms.len() != ns
                 || cl.n_classifier > ns
                 || cl.clf_coef.len() != cl.n_classifier * np
@@ -869,6 +1005,7 @@ fn build_class(
     pairs: &[PairDual],
     duals: [&svr::SvrDual; 2],
     chosen: [(f64, f64); 2],
+    projection: Option<&Projection>,
 ) -> ClassModel {
     let n = idx.len();
     let np = pairs.len();
@@ -890,8 +1027,8 @@ fn build_class(
         (0..n)
             .filter(|&s| clf[s].is_none() && (duals[0].coef[s] != 0.0 || duals[1].coef[s] != 0.0)),
     );
-    let samples = F16Matrix::from_rows(xc, &order);
-    let norms = samples.sq_norms();
+    let samples = SampleRows::from_rows(xc, &order, projection);
+    let norms = samples.norms();
     let clf_coef = order[..n_classifier]
         .iter()
         .flat_map(|&s| clf[s].clone().unwrap_or_default())

@@ -92,6 +92,12 @@ impl Matrix {
         Ok(Self { data, dim })
     }
 
+    /// Takes values known to be finite whole rows (no scan, for hot paths).
+    pub(crate) fn from_parts(data: Vec<f32>, dim: usize) -> Self {
+        debug_assert!(dim > 0 && data.len().is_multiple_of(dim));
+        Self { data, dim }
+    }
+
     /// Borrowed view.
     pub fn view(&self) -> MatrixRef<'_> {
         MatrixRef {

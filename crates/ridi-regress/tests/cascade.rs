@@ -5,7 +5,7 @@ mod common;
 use ridi_features::{Channel, FeatureConfig};
 use ridi_regress::{
     Cascade, CascadeParams, GridSpec, MatrixRef, NoProgress, ProgressEvent, RegressError,
-    RegressorChoice, Stage, TrainingSet, model_file,
+    RegressorChoice, Stage, Storage, StoredAs, TrainingSet, model_file,
 };
 
 struct Data {
@@ -33,8 +33,13 @@ impl Data {
 /// `placements` classes, `seqs` sequences each, `per_seq` samples per sequence; the
 /// placement shifts a feature pattern, the velocity is a smooth function of a latent state.
 fn make(placements: usize, seqs: usize, per_seq: usize, seed: u64) -> Data {
+    make_window(placements, seqs, per_seq, seed, 4)
+}
+
+/// [`make`] with `window` frames per sample (`6 × window` values).
+fn make_window(placements: usize, seqs: usize, per_seq: usize, seed: u64, window: usize) -> Data {
     let config = FeatureConfig {
-        window: 4,
+        window,
         channels: vec![Channel::Gyro, Channel::LinearAcceleration],
         ..FeatureConfig::default()
     };
@@ -197,26 +202,24 @@ fn training_is_deterministic_and_model_files_round_trip() {
         );
     }
     let mut newer = bytes.clone();
-    newer[8..12].copy_from_slice(&3u32.to_le_bytes());
+    newer[8..12].copy_from_slice(&4u32.to_le_bytes());
     assert!(matches!(
         model_file::from_bytes(&newer),
         Err(RegressError::UnsupportedVersion {
-            found: 3,
-            supported: 2
+            found: 4,
+            supported: 3
         })
     ));
-    // Version 1 stored f32 samples: refused with advice, not misread as version 2.
-    let mut older = bytes.clone();
-    older[8..12].copy_from_slice(&1u32.to_le_bytes());
-    let err = model_file::from_bytes(&older).unwrap_err();
-    assert!(matches!(
-        err,
-        RegressError::UnsupportedVersion {
-            found: 1,
-            supported: 2
-        }
-    ));
-    assert!(err.to_string().contains("retrain"), "{err}");
+    // Versions 1 (f32 samples) and 2 (half precision only): refused with advice, not misread.
+    for v in [1u32, 2] {
+        let mut older = bytes.clone();
+        older[8..12].copy_from_slice(&v.to_le_bytes());
+        let err = model_file::from_bytes(&older).unwrap_err();
+        assert!(
+            matches!(err, RegressError::UnsupportedVersion { found, supported: 3 } if found == v)
+        );
+        assert!(err.to_string().contains("retrain"), "{err}");
+    }
     let mut magic = bytes.clone();
     magic[0] = b'X';
     assert!(matches!(
@@ -328,6 +331,72 @@ fn half_precision_samples_stay_close_to_the_exact_model() {
             );
         }
     }
+}
+
+#[test]
+fn projected_samples_stay_close_to_the_exact_model() {
+    // 240 values per row with a handful of directions of variance plus faint noise.
+    let data = make_window(3, 4, 15, 1, 40);
+    let d = data.config.feature_dim();
+    let params = |storage| CascadeParams {
+        regressors: RegressorChoice::Fixed {
+            c: 10.0,
+            epsilon: 0.01,
+        },
+        storage,
+        ..CascadeParams::default()
+    };
+    let model = Cascade::train(
+        &data.set(),
+        &params(Storage::Projected { energy: 0.999 }),
+        &mut NoProgress,
+    )
+    .unwrap();
+    let StoredAs::Projected { components, energy } = model.stored_as() else {
+        panic!("not projected: {:?}", model.stored_as());
+    };
+    assert_eq!(components, 64, "a few directions, at least 64 kept");
+    assert!((0.999..=1.0).contains(&energy), "{energy}");
+    let half = Cascade::train(&data.set(), &params(Storage::Half), &mut NoProgress).unwrap();
+    assert_eq!(half.stored_as(), StoredAs::Half);
+
+    let test = make_window(3, 2, 20, 99, 40);
+    let xt = MatrixRef::new(&test.x, d).unwrap();
+    let r = model.rounding_effect(data.set().features, xt).unwrap();
+    assert_eq!(r.queries, 120);
+    assert_eq!(r.placement_agreement, 1.0);
+    // Dropping the noise directions leaves `2 r_q·r_s` out of each squared distance (about
+    // 3e-3 here, 1e-5 of a kernel value); with C = 10 on 60 samples a class's coefficients
+    // are large and of both signs, so that adds up to a few mm/s (15x half precision's
+    // rounding on these rows; about 3x on the Tyrex features, docs/benchmarks.md).
+    for ch in 0..2 {
+        assert!(r.max_velocity_diff[ch] < 1e-2, "{r:?}");
+        assert!(
+            r.max_velocity_diff[ch] > 0.0,
+            "projection had no effect: {r:?}"
+        );
+    }
+    // Both storages answer alike, and one query agrees with the batched path.
+    let batch = model.predict(xt).unwrap();
+    for ((b, h), i) in batch.iter().zip(half.predict(xt).unwrap()).zip(0..) {
+        assert_eq!(b.placement, h.placement);
+        let one = model.predict_one(xt.row(i)).unwrap();
+        assert_eq!(one.placement, b.placement);
+        for ch in 0..2 {
+            assert!((b.velocity[ch] - h.velocity[ch]).abs() < 1e-2, "query {i}");
+            assert!(
+                (one.velocity[ch] - b.velocity[ch]).abs() < 1e-4,
+                "query {i}"
+            );
+        }
+    }
+    let bytes = model_file::to_bytes(&model).unwrap();
+    assert_eq!(model_file::from_bytes(&bytes).unwrap(), model);
+    // Projected samples are not bound to the half-precision range.
+    let mut big = make_window(2, 3, 10, 3, 40);
+    big.x.iter_mut().for_each(|v| *v *= 1.0e5);
+    assert!(Cascade::train(&big.set(), &params(Storage::DEFAULT), &mut NoProgress).is_ok());
+    assert!(Cascade::train(&big.set(), &params(Storage::Half), &mut NoProgress).is_err());
 }
 
 #[test]

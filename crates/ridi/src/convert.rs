@@ -4,10 +4,10 @@ use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
 use rayon::prelude::*;
-use ridi_data::tyrex;
 use ridi_data::{
     DataError, Format, Location, ReadOptions, detect, write_atomically, write_ridi_csv,
 };
+use ridi_data::{ilc, tyrex};
 
 use crate::source::read_any;
 
@@ -38,8 +38,9 @@ pub struct ConvertSummary {
 /// What converting one source produced: the sequences written and the warnings.
 type Written = (Vec<Converted>, Vec<String>);
 
-/// The sources under `source`: one sequence, the runs of a Tyrex root, or the sequences one
-/// level below a folder (a RIDI dataset folder).
+/// The sources under `source`: one sequence, the runs of a Tyrex root, the sequences one
+/// level below a folder (a RIDI dataset folder), or else the Indoor Location Competition path
+/// files in the folder and its sub-folders.
 fn sources(source: &Path, from: Option<Format>) -> Result<Vec<PathBuf>, DataError> {
     let detected = detect(source).ok();
     if from.is_none_or(|f| f == Format::Tyrex) {
@@ -53,8 +54,15 @@ fn sources(source: &Path, from: Option<Format>) -> Result<Vec<PathBuf>, DataErro
             return tyrex::list_sequences(source);
         }
     }
+    if from == Some(Format::Ilc) && detected != Some(Format::Ilc) {
+        return ilc::list_paths(source);
+    }
     if detected.is_some() {
         return Ok(vec![source.to_path_buf()]);
+    }
+    if !source.is_dir() {
+        // Say why the file is not a sequence rather than that it is not a folder.
+        return detect(source).map(|_| vec![source.to_path_buf()]);
     }
     let entries = std::fs::read_dir(source).map_err(|e| DataError::io(source, e))?;
     let mut found = Vec::new();
@@ -65,10 +73,15 @@ fn sources(source: &Path, from: Option<Format>) -> Result<Vec<PathBuf>, DataErro
         }
     }
     if found.is_empty() {
+        if from.is_none()
+            && let Ok(paths) = ilc::list_paths(source)
+        {
+            return Ok(paths);
+        }
         return Err(DataError::format(
             Location::file(source),
             "no sequence found: expected a RIDI data.csv, data_plain.txt or raw folder, a Tyrex \
-             folder or root, or a folder of those",
+             folder or root, a folder of those, or Indoor Location Competition path files",
         ));
     }
     found.sort();
@@ -88,7 +101,8 @@ fn tyrex_subject(name: &str) -> Option<&str> {
 
 /// Converts every sequence under `source` into `<out>/<name>/processed/data.csv` and writes
 /// list files (`name,placement` per line, relative to `out`): `list_all.txt`, and for Tyrex
-/// sources one `list_<person>.txt` per person. The placement of a Tyrex run is its motion name.
+/// sources one `list_<person>.txt` per person. The placement of a Tyrex run is its motion name,
+/// that of an Indoor Location Competition path `hand`.
 pub fn convert(
     source: &Path,
     out: &Path,
@@ -165,5 +179,34 @@ mod tests {
         );
         assert_eq!(tyrex_subject("dan_body1"), None);
         assert_eq!(tyrex_subject("x_Texting_partly"), None);
+    }
+
+    #[test]
+    fn path_files_are_found_in_sub_folders_as_a_fallback() {
+        let dir = tempfile::tempdir().unwrap();
+        let floor = dir.path().join("data/site1/F1");
+        std::fs::create_dir_all(floor.join("path_data_files")).unwrap();
+        for name in ["b.txt", "a.txt"] {
+            let f = floor.join("path_data_files").join(name);
+            std::fs::write(f, "#\tstartTime:1574559495255\n").unwrap();
+        }
+        std::fs::write(floor.join("floor_info.json"), "{}").unwrap();
+        std::fs::write(floor.join("notes.txt"), "not a path file\n").unwrap();
+        let want: Vec<PathBuf> = ["a.txt", "b.txt"]
+            .iter()
+            .map(|n| floor.join("path_data_files").join(n))
+            .collect();
+        assert_eq!(sources(dir.path(), None).unwrap(), want);
+        assert_eq!(sources(dir.path(), Some(Format::Ilc)).unwrap(), want);
+        assert_eq!(sources(&want[1], Some(Format::Ilc)).unwrap(), &want[1..]);
+        assert_eq!(sources(&want[1], None).unwrap(), &want[1..]);
+        let e = sources(&floor.join("notes.txt"), Some(Format::Ilc)).unwrap_err();
+        assert!(
+            e.to_string()
+                .contains("no Indoor Location Competition path file"),
+            "{e}"
+        );
+        let e = sources(&floor.join("floor_info.json"), None).unwrap_err();
+        assert!(e.to_string().contains("unknown file type"), "{e}");
     }
 }

@@ -16,8 +16,9 @@ pub struct Loaded {
     pub warnings: Vec<String>,
 }
 
-/// Reads the sequence(s) at `path`: a RIDI `data.csv`, `data_plain.txt`, RIDI raw folder or
-/// Tyrex sequence folder. `from` forces a format instead of detecting it.
+/// Reads the sequence(s) at `path`: a RIDI `data.csv`, `data_plain.txt`, RIDI raw folder,
+/// Tyrex sequence folder or Indoor Location Competition path file. `from` forces a format
+/// instead of detecting it.
 pub fn read_any(
     path: &Path,
     from: Option<Format>,

@@ -1,18 +1,28 @@
-//! `convert` on the full Tyrex data in `../shared` (beside the checkout); returns early with a
-//! note when the data are not there.
+//! `convert` on the full Tyrex and Indoor Location Competition data in `../shared` (beside the
+//! checkout); each test returns early with a note when the data are not there.
 
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 use ridi::data::{ReadOptions, read_list};
 
+/// `../shared/data/raw/<dataset>` when it holds `probe`.
+fn shared(dataset: &str, probe: &str) -> Option<PathBuf> {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../../../shared/data/raw")
+        .join(dataset);
+    if root.join(probe).is_dir() {
+        Some(root)
+    } else {
+        eprintln!("note: {} not found: skipped", root.display());
+        None
+    }
+}
+
 #[test]
 fn the_whole_tyrex_root_converts_with_one_list_per_person() {
-    let root = Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../../../shared/data/raw/tyrex-attitude-smartphones");
-    if !root.join("datasets/android").is_dir() {
-        eprintln!("note: {} not found: skipped", root.display());
+    let Some(root) = shared("tyrex-attitude-smartphones", "datasets/android") else {
         return;
-    }
+    };
     let out = tempfile::tempdir().unwrap();
     let summary = ridi::convert::convert(&root, out.path(), None, &ReadOptions::default()).unwrap();
     // 24 runs, some split at long mocap or sensor gaps into parts, each named and listed.
@@ -33,5 +43,26 @@ fn the_whole_tyrex_root_converts_with_one_list_per_person() {
     assert_eq!(per_person, all.len(), "every part is in its person's list");
     for c in &summary.sequences {
         assert!(c.path.is_file(), "{}", c.path.display());
+    }
+}
+
+#[test]
+fn indoor_location_competition_paths_convert_with_the_hand_placement() {
+    let Some(root) = shared("indoor-location-competition-20", "data") else {
+        return;
+    };
+    let out = tempfile::tempdir().unwrap();
+    let summary = ridi::convert::convert(&root, out.path(), None, &ReadOptions::default()).unwrap();
+    assert_eq!(summary.sequences.len(), 12);
+    assert!(summary.warnings.is_empty(), "{:?}", summary.warnings);
+    let all = read_list(out.path().join("list_all.txt")).unwrap();
+    assert_eq!(all.len(), 12);
+    assert!(all.iter().all(|e| e.placement.as_deref() == Some("hand")));
+    // The converted files read back with their ground truth, at 200 Hz.
+    let seqs =
+        ridi::data::load_list(out.path().join("list_all.txt"), &ReadOptions::default()).unwrap();
+    for s in &seqs {
+        assert!(s.ground_truth().is_some() && s.magnet().is_some());
+        assert!((s.rate_hz() - 200.0).abs() < 0.01, "{}", s.rate_hz());
     }
 }

@@ -143,3 +143,20 @@ pub fn write_files(dir: &Path, files: &[(&str, String)]) {
         std::fs::write(dir.join(name), content).unwrap();
     }
 }
+
+/// `../shared/data/raw/<dataset>` beside the checkout when it holds `probe`; otherwise `None`,
+/// after a note that the checks against it are skipped.
+pub fn shared_dataset(dataset: &str, probe: &str) -> Option<std::path::PathBuf> {
+    let p = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../../../shared/data/raw")
+        .join(dataset);
+    if p.join(probe).exists() {
+        Some(p)
+    } else {
+        eprintln!(
+            "note: {} not found: shared-data checks skipped",
+            p.display()
+        );
+        None
+    }
+}

@@ -1,0 +1,918 @@
+//! Reader for the path files of the Indoor Location Competition 2.0 (Microsoft Research and
+//! XYZ10, 2020; <https://github.com/location-competition/indoor-location-competition-20>, MIT
+//! licence): Android recordings of surveyors walking through buildings with the phone held flat
+//! in front of the body, with sparse surveyor-marked waypoints as ground truth.
+//!
+//! # Layout
+//! One text file per walk, `data/<site>/<floor>/path_data_files/<path id>.txt`:
+//! ```text
+//! #  startTime:1574559495255
+//! #  SiteID:5dd3d7732a57a34356595932  SiteName:...  FloorId:...  FloorName:F1
+//! #  Brand:OPPO  Model:PBCM10  AndroidName:8.1.0  APILevel:27
+//! #  type:1  name:BMI160 Accelerometer  vendor:BOSCH  resolution:0.0023956299  ...
+//! 1574559495263  TYPE_WAYPOINT  81.317215  93.31349
+//! 1574559495401  TYPE_ACCELEROMETER  -0.85562134  1.8243561  9.826508  2
+//! 1574559495401  TYPE_GYROSCOPE  -0.3919525  -0.07966614  0.09211731  3
+//! 1574559495401  TYPE_ROTATION_VECTOR  0.062149726  0.0793645  0.57060283  3
+//! ...
+//! #  endTime:1574559526762
+//! ```
+//! Records are tab-separated, `unix_ms TYPE values...`; `#` lines are the header (start time,
+//! site and floor, phone, one line per sensor) and the `endTime` footer. Read are
+//!
+//! | type | values | unit |
+//! | --- | --- | --- |
+//! | `TYPE_ACCELEROMETER` | `x y z [accuracy]` | m/s², with gravity |
+//! | `TYPE_GYROSCOPE` | `x y z [accuracy]` | rad/s, calibrated |
+//! | `TYPE_MAGNETIC_FIELD` (optional) | `x y z [accuracy]` | µT, calibrated |
+//! | `TYPE_ROTATION_VECTOR` | `x y z [accuracy]` | vector part of the quaternion |
+//! | `TYPE_WAYPOINT` | `x y` | metres, floor-map frame |
+//!
+//! as the competition's own reader (`io_f.py`) reads them: the fourth value the recorder adds is
+//! the sensor's accuracy status (0..3), not the quaternion's `w`, and is ignored. Every other type
+//! (`*_UNCALIBRATED`, `TYPE_WIFI`, `TYPE_BEACON`, ...) is skipped unread. The types interleave
+//! and the file as a whole is not in time order (WiFi scans are logged when they complete, the
+//! last waypoint may be the last record); each type on its own must be. IMU records come at
+//! about 50 Hz; a walk lasts 20-40 s with 4-8 waypoints.
+//!
+//! # What the sequence holds
+//! - Device frame: the Android sensor frame. Orientation: the rotation vector
+//!   ([`OrientationSource::RotationVector`]: magnetometer-based, world = east-north-up) with
+//!   `w = sqrt(1 - x² - y² - z²)`. Gravity is derived from it as for Tyrex (there is no gravity
+//!   sensor): `gravity_in_device(orientation, g)` with `g` = [`IlcOptions::gravity`], and linear
+//!   acceleration = accelerometer − gravity. The magnetometer is kept.
+//! - Timeline: uniform at [`IlcOptions::rate_hz`] (200 Hz, what the RIDI models expect: the
+//!   50 Hz samples are interpolated linearly, the rotation vector by slerp) over the time every
+//!   IMU stream and the waypoints cover. Nothing is extrapolated: IMU data before the first or
+//!   after the last waypoint (usually under 1.5 s) is dropped. Times are Unix seconds.
+//! - Ground truth: the waypoints, linearly interpolated in time, `z = 0`, in the floor-map frame
+//!   (metres on the floor plan, x right, y up; its heading has nothing to do with the device's
+//!   world frame, so compare trajectories after a 2D alignment). It is a straight line at
+//!   constant speed between marks 2-10 s apart: exact at the waypoint times, corners cut and speed
+//!   changes smoothed between them. Good for position errors over the walk; not for velocities,
+//!   so do not train on it. The ground-truth orientation is the rotation vector itself, the
+//!   phone's own estimate and not an independent measurement, so orientation errors against it
+//!   mean nothing. Its world (magnetic east-north-up) is not the floor-map frame the positions
+//!   are in, as [`GroundTruth`] assumes: velocity targets in the stabilized frame (a velocity
+//!   error, training) are turned by the yaw between the two, about 3 degrees on the shared
+//!   site1/F1 files and unknown elsewhere.
+//! - Placement: [`IlcOptions::placement`], `hand` by default (the competition's phones were held
+//!   flat in front of the body); a list file's placement overrides it.
+//! - Name: the file name without `.txt` (the path id).
+//!
+//! # Errors
+//! Every error names the file, and the line and field when one is to blame: a non-numeric or
+//! non-finite value, too few values (a truncated line), too many (two records run together
+//! without a line break), a record line that is not `unix_ms<TAB>TYPE_...`, timestamps of one
+//! type that go back or leave a gap longer than the validation's `max_gap_s` (repeated
+//! timestamps keep their first record), a rotation vector longer than 1, a missing accelerometer,
+//! gyroscope or rotation vector, fewer than 2 waypoints, waypoints that do not overlap the IMU
+//! data, and a last record without a line break after it (a file cut off while being written;
+//! complete files end with the `#<TAB>endTime` line).
+//!
+//! # Example
+//! ```no_run
+//! use ridi_data::ilc::{self, IlcOptions};
+//!
+//! let root = std::path::Path::new("indoor-location-competition-20/data");
+//! for file in ilc::list_paths(root)? {
+//!     let path = ilc::read(&file, &IlcOptions::default())?;
+//!     let seq = &path.sequence;
+//!     println!("{} {:.0} s, {} waypoints, {:.1} m", seq.name(), seq.duration(),
+//!              path.waypoints.len(), seq.path_length().unwrap_or(0.0));
+//! }
+//! # Ok::<(), ridi_data::DataError>(())
+//! ```
+
+use std::io::Read as _;
+use std::path::{Path, PathBuf};
+
+use ridi_frames::{Frame, STANDARD_GRAVITY, Vec3, World, WorldFromDevice};
+
+use crate::android;
+use crate::error::{DataError, Location, Result};
+use crate::options::ReadOptions;
+use crate::resample::{interpolate_rot, interpolate_vec3, uniform_timeline};
+use crate::sequence::{GroundTruth, OrientationSource, Sequence, SequenceParts, Validation};
+use crate::text::{self, Nan};
+
+/// Placement label of every path unless [`IlcOptions::placement`] says otherwise.
+pub const DEFAULT_PLACEMENT: &str = "hand";
+
+/// How path files are turned into sequences.
+#[derive(Debug, Clone, PartialEq)]
+pub struct IlcOptions {
+    /// Rate of the output timeline, Hz.
+    pub rate_hz: f64,
+    /// Gravity magnitude used to build the gravity channel from the orientation, m/s².
+    pub gravity: f64,
+    /// Placement label of the sequences ([`DEFAULT_PLACEMENT`] by default).
+    pub placement: Option<String>,
+    /// Limits the sequence is checked against; `max_gap_s` also applies to each IMU type's own
+    /// timestamps.
+    pub validation: Validation,
+}
+
+impl Default for IlcOptions {
+    fn default() -> Self {
+        Self {
+            rate_hz: 200.0,
+            gravity: STANDARD_GRAVITY,
+            placement: Some(DEFAULT_PLACEMENT.to_owned()),
+            validation: Validation::default(),
+        }
+    }
+}
+
+impl From<&ReadOptions> for IlcOptions {
+    /// The validation limits and timeline rate of the generic reader options, ILC defaults for
+    /// the rest.
+    fn from(o: &ReadOptions) -> Self {
+        Self {
+            rate_hz: o.rate_without_pose_hz,
+            validation: o.validation.clone(),
+            ..Self::default()
+        }
+    }
+}
+
+/// One `TYPE_WAYPOINT` record: where the surveyor marked the phone to be.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Waypoint {
+    /// Unix time, seconds.
+    pub time: f64,
+    /// `[x, y]` in the floor-map frame, metres.
+    pub position: [f64; 2],
+    /// 1-based line of the record.
+    pub line: usize,
+}
+
+/// What [`read`] found in one path file.
+#[derive(Debug, Clone, PartialEq)]
+pub struct IlcPath {
+    /// The walk, on the waypoints' time span (see the module documentation).
+    pub sequence: Sequence,
+    /// Every waypoint of the file, in time order, also those outside the sequence's span.
+    pub waypoints: Vec<Waypoint>,
+    /// `Brand Model (Android version)` from the header, when given.
+    pub device: Option<String>,
+    /// `SiteID` from the header, when given.
+    pub site: Option<String>,
+    /// `FloorName` from the header, when given.
+    pub floor: Option<String>,
+}
+
+/// A record type that is read: its name, the names of its values (for errors) and how many
+/// more values it may carry (the accuracy status).
+struct Kind {
+    name: &'static str,
+    fields: &'static [&'static str],
+    extra: usize,
+}
+
+const ACCE: usize = 0;
+const GYRO: usize = 1;
+const MAGNET: usize = 2;
+const RV: usize = 3;
+const WAYPOINT: usize = 4;
+
+const KINDS: [Kind; 5] = [
+    Kind {
+        name: "TYPE_ACCELEROMETER",
+        fields: &[
+            "TYPE_ACCELEROMETER x",
+            "TYPE_ACCELEROMETER y",
+            "TYPE_ACCELEROMETER z",
+        ],
+        extra: 1,
+    },
+    Kind {
+        name: "TYPE_GYROSCOPE",
+        fields: &["TYPE_GYROSCOPE x", "TYPE_GYROSCOPE y", "TYPE_GYROSCOPE z"],
+        extra: 1,
+    },
+    Kind {
+        name: "TYPE_MAGNETIC_FIELD",
+        fields: &[
+            "TYPE_MAGNETIC_FIELD x",
+            "TYPE_MAGNETIC_FIELD y",
+            "TYPE_MAGNETIC_FIELD z",
+        ],
+        extra: 1,
+    },
+    Kind {
+        name: "TYPE_ROTATION_VECTOR",
+        fields: &[
+            "TYPE_ROTATION_VECTOR x",
+            "TYPE_ROTATION_VECTOR y",
+            "TYPE_ROTATION_VECTOR z",
+        ],
+        extra: 1,
+    },
+    Kind {
+        name: "TYPE_WAYPOINT",
+        fields: &["TYPE_WAYPOINT x", "TYPE_WAYPOINT y"],
+        extra: 0,
+    },
+];
+
+/// The records of one type: times in seconds, values (unused ones 0) and their lines.
+#[derive(Default)]
+struct Stream {
+    time: Vec<f64>,
+    values: Vec<[f64; 3]>,
+    lines: Vec<usize>,
+}
+
+impl Stream {
+    fn span(&self) -> (f64, f64) {
+        (self.time[0], self.time[self.time.len() - 1])
+    }
+
+    /// The values as vectors of frame `F`, interpolated at `time`.
+    fn resample<F: Frame>(&self, time: &[f64]) -> Vec<Vec3<F>> {
+        let v: Vec<Vec3<F>> = self.values.iter().map(|&v| Vec3::from_array(v)).collect();
+        interpolate_vec3(&self.time, &v, time)
+    }
+}
+
+/// The header fields kept.
+#[derive(Default)]
+struct Header {
+    site: Option<String>,
+    floor: Option<String>,
+    brand: Option<String>,
+    model: Option<String>,
+    android: Option<String>,
+}
+
+impl Header {
+    /// Takes the `key:value` cells of a `#` line; the first value of a key wins.
+    fn read(&mut self, line: &str) {
+        for cell in text::cells(line, b'\t') {
+            let Some((key, value)) = cell.split_once(':') else {
+                continue;
+            };
+            let slot = match key.trim() {
+                "SiteID" => &mut self.site,
+                "FloorName" => &mut self.floor,
+                "Brand" => &mut self.brand,
+                "Model" => &mut self.model,
+                "AndroidName" => &mut self.android,
+                _ => continue,
+            };
+            let value = value.trim();
+            if slot.is_none() && !value.is_empty() {
+                *slot = Some(value.to_owned());
+            }
+        }
+    }
+
+    fn device(&self) -> Option<String> {
+        let name = match (&self.brand, &self.model) {
+            (Some(b), Some(m)) => format!("{b} {m}"),
+            (Some(x), None) | (None, Some(x)) => x.clone(),
+            (None, None) => return None,
+        };
+        Some(match &self.android {
+            Some(a) => format!("{name} (Android {a})"),
+            None => name,
+        })
+    }
+}
+
+/// Reads one path file (plain or gzip-compressed). See the module documentation.
+pub fn read(path: impl AsRef<Path>, options: &IlcOptions) -> Result<IlcPath> {
+    let path = path.as_ref();
+    parse(&text::read_file(path)?, path, options)
+}
+
+/// The sequence name of a path file: its file name without `.txt` (and `.gz`).
+fn name_of(path: &Path) -> String {
+    let name = path
+        .file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    let name = name.strip_suffix(".gz").unwrap_or(&name);
+    name.strip_suffix(".txt").unwrap_or(name).to_owned()
+}
+
+/// Parses the content of a path file; `path` names it in errors and gives the sequence name.
+pub fn parse(bytes: &[u8], path: &Path, options: &IlcOptions) -> Result<IlcPath> {
+    if !(options.rate_hz.is_finite() && options.rate_hz > 0.0) {
+        return Err(DataError::format(
+            Location::file(path).with_field("rate_hz"),
+            format!("output rate must be positive, got {}", options.rate_hz),
+        ));
+    }
+    let content = text::as_text(bytes, path)?;
+    let (streams, header) = parse_records(content, path)?;
+
+    for k in [ACCE, GYRO, RV] {
+        if streams[k].time.is_empty() {
+            return Err(DataError::format(
+                Location::file(path).with_field(KINDS[k].name),
+                format!(
+                    "no {} records: a path file needs TYPE_ACCELEROMETER, TYPE_GYROSCOPE and \
+                     TYPE_ROTATION_VECTOR",
+                    KINDS[k].name
+                ),
+            ));
+        }
+    }
+    let wp = &streams[WAYPOINT];
+    if wp.time.len() < 2 {
+        return Err(DataError::format(
+            Location::file(path).with_field(KINDS[WAYPOINT].name),
+            format!(
+                "{} TYPE_WAYPOINT record(s): the ground truth needs at least 2",
+                wp.time.len()
+            ),
+        ));
+    }
+    for (k, s) in streams.iter().enumerate() {
+        let gap = if k == WAYPOINT {
+            f64::INFINITY
+        } else {
+            options.validation.max_gap_s
+        };
+        text::check_time(&s.time, &s.lines, path, "unix_ms", gap)?;
+    }
+
+    let rv = &streams[RV];
+    let rotations = rv
+        .values
+        .iter()
+        .zip(&rv.lines)
+        .map(|(v, &line)| {
+            android::rotation_vector(*v, None).map_err(|message| {
+                DataError::format(
+                    Location::line(path, line).with_field("TYPE_ROTATION_VECTOR x..z"),
+                    message,
+                )
+            })
+        })
+        .collect::<Result<Vec<WorldFromDevice>>>()?;
+
+    let (start, end) = span(&streams, path)?;
+    let time = uniform_timeline(start, end, options.rate_hz);
+    let orientation = interpolate_rot(&rv.time, &rotations, &time);
+    let acce = streams[ACCE].resample(&time);
+    let (gravity, linacce) = android::gravity_and_linacce(&orientation, &acce, options.gravity);
+    let waypoints: Vec<Waypoint> = (0..wp.time.len())
+        .map(|i| Waypoint {
+            time: wp.time[i],
+            position: [wp.values[i][0], wp.values[i][1]],
+            line: wp.lines[i],
+        })
+        .collect();
+    let ground_truth = GroundTruth {
+        // The waypoints' third value is 0.
+        position: wp.resample::<World>(&time),
+        orientation: orientation.clone(),
+    };
+    let parts = SequenceParts {
+        name: name_of(path),
+        placement: options.placement.clone(),
+        gyro: streams[GYRO].resample(&time),
+        acce,
+        linacce,
+        gravity,
+        magnet: (!streams[MAGNET].time.is_empty()).then(|| streams[MAGNET].resample(&time)),
+        orientation,
+        orientation_source: Some(OrientationSource::RotationVector),
+        ground_truth: Some(ground_truth),
+        steps: None,
+        time,
+    };
+    let sequence = Sequence::with_validation(parts, &options.validation)
+        .map_err(|e| DataError::sequence(path, e))?;
+    Ok(IlcPath {
+        sequence,
+        waypoints,
+        device: header.device(),
+        site: header.site,
+        floor: header.floor,
+    })
+}
+
+/// The records of the read types and the header, checked line by line.
+fn parse_records(content: &str, path: &Path) -> Result<([Stream; 5], Header)> {
+    let mut streams: [Stream; 5] = Default::default();
+    let mut header = Header::default();
+    // The last non-blank line and the read type it holds, if it is such a record.
+    let mut last: Option<(usize, Option<usize>)> = None;
+    for (line, l) in text::lines(content) {
+        // Some recorders end lines with a tab.
+        let l = l.trim_end();
+        if l.trim_start().starts_with('#') {
+            header.read(l);
+            last = Some((line, None));
+            continue;
+        }
+        let mut cells = text::cells(l, b'\t');
+        let stamp = cells.next().unwrap_or("");
+        let ty = cells.next().map(str::trim).unwrap_or("");
+        if !ty.starts_with("TYPE_") {
+            return Err(DataError::format(
+                Location::line(path, line).with_field("type"),
+                format!(
+                    "expected a record `unix_ms<TAB>TYPE_...<TAB>values`, found `{}`",
+                    text::snippet(l)
+                ),
+            ));
+        }
+        let Some(k) = KINDS.iter().position(|k| k.name == ty) else {
+            last = Some((line, None));
+            continue;
+        };
+        let kind = &KINDS[k];
+        let want = kind.fields.len();
+        let t_ms = text::number(stamp, path, line, "unix_ms", Nan::Reject)?;
+        let mut v = [0.0; 3];
+        let mut n = 0;
+        for cell in cells {
+            if n < want {
+                v[n] = text::number(cell, path, line, kind.fields[n], Nan::Reject)?;
+            }
+            n += 1;
+        }
+        let expected = || {
+            let names: Vec<&str> = kind
+                .fields
+                .iter()
+                .filter_map(|f| f.split(' ').nth(1))
+                .collect();
+            let extra = if kind.extra > 0 { " [accuracy]" } else { "" };
+            format!("`{}{extra}`", names.join(" "))
+        };
+        if n < want {
+            return Err(DataError::format(
+                Location::line(path, line).with_field(kind.fields[n]),
+                format!(
+                    "{n} values for {ty}, expected {}: truncated line?",
+                    expected()
+                ),
+            ));
+        }
+        if n > want + kind.extra {
+            return Err(DataError::format(
+                Location::line(path, line).with_field(ty),
+                format!(
+                    "{n} values for {ty}, expected {}: two records run together (a missing \
+                     line break)?",
+                    expected()
+                ),
+            ));
+        }
+        // Division by the exact 1000 rounds once.
+        let t = t_ms / 1000.0;
+        let s = &mut streams[k];
+        // A repeated IMU timestamp keeps its first record; repeated waypoint times are an
+        // error (two positions at one time), found by the time check.
+        if k == WAYPOINT || s.time.last() != Some(&t) {
+            s.time.push(t);
+            s.values.push(v);
+            s.lines.push(line);
+        }
+        last = Some((line, Some(k)));
+    }
+    let complete = content.trim_end_matches([' ', '\t', '\r']).ends_with('\n');
+    if let Some((line, Some(k))) = last
+        && !complete
+    {
+        return Err(DataError::format(
+            Location::line(path, line).with_field(KINDS[k].name),
+            "the file ends inside this record, without a line break: cut off while being \
+             written? (complete path files end with a `#\tendTime` line)",
+        ));
+    }
+    Ok((streams, header))
+}
+
+/// The time every IMU stream and the waypoints cover.
+fn span(streams: &[Stream; 5], path: &Path) -> Result<(f64, f64)> {
+    let imu: Vec<&Stream> = [ACCE, GYRO, RV, MAGNET]
+        .iter()
+        .map(|&k| &streams[k])
+        .filter(|s| !s.time.is_empty())
+        .collect();
+    let imu_start = imu.iter().map(|s| s.span().0).fold(f64::MIN, f64::max);
+    let imu_end = imu.iter().map(|s| s.span().1).fold(f64::MAX, f64::min);
+    let ms = |t: f64| format!("{:.0}", t * 1000.0);
+    if imu_start > imu_end {
+        return Err(DataError::format(
+            Location::file(path),
+            "the IMU record types (accelerometer, gyroscope, rotation vector, magnetic field) \
+             do not overlap in time",
+        ));
+    }
+    let (wp_start, wp_end) = streams[WAYPOINT].span();
+    let (start, end) = (imu_start.max(wp_start), imu_end.min(wp_end));
+    if start >= end {
+        return Err(DataError::format(
+            Location::file(path).with_field("TYPE_WAYPOINT"),
+            format!(
+                "the waypoints ({}..{} ms) and the time every IMU type covers ({}..{} ms) do \
+                 not overlap: no frame has ground truth",
+                ms(wp_start),
+                ms(wp_end),
+                ms(imu_start),
+                ms(imu_end)
+            ),
+        ));
+    }
+    Ok((start, end))
+}
+
+/// How many bytes [`is_path_file`] looks at.
+const SNIFF_BYTES: u64 = 8192;
+
+/// Whether `head`, the first bytes of a file, look like a path file: a `#\tstartTime:` line or
+/// a `unix_ms<TAB>TYPE_...` record among its first lines.
+pub fn looks_like_path_file(head: &[u8]) -> bool {
+    let head = String::from_utf8_lossy(head);
+    head.lines().take(64).any(|l| {
+        if l.starts_with("#\tstartTime:") {
+            return true;
+        }
+        let mut cells = l.split('\t');
+        let stamp = cells.next().unwrap_or("");
+        !stamp.is_empty()
+            && stamp.bytes().all(|b| b.is_ascii_digit())
+            && cells.next().is_some_and(|t| t.starts_with("TYPE_"))
+    })
+}
+
+/// Whether the file at `path` is a path file (plain or gzip-compressed), judged by its first
+/// bytes (see [`looks_like_path_file`]); `false` when it cannot be read.
+pub fn is_path_file(path: &Path) -> bool {
+    let mut head = Vec::new();
+    let Ok(file) = std::fs::File::open(path) else {
+        return false;
+    };
+    if file.take(SNIFF_BYTES).read_to_end(&mut head).is_err() {
+        return false;
+    }
+    if head.starts_with(&[0x1f, 0x8b]) {
+        let Ok(file) = std::fs::File::open(path) else {
+            return false;
+        };
+        head.clear();
+        // A short or broken stream still leaves what it decoded in `head`.
+        let _ = flate2::read::MultiGzDecoder::new(file)
+            .take(SNIFF_BYTES)
+            .read_to_end(&mut head);
+    }
+    looks_like_path_file(&head)
+}
+
+/// Folder levels [`list_paths`] descends (the dataset root is `data/<site>/<floor>/
+/// path_data_files/` deep).
+const MAX_DEPTH: usize = 6;
+
+fn walk(dir: &Path, depth: usize, out: &mut Vec<PathBuf>) -> Result<()> {
+    let mut entries = Vec::new();
+    for entry in std::fs::read_dir(dir).map_err(|e| DataError::io(dir, e))? {
+        entries.push(entry.map_err(|e| DataError::io(dir, e))?.path());
+    }
+    entries.sort();
+    for p in entries {
+        if p.is_dir() {
+            if depth < MAX_DEPTH {
+                walk(&p, depth + 1, out)?;
+            }
+        } else {
+            let name = p.file_name().map(|n| n.to_string_lossy().to_lowercase());
+            let txt = name.is_some_and(|n| n.ends_with(".txt") || n.ends_with(".txt.gz"));
+            if txt && is_path_file(&p) {
+                out.push(p);
+            }
+        }
+    }
+    Ok(())
+}
+
+/// The path files at `root`: the file itself, or every `.txt` (`.txt.gz`) path file in the
+/// folder and its sub-folders (a few levels deep, enough for the dataset root), sorted.
+pub fn list_paths(root: impl AsRef<Path>) -> Result<Vec<PathBuf>> {
+    let root = root.as_ref();
+    let mut out = Vec::new();
+    if root.is_dir() {
+        walk(root, 0, &mut out)?;
+    } else if is_path_file(root) {
+        out.push(root.to_path_buf());
+    }
+    if out.is_empty() {
+        return Err(DataError::format(
+            Location::file(root),
+            "no Indoor Location Competition path file (a `.txt` of `unix_ms<TAB>TYPE_...` \
+             records) here or in its sub-folders",
+        ));
+    }
+    Ok(out)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A walk of `seconds` at 50 Hz: the phone lies flat (screen up) and turns about z at
+    /// 0.1 rad/s; a waypoint every second along x at 1 m/s, the last one written at the end of
+    /// the file as the recorder does.
+    fn synthetic(seconds: usize) -> String {
+        let t0 = 1_574_559_495_000_i64;
+        let mut s = String::from(
+            "#\tstartTime:1574559495000\n#\tSiteID:site\tFloorName:F1\n\
+             #\tBrand:OPPO\tModel:PBCM10\tAndroidName:8.1.0\tAPILevel:27\t\n",
+        );
+        let n = seconds * 50;
+        let mut waypoints = Vec::new();
+        for i in 0..=n {
+            let ms = t0 + 20 * i as i64;
+            let t = i as f64 / 50.0;
+            if i % 50 == 0 {
+                waypoints.push(format!("{ms}\tTYPE_WAYPOINT\t{t}\t5\n"));
+            }
+            let half = 0.05 * t;
+            s += &format!("{ms}\tTYPE_ACCELEROMETER\t0.1\t0.2\t9.81\t3\n");
+            s += &format!("{ms}\tTYPE_GYROSCOPE\t0\t0\t0.1\t3\n");
+            s += &format!("{ms}\tTYPE_MAGNETIC_FIELD\t20\t0\t-40\t3\n");
+            s += &format!("{ms}\tTYPE_ROTATION_VECTOR\t0\t0\t{}\t3\n", half.sin());
+            s += &format!("{ms}\tTYPE_GYROSCOPE_UNCALIBRATED\t0\t0\t0.1\t0\t0\t0\t3\t\n");
+            if i % 25 == 0 {
+                s += &format!("{}\tTYPE_WIFI\tssid\tbssid\t-60\t5180\t{ms}\n", ms - 700);
+            }
+            if i % 50 == 0 && i < n {
+                s += &waypoints[i / 50];
+            }
+        }
+        s += &waypoints[n / 50];
+        s += &format!("#\tendTime:{}\n", t0 + 20 * n as i64);
+        s
+    }
+
+    /// `s` with each line replaced by `f(line)`, or dropped when that is `None`.
+    fn map_lines(s: &str, f: impl Fn(&str) -> Option<String>) -> String {
+        s.lines().filter_map(f).map(|l| l + "\n").collect()
+    }
+
+    fn parse_str(s: &str) -> Result<IlcPath> {
+        parse(s.as_bytes(), Path::new("p/abc.txt"), &IlcOptions::default())
+    }
+
+    fn err(s: &str) -> String {
+        parse_str(s).unwrap_err().to_string()
+    }
+
+    #[test]
+    fn a_synthetic_walk_is_read() {
+        let p = parse_str(&synthetic(6)).unwrap();
+        let seq = &p.sequence;
+        assert_eq!(seq.name(), "abc");
+        assert_eq!(seq.placement(), Some("hand"));
+        assert_eq!(
+            seq.orientation_source(),
+            Some(OrientationSource::RotationVector)
+        );
+        assert_eq!(p.device.as_deref(), Some("OPPO PBCM10 (Android 8.1.0)"));
+        assert_eq!(
+            (p.site.as_deref(), p.floor.as_deref()),
+            (Some("site"), Some("F1"))
+        );
+        assert_eq!(p.waypoints.len(), 7);
+        assert!(p.waypoints.windows(2).all(|w| w[0].time < w[1].time));
+        // 6 s at 200 Hz, both ends included.
+        assert_eq!(seq.len(), 1201);
+        assert!((seq.rate_hz() - 200.0).abs() < 1e-6);
+        assert!((seq.time()[0] - 1_574_559_495.0).abs() < 1e-6);
+        let gt = seq.ground_truth().unwrap();
+        // Waypoints every second: x = t, y = 5.
+        for (i, &t) in seq.time().iter().enumerate().step_by(37) {
+            let x = t - 1_574_559_495.0;
+            let p = gt.position[i];
+            assert!((p.x() - x).abs() < 1e-6 && (p.y() - 5.0).abs() < 1e-12 && p.z() == 0.0);
+        }
+        assert!((seq.path_length().unwrap() - 6.0).abs() < 1e-6);
+        assert_eq!(gt.orientation, seq.orientation());
+        // Flat, screen up: gravity along +z, yaw 0.1 rad/s.
+        let g = seq.gravity()[600];
+        assert!((g.z() - STANDARD_GRAVITY).abs() < 1e-9 && g.x().abs() < 1e-9);
+        let yaw = seq.orientation()[1200].angle_to(&seq.orientation()[0]);
+        assert!((yaw - 0.6).abs() < 1e-6, "{yaw}");
+        let l = seq.linacce()[10];
+        assert!((l.x() - 0.1).abs() < 1e-9 && (l.z() - (9.81 - STANDARD_GRAVITY)).abs() < 1e-9);
+        assert!(seq.magnet().is_some_and(|m| (m[5].x() - 20.0).abs() < 1e-9));
+        assert!((seq.gyro()[3].z() - 0.1).abs() < 1e-12);
+    }
+
+    #[test]
+    fn frames_outside_the_waypoints_are_cut_and_placement_is_an_option() {
+        // Waypoints from 1 s to 5 s only.
+        let s = map_lines(&synthetic(6), |l| {
+            (!l.contains("TYPE_WAYPOINT")).then(|| l.to_owned())
+        })
+        .replace(
+            "#\tendTime",
+            "1574559496000\tTYPE_WAYPOINT\t0\t0\n1574559500000\tTYPE_WAYPOINT\t4\t0\n#\tendTime",
+        );
+        let opts = IlcOptions {
+            placement: None,
+            ..IlcOptions::default()
+        };
+        let p = parse(s.as_bytes(), Path::new("x.txt.gz"), &opts).unwrap();
+        let seq = p.sequence;
+        assert_eq!(seq.name(), "x");
+        assert_eq!(seq.placement(), None);
+        assert_eq!(seq.len(), 801);
+        assert!((seq.time()[0] - 1_574_559_496.0).abs() < 1e-6);
+        assert!((seq.path_length().unwrap() - 4.0).abs() < 1e-9);
+    }
+
+    #[test]
+    fn bad_input_names_file_line_and_field() {
+        let good = synthetic(3);
+        let cases: &[(&str, &str, &str)] = &[
+            (
+                "1574559495020\tTYPE_ACCELEROMETER\t0.1\t0.2\t9.81\t3",
+                "1574559495020\tTYPE_ACCELEROMETER\t0.1\tabc\t9.81\t3",
+                "p/abc.txt:11: field `TYPE_ACCELEROMETER y`: `abc` is not a number",
+            ),
+            (
+                "1574559495020\tTYPE_ACCELEROMETER\t0.1\t0.2\t9.81\t3",
+                "1574559495020\tTYPE_ACCELEROMETER\t0.1\t0.2\tinf\t3",
+                "p/abc.txt:11: field `TYPE_ACCELEROMETER z`: `inf` is not a finite number",
+            ),
+            (
+                "1574559495020\tTYPE_GYROSCOPE\t0\t0\t0.1\t3",
+                "1574559495020\tTYPE_GYROSCOPE\t0\t0",
+                "p/abc.txt:12: field `TYPE_GYROSCOPE z`: 2 values for TYPE_GYROSCOPE, expected \
+                 `x y z [accuracy]`: truncated line?",
+            ),
+            (
+                "1574559495020\tTYPE_GYROSCOPE\t0\t0\t0.1\t3",
+                "1574559495020\tTYPE_GYROSCOPE\t0\t0\t0.1\t31574559495020\tTYPE_MAGNETIC_FIELD",
+                "p/abc.txt:12: field `TYPE_GYROSCOPE`: 5 values for TYPE_GYROSCOPE, expected \
+                 `x y z [accuracy]`: two records run together",
+            ),
+            (
+                "1574559495020\tTYPE_ACCELEROMETER\t0.1\t0.2\t9.81\t3",
+                "1574559495020x\tTYPE_ACCELEROMETER\t0.1\t0.2\t9.81\t3",
+                "p/abc.txt:11: field `unix_ms`: `1574559495020x` is not a number",
+            ),
+            (
+                "1574559495040\tTYPE_ROTATION_VECTOR",
+                "1574559495000\tTYPE_ROTATION_VECTOR",
+                // Unix milliseconds as f64 seconds: 0.24 µs resolution.
+                "p/abc.txt:19: field `unix_ms`: timestamp goes back by 0.0199999",
+            ),
+            (
+                "1574559495020\tTYPE_ROTATION_VECTOR\t0\t0\t0.0009999998333333417",
+                "1574559495020\tTYPE_ROTATION_VECTOR\t0.9\t0.9\t0.0009999998333333417",
+                "p/abc.txt:14: field `TYPE_ROTATION_VECTOR x..z`: quaternion x,y,z,w has norm \
+                 1.2728, not 1",
+            ),
+            (
+                "1574559494300\tTYPE_WIFI",
+                "1574559494300 TYPE_WIFI",
+                "p/abc.txt:9: field `type`: expected a record `unix_ms<TAB>TYPE_...<TAB>values`, \
+                 found `1574559494300 TYPE_WIFI\tssid\tbssid\t-60\t5...`",
+            ),
+            (
+                "1574559496000\tTYPE_WAYPOINT\t1\t5",
+                "1574559494000\tTYPE_WAYPOINT\t1\t5",
+                "p/abc.txt:263: field `unix_ms`: timestamp goes back by 1.000000000 s from line 10",
+            ),
+            (
+                "1574559496000\tTYPE_WAYPOINT\t1\t5",
+                "1574559496000\tTYPE_WAYPOINT\t1\t5\t0",
+                "p/abc.txt:263: field `TYPE_WAYPOINT`: 3 values for TYPE_WAYPOINT, expected \
+                 `x y`: two records run together",
+            ),
+        ];
+        for (from, to, want) in cases {
+            assert!(good.contains(from), "{from}");
+            let e = err(&good.replacen(from, to, 1));
+            assert!(e.starts_with(want), "{e}\nwant {want}");
+        }
+    }
+
+    #[test]
+    fn waypoint_problems_are_reported() {
+        let good = synthetic(3);
+        let only_first = map_lines(&good, |l| {
+            (!l.contains("TYPE_WAYPOINT") || l.starts_with("1574559495000")).then(|| l.to_owned())
+        });
+        assert_eq!(
+            err(&only_first),
+            "p/abc.txt: field `TYPE_WAYPOINT`: 1 TYPE_WAYPOINT record(s): the ground truth \
+             needs at least 2"
+        );
+        let same = good.replace(
+            "1574559496000\tTYPE_WAYPOINT\t1\t5",
+            "1574559495000\tTYPE_WAYPOINT\t1\t5",
+        );
+        assert!(
+            err(&same).starts_with(
+                "p/abc.txt:263: field `unix_ms`: duplicate timestamp (same as line 10)"
+            ),
+            "{}",
+            err(&same)
+        );
+        // Every waypoint 100 s after the IMU data.
+        let late = map_lines(&good, |l| {
+            Some(match l.split_once("\tTYPE_WAYPOINT") {
+                Some((ms, rest)) => {
+                    format!(
+                        "{}\tTYPE_WAYPOINT{rest}",
+                        ms.parse::<i64>().unwrap() + 100_000
+                    )
+                }
+                None => l.to_owned(),
+            })
+        });
+        let e = err(&late);
+        assert_eq!(
+            e,
+            "p/abc.txt: field `TYPE_WAYPOINT`: the waypoints (1574559595000..1574559598000 ms) \
+             and the time every IMU type covers (1574559495000..1574559498000 ms) do not \
+             overlap: no frame has ground truth"
+        );
+    }
+
+    #[test]
+    fn missing_streams_gaps_and_truncation_are_reported() {
+        let good = synthetic(3);
+        for ty in [
+            "TYPE_ACCELEROMETER",
+            "TYPE_GYROSCOPE",
+            "TYPE_ROTATION_VECTOR",
+        ] {
+            let without = map_lines(&good, |l| {
+                (l.split('\t').nth(1) != Some(ty)).then(|| l.to_owned())
+            });
+            let e = err(&without);
+            assert!(
+                e.starts_with(&format!("p/abc.txt: field `{ty}`: no {ty} records")),
+                "{e}"
+            );
+        }
+        // No magnetometer is fine.
+        let no_mag = map_lines(&good, |l| {
+            (!l.contains("TYPE_MAGNETIC_FIELD\t")).then(|| l.to_owned())
+        });
+        assert!(parse_str(&no_mag).unwrap().sequence.magnet().is_none());
+        // A 1.5 s hole in the accelerometer.
+        let holed = map_lines(&good, |l| {
+            let t: i64 = l.split('\t').next().unwrap().parse().unwrap_or(0);
+            let hole = (1_574_559_496_000..1_574_559_497_500).contains(&t);
+            (!(hole && l.contains("TYPE_ACCELEROMETER\t"))).then(|| l.to_owned())
+        });
+        let e = err(&holed);
+        assert!(e.contains("field `unix_ms`: gap of 1.520 s"), "{e}");
+        // Cut off inside an accelerometer record.
+        let cut_at = good.find("1574559496500\tTYPE_ACCELEROMETER").unwrap() + 44;
+        assert!(good[..cut_at].ends_with("\t0.1\t0.2\t9.8"));
+        let e = err(&good[..cut_at]);
+        assert!(
+            e.contains("field `TYPE_ACCELEROMETER`: the file ends inside this record"),
+            "{e}"
+        );
+        // Cut off after a complete line, or inside an ignored record: the data are usable.
+        let after_line = good.find("1574559496500\tTYPE_ACCELEROMETER").unwrap();
+        assert!(parse_str(&good[..after_line]).is_ok());
+        let in_wifi = good.rfind("\tTYPE_WIFI\tssid").unwrap() + 12;
+        assert!(parse_str(&good[..in_wifi]).is_ok());
+        // Repeated IMU timestamps keep the first record.
+        let dup = good.replacen(
+            "1574559495020\tTYPE_GYROSCOPE\t0\t0\t0.1\t3\n",
+            "1574559495020\tTYPE_GYROSCOPE\t0\t0\t0.1\t3\n1574559495020\tTYPE_GYROSCOPE\t9\t9\t9\t3\n",
+            1,
+        );
+        let seq = parse_str(&dup).unwrap().sequence;
+        assert!(seq.gyro().iter().all(|g| g.x() == 0.0));
+        // Nothing at all.
+        assert!(err("").contains("no TYPE_ACCELEROMETER records"));
+        let e = parse(
+            b"x",
+            Path::new("a.txt"),
+            &IlcOptions {
+                rate_hz: 0.0,
+                ..Default::default()
+            },
+        )
+        .unwrap_err();
+        assert!(e.to_string().contains("rate must be positive"), "{e}");
+    }
+
+    #[test]
+    fn path_files_are_recognized_by_their_first_lines() {
+        assert!(looks_like_path_file(synthetic(1).as_bytes()));
+        assert!(looks_like_path_file(
+            b"1574559495263\tTYPE_WAYPOINT\t1\t2\n"
+        ));
+        assert!(!looks_like_path_file(b"3 27\n1\t2\t3\n"));
+        assert!(!looks_like_path_file(b"# t x y z\n12 0.1 0.2 0.3\n"));
+        assert!(!looks_like_path_file(b""));
+    }
+}
