@@ -1,9 +1,9 @@
 //! The RIDI cascade: a placement classifier, then two epsilon-SVRs per placement for the two
 //! horizontal velocity components in the stabilized frame S.
 //!
-//! Storage: each placement keeps its samples once, as `f32` coordinates on the leading
-//! principal directions of the training features or in half precision ([`Storage`]: a query
-//! is bound by the bytes it streams), ordered so that the classifier's support vectors of
+//! Storage: each placement keeps its samples once in half precision, as coordinates on the
+//! leading principal directions of the training features or as the features themselves
+//! ([`Storage`]: a query is bound by the bytes it streams), ordered so that the classifier's support vectors of
 //! that placement come first, followed by the other samples that either regressor uses.
 //! Prediction computes the squared distances of a query to the classifier part of every
 //! placement, classifies, and then reuses those distances for the regressors of the predicted
@@ -87,10 +87,11 @@ impl Gamma {
 pub enum Storage {
     /// Every feature value in half precision.
     Half,
-    /// `f32` coordinates on the leading principal directions of the training features that
-    /// hold at least `energy` of their variance, plus each sample's exact residual norm.
-    /// Falls back to [`Storage::Half`] when that would not save bytes (features without
-    /// low-dimensional structure, or fewer than 32 values per row).
+    /// Coordinates on the leading principal directions of the training features that hold at
+    /// least `energy` of their variance (at least 64, in half precision; the 32 largest as two
+    /// half-precision values, `hi + lo`), plus each sample's exact residual norm. Falls back
+    /// to [`Storage::Half`] when that would not halve the bytes (features without
+    /// low-dimensional structure, or fewer than 192 values per row).
     Projected {
         /// Share of the variance to keep, in `(0, 1]`.
         energy: f64,
@@ -507,7 +508,7 @@ impl Cascade {
                 [&d0, &d1],
                 [chosen[0], chosen[1]],
                 projection.as_ref(),
-            ));
+            )?);
         }
         Ok(Self {
             feature_config: data.feature_config.clone(),
@@ -578,7 +579,7 @@ impl Cascade {
                 return self.predict_single(q, kernel::dot(q, q), s);
             };
             let mut z = std::mem::take(&mut s.z);
-            z.resize(p.dim(), 0.0);
+            z.resize(p.stored_dim(), 0.0);
             let qn = p.project_one(q, &mut s.centred, &mut z);
             let out = self.predict_single(&z, qn, s);
             s.z = z;
@@ -725,9 +726,13 @@ impl Cascade {
             bytes.hash(&mut h);
             h.finish()
         };
-        let stored =
-            |i: usize| SampleRows::from_rows(training, &[i], self.projection.as_ref()).row_bytes(0);
-        let forms: Vec<Vec<u8>> = (0..training.rows()).into_par_iter().map(stored).collect();
+        let stored = |i: usize| {
+            SampleRows::from_rows(training, &[i], self.projection.as_ref()).map(|s| s.row_bytes(0))
+        };
+        let forms: Vec<Vec<u8>> = (0..training.rows())
+            .into_par_iter()
+            .map(stored)
+            .collect::<Result<_, _>>()?;
         let mut by_key: HashMap<u64, Vec<usize>> = HashMap::new();
         for (i, f) in forms.iter().enumerate() {
             by_key.entry(key(f)).or_default().push(i);
@@ -803,10 +808,8 @@ impl Cascade {
                 let mut tile = Vec::new();
                 for t0 in (r0..r1).step_by(WIDEN_ROWS) {
                     let t1 = (t0 + WIDEN_ROWS).min(r1);
-                    let b = MatrixRef::trusted(
-                        cl.samples.rows_f32(t0, t1, &mut wide),
-                        cl.samples.dim(),
-                    );
+                    cl.samples.rows_f32(t0, t1, &mut wide);
+                    let b = MatrixRef::trusted(&wide, cl.samples.dim());
                     if t1 - t0 == w {
                         run(b, &cl.norms[t0..t1], out);
                         continue;
@@ -974,17 +977,13 @@ impl Cascade {
                 if p.input_dim() != self.dim {
                     return bad("projection dimension");
                 }
-                p.dim()
+                p.stored_dim()
             }
         };
         for cl in &self.classes {
             cl.samples.check()?;
             let ns = cl.samples.rows();
-            let form_ok = matches!(
-                (&cl.samples, &self.projection),
-                (SampleRows::Half(_), None) | (SampleRows::Projected { .. }, Some(_))
-            );
-            if !form_ok
+            if cl.samples.is_projected() != self.projection.is_some()
                 || cl.samples.dim() != stored_dim
                 || cl.norms.len() != ns
                 || cl.n_classifier > ns
@@ -1006,7 +1005,7 @@ fn build_class(
     duals: [&svr::SvrDual; 2],
     chosen: [(f64, f64); 2],
     projection: Option<&Projection>,
-) -> ClassModel {
+) -> Result<ClassModel, RegressError> {
     let n = idx.len();
     let np = pairs.len();
     // Classifier coefficients of this class's samples, by local index.
@@ -1027,7 +1026,7 @@ fn build_class(
         (0..n)
             .filter(|&s| clf[s].is_none() && (duals[0].coef[s] != 0.0 || duals[1].coef[s] != 0.0)),
     );
-    let samples = SampleRows::from_rows(xc, &order, projection);
+    let samples = SampleRows::from_rows(xc, &order, projection)?;
     let norms = samples.norms();
     let clf_coef = order[..n_classifier]
         .iter()
@@ -1037,7 +1036,7 @@ fn build_class(
         .iter()
         .flat_map(|&s| [duals[0].coef[s], duals[1].coef[s]])
         .collect();
-    ClassModel {
+    Ok(ClassModel {
         samples,
         norms,
         n_classifier,
@@ -1047,7 +1046,7 @@ fn build_class(
         reg_params: chosen,
         reg_info: [duals[0].info(), duals[1].info()],
         n_train: n,
-    }
+    })
 }
 
 /// `out (k) = kvals (n) · coef (n × k)`, accumulated in f64 in the order of

@@ -20,9 +20,9 @@
 //! All fits of a placement index one kernel over its samples: the two velocity channels, every
 //! grid point and every cross-validation fold ([`grid`]). Fits along the `C` axis start from
 //! the previous solution scaled by `C_new / C_old`. A trained [`Cascade`] stores each
-//! placement's samples once, by default as `f32` coordinates on the few principal directions
-//! that hold 99.99 % of the training features' variance (304 of 1200 on Tyrex features), else in
-//! half precision ([`Storage`]): prediction is bound by the bytes it streams, and
+//! placement's samples once in half precision, by default as coordinates on the few principal
+//! directions that hold 99.99 % of the training features' variance (304 of 1200 on Tyrex
+//! features), else as the features ([`Storage`]): prediction is bound by the bytes it streams, and
 //! [`Cascade::rounding_effect`] measures what the compact storage costs. At prediction one
 //! distance pass per placement feeds the classifier and is reused by the regressors
 //! ([`Cascade::predict`] batches with GEMM, [`Cascade::predict_one`] streams the rows once).

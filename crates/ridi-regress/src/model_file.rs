@@ -10,11 +10,12 @@
 //! | 4     | CRC32 of the payload                      |
 //! | n     | payload: bincode 2 (standard config, serde) of the [`Cascade`] |
 //!
-//! Version 3 stores each placement's samples either as `f32` principal-component coordinates
-//! with their residual norms, next to the projection (mean and directions), or as
-//! little-endian IEEE binary16 in one byte string ([`crate::Storage`]); squared norms are
-//! recomputed on load. Version 2 (binary16 only) and version 1 (`f32` features) files are
-//! refused with [`RegressError::UnsupportedVersion`]: retrain the model.
+//! Version 4 stores each placement's samples as little-endian IEEE binary16 in one byte
+//! string: principal-component coordinates (with their residual norms, next to the projection's
+//! mean and directions) or the features themselves ([`crate::Storage`]); squared norms are
+//! recomputed on load. Older files are refused with [`RegressError::UnsupportedVersion`]
+//! (retrain the model): version 3 kept the leading coordinates as a separate `f32` block,
+//! version 2 stored binary16 features only, version 1 `f32` features.
 //!
 //! The header is checked before the payload is decoded, so a newer version, a truncated file
 //! or a corrupt payload each give their own error. Encoding is deterministic (no maps, no
@@ -30,7 +31,7 @@ use crate::error::RegressError;
 /// File magic number.
 pub const MAGIC: [u8; 8] = *b"RIDIREG\0";
 /// Format version written and read by this build.
-pub const FORMAT_VERSION: u32 = 3;
+pub const FORMAT_VERSION: u32 = 4;
 const HEADER: usize = 8 + 4 + 8 + 4;
 /// Refuses to allocate for absurd payload lengths from a corrupt header.
 const MAX_PAYLOAD: u64 = 1 << 40;

@@ -16,7 +16,10 @@
 //! same size as half-precision rounding ([`crate::Cascade::rounding_effect`] measures both;
 //! figures in docs/benchmarks.md).
 //!
-//! The first [`F32_LEAD`] coordinates are kept in `f32`, the others in half precision.
+//! Coordinates are stored in half precision, the first [`SPLIT_LEAD`] of them as two binary16
+//! values each (`hi = f16(z)`, `lo = f16(z − hi)`, about 22 significant bits). A query is
+//! written in the same layout, `[z_lead, z_lead, z_rest]`, so one half-precision dot product
+//! over `k + SPLIT_LEAD` values gives `z_q·(hi + lo) + z_q·rest` in a single stream.
 
 use faer::linalg::matmul::matmul;
 use faer::{Accum, Mat, MatMut, MatRef, Par, Side};
@@ -37,19 +40,19 @@ const CHUNK_ROWS: usize = 2048;
 /// Components are kept in multiples of this (the SIMD width of the dot products).
 const ROUND_TO: usize = 16;
 
-/// Leading coordinates stored in `f32`; the others are stored in half precision. The leading
-/// ones are large (they carry most of the variance), and half precision on them would cost
-/// more than the truncation does (on features with few dominant directions, 2x the velocity
-/// change); further down the coordinates are small and binary16's relative precision is
-/// plenty.
-pub(crate) const F32_LEAD: usize = 32;
+/// Leading coordinates stored as two binary16 values (`hi + lo`); the others as one. The
+/// leading ones are large (they carry most of the variance), and plain half precision on them
+/// would cost more than the truncation does (on features with few dominant directions, 2x the
+/// velocity change); further down the coordinates are small and binary16's relative precision
+/// is plenty.
+pub(crate) const SPLIT_LEAD: usize = 32;
 
 /// Fewest coordinates kept (the half-precision part then has at least 32).
 const MIN_COMPONENTS: usize = 64;
 
-/// Bytes per sample for `k` coordinates ([`F32_LEAD`] in `f32`, the rest in `f16`).
+/// Bytes per sample for `k` coordinates.
 fn stored_bytes(k: usize) -> usize {
-    4 * F32_LEAD + 2 * (k - F32_LEAD)
+    2 * (k + SPLIT_LEAD)
 }
 
 /// Mean and leading principal directions of the training features.
@@ -151,6 +154,11 @@ impl Projection {
         self.basis.rows()
     }
 
+    /// Values per stored sample and per query in stored form (`dim() + SPLIT_LEAD`).
+    pub(crate) fn stored_dim(&self) -> usize {
+        self.dim() + SPLIT_LEAD
+    }
+
     /// Dimension of the vectors projected.
     pub(crate) fn input_dim(&self) -> usize {
         self.mean.len()
@@ -161,23 +169,25 @@ impl Projection {
         self.energy
     }
 
-    /// Writes the coordinates of `q` into `z` (`dim()` values) using `centred` as scratch,
-    /// and returns the exact `|q − μ|²`. Row by row, so the same input always gives the same
-    /// bits (stored samples are matched against training rows by them).
-    pub(crate) fn project_one(&self, q: &[f32], centred: &mut Vec<f32>, z: &mut [f32]) -> f32 {
+    /// Writes `q` in stored form, `[z_lead, z_lead, z_rest]` (`stored_dim()` values; the
+    /// coordinates `z` are `out[SPLIT_LEAD..]`), using `centred` as scratch, and returns the
+    /// exact `|q − μ|²`. Row by row, so the same input always gives the same bits (stored
+    /// samples are matched against training rows by them).
+    pub(crate) fn project_one(&self, q: &[f32], centred: &mut Vec<f32>, out: &mut [f32]) -> f32 {
         centred.clear();
         centred.extend(q.iter().zip(&self.mean).map(|(&v, &mu)| v - mu));
-        for (o, b) in z
+        for (o, b) in out[SPLIT_LEAD..]
             .iter_mut()
             .zip(self.basis.as_slice().chunks_exact(self.input_dim()))
         {
             *o = kernel::dot(centred, b);
         }
+        out.copy_within(SPLIT_LEAD..2 * SPLIT_LEAD, 0);
         kernel::dot(centred, centred)
     }
 
-    /// Coordinates of every row of `x` and the exact `|x_i − μ|²` (one GEMM; the batched
-    /// query path).
+    /// Every row of `x` in stored form (as [`Self::project_one`]) and the exact `|x_i − μ|²`
+    /// (one GEMM; the batched query path).
     pub(crate) fn project(&self, x: MatrixRef<'_>) -> (Matrix, Vec<f32>) {
         let (n, d, k) = (x.rows(), self.input_dim(), self.dim());
         let mut centred = x.as_slice().to_vec();
@@ -194,7 +204,13 @@ impl Projection {
             1.0f32,
             Par::Seq,
         );
-        (Matrix::from_parts(data, k), norms)
+        let w = self.stored_dim();
+        let mut out = vec![0.0f32; n * w];
+        for (o, z) in out.chunks_exact_mut(w).zip(data.chunks_exact(k)) {
+            o[..SPLIT_LEAD].copy_from_slice(&z[..SPLIT_LEAD]);
+            o[SPLIT_LEAD..].copy_from_slice(z);
+        }
+        (Matrix::from_parts(out, w), norms)
     }
 
     /// Consistency after decoding.
@@ -250,17 +266,20 @@ mod tests {
             .expect("low rank gains");
         assert_eq!(p.dim(), 64, "3 directions, at least 64 kept");
         assert!(p.energy() > 0.9999);
+        assert_eq!(p.stored_dim(), 64 + SPLIT_LEAD);
         let (z, n) = p.project(x.view());
         let mut buf = Vec::new();
-        let mut zi = vec![0.0; 64];
+        let mut zi = vec![0.0; p.stored_dim()];
+        let coords = |i: usize| &z.row(i)[SPLIT_LEAD..];
         for (i, j) in [(0, 1), (10, 400), (77, 78)] {
+            assert_eq!(&z.row(i)[..SPLIT_LEAD], &coords(i)[..SPLIT_LEAD]);
             let exact: f32 = x
                 .row(i)
                 .iter()
                 .zip(x.row(j))
                 .map(|(a, b)| (a - b) * (a - b))
                 .sum();
-            let approx = n[i] + n[j] - 2.0 * kernel::dot(z.row(i), z.row(j));
+            let approx = n[i] + n[j] - 2.0 * kernel::dot(coords(i), coords(j));
             assert!(
                 (exact - approx).abs() < 1e-3 * exact.max(1.0),
                 "{exact} vs {approx}"

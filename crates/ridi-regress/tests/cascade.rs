@@ -202,21 +202,22 @@ fn training_is_deterministic_and_model_files_round_trip() {
         );
     }
     let mut newer = bytes.clone();
-    newer[8..12].copy_from_slice(&4u32.to_le_bytes());
+    newer[8..12].copy_from_slice(&5u32.to_le_bytes());
     assert!(matches!(
         model_file::from_bytes(&newer),
         Err(RegressError::UnsupportedVersion {
-            found: 4,
-            supported: 3
+            found: 5,
+            supported: 4
         })
     ));
-    // Versions 1 (f32 samples) and 2 (half precision only): refused with advice, not misread.
-    for v in [1u32, 2] {
+    // Versions 1 (f32 samples), 2 (half precision only) and 3 (an f32 block of leading
+    // coordinates): refused with advice, not misread.
+    for v in [1u32, 2, 3] {
         let mut older = bytes.clone();
         older[8..12].copy_from_slice(&v.to_le_bytes());
         let err = model_file::from_bytes(&older).unwrap_err();
         assert!(
-            matches!(err, RegressError::UnsupportedVersion { found, supported: 3 } if found == v)
+            matches!(err, RegressError::UnsupportedVersion { found, supported: 4 } if found == v)
         );
         assert!(err.to_string().contains("retrain"), "{err}");
     }
@@ -392,11 +393,17 @@ fn projected_samples_stay_close_to_the_exact_model() {
     }
     let bytes = model_file::to_bytes(&model).unwrap();
     assert_eq!(model_file::from_bytes(&bytes).unwrap(), model);
-    // Projected samples are not bound to the half-precision range.
+    // Coordinates beyond the half-precision range are refused like features are.
     let mut big = make_window(2, 3, 10, 3, 40);
-    big.x.iter_mut().for_each(|v| *v *= 1.0e5);
-    assert!(Cascade::train(&big.set(), &params(Storage::DEFAULT), &mut NoProgress).is_ok());
-    assert!(Cascade::train(&big.set(), &params(Storage::Half), &mut NoProgress).is_err());
+    big.x.iter_mut().for_each(|v| *v *= 1.0e4);
+    match Cascade::train(
+        &big.set(),
+        &params(Storage::Projected { energy: 0.999 }),
+        &mut NoProgress,
+    ) {
+        Err(RegressError::NonFinite(m)) => assert!(m.contains("standardize"), "{m}"),
+        other => panic!("expected NonFinite, got {other:?}"),
+    }
 }
 
 #[test]
