@@ -400,8 +400,8 @@ pub fn parse(bytes: &[u8], path: &Path, options: &IlcOptions) -> Result<IlcPath>
 fn parse_records(content: &str, path: &Path) -> Result<([Stream; 5], Header)> {
     let mut streams: [Stream; 5] = Default::default();
     let mut header = Header::default();
-    // The last non-blank line and the read type it holds, if it is such a record.
-    let mut last: Option<(usize, Option<usize>)> = None;
+    // The last non-blank line and its record type, if it is a record (read or not).
+    let mut last: Option<(usize, Option<&str>)> = None;
     for (line, l) in text::lines(content) {
         // Some recorders end lines with a tab.
         let l = l.trim_end();
@@ -423,7 +423,8 @@ fn parse_records(content: &str, path: &Path) -> Result<([Stream; 5], Header)> {
             ));
         }
         let Some(k) = KINDS.iter().position(|k| k.name == ty) else {
-            last = Some((line, None));
+            // Unread, but a cut-off file may end in one.
+            last = Some((line, Some(ty)));
             continue;
         };
         let kind = &KINDS[k];
@@ -475,14 +476,14 @@ fn parse_records(content: &str, path: &Path) -> Result<([Stream; 5], Header)> {
             s.values.push(v);
             s.lines.push(line);
         }
-        last = Some((line, Some(k)));
+        last = Some((line, Some(kind.name)));
     }
     let complete = content.trim_end_matches([' ', '\t', '\r']).ends_with('\n');
-    if let Some((line, Some(k))) = last
+    if let Some((line, Some(ty))) = last
         && !complete
     {
         return Err(DataError::format(
-            Location::line(path, line).with_field(KINDS[k].name),
+            Location::line(path, line).with_field(ty),
             "the file ends inside this record, without a line break: cut off while being \
              written? (complete path files end with a `#\tendTime` line)",
         ));
@@ -878,11 +879,16 @@ mod tests {
             e.contains("field `TYPE_ACCELEROMETER`: the file ends inside this record"),
             "{e}"
         );
-        // Cut off after a complete line, or inside an ignored record: the data are usable.
+        // Cut off after a complete line: nothing tells, the data are usable. Inside a record of
+        // a type that is not read: still a cut-off file.
         let after_line = good.find("1574559496500\tTYPE_ACCELEROMETER").unwrap();
         assert!(parse_str(&good[..after_line]).is_ok());
         let in_wifi = good.rfind("\tTYPE_WIFI\tssid").unwrap() + 12;
-        assert!(parse_str(&good[..in_wifi]).is_ok());
+        let e = err(&good[..in_wifi]);
+        assert!(
+            e.contains("field `TYPE_WIFI`: the file ends inside this record"),
+            "{e}"
+        );
         // Repeated IMU timestamps keep the first record.
         let dup = good.replacen(
             "1574559495020\tTYPE_GYROSCOPE\t0\t0\t0.1\t3\n",

@@ -19,7 +19,7 @@ mod synth;
 #[path = "common/timing.rs"]
 mod timing;
 
-use timing::{thread_cpu_s, time_one};
+use timing::{peak_mb, thread_cpu_s, time_one};
 
 use std::time::Instant;
 
@@ -28,17 +28,6 @@ use ridi_regress::{
     Cascade, CascadeParams, GridSpec, MatrixRef, Precompute, ProgressEvent, RegressorChoice,
     SolverConfig, Storage, Svc, SvcParams, Svr, SvrParams, TrainingSet,
 };
-
-fn peak_mb() -> f64 {
-    std::fs::read_to_string("/proc/self/status")
-        .ok()
-        .and_then(|s| {
-            s.lines()
-                .find(|l| l.starts_with("VmHWM"))
-                .and_then(|l| l.split_whitespace().nth(1)?.parse::<f64>().ok())
-        })
-        .map_or(f64::NAN, |kb| kb / 1024.0)
-}
 
 fn arg<T: std::str::FromStr>(args: &[String], name: &str, default: T) -> T {
     args.iter()

@@ -93,6 +93,10 @@ fn main() -> Result<(), Error> {
         rayon::current_num_threads(),
         n as f64 / batch
     );
+    println!(
+        "peak RSS {:.0} MB (model, the {n} queries' features and the recordings they came from)",
+        timing::peak_mb()
+    );
     if !lists[0].is_empty() {
         let train = features(&model, &lists[0])?;
         let r = model.rounding_effect(MatrixRef::new(&train, dim)?, q)?;

@@ -5,6 +5,18 @@ use std::time::Instant;
 
 use ridi_regress::{Cascade, MatrixRef};
 
+/// Peak resident memory of the process, MB (`VmHWM`).
+pub fn peak_mb() -> f64 {
+    std::fs::read_to_string("/proc/self/status")
+        .ok()
+        .and_then(|s| {
+            s.lines()
+                .find(|l| l.starts_with("VmHWM"))
+                .and_then(|l| l.split_whitespace().nth(1)?.parse::<f64>().ok())
+        })
+        .map_or(f64::NAN, |kb| kb / 1024.0)
+}
+
 /// CPU time of the calling thread, seconds (`/proc/thread-self/schedstat`).
 pub fn thread_cpu_s() -> f64 {
     std::fs::read_to_string("/proc/thread-self/schedstat")
