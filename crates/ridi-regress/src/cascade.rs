@@ -220,7 +220,10 @@ pub(crate) struct ClassModel {
     #[serde(skip)]
     pub norms: Vec<f32>,
     pub n_classifier: usize,
-    /// `n_classifier × pairs` row-major.
+    /// The classifier pairs (one-vs-one) this placement takes part in, ascending: its samples
+    /// have coefficients in those only.
+    pub clf_pairs: Vec<u32>,
+    /// `n_classifier × clf_pairs` row-major.
     pub clf_coef: Vec<f64>,
     /// `samples × 2` row-major.
     pub reg_coef: Vec<f64>,
@@ -617,9 +620,11 @@ impl Cascade {
                     kernel::dist_from_dots(d, qn, &cl.norms[..nc]);
                     s.kv.resize(nc, 0.0);
                     kernel::exp_neg_scaled(d, head.gamma, &mut s.kv);
-                    s.tmp.resize(np, 0.0);
+                    s.tmp.resize(cl.clf_pairs.len(), 0.0);
                     weighted_sum(&s.kv, &cl.clf_coef, &mut s.tmp);
-                    s.dec.iter_mut().zip(&s.tmp).for_each(|(a, b)| *a += b);
+                    for (&p, &v) in cl.clf_pairs.iter().zip(&s.tmp) {
+                        s.dec[p as usize] += v;
+                    }
                 }
                 s.dec.iter_mut().zip(&head.rho).for_each(|(v, r)| *v -= r);
                 s.votes.resize(k, 0);
@@ -857,15 +862,20 @@ impl Cascade {
             (None, Some(head)) => {
                 let np = head.pairs.len();
                 let mut dec = vec![0.0f64; m * np];
-                let mut tmp = vec![0.0f64; m * np];
                 for (cl, d) in self.classes.iter().zip(&dists) {
-                    if cl.n_classifier == 0 {
+                    let mp = cl.clf_pairs.len();
+                    if cl.n_classifier == 0 || mp == 0 {
                         continue;
                     }
                     let mut kv = vec![0.0f32; d.len()];
                     kernel::exp_neg_scaled(d, head.gamma, &mut kv);
-                    weighted_sums(&kv, &cl.clf_coef, np, &mut tmp);
-                    dec.iter_mut().zip(&tmp).for_each(|(a, b)| *a += b);
+                    let mut tmp = vec![0.0f64; m * mp];
+                    weighted_sums(&kv, &cl.clf_coef, mp, &mut tmp);
+                    for (row, t) in dec.chunks_exact_mut(np).zip(tmp.chunks_exact(mp)) {
+                        for (&p, &v) in cl.clf_pairs.iter().zip(t) {
+                            row[p as usize] += v;
+                        }
+                    }
                 }
                 let mut votes = vec![0u32; self.classes.len()];
                 for (i, o) in out.iter_mut().enumerate() {
@@ -987,7 +997,9 @@ impl Cascade {
                 || cl.samples.dim() != stored_dim
                 || cl.norms.len() != ns
                 || cl.n_classifier > ns
-                || cl.clf_coef.len() != cl.n_classifier * np
+                || cl.clf_coef.len() != cl.n_classifier * cl.clf_pairs.len()
+                || cl.clf_pairs.windows(2).any(|w| w[0] >= w[1])
+                || cl.clf_pairs.iter().any(|&p| p as usize >= np)
                 || cl.reg_coef.len() != ns * 2
             {
                 return bad("class sample store sizes");
@@ -1007,16 +1019,15 @@ fn build_class(
     projection: Option<&Projection>,
 ) -> Result<ClassModel, RegressError> {
     let n = idx.len();
-    let np = pairs.len();
-    // Classifier coefficients of this class's samples, by local index.
+    let own: Vec<usize> = (0..pairs.len())
+        .filter(|&p| pairs[p].a == c || pairs[p].b == c)
+        .collect();
+    // Classifier coefficients of this class's samples, by local index, in its own pairs.
     let mut clf: Vec<Option<Vec<f64>>> = vec![None; n];
-    for (p, d) in pairs.iter().enumerate() {
-        if d.a != c && d.b != c {
-            continue;
-        }
+    for (j, d) in own.iter().map(|&p| &pairs[p]).enumerate() {
         for (&g, &a) in d.sv.iter().zip(&d.coef) {
             if let Ok(s) = idx.binary_search(&g) {
-                clf[s].get_or_insert_with(|| vec![0.0; np])[p] = a;
+                clf[s].get_or_insert_with(|| vec![0.0; own.len()])[j] = a;
             }
         }
     }
@@ -1040,6 +1051,7 @@ fn build_class(
         samples,
         norms,
         n_classifier,
+        clf_pairs: own.iter().map(|&p| p as u32).collect(),
         clf_coef,
         reg_coef,
         reg_rho: [duals[0].rho, duals[1].rho],

@@ -5,7 +5,7 @@ mod common;
 use ridi_features::{Channel, FeatureConfig};
 use ridi_regress::{
     Cascade, CascadeParams, GridSpec, MatrixRef, NoProgress, ProgressEvent, RegressError,
-    RegressorChoice, Stage, Storage, StoredAs, TrainingSet, model_file,
+    RegressorChoice, Stage, Storage, StoredAs, Svc, SvcParams, TrainingSet, model_file,
 };
 
 struct Data {
@@ -135,6 +135,14 @@ fn cascade_classifies_regresses_and_batches_consistently() {
         .filter(|(p, t)| p.placement == **t)
         .count();
     assert!(correct >= 57, "placement accuracy {correct}/60");
+    // The cascade's classifier (each placement keeping the coefficients of its own pairs) is
+    // the stand-alone one-vs-one classifier on the same data.
+    let train_x = MatrixRef::new(&data.x, 24).unwrap();
+    let svc = Svc::fit(train_x, &data.placement, &SvcParams::new(10.0, 1.0 / 24.0)).unwrap();
+    let labels = svc.predict(xt).unwrap();
+    for (b, l) in batch.iter().zip(&labels) {
+        assert_eq!(b.placement, *l);
+    }
     let mse: f64 = batch
         .iter()
         .zip(&test.y)
@@ -202,22 +210,22 @@ fn training_is_deterministic_and_model_files_round_trip() {
         );
     }
     let mut newer = bytes.clone();
-    newer[8..12].copy_from_slice(&5u32.to_le_bytes());
+    newer[8..12].copy_from_slice(&6u32.to_le_bytes());
     assert!(matches!(
         model_file::from_bytes(&newer),
         Err(RegressError::UnsupportedVersion {
-            found: 5,
-            supported: 4
+            found: 6,
+            supported: 5
         })
     ));
-    // Versions 1 (f32 samples), 2 (half precision only) and 3 (an f32 block of leading
-    // coordinates): refused with advice, not misread.
-    for v in [1u32, 2, 3] {
+    // Versions 1 (f32 samples), 2 (half precision only), 3 (an f32 block of leading
+    // coordinates) and 4 (every pair's classifier coefficient): refused with advice.
+    for v in [1u32, 2, 3, 4] {
         let mut older = bytes.clone();
         older[8..12].copy_from_slice(&v.to_le_bytes());
         let err = model_file::from_bytes(&older).unwrap_err();
         assert!(
-            matches!(err, RegressError::UnsupportedVersion { found, supported: 4 } if found == v)
+            matches!(err, RegressError::UnsupportedVersion { found, supported: 5 } if found == v)
         );
         assert!(err.to_string().contains("retrain"), "{err}");
     }
