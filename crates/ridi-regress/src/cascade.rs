@@ -596,15 +596,8 @@ impl Cascade {
     /// (projected when the samples are) and `qn` its squared norm as the distances need it.
     fn predict_single(&self, q: &[f32], qn: f32, s: &mut Scratch) -> Prediction {
         let k = self.classes.len();
-        let offsets: Vec<usize> = self
-            .classes
-            .iter()
-            .scan(0, |o, cl| {
-                let start = *o;
-                *o += cl.n_classifier;
-                Some(start)
-            })
-            .collect();
+        // Where each placement's classifier distances start in `s.dist`.
+        let offset = |p: usize| -> usize { self.classes[..p].iter().map(|c| c.n_classifier).sum() };
         let total: usize = self.classes.iter().map(|cl| cl.n_classifier).sum();
         s.dist.resize(total, 0.0);
         let placement = match &self.classifier {
@@ -613,7 +606,8 @@ impl Cascade {
                 let np = head.pairs.len();
                 s.dec.clear();
                 s.dec.resize(np, 0.0);
-                for (cl, &off) in self.classes.iter().zip(&offsets) {
+                for (p, cl) in self.classes.iter().enumerate() {
+                    let off = offset(p);
                     let nc = cl.n_classifier;
                     let d = &mut s.dist[off..off + nc];
                     cl.samples.dots(q, 0, d);
@@ -639,7 +633,7 @@ impl Cascade {
         } else {
             0
         };
-        let off = offsets[placement];
+        let off = offset(placement);
         s.kv.resize(ns, 0.0);
         let (head, rest) = s.kv.split_at_mut(reuse);
         kernel::exp_neg_scaled(&s.dist[off..off + reuse], self.regressor_gamma, head);
@@ -837,14 +831,14 @@ impl Cascade {
         out: &mut [Prediction],
     ) {
         let m = q.rows();
-        let projected = match (rows, &self.projection) {
-            (Rows::Stored, Some(p)) => Some(p.project(q)),
-            _ => None,
+        let (projected, qn) = match (rows, &self.projection) {
+            (Rows::Stored, Some(p)) => {
+                let (z, n) = p.project(q);
+                (Some(z), n)
+            }
+            _ => (None, kernel::sq_norms(q)),
         };
-        let (q, qn) = match projected {
-            Some((ref z, ref n)) => (z.view(), n.clone()),
-            None => (q, kernel::sq_norms(q)),
-        };
+        let q = projected.as_ref().map_or(q, Matrix::view);
         // Squared distances to the classifier part of each placement.
         let dists: Vec<Vec<f32>> = (0..self.classes.len())
             .map(|p| {
