@@ -176,7 +176,7 @@ pub fn run(opts: Options) -> Result<()> {
     if !opts.quick && shared.is_dir() {
         eprintln!("bench: accuracy protocol (eval-tyrex --quick)");
         let out = target.join("bench-accuracy.md");
-        crate::eval_tyrex::run(Some(shared), Some(out.clone()), true)?;
+        crate::eval_tyrex::run(Some(shared), Some(out.clone()), true, None)?;
         eprintln!("bench: accuracy report in {}", out.display());
     }
 

@@ -17,7 +17,7 @@ use ridi::baselines::{Method, trajectory};
 use ridi::correct::{InitialVelocity, PlacementSmoother};
 use ridi::data::tyrex::{self, TyrexOptions};
 use ridi::data::{Sequence, write_atomically};
-use ridi::eval::{EvalConfig, evaluate_trajectory};
+use ridi::eval::{AlignWindow, EvalConfig, evaluate_trajectory};
 use ridi::evaluate::{SequenceResult, Traces};
 use ridi::features::{SampleSchedule, compute_targets};
 use ridi::regress::{Cascade, Gamma, NoProgress};
@@ -35,6 +35,8 @@ struct Variant {
     standardize: bool,
     gamma: Gamma,
     estimated_orientation: bool,
+    turned_copies: usize,
+    speed: bool,
     // Test time only.
     estimate_v0: bool,
     smoothing: bool,
@@ -44,8 +46,13 @@ impl Variant {
     /// Variants with equal keys train the same models.
     fn train_key(&self) -> String {
         format!(
-            "{} {} {:?} {}",
-            self.groups, self.standardize, self.gamma, self.estimated_orientation
+            "{} {} {:?} {} {} {}",
+            self.groups,
+            self.standardize,
+            self.gamma,
+            self.estimated_orientation,
+            self.turned_copies,
+            self.speed
         )
     }
 }
@@ -56,6 +63,8 @@ const PAPER: Variant = Variant {
     standardize: true,
     gamma: Gamma::InverseDim,
     estimated_orientation: false,
+    turned_copies: 0,
+    speed: false,
     estimate_v0: false,
     smoothing: false,
 };
@@ -70,6 +79,15 @@ const RECOMMENDED: Variant = Variant {
     name: "majority + orientation from gyro + accelerometer",
     smoothing: true,
     estimated_orientation: true,
+    ..PAPER
+};
+
+/// What `ridi train` and `ridi track` do by default.
+const DEFAULTS: Variant = Variant {
+    name: "turned copy + speed regressor + majority (ridi's defaults)",
+    turned_copies: 1,
+    speed: true,
+    smoothing: true,
     ..PAPER
 };
 
@@ -107,6 +125,28 @@ fn variants(quick: bool) -> Vec<Variant> {
             gamma: Gamma::Value(4.0 / 1200.0),
             ..PAPER
         },
+        Variant {
+            name: "gamma 0.25/1200",
+            gamma: Gamma::Value(0.25 / 1200.0),
+            ..PAPER
+        },
+        Variant {
+            name: "speed regressor",
+            speed: true,
+            ..PAPER
+        },
+        Variant {
+            name: "one turned copy of each training window",
+            turned_copies: 1,
+            ..PAPER
+        },
+        Variant {
+            name: "turned copy + speed regressor",
+            turned_copies: 1,
+            speed: true,
+            ..PAPER
+        },
+        DEFAULTS,
     ]
 }
 
@@ -118,10 +158,13 @@ struct SeqRow {
     /// to the walk that the regressors learned, against this person's.
     mean_regressed: [f64; 2],
     mean_true: [f64; 2],
+    /// RIDI's RTE 5 s with the alignment fitted on the whole run instead of the first 10 s:
+    /// separates drift from a start where the person stood (the 10 s then fix no heading).
+    rte_5s_whole: f64,
 }
 
 impl SeqRow {
-    fn new(result: SequenceResult, traces: &Traces) -> Self {
+    fn new(result: SequenceResult, traces: &Traces, time: &[f64]) -> Result<Self> {
         let mean = |v: &[[f64; 2]]| {
             let n = v.len().max(1) as f64;
             [
@@ -129,11 +172,23 @@ impl SeqRow {
                 v.iter().map(|x| x[1]).sum::<f64>() / n,
             ]
         };
-        Self {
+        let ridi = traces
+            .methods
+            .iter()
+            .find(|(m, _)| *m == Method::Ridi)
+            .context("no RIDI trajectory")?;
+        let whole = EvalConfig {
+            align: AlignWindow::All,
+            ..EvalConfig::default()
+        };
+        Ok(Self {
             mean_regressed: mean(&traces.regressed),
             mean_true: mean(&traces.true_velocity),
+            rte_5s_whole: evaluate_trajectory(time, &ridi.1, &traces.ground_truth, &whole)?
+                .metrics
+                .rte_5s_m,
             result,
-        }
+        })
     }
 }
 
@@ -147,6 +202,7 @@ struct Row {
     ate: Vec<(String, f64)>,
     path_ratio: Vec<(String, f64)>,
     oracle_rte_5s: f64,
+    rte_5s_whole: f64,
     train_s: f64,
     per_sequence: Vec<SeqRow>,
 }
@@ -205,11 +261,13 @@ fn prepare(all: &[Sequence], v: &Variant) -> Result<Vec<Sequence>> {
 fn train_folds(seqs: &[Sequence], v: &Variant) -> Result<(Vec<Cascade>, f64)> {
     let mut opts = TrainOptions {
         standardize: v.standardize,
+        turned_copies: v.turned_copies,
         ..TrainOptions::default()
     };
     opts.cascade.regressors = GridChoice::None.regressors();
     opts.cascade.classifier_gamma = v.gamma;
     opts.cascade.regressor_gamma = v.gamma;
+    opts.cascade.speed = v.speed;
     let started = Instant::now();
     let models = PEOPLE
         .iter()
@@ -247,13 +305,9 @@ fn run_variant(seqs: &[Sequence], models: &[Cascade], train_s: f64, v: &Variant)
             .cloned()
             .collect();
         let (report, traces) = ridi::evaluate(&test, model, &eval_opts)?;
-        per_sequence.extend(
-            report
-                .sequences
-                .into_iter()
-                .zip(&traces)
-                .map(|(r, t)| SeqRow::new(r, t)),
-        );
+        for ((r, t), s) in report.sequences.into_iter().zip(&traces).zip(&test) {
+            per_sequence.push(SeqRow::new(r, t, s.time())?);
+        }
         for s in &test {
             oracle.push(oracle_rte(s, &eval_opts)?);
         }
@@ -282,6 +336,7 @@ fn run_variant(seqs: &[Sequence], models: &[Cascade], train_s: f64, v: &Variant)
         ate: per_method(|m| m.ate_m),
         path_ratio: per_method(|m| m.path_length_ratio.unwrap_or(f64::NAN)),
         oracle_rte_5s: oracle.iter().sum::<f64>() / oracle.len() as f64,
+        rte_5s_whole: per_sequence.iter().map(|s| s.rte_5s_whole).sum::<f64>() / n,
         train_s,
         per_sequence,
     })
@@ -335,7 +390,7 @@ fn per_sequence(md: &mut String, v: &Variant, r: &Row) {
     );
     let _ = writeln!(
         md,
-        "| sequence | placement | velocity MSE S-x / S-z | placement accuracy | mean true v (S-x, S-z) | mean regressed v | RTE 5 s (m) | path length ratio |\n| --- | --- | --- | --- | --- | --- | --- | --- |"
+        "| sequence | placement | velocity MSE S-x / S-z | placement accuracy | mean true v (S-x, S-z) | mean regressed v | RTE 5 s (m) | RTE 5 s, whole-run alignment (m) | path length ratio |\n| --- | --- | --- | --- | --- | --- | --- | --- | --- |"
     );
     let mut rows: Vec<&SeqRow> = r.per_sequence.iter().collect();
     rows.sort_by(|a, b| a.result.name.cmp(&b.result.name));
@@ -343,7 +398,7 @@ fn per_sequence(md: &mut String, v: &Variant, r: &Row) {
         let q = &s.result;
         let _ = writeln!(
             md,
-            "| {} | {} | {:.3} / {:.3} | {:.3} | ({:+.2}, {:+.2}) | ({:+.2}, {:+.2}) | {:.3} | {:.3} |",
+            "| {} | {} | {:.3} / {:.3} | {:.3} | ({:+.2}, {:+.2}) | ({:+.2}, {:+.2}) | {:.3} | {:.3} | {:.3} |",
             q.name,
             q.placement.as_deref().unwrap_or("-"),
             q.velocity_mse[0],
@@ -354,6 +409,7 @@ fn per_sequence(md: &mut String, v: &Variant, r: &Row) {
             s.mean_regressed[0],
             s.mean_regressed[1],
             q.methods["ridi"].rte_5s_m,
+            s.rte_5s_whole,
             q.methods["ridi"].path_length_ratio.unwrap_or(f64::NAN),
         );
     }
@@ -366,7 +422,12 @@ fn get(v: &[(String, f64)], key: &str) -> f64 {
 }
 
 /// Runs the protocol and writes the markdown report; returns its path.
-pub fn run(data: Option<PathBuf>, out: Option<PathBuf>, quick: bool) -> Result<PathBuf> {
+pub fn run(
+    data: Option<PathBuf>,
+    out: Option<PathBuf>,
+    quick: bool,
+    only: Option<String>,
+) -> Result<PathBuf> {
     let root = xtask::workspace_root();
     let data = data.unwrap_or_else(|| root.join("../shared/data/raw/tyrex-attitude-smartphones"));
     let out = out.unwrap_or_else(|| root.join("docs/bench-accuracy.md"));
@@ -376,7 +437,12 @@ pub fn run(data: Option<PathBuf>, out: Option<PathBuf>, quick: bool) -> Result<P
     // Sequences and models of the previous variant, kept while the next one shares them
     // (`prepare` depends only on what the training key holds).
     let mut shared: Option<(String, Vec<Sequence>, Vec<Cascade>, f64)> = None;
-    for v in variants(quick) {
+    let chosen: Vec<Variant> = variants(quick)
+        .into_iter()
+        .filter(|v| only.as_deref().is_none_or(|o| v.name.contains(o)))
+        .collect();
+    anyhow::ensure!(!chosen.is_empty(), "no variant matches {only:?}");
+    for v in chosen {
         if shared.as_ref().is_none_or(|s| s.0 != v.train_key()) {
             drop(shared.take()); // free the previous models first
             let seqs = prepare(&all, &v)?;
@@ -394,24 +460,26 @@ pub fn run(data: Option<PathBuf>, out: Option<PathBuf>, quick: bool) -> Result<P
     );
     let _ = writeln!(
         md,
-        "Command: `cargo xtask eval-tyrex{}` ({:.0} s in all on a 2-core machine shared with other work). \
+        "Command: `cargo xtask eval-tyrex{}{}` ({:.0} s in all on a 2-core machine shared with other work). \
          {} test sequences (24 runs; runs split at long mocap or sensor gaps count once per part). \
          Train on two people, test on the third, three folds; C = 10, epsilon = 0.01, no grid search; \
          trajectories aligned on the first 10 s; means over test sequences. Variants that differ \
          only at test time share their models (and their training time).\n",
         if quick { " --quick" } else { "" },
+        only.as_deref()
+            .map_or(String::new(), |o| format!(" --only '{o}'")),
         started.elapsed().as_secs_f64(),
         rows.first().map_or(0, |r| r.1.sequences)
     );
     let _ = writeln!(md, "## RIDI per variant\n");
     let _ = writeln!(
         md,
-        "| variant | velocity MSE S-x / S-z (m/s)^2 | RTE 5 s (m) | ATE (m) | path length ratio | placement accuracy | GT-velocity floor RTE 5 s (m) | training (s, 3 folds) |\n| --- | --- | --- | --- | --- | --- | --- | --- |"
+        "| variant | velocity MSE S-x / S-z (m/s)^2 | RTE 5 s (m) | ATE (m) | path length ratio | placement accuracy | GT-velocity floor RTE 5 s (m) | RTE 5 s aligned on the whole run (m) | training (s, 3 folds) |\n| --- | --- | --- | --- | --- | --- | --- | --- | --- |"
     );
     for (v, r) in &rows {
         let _ = writeln!(
             md,
-            "| {} | {:.3} / {:.3} | {:.3} | {:.3} | {:.3} | {:.3} | {:.3} | {:.1} |",
+            "| {} | {:.3} / {:.3} | {:.3} | {:.3} | {:.3} | {:.3} | {:.3} | {:.3} | {:.1} |",
             v.name,
             r.velocity_mse[0],
             r.velocity_mse[1],
@@ -420,10 +488,14 @@ pub fn run(data: Option<PathBuf>, out: Option<PathBuf>, quick: bool) -> Result<P
             get(&r.path_ratio, "ridi"),
             r.placement_accuracy,
             r.oracle_rte_5s,
+            r.rte_5s_whole,
             r.train_s
         );
     }
-    if let Some((v, r)) = rows.first() {
+    for (v, r) in rows
+        .iter()
+        .filter(|(v, _)| [PAPER.name, DEFAULTS.name].contains(&v.name))
+    {
         let _ = writeln!(md, "\n## Every method, {}\n", v.name);
         let _ = writeln!(
             md,
@@ -442,11 +514,14 @@ pub fn run(data: Option<PathBuf>, out: Option<PathBuf>, quick: bool) -> Result<P
     }
     for (v, r) in rows
         .iter()
-        .filter(|(v, _)| v.name == PAPER.name || v.name == RECOMMENDED.name)
+        .filter(|(v, _)| [PAPER.name, RECOMMENDED.name, DEFAULTS.name].contains(&v.name))
     {
         per_placement(&mut md, v, r);
     }
-    if let Some((v, r)) = rows.first() {
+    for (v, r) in rows
+        .iter()
+        .filter(|(v, _)| [PAPER.name, DEFAULTS.name].contains(&v.name))
+    {
         per_sequence(&mut md, v, r);
     }
     write_atomically(&out, |w| w.write_all(md.as_bytes()))?;

@@ -61,6 +61,9 @@ enum Task {
         /// Only the reference variant.
         #[arg(long)]
         quick: bool,
+        /// Only the variants whose name contains this text (e.g. "turned").
+        #[arg(long, value_name = "TEXT")]
+        only: Option<String>,
     },
     /// Rebuild the bundled sample (datasets/sample) from the Tyrex data: 24 s of every Nexus 5
     /// run, RIDI processed layout, gzip + f32, with list files.
@@ -159,8 +162,13 @@ fn run(cli: Cli) -> Result<()> {
             let list = checksum::list_tree(&folder)?;
             print!("{}", checksum::format_list(&list));
         }
-        Task::EvalTyrex { data, out, quick } => {
-            let out = eval_tyrex::run(data, out, quick)?;
+        Task::EvalTyrex {
+            data,
+            out,
+            quick,
+            only,
+        } => {
+            let out = eval_tyrex::run(data, out, quick, only)?;
             println!("wrote {}", out.display());
         }
         Task::Sample { data, out } => {

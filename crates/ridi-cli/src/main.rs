@@ -64,7 +64,8 @@ enum Command {
     #[command(after_help = "Examples:\n  \
         ridi train --list datasets/sample/list_train.txt --out model.ridi --grid small \
         --placement-map tyrex4\n  \
-        ridi train --list ridi/list_train_publish_v2.txt --out ridi.model --grid paper --jobs 2\n\n\
+        ridi train --list ridi/list_train_publish_v2.txt --out ridi.model --grid paper --jobs 2\n  \
+        ridi train --list list.txt --out paper.ridi --turned-copies 0 --no-speed   (the paper exactly)\n\n\
         Every sequence needs ground truth and a placement (the list's second column).")]
     Train {
         /// List files (`path,placement` per line); several are concatenated.
@@ -93,6 +94,16 @@ enum Command {
         /// How the model stores its samples for prediction.
         #[arg(long, value_enum, default_value = "projected")]
         storage: StorageArg,
+        /// Also train on N copies of each window turned about the vertical (features and
+        /// velocity together), for phones carried at other headings than in the training
+        /// recordings; 0 for the paper. Training time grows about (N + 1)^2-fold.
+        #[arg(long, default_value_t = 1, value_name = "N")]
+        turned_copies: usize,
+        /// No speed regressor (the paper): by default each placement also regresses the speed
+        /// and each regressed velocity is scaled to it, since turned training windows make the
+        /// velocity's direction less certain than its size.
+        #[arg(long)]
+        no_speed: bool,
         /// Worker threads (default: all cores).
         #[arg(long)]
         jobs: Option<usize>,
@@ -333,16 +344,20 @@ fn run(cli: Cli) -> Result<()> {
             jobs,
             orientation,
             storage,
+            turned_copies,
+            no_speed,
         } => {
             set_jobs(jobs)?;
             let seqs = load_lists(&list, placement_map.as_deref(), orientation.into())?;
             let mut opts = TrainOptions {
                 standardize: !no_standardize,
+                turned_copies,
                 ..TrainOptions::default()
             };
             opts.cascade.classifier_c = classifier_c;
             opts.cascade.regressors = GridChoice::from(grid).regressors();
             opts.cascade.storage = storage.into();
+            opts.cascade.speed = !no_speed;
             let model = train_with_progress(&seqs, &opts)?;
             print_training(&model);
             model_file::save(&model, &out)
@@ -510,8 +525,11 @@ fn print_training(model: &Cascade) {
     }
     for (p, name) in model.placements().iter().enumerate() {
         if let Some([x, z]) = model.regressor_params(p) {
+            let speed = model
+                .speed_params(p)
+                .map_or(String::new(), |s| format!("  speed: C={} eps={}", s.0, s.1));
             println!(
-                "  {name:<12} {:>6} samples  S-x: C={} eps={}  S-z: C={} eps={}",
+                "  {name:<12} {:>6} samples  S-x: C={} eps={}  S-z: C={} eps={}{speed}",
                 model.stored_samples(p),
                 x.0,
                 x.1,
@@ -531,7 +549,7 @@ fn print_training(model: &Cascade) {
             println!(
                 "  {:<12} {:>7} {:>8} {:>8} {:>10.5}",
                 r.placement,
-                if r.channel == 0 { "S-x" } else { "S-z" },
+                ["S-x", "S-z", "speed"][usize::from(r.channel.min(2))],
                 r.c,
                 r.epsilon,
                 r.mse

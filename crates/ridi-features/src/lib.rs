@@ -32,6 +32,14 @@
 //! sigma 30 over the whole sequence; the target is `[S-x, S-z]` in `f64` (S-x right, S-z back,
 //! so forward walking is negative S-z, as in the original).
 //!
+//! # Turned copies
+//!
+//! [`YawTurn`] turns a feature row and its target about S-up (+y), which is what the phone
+//! would have measured carried turned by the opposite angle about the vertical;
+//! [`turned_copies`] adds evenly spaced turned copies of every training row (the pipeline's
+//! default training adds one), so that regressors do not tie the velocity to the headings at
+//! which the training people happened to carry their phones.
+//!
 //! # Smoothing
 //!
 //! [`gaussian_filter1d`] reproduces `scipy.ndimage.gaussian_filter1d(x, sigma,
@@ -79,6 +87,7 @@ mod features;
 pub mod gaussian;
 mod matrix;
 mod targets;
+mod turn;
 
 pub use config::{Channel, FeatureConfig, Standardization, StandardizationFit};
 pub use error::FeatureError;
@@ -88,3 +97,4 @@ pub use features::{
 pub use gaussian::{gaussian_filter1d, gaussian_kernel};
 pub use matrix::FeatureMatrix;
 pub use targets::{GroundTruthView, Targets, compute_targets, stabilized_velocity};
+pub use turn::{TurnedRows, YawTurn, turned_copies};

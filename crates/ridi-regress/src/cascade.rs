@@ -159,6 +159,12 @@ pub struct CascadeParams {
     /// Sample storage of the trained model (prediction speed against a small, measured
     /// change of the predictions).
     pub storage: Storage,
+    /// Also regress the speed `|v|` per placement (a third epsilon-SVR on the same kernel)
+    /// and scale each regressed velocity to it ([`Prediction::velocity`]). Not in the paper:
+    /// where the heading of the phone relative to the walk is uncertain (training on turned
+    /// windows), the two velocity components shrink towards zero while the speed, which does
+    /// not depend on the heading, does not.
+    pub speed: bool,
 }
 
 impl Default for CascadeParams {
@@ -171,6 +177,7 @@ impl Default for CascadeParams {
             solver: SolverConfig::default(),
             min_class_samples: 10,
             storage: Storage::DEFAULT,
+            speed: false,
         }
     }
 }
@@ -197,9 +204,15 @@ pub struct TrainingSet<'a> {
 pub struct Prediction {
     /// Placement index (into [`Cascade::placements`]).
     pub placement: usize,
-    /// Velocity in S (same components as the targets).
+    /// Velocity in S (same components as the targets). With a speed regressor
+    /// ([`CascadeParams::speed`]) the regressed components `v` scaled by
+    /// `max(s, 0) / max(|v|, 0.1 m/s)`, `s` the regressed speed: the floor keeps a direction
+    /// that is barely known from being blown up.
     pub velocity: [f32; 2],
 }
+
+/// Below this regressed velocity (m/s) the speed channel scales by `s / SPEED_FLOOR` at most.
+const SPEED_FLOOR: f64 = 0.1;
 
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub(crate) struct ClassifierHead {
@@ -231,7 +244,38 @@ pub(crate) struct ClassModel {
     /// `(C, epsilon)` per channel.
     pub reg_params: [(f64, f64); 2],
     pub reg_info: [FitInfo; 2],
+    /// The speed regressor ([`CascadeParams::speed`]); its coefficients are the third column
+    /// of `reg_coef`.
+    pub speed: Option<SpeedRegressor>,
     pub n_train: usize,
+}
+
+/// Offset, `(C, epsilon)` and fit report of a placement's speed regressor.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub(crate) struct SpeedRegressor {
+    pub rho: f64,
+    pub params: (f64, f64),
+    pub info: FitInfo,
+}
+
+impl ClassModel {
+    /// Columns of `reg_coef`: S-x, S-z and, with a speed regressor, the speed.
+    fn channels(&self) -> usize {
+        2 + usize::from(self.speed.is_some())
+    }
+
+    /// The velocity from the kernel-weighted sums of the channels (before their offsets).
+    fn velocity(&self, sums: &[f64]) -> [f32; 2] {
+        let v = [sums[0] - self.reg_rho[0], sums[1] - self.reg_rho[1]];
+        let v = match &self.speed {
+            None => v,
+            Some(sp) => {
+                let gain = (sums[2] - sp.rho).max(0.0) / v[0].hypot(v[1]).max(SPEED_FLOOR);
+                [v[0] * gain, v[1] * gain]
+            }
+        };
+        [v[0] as f32, v[1] as f32]
+    }
 }
 
 /// How far the compact sample storage (half precision or projection, [`Storage`]) moves
@@ -453,11 +497,16 @@ impl Cascade {
                 params.solver.kernel_memory,
                 params.solver.regressor_kernel,
             );
-            let targets: Vec<Vec<f64>> = (0..2)
-                .map(|ch| idx.iter().map(|&i| data.targets[i][ch] as f64).collect())
+            let channels = 2 + usize::from(params.speed);
+            let target = |i: usize, ch: usize| {
+                let [x, z] = data.targets[i].map(f64::from);
+                [x, z, x.hypot(z)][ch]
+            };
+            let targets: Vec<Vec<f64>> = (0..channels)
+                .map(|ch| idx.iter().map(|&i| target(i, ch)).collect())
                 .collect();
             let chosen: Vec<(f64, f64)> = match &params.regressors {
-                RegressorChoice::Fixed { c, epsilon } => vec![(*c, *epsilon); 2],
+                RegressorChoice::Fixed { c, epsilon } => vec![(*c, *epsilon); channels],
                 RegressorChoice::Grid(spec) => {
                     let groups: Vec<u64> = idx.iter().map(|&i| data.groups[i]).collect();
                     let table = grid::search(
@@ -475,12 +524,12 @@ impl Cascade {
                         }
                         other => other,
                     })?;
-                    let best = grid::best(&table, 2);
+                    let best = grid::best(&table, channels);
                     grid_rows.extend(table);
                     best
                 }
             };
-            report(progress, Stage::Regressors { placement: name }, 0, 2)?;
+            report(progress, Stage::Regressors { placement: name }, 0, channels)?;
             let local: Vec<usize> = (0..idx.len()).collect();
             let smo = &params.solver.smo;
             let rows_ref = rows.as_ref();
@@ -496,20 +545,25 @@ impl Cascade {
                 )
             };
             // In parallel only over a precomputed kernel (see `grid::search` on determinism).
-            let (d0, d1) = if rows_ref.batch_size() == 0 {
-                rayon::join(|| fit(0), || fit(1))
+            let duals: Vec<svr::SvrDual> = if rows_ref.batch_size() == 0 {
+                (0..channels).into_par_iter().map(fit).collect()
             } else {
-                (fit(0), fit(1))
+                (0..channels).map(fit).collect()
             };
             drop(rows);
-            report(progress, Stage::Regressors { placement: name }, 2, 2)?;
+            report(
+                progress,
+                Stage::Regressors { placement: name },
+                channels,
+                channels,
+            )?;
             classes.push(build_class(
                 c,
                 idx,
                 xc.view(),
                 &pair_duals,
-                [&d0, &d1],
-                [chosen[0], chosen[1]],
+                &duals,
+                &chosen,
                 projection.as_ref(),
             )?);
         }
@@ -548,6 +602,12 @@ impl Cascade {
     /// Chosen `(C, epsilon)` of the two regressors of placement `p`.
     pub fn regressor_params(&self, p: usize) -> Option<[(f64, f64); 2]> {
         self.classes.get(p).map(|c| c.reg_params)
+    }
+
+    /// Chosen `(C, epsilon)` of the speed regressor of placement `p`, if the model has one
+    /// ([`CascadeParams::speed`]).
+    pub fn speed_params(&self, p: usize) -> Option<(f64, f64)> {
+        self.classes.get(p)?.speed.as_ref().map(|s| s.params)
     }
 
     /// How the samples are stored.
@@ -639,11 +699,12 @@ impl Cascade {
         kernel::exp_neg_scaled(&s.dist[off..off + reuse], self.regressor_gamma, head);
         cl.samples.dots(q, reuse, rest);
         kernel::rbf_from_dots(rest, qn, &cl.norms[reuse..], self.regressor_gamma);
-        let mut v = [0.0f64; 2];
-        weighted_sum(&s.kv, &cl.reg_coef, &mut v);
+        let mut v = [0.0f64; 3];
+        let v = &mut v[..cl.channels()];
+        weighted_sum(&s.kv, &cl.reg_coef, v);
         Prediction {
             placement,
-            velocity: [(v[0] - cl.reg_rho[0]) as f32, (v[1] - cl.reg_rho[1]) as f32],
+            velocity: cl.velocity(v),
         }
     }
 
@@ -921,13 +982,11 @@ impl Cascade {
                         .copy_from_slice(&block[r * (ns - start)..(r + 1) * (ns - start)]);
                 }
             }
-            let mut v = vec![0.0f64; sel.len() * 2];
-            weighted_sums(&kv, &cl.reg_coef, 2, &mut v);
-            for (r, &i) in sel.iter().enumerate() {
-                out[i].velocity = [
-                    (v[2 * r] - cl.reg_rho[0]) as f32,
-                    (v[2 * r + 1] - cl.reg_rho[1]) as f32,
-                ];
+            let w = cl.channels();
+            let mut v = vec![0.0f64; sel.len() * w];
+            weighted_sums(&kv, &cl.reg_coef, w, &mut v);
+            for (&i, sums) in sel.iter().zip(v.chunks_exact(w)) {
+                out[i].velocity = cl.velocity(sums);
             }
         }
     }
@@ -994,7 +1053,7 @@ impl Cascade {
                 || cl.clf_coef.len() != cl.n_classifier * cl.clf_pairs.len()
                 || cl.clf_pairs.windows(2).any(|w| w[0] >= w[1])
                 || cl.clf_pairs.iter().any(|&p| p as usize >= np)
-                || cl.reg_coef.len() != ns * 2
+                || cl.reg_coef.len() != ns * cl.channels()
             {
                 return bad("class sample store sizes");
             }
@@ -1008,8 +1067,8 @@ fn build_class(
     idx: &[usize],
     xc: MatrixRef<'_>,
     pairs: &[PairDual],
-    duals: [&svr::SvrDual; 2],
-    chosen: [(f64, f64); 2],
+    duals: &[svr::SvrDual],
+    chosen: &[(f64, f64)],
     projection: Option<&Projection>,
 ) -> Result<ClassModel, RegressError> {
     let n = idx.len();
@@ -1027,10 +1086,7 @@ fn build_class(
     }
     let mut order: Vec<usize> = (0..n).filter(|&s| clf[s].is_some()).collect();
     let n_classifier = order.len();
-    order.extend(
-        (0..n)
-            .filter(|&s| clf[s].is_none() && (duals[0].coef[s] != 0.0 || duals[1].coef[s] != 0.0)),
-    );
+    order.extend((0..n).filter(|&s| clf[s].is_none() && duals.iter().any(|d| d.coef[s] != 0.0)));
     let samples = SampleRows::from_rows(xc, &order, projection)?;
     let norms = samples.norms();
     let clf_coef = order[..n_classifier]
@@ -1039,7 +1095,7 @@ fn build_class(
         .collect();
     let reg_coef = order
         .iter()
-        .flat_map(|&s| [duals[0].coef[s], duals[1].coef[s]])
+        .flat_map(|&s| duals.iter().map(move |d| d.coef[s]))
         .collect();
     Ok(ClassModel {
         samples,
@@ -1049,8 +1105,13 @@ fn build_class(
         clf_coef,
         reg_coef,
         reg_rho: [duals[0].rho, duals[1].rho],
-        reg_params: chosen,
+        reg_params: [chosen[0], chosen[1]],
         reg_info: [duals[0].info(), duals[1].info()],
+        speed: duals.get(2).map(|d| SpeedRegressor {
+            rho: d.rho,
+            params: chosen[2],
+            info: d.info(),
+        }),
         n_train: n,
     })
 }

@@ -67,7 +67,7 @@ impl GridSpec {
 pub struct GridRow {
     /// Placement name.
     pub placement: String,
-    /// Velocity channel (0: S-x, 1: S-z).
+    /// Regressor channel (0: S-x, 1: S-z, 2: speed when [`crate::CascadeParams::speed`] is set).
     pub channel: u8,
     /// `C` of this grid point.
     pub c: f64,

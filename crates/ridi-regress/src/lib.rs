@@ -2,7 +2,9 @@
 //!
 //! RIDI classifies the phone placement with an RBF C-SVC and regresses the two horizontal
 //! velocity components in the stabilized frame S with one RBF epsilon-SVR per placement and
-//! component. This crate holds its own SMO solver instead of using linfa-svm, whose solver
+//! component. Optionally ([`CascadeParams::speed`], not in the paper) a third SVR per
+//! placement regresses the speed and each velocity is scaled to it. This crate holds its own
+//! SMO solver instead of using linfa-svm, whose solver
 //! builds the full `n × n` kernel with a scalar loop and only handles binary classification.
 //!
 //! # Solver
@@ -17,7 +19,7 @@
 //!
 //! # Reuse
 //!
-//! All fits of a placement index one kernel over its samples: the two velocity channels, every
+//! All fits of a placement index one kernel over its samples: the velocity (and speed) channels, every
 //! grid point and every cross-validation fold ([`grid`]). Fits along the `C` axis start from
 //! the previous solution scaled by `C_new / C_old`. A trained [`Cascade`] stores each
 //! placement's samples once in half precision, by default as coordinates on the few principal

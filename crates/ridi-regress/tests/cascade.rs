@@ -168,6 +168,60 @@ fn cascade_classifies_regresses_and_batches_consistently() {
     assert!(model.predict_one(&test.x[..23]).is_err());
 }
 
+/// The speed regressor: a third grid channel, velocities scaled to the regressed speed, the
+/// same on every path and through the file.
+#[test]
+fn speed_regressor_scales_velocities_to_the_regressed_speed() {
+    let data = make(2, 3, 15, 3);
+    let params = CascadeParams {
+        speed: true,
+        ..small_grid()
+    };
+    let model = Cascade::train(&data.set(), &params, &mut NoProgress).unwrap();
+    let plain = Cascade::train(&data.set(), &small_grid(), &mut NoProgress).unwrap();
+    // Grid table: 2 placements × 3 channels × 4 points; the plain model has no speed channel.
+    assert_eq!(model.grid_results().len(), 24);
+    for p in 0..2 {
+        let (c, e) = model.speed_params(p).unwrap();
+        let best = model
+            .grid_results()
+            .iter()
+            .filter(|r| r.placement == data.names[p] && r.channel == 2)
+            .min_by(|a, b| a.mse.total_cmp(&b.mse))
+            .unwrap();
+        assert_eq!((best.c, best.epsilon), (c, e));
+        assert_eq!(plain.speed_params(p), None);
+        // The velocity regressors are the plain model's.
+        assert_eq!(model.regressor_params(p), plain.regressor_params(p));
+    }
+    let test = make(2, 1, 20, 98);
+    let xt = MatrixRef::new(&test.x, 24).unwrap();
+    let scaled = model.predict(xt).unwrap();
+    let unscaled = plain.predict(xt).unwrap();
+    let speed = |v: [f32; 2]| v[0].hypot(v[1]);
+    let (mut err_scaled, mut moved) = (0.0f32, 0.0f32);
+    for (i, (s, u)) in scaled.iter().zip(&unscaled).enumerate() {
+        assert_eq!(s.placement, u.placement);
+        // Same direction as the plain model's velocity, only its size changes.
+        let cross = s.velocity[0] * u.velocity[1] - s.velocity[1] * u.velocity[0];
+        assert!(
+            cross.abs() < 1e-3 * speed(u.velocity).max(1.0),
+            "{s:?} {u:?}"
+        );
+        assert!(s.velocity[0] * u.velocity[0] + s.velocity[1] * u.velocity[1] >= 0.0);
+        err_scaled = err_scaled.max((speed(s.velocity) - speed(test.y[i])).abs());
+        moved = moved.max((speed(s.velocity) - speed(u.velocity)).abs());
+        let one = model.predict_one(xt.row(i)).unwrap();
+        for ch in 0..2 {
+            assert!((one.velocity[ch] - s.velocity[ch]).abs() < 1e-4);
+        }
+    }
+    assert!(moved > 0.0, "the speed channel changed nothing");
+    assert!(err_scaled < 0.3, "largest speed error {err_scaled}");
+    let back = model_file::from_bytes(&model_file::to_bytes(&model).unwrap()).unwrap();
+    assert_eq!(back.predict(xt).unwrap(), scaled);
+}
+
 #[test]
 fn training_is_deterministic_and_model_files_round_trip() {
     let data = make(2, 3, 12, 5);
@@ -210,22 +264,23 @@ fn training_is_deterministic_and_model_files_round_trip() {
         );
     }
     let mut newer = bytes.clone();
-    newer[8..12].copy_from_slice(&6u32.to_le_bytes());
+    newer[8..12].copy_from_slice(&7u32.to_le_bytes());
     assert!(matches!(
         model_file::from_bytes(&newer),
         Err(RegressError::UnsupportedVersion {
-            found: 6,
-            supported: 5
+            found: 7,
+            supported: 6
         })
     ));
     // Versions 1 (f32 samples), 2 (half precision only), 3 (an f32 block of leading
-    // coordinates) and 4 (every pair's classifier coefficient): refused with advice.
-    for v in [1u32, 2, 3, 4] {
+    // coordinates), 4 (every pair's classifier coefficient) and 5 (no speed regressor):
+    // refused with advice.
+    for v in [1u32, 2, 3, 4, 5] {
         let mut older = bytes.clone();
         older[8..12].copy_from_slice(&v.to_le_bytes());
         let err = model_file::from_bytes(&older).unwrap_err();
         assert!(
-            matches!(err, RegressError::UnsupportedVersion { found, supported: 5 } if found == v)
+            matches!(err, RegressError::UnsupportedVersion { found, supported: 6 } if found == v)
         );
         assert!(err.to_string().contains("retrain"), "{err}");
     }

@@ -44,7 +44,10 @@ impl GridChoice {
     }
 }
 
-/// How to train.
+/// How to train. [`Default`] is the paper's method (features, cascade, paper grid) with two
+/// additions measured on the Tyrex leave-one-subject-out protocol (docs/bench-accuracy.md):
+/// one turned copy of each training window and a speed regressor per placement. Set
+/// `turned_copies: 0` and `cascade.speed: false` for the paper exactly.
 #[derive(Debug, Clone, PartialEq)]
 pub struct TrainOptions {
     /// Feature configuration (its `standardization` is filled in when `standardize` is set).
@@ -54,6 +57,10 @@ pub struct TrainOptions {
     pub standardize: bool,
     /// Cascade hyper-parameters.
     pub cascade: CascadeParams,
+    /// Turned copies of each training window ([`TrainingData::with_turned_copies`]; not in
+    /// the paper, default 1): 0 trains on the windows as recorded. Training time grows with
+    /// the square of the rows: one copy made it about 4x longer on the Tyrex runs.
+    pub turned_copies: usize,
 }
 
 impl Default for TrainOptions {
@@ -63,8 +70,10 @@ impl Default for TrainOptions {
             standardize: true,
             cascade: CascadeParams {
                 regressors: GridChoice::Paper.regressors(),
+                speed: true,
                 ..CascadeParams::default()
             },
+            turned_copies: 1,
         }
     }
 }
@@ -82,6 +91,27 @@ pub struct TrainingData {
     pub placement_names: Vec<String>,
     /// Index of the sequence each sample comes from.
     pub groups: Vec<u64>,
+}
+
+impl TrainingData {
+    /// Adds `copies` copies of every sample turned about S-up, features and targets together
+    /// ([`ridi_features::turned_copies`]), with the placement and group of the sample they
+    /// come from (so cross-validation folds still keep a sequence whole). Teaches the
+    /// regressors that the velocity turns with the signal, for people who carry the phone at
+    /// other headings than the training people did.
+    pub fn with_turned_copies(self, copies: usize) -> Result<Self> {
+        if copies == 0 {
+            return Ok(self);
+        }
+        let turned = ridi_features::turned_copies(&self.features, &self.targets, copies)?;
+        Ok(Self {
+            placements: turned.source.iter().map(|&i| self.placements[i]).collect(),
+            groups: turned.source.iter().map(|&i| self.groups[i]).collect(),
+            features: turned.features,
+            targets: turned.targets,
+            placement_names: self.placement_names,
+        })
+    }
 }
 
 /// The IMU streams of `seq` as feature input.
@@ -175,7 +205,7 @@ pub fn train(
     opts: &TrainOptions,
     progress: &mut dyn Progress,
 ) -> Result<Cascade> {
-    let mut data = training_data(seqs, &opts.features)?;
+    let mut data = training_data(seqs, &opts.features)?.with_turned_copies(opts.turned_copies)?;
     let mut config = FeatureConfig {
         standardization: None,
         ..opts.features.clone()

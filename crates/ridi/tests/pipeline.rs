@@ -240,3 +240,38 @@ fn training_without_labels_or_ground_truth_names_the_sequence() {
         .to_string();
     assert!(err.contains("window"), "{err}");
 }
+
+#[test]
+fn turned_copies_repeat_labels_and_groups_and_keep_speeds() {
+    let seqs = load("list_train.txt");
+    let config = ridi::features::FeatureConfig::default();
+    let data = ridi::train::training_data(&seqs[..3], &config).unwrap();
+    let n = data.targets.len();
+    let turned = data.clone().with_turned_copies(2).unwrap();
+    assert_eq!(turned.features.rows(), 3 * n);
+    assert_eq!(turned.placement_names, data.placement_names);
+    for copy in 0..3 {
+        let part = copy * n..(copy + 1) * n;
+        assert_eq!(turned.placements[part.clone()], data.placements[..]);
+        assert_eq!(turned.groups[part.clone()], data.groups[..]);
+        for (a, b) in turned.targets[part].iter().zip(&data.targets) {
+            assert!((a[0].hypot(a[1]) - b[0].hypot(b[1])).abs() < 1e-5);
+        }
+    }
+    // The copies are turned: the horizontal components change, the vertical (S-y) do not.
+    let (orig, copy) = (data.features.row(5), turned.features.row(n + 5));
+    assert!(
+        orig.iter()
+            .zip(copy)
+            .step_by(3)
+            .any(|(a, b)| (a - b).abs() > 1e-3)
+    );
+    assert!(
+        orig.iter()
+            .zip(copy)
+            .skip(1)
+            .step_by(3)
+            .all(|(a, b)| a == b)
+    );
+    assert_eq!(data.clone().with_turned_copies(0).unwrap(), data);
+}

@@ -1,0 +1,210 @@
+//! Turning features and targets about S's up axis: training windows as they would have been
+//! measured with the phone carried turned by some angle about the vertical.
+//!
+//! Every channel of a feature is a 3-vector in S and the Gaussian smoothing is linear, so a
+//! window of a phone turned by `angle` about S-up (+y) is the same window with each x-z pair
+//! rotated; its target turns the same way. A regressor trained only on the headings the
+//! training people happened to carry the phone at fails on a person who carries it otherwise
+//! (a back-pocket phone turned 100 degrees, a swinging hand turned around); turned copies teach
+//! it that the velocity turns with the signal.
+
+use crate::FeatureError;
+use crate::matrix::FeatureMatrix;
+
+/// Rotation about S-up by `angle` radians, as the `(cos, sin)` of an x-z rotation:
+/// `x' = c x + s z`, `z' = -s x + c z` (right-handed about +y).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct YawTurn {
+    cos: f32,
+    sin: f32,
+}
+
+impl YawTurn {
+    /// The turn by `angle` radians about S-up.
+    pub fn new(angle: f64) -> Self {
+        Self {
+            cos: angle.cos() as f32,
+            sin: angle.sin() as f32,
+        }
+    }
+
+    /// Turns a horizontal vector `[S-x, S-z]` (a velocity target).
+    pub fn horizontal(&self, v: [f32; 2]) -> [f32; 2] {
+        [
+            self.cos * v[0] + self.sin * v[1],
+            -self.sin * v[0] + self.cos * v[1],
+        ]
+    }
+
+    /// Turns every 3-vector `x y z` of a feature row in place (any number of channels: all
+    /// are vectors in S). Fails when the row is not made of whole 3-vectors.
+    pub fn row(&self, row: &mut [f32]) -> Result<(), FeatureError> {
+        if !row.len().is_multiple_of(3) {
+            return Err(FeatureError::DimensionMismatch {
+                expected: row.len() / 3 * 3,
+                found: row.len(),
+            });
+        }
+        for v in row.chunks_exact_mut(3) {
+            [v[0], v[2]] = self.horizontal([v[0], v[2]]);
+        }
+        Ok(())
+    }
+}
+
+/// Rows with their turned copies ([`turned_copies`]).
+#[derive(Debug, Clone, PartialEq)]
+pub struct TurnedRows {
+    /// The input rows, then copy 0 of every row, copy 1, ...
+    pub features: FeatureMatrix,
+    /// Their targets, turned with them.
+    pub targets: Vec<[f32; 2]>,
+    /// For each row, the input row it comes from (to repeat labels and groups).
+    pub source: Vec<usize>,
+}
+
+/// Training rows plus `copies` turned copies of each: copy `j` of row `i` is turned by
+/// `2 pi frac(i phi + j / copies)` (phi the golden ratio), so each row's copies are evenly
+/// spaced around the circle and neighbouring rows, which overlap in time, start at well spread
+/// angles. Deterministic. Fails when `targets` and `features` differ in length.
+pub fn turned_copies(
+    features: &FeatureMatrix,
+    targets: &[[f32; 2]],
+    copies: usize,
+) -> Result<TurnedRows, FeatureError> {
+    if targets.len() != features.rows() {
+        return Err(FeatureError::DimensionMismatch {
+            expected: features.rows(),
+            found: targets.len(),
+        });
+    }
+    let n = features.rows();
+    let total = n.checked_mul(copies + 1).ok_or_else(|| {
+        FeatureError::InvalidConfig(format!("{copies} turned copies of {n} rows overflow"))
+    })?;
+    let mut out = TurnedRows {
+        features: FeatureMatrix::zeros(total, features.cols()),
+        targets: Vec::with_capacity(total),
+        source: Vec::with_capacity(total),
+    };
+    out.features.as_mut_slice()[..features.as_slice().len()].copy_from_slice(features.as_slice());
+    out.targets.extend_from_slice(targets);
+    out.source.extend(0..n);
+    const PHI: f64 = 0.618_033_988_749_894_9;
+    for j in 0..copies {
+        for (i, target) in targets.iter().enumerate() {
+            let turn = (i as f64 * PHI + j as f64 / copies as f64).fract();
+            let t = YawTurn::new(std::f64::consts::TAU * turn);
+            let row = out.features.row_mut((j + 1) * n + i);
+            row.copy_from_slice(features.row(i));
+            t.row(row)?;
+            out.targets.push(t.horizontal(*target));
+            out.source.push(i);
+        }
+    }
+    Ok(out)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::{FeatureConfig, FeatureExtractor, GroundTruthView, ImuView, compute_targets};
+    use ridi_frames::nalgebra::Vector3;
+    use ridi_frames::{DeviceVec, WorldFromDevice, WorldVec};
+
+    /// A flat phone with heading `yaw` (about world up) walking along world +y at 1 m/s, its
+    /// gyro and linear acceleration given in the world and measured in the device frame.
+    fn walk(yaw: f64) -> (FeatureMatrix, Vec<[f32; 2]>) {
+        let n = 1000;
+        let time: Vec<f64> = (0..n).map(|i| i as f64 / 200.0).collect();
+        let q = WorldFromDevice::from_axis_angle(&Vector3::z_axis(), yaw);
+        let gyro: Vec<DeviceVec> = (0..n)
+            .map(|i| q.inverse() * WorldVec::new(0.3 * (i as f64 * 0.05).sin(), 0.1, 0.2))
+            .collect();
+        let linacce: Vec<DeviceVec> = (0..n)
+            .map(|i| q.inverse() * WorldVec::new(0.5, -0.7 * (i as f64 * 0.07).cos(), 0.1))
+            .collect();
+        let gravity = vec![DeviceVec::new(0.0, 0.0, 9.81); n];
+        let position: Vec<WorldVec> = time.iter().map(|&t| WorldVec::new(0.0, t, 0.0)).collect();
+        let orientation = vec![q; n];
+        let config = FeatureConfig::default();
+        let frames: Vec<usize> = vec![300, 600, 900];
+        let fx = FeatureExtractor::new(config.clone()).unwrap();
+        let stab = fx
+            .stabilize(&ImuView::new(&gyro, &linacce, &gravity).unwrap())
+            .unwrap();
+        let x = fx.features(&stab, &frames).unwrap();
+        let gt = GroundTruthView {
+            time: &time,
+            position: &position,
+            orientation: &orientation,
+            gravity: &gravity,
+        };
+        let y = compute_targets(&gt, &config, &frames).unwrap();
+        let y = y
+            .values
+            .iter()
+            .map(|v| [v[0] as f32, v[1] as f32])
+            .collect();
+        (x, y)
+    }
+
+    #[test]
+    fn turning_keeps_up_and_lengths() {
+        let t = YawTurn::new(1.0);
+        let mut row = [1.0f32, 2.0, 3.0, -4.0, 5.0, 6.0];
+        t.row(&mut row).unwrap();
+        assert_eq!((row[1], row[4]), (2.0, 5.0));
+        assert!(((row[0].powi(2) + row[2].powi(2)) - 10.0).abs() < 1e-5);
+        assert!(((row[3].powi(2) + row[5].powi(2)) - 52.0).abs() < 1e-4);
+        let back = YawTurn::new(-1.0);
+        back.row(&mut row).unwrap();
+        for (a, b) in row.iter().zip([1.0f32, 2.0, 3.0, -4.0, 5.0, 6.0]) {
+            assert!((a - b).abs() < 1e-5);
+        }
+        assert!(t.row(&mut [0.0; 4]).is_err());
+    }
+
+    /// A phone carried turned by `a` about the vertical measures the window and target of
+    /// the unturned phone turned by `-a` about S-up.
+    #[test]
+    fn turned_window_is_the_window_of_a_turned_phone() {
+        let (x, y) = walk(0.3);
+        let (x_turned, y_turned) = walk(0.3 + 0.7);
+        let t = YawTurn::new(-0.7);
+        for i in 0..x.rows() {
+            let mut row = x.row(i).to_vec();
+            t.row(&mut row).unwrap();
+            for (a, b) in row.iter().zip(x_turned.row(i)) {
+                assert!((a - b).abs() < 1e-5, "{a} {b}");
+            }
+            let v = t.horizontal(y[i]);
+            assert!((v[0] - y_turned[i][0]).abs() < 1e-5 && (v[1] - y_turned[i][1]).abs() < 1e-5);
+        }
+    }
+
+    #[test]
+    fn copies_are_spread_and_keep_speed_and_up() {
+        let (x, y) = walk(0.3);
+        let TurnedRows {
+            features: turned,
+            targets: ty,
+            source,
+        } = turned_copies(&x, &y, 2).unwrap();
+        assert_eq!(turned.rows(), 9);
+        assert_eq!(source, vec![0, 1, 2, 0, 1, 2, 0, 1, 2]);
+        for r in 0..turned.rows() {
+            let i = source[r];
+            // Speed and the vertical channels are kept.
+            let speed = |v: [f32; 2]| (v[0] * v[0] + v[1] * v[1]).sqrt();
+            assert!((speed(ty[r]) - speed(y[i])).abs() < 1e-5);
+            for k in (1..1200).step_by(3) {
+                assert_eq!(turned.row(r)[k], x.row(i)[k]);
+            }
+        }
+        // The two copies of one row are half a turn apart.
+        let (a, b) = (ty[3], ty[6]);
+        assert!((a[0] + b[0]).abs() < 1e-5 && (a[1] + b[1]).abs() < 1e-5);
+        assert!(turned_copies(&x, &y[..2], 1).is_err());
+    }
+}
