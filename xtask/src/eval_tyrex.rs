@@ -37,6 +37,8 @@ struct Variant {
     estimated_orientation: bool,
     turned_copies: usize,
     speed: bool,
+    /// Training sample step in frames (paper: 10).
+    step: usize,
     // Test time only.
     estimate_v0: bool,
     smoothing: bool,
@@ -46,13 +48,14 @@ impl Variant {
     /// Variants with equal keys train the same models.
     fn train_key(&self) -> String {
         format!(
-            "{} {} {:?} {} {} {}",
+            "{} {} {:?} {} {} {} {}",
             self.groups,
             self.standardize,
             self.gamma,
             self.estimated_orientation,
             self.turned_copies,
-            self.speed
+            self.speed,
+            self.step
         )
     }
 }
@@ -65,6 +68,7 @@ const PAPER: Variant = Variant {
     estimated_orientation: false,
     turned_copies: 0,
     speed: false,
+    step: 10,
     estimate_v0: false,
     smoothing: false,
 };
@@ -82,11 +86,13 @@ const RECOMMENDED: Variant = Variant {
     ..PAPER
 };
 
-/// What `ridi train` and `ridi track` do by default.
+/// What `ridi train` and `ridi track` do by default: a window every 20 frames and one turned
+/// copy of each, the paper's number of rows.
 const DEFAULTS: Variant = Variant {
-    name: "turned copy + speed regressor + majority (ridi's defaults)",
+    name: "turned copy + speed regressor + majority, step 20 (ridi's defaults)",
     turned_copies: 1,
     speed: true,
+    step: 20,
     smoothing: true,
     ..PAPER
 };
@@ -145,6 +151,11 @@ fn variants(quick: bool) -> Vec<Variant> {
             turned_copies: 1,
             speed: true,
             ..PAPER
+        },
+        Variant {
+            name: "turned copy + speed regressor + majority",
+            step: 10,
+            ..DEFAULTS
         },
         DEFAULTS,
     ]
@@ -268,6 +279,7 @@ fn train_folds(seqs: &[Sequence], v: &Variant) -> Result<(Vec<Cascade>, f64)> {
     opts.cascade.classifier_gamma = v.gamma;
     opts.cascade.regressor_gamma = v.gamma;
     opts.cascade.speed = v.speed;
+    opts.features.step = v.step;
     let started = Instant::now();
     let models = PEOPLE
         .iter()

@@ -10,6 +10,7 @@ use indicatif::{ProgressBar, ProgressStyle};
 
 use ridi::correct::PlacementSmoother;
 use ridi::data::{Format, ReadOptions, Sequence};
+use ridi::features::FeatureConfig;
 use ridi::regress::{Cascade, ProgressEvent, Stage, Storage, StoredAs, model_file};
 use ridi::{
     EvalOptions, GridChoice, Method, Orientation, PlacementMap, TrackOptions, TrainOptions,
@@ -96,9 +97,13 @@ enum Command {
         storage: StorageArg,
         /// Also train on N copies of each window turned about the vertical (features and
         /// velocity together), for phones carried at other headings than in the training
-        /// recordings; 0 for the paper. Training time grows about (N + 1)^2-fold.
+        /// recordings; 0 for the paper.
         #[arg(long, default_value_t = 1, value_name = "N")]
         turned_copies: usize,
+        /// Frames between training windows [default: 10 x (N + 1), N turned copies: the
+        /// paper's 10 without copies, and the paper's number of rows with them].
+        #[arg(long, value_name = "FRAMES")]
+        step: Option<usize>,
         /// No speed regressor (the paper): by default each placement also regresses the speed
         /// and each regressed velocity is scaled to it, since turned training windows make the
         /// velocity's direction less certain than its size.
@@ -345,6 +350,7 @@ fn run(cli: Cli) -> Result<()> {
             orientation,
             storage,
             turned_copies,
+            step,
             no_speed,
         } => {
             set_jobs(jobs)?;
@@ -352,6 +358,10 @@ fn run(cli: Cli) -> Result<()> {
             let mut opts = TrainOptions {
                 standardize: !no_standardize,
                 turned_copies,
+                features: FeatureConfig {
+                    step: step.unwrap_or(10usize.saturating_mul(turned_copies.saturating_add(1))),
+                    ..FeatureConfig::default()
+                },
                 ..TrainOptions::default()
             };
             opts.cascade.classifier_c = classifier_c;

@@ -94,8 +94,36 @@ fn convert_train_track_and_eval() {
         "tyrex4",
     ]);
     assert!(out.status.success(), "{}", stderr(&out));
-    assert!(
-        String::from_utf8_lossy(&out.stdout).contains("placements: hand, pocket, running, swing")
+    let printed = String::from_utf8_lossy(&out.stdout);
+    assert!(printed.contains("placements: hand, pocket, running, swing"));
+    // Default training has a speed regressor per placement; the paper's has none.
+    assert!(printed.contains("speed: C=10 eps=0.01"), "{printed}");
+    let paper = dir.path().join("paper.ridi");
+    let out = ridi(&[
+        "train",
+        "--list",
+        s(&list),
+        "--out",
+        s(&paper),
+        "--grid",
+        "none",
+        "--placement-map",
+        "tyrex4",
+        "--turned-copies",
+        "0",
+        "--no-speed",
+    ]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let printed = String::from_utf8_lossy(&out.stdout);
+    assert!(!printed.contains("speed:"), "{printed}");
+    let paper_model = ridi::regress::model_file::load(&paper).unwrap();
+    assert_eq!(paper_model.feature_config().step, 10);
+    assert_eq!(
+        ridi::regress::model_file::load(&model)
+            .unwrap()
+            .feature_config()
+            .step,
+        20
     );
 
     let csv = dir.path().join("t.csv");
