@@ -92,7 +92,7 @@ const DEFAULTS: Variant = Variant {
     name: "turned copy + speed regressor + majority, step 20 (ridi's defaults)",
     turned_copies: 1,
     speed: true,
-    step: 20,
+    step: ridi::train::default_step(1),
     smoothing: true,
     ..PAPER
 };

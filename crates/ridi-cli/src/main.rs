@@ -359,7 +359,7 @@ fn run(cli: Cli) -> Result<()> {
                 standardize: !no_standardize,
                 turned_copies,
                 features: FeatureConfig {
-                    step: step.unwrap_or(10usize.saturating_mul(turned_copies.saturating_add(1))),
+                    step: step.unwrap_or(ridi::train::default_step(turned_copies)),
                     ..FeatureConfig::default()
                 },
                 ..TrainOptions::default()

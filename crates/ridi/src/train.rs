@@ -44,11 +44,12 @@ impl GridChoice {
     }
 }
 
-/// How to train. [`Default`] is the paper's method (features, cascade, paper grid) with two
+/// How to train. [`Default`] is the paper's method (features, cascade, paper grid) with
 /// additions measured on the Tyrex leave-one-subject-out protocol (docs/bench-accuracy.md):
-/// one turned copy of each training window, a window every 20 frames instead of 10 (so the
-/// rows, and the training time, stay the paper's), and a speed regressor per placement. Set
-/// `turned_copies: 0`, `features.step: 10` and `cascade.speed: false` for the paper exactly.
+/// one turned copy of each training window, taken every [`default_step`]`(1)` = 20 frames
+/// instead of 10 (so the rows, and the training time, stay the paper's), and a speed regressor
+/// per placement. Set `turned_copies: 0`, `features.step: 10` and `cascade.speed: false` for
+/// the paper exactly.
 #[derive(Debug, Clone, PartialEq)]
 pub struct TrainOptions {
     /// Feature configuration (its `standardization` is filled in when `standardize` is set).
@@ -64,11 +65,17 @@ pub struct TrainOptions {
     pub turned_copies: usize,
 }
 
+/// Training sample step for `turned_copies` copies of each window: the paper's 10 frames times
+/// `turned_copies + 1`, so that the number of rows stays the paper's.
+pub const fn default_step(turned_copies: usize) -> usize {
+    10usize.saturating_mul(turned_copies.saturating_add(1))
+}
+
 impl Default for TrainOptions {
     fn default() -> Self {
         Self {
             features: FeatureConfig {
-                step: 20,
+                step: default_step(1),
                 ..FeatureConfig::default()
             },
             standardize: true,
