@@ -79,30 +79,38 @@ pub fn turned_copies(
         });
     }
     let n = features.rows();
-    let total = n.checked_mul(copies + 1).ok_or_else(|| {
-        FeatureError::InvalidConfig(format!("{copies} turned copies of {n} rows overflow"))
-    })?;
-    let mut out = TurnedRows {
-        features: FeatureMatrix::zeros(total, features.cols()),
-        targets: Vec::with_capacity(total),
-        source: Vec::with_capacity(total),
-    };
-    out.features.as_mut_slice()[..features.as_slice().len()].copy_from_slice(features.as_slice());
-    out.targets.extend_from_slice(targets);
-    out.source.extend(0..n);
+    let total = copies
+        .checked_add(1)
+        .and_then(|c| n.checked_mul(c))
+        .ok_or_else(|| {
+            FeatureError::InvalidConfig(format!("{copies} turned copies of {n} rows overflow"))
+        })?;
+    // Checked once here, so that the rows below cannot fail half-way.
+    YawTurn::new(0.0).row(&mut vec![0.0; features.cols()])?;
+    // Appended rather than zero-filled and overwritten: the matrix is the whole training set.
+    let mut data = Vec::with_capacity(total * features.cols());
+    data.extend_from_slice(features.as_slice());
+    let mut targets_out = Vec::with_capacity(total);
+    targets_out.extend_from_slice(targets);
+    let mut source = Vec::with_capacity(total);
+    source.extend(0..n);
     const PHI: f64 = 0.618_033_988_749_894_9;
     for j in 0..copies {
         for (i, target) in targets.iter().enumerate() {
             let turn = (i as f64 * PHI + j as f64 / copies as f64).fract();
             let t = YawTurn::new(std::f64::consts::TAU * turn);
-            let row = out.features.row_mut((j + 1) * n + i);
-            row.copy_from_slice(features.row(i));
-            t.row(row)?;
-            out.targets.push(t.horizontal(*target));
-            out.source.push(i);
+            let start = data.len();
+            data.extend_from_slice(features.row(i));
+            t.row(&mut data[start..])?;
+            targets_out.push(t.horizontal(*target));
+            source.push(i);
         }
     }
-    Ok(out)
+    Ok(TurnedRows {
+        features: FeatureMatrix::from_vec(total, features.cols(), data)?,
+        targets: targets_out,
+        source,
+    })
 }
 
 #[cfg(test)]

@@ -500,7 +500,7 @@ impl Cascade {
             let channels = 2 + usize::from(params.speed);
             let target = |i: usize, ch: usize| {
                 let [x, z] = data.targets[i].map(f64::from);
-                [x, z, x.hypot(z)][ch]
+                if ch < 2 { [x, z][ch] } else { x.hypot(z) }
             };
             let targets: Vec<Vec<f64>> = (0..channels)
                 .map(|ch| idx.iter().map(|&i| target(i, ch)).collect())
