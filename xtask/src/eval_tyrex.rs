@@ -20,6 +20,7 @@ use ridi::data::{Sequence, write_atomically};
 use ridi::eval::{AlignWindow, EvalConfig, evaluate_trajectory};
 use ridi::evaluate::{SequenceResult, Traces};
 use ridi::features::{SampleSchedule, compute_targets};
+use ridi::frames::UpAxis;
 use ridi::regress::{Cascade, Gamma, NoProgress};
 use ridi::track::Regressed;
 use ridi::train::ground_truth_view;
@@ -39,6 +40,7 @@ struct Variant {
     speed: bool,
     /// Training sample step in frames (paper: 10).
     step: usize,
+    up_axis: UpAxis,
     // Test time only.
     estimate_v0: bool,
     smoothing: bool,
@@ -48,14 +50,15 @@ impl Variant {
     /// Variants with equal keys train the same models.
     fn train_key(&self) -> String {
         format!(
-            "{} {} {:?} {} {} {} {}",
+            "{} {} {:?} {} {} {} {} {:?}",
             self.groups,
             self.standardize,
             self.gamma,
             self.estimated_orientation,
             self.turned_copies,
             self.speed,
-            self.step
+            self.step,
+            self.up_axis
         )
     }
 }
@@ -69,6 +72,7 @@ const PAPER: Variant = Variant {
     turned_copies: 0,
     speed: false,
     step: 10,
+    up_axis: UpAxis::PlusY,
     estimate_v0: false,
     smoothing: false,
 };
@@ -87,12 +91,14 @@ const RECOMMENDED: Variant = Variant {
 };
 
 /// What `ridi train` and `ridi track` do by default: a window every 20 frames and one turned
-/// copy of each, the paper's number of rows.
+/// copy of each (the paper's number of rows), the speed regressor, S on device -y while the
+/// phone is upside down.
 const DEFAULTS: Variant = Variant {
-    name: "turned copy + speed regressor + majority, step 20 (ridi's defaults)",
+    name: "turned copy + speed regressor + majority + S on -y upside down, step 20 (ridi's defaults)",
     turned_copies: 1,
     speed: true,
     step: ridi::train::default_step(1),
+    up_axis: UpAxis::PlusOrMinusY,
     smoothing: true,
     ..PAPER
 };
@@ -150,8 +156,19 @@ fn variants(quick: bool) -> Vec<Variant> {
             ..PAPER
         },
         Variant {
+            name: "S on -y upside down",
+            up_axis: UpAxis::PlusOrMinusY,
+            ..PAPER
+        },
+        Variant {
             name: "turned copy + speed regressor, step 20",
             smoothing: false,
+            up_axis: UpAxis::PlusY,
+            ..DEFAULTS
+        },
+        Variant {
+            name: "turned copy + speed regressor + majority, step 20",
+            up_axis: UpAxis::PlusY,
             ..DEFAULTS
         },
         DEFAULTS,
@@ -277,6 +294,7 @@ fn train_folds(seqs: &[Sequence], v: &Variant) -> Result<(Vec<Cascade>, f64)> {
     opts.cascade.regressor_gamma = v.gamma;
     opts.cascade.speed = v.speed;
     opts.features.step = v.step;
+    opts.features.up_axis = v.up_axis;
     let started = Instant::now();
     let models = PEOPLE
         .iter()

@@ -11,6 +11,7 @@ use indicatif::{ProgressBar, ProgressStyle};
 use ridi::correct::PlacementSmoother;
 use ridi::data::{Format, ReadOptions, Sequence};
 use ridi::features::FeatureConfig;
+use ridi::frames::UpAxis;
 use ridi::regress::{Cascade, ProgressEvent, Stage, Storage, StoredAs, model_file};
 use ridi::{
     EvalOptions, GridChoice, Method, Orientation, PlacementMap, TrackOptions, TrainOptions,
@@ -66,7 +67,7 @@ enum Command {
         ridi train --list datasets/sample/list_train.txt --out model.ridi --grid small \
         --placement-map tyrex4\n  \
         ridi train --list ridi/list_train_publish_v2.txt --out ridi.model --grid paper --jobs 2\n  \
-        ridi train --list list.txt --out paper.ridi --turned-copies 0 --no-speed   (the paper exactly)\n\n\
+        ridi train --list list.txt --out paper.ridi --turned-copies 0 --no-speed --up-axis plus-y   (the paper exactly)\n\n\
         Every sequence needs ground truth and a placement (the list's second column).")]
     Train {
         /// List files (`path,placement` per line); several are concatenated.
@@ -109,6 +110,11 @@ enum Command {
         /// velocity's direction less certain than its size.
         #[arg(long)]
         no_speed: bool,
+        /// The device axis the stabilized frame S is built on: `plus-y` always (the paper),
+        /// or `plus-or-minus-y`, which builds it on -y while the phone is upside down (top
+        /// down in a hanging hand, say), where the paper's S turns erratically.
+        #[arg(long, value_enum, default_value = "plus-or-minus-y")]
+        up_axis: UpAxisArg,
         /// Worker threads (default: all cores).
         #[arg(long)]
         jobs: Option<usize>,
@@ -272,6 +278,23 @@ impl From<StorageArg> for Storage {
 }
 
 #[derive(Clone, Copy, PartialEq, ValueEnum)]
+enum UpAxisArg {
+    /// Device +y at every attitude (the paper's S).
+    PlusY,
+    /// Device -y while the phone is upside down, +y otherwise.
+    PlusOrMinusY,
+}
+
+impl From<UpAxisArg> for UpAxis {
+    fn from(a: UpAxisArg) -> Self {
+        match a {
+            UpAxisArg::PlusY => UpAxis::PlusY,
+            UpAxisArg::PlusOrMinusY => UpAxis::PlusOrMinusY,
+        }
+    }
+}
+
+#[derive(Clone, Copy, PartialEq, ValueEnum)]
 enum Plots {
     Png,
     Svg,
@@ -352,6 +375,7 @@ fn run(cli: Cli) -> Result<()> {
             turned_copies,
             step,
             no_speed,
+            up_axis,
         } => {
             set_jobs(jobs)?;
             let seqs = load_lists(&list, placement_map.as_deref(), orientation.into())?;
@@ -360,6 +384,7 @@ fn run(cli: Cli) -> Result<()> {
                 turned_copies,
                 features: FeatureConfig {
                     step: step.unwrap_or(ridi::train::default_step(turned_copies)),
+                    up_axis: up_axis.into(),
                     ..FeatureConfig::default()
                 },
                 ..TrainOptions::default()
@@ -525,6 +550,11 @@ fn train_with_progress(seqs: &[Sequence], opts: &TrainOptions) -> Result<Cascade
 
 fn print_training(model: &Cascade) {
     println!("placements: {}", model.placements().join(", "));
+    let up = match model.feature_config().up_axis {
+        UpAxis::PlusY => "device +y",
+        UpAxis::PlusOrMinusY => "device +y, or -y while upside down",
+    };
+    println!("stabilized frame S built on: {up}");
     match model.stored_as() {
         StoredAs::Half => println!("samples stored: {} values in half precision", model.dim()),
         StoredAs::Projected { components, energy } => println!(

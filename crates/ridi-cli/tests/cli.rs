@@ -37,6 +37,18 @@ fn inspect_prints_text_and_json() {
     assert_eq!(json["frames"], 4800);
     assert_eq!(json["placement"], serde_json::Value::Null);
     assert!(json["path_length_m"].as_f64().unwrap() > 5.0);
+    assert_eq!(json["upside_down_fraction"], 0.0);
+
+    // Guillaume swings the phone top down: inspect says so.
+    let seq = sample().join("Guillaume_Nexus5_NoDist_Swinging");
+    let out = ridi(&["inspect", s(&seq), "--json"]);
+    let json: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert!(
+        json["upside_down_fraction"].as_f64().unwrap() > 0.9,
+        "{json}"
+    );
+    let warnings = json["warnings"].to_string();
+    assert!(warnings.contains("upside down"), "{warnings}");
 }
 
 #[test]

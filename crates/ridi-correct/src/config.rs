@@ -1,6 +1,6 @@
 //! Configuration of the correction objective.
 
-use ridi_frames::WorldVec;
+use ridi_frames::{UpAxis, WorldVec};
 use serde::{Deserialize, Serialize};
 
 use crate::error::CorrectError;
@@ -39,6 +39,10 @@ pub struct CorrectionConfig {
     /// Largest accepted time step, seconds: a longer gap is an error rather than an
     /// integration across missing data. Default 0.1 s (20 samples at 200 Hz).
     pub max_dt: f64,
+    /// The definition of S the target velocities are expressed in: the one of the regressor
+    /// that produced them (a model's feature configuration records it). Default: the paper's,
+    /// [`UpAxis::PlusY`].
+    pub up_axis: UpAxis,
 }
 
 impl Default for CorrectionConfig {
@@ -52,6 +56,7 @@ impl Default for CorrectionConfig {
             vertical_weight: 1.0,
             initial_velocity: InitialVelocity::default(),
             max_dt: 0.1,
+            up_axis: UpAxis::PlusY,
         }
     }
 }

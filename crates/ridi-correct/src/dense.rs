@@ -6,7 +6,7 @@
 //! `O(K³)` time: fine for a minute of data, not for an hour.
 
 use ridi_frames::nalgebra::{DMatrix, DVector, Matrix3, Vector3};
-use ridi_frames::{DeviceVec, WorldVec, stab_from_world};
+use ridi_frames::{DeviceVec, WorldVec};
 
 use crate::config::{CorrectionConfig, InitialVelocity};
 use crate::error::CorrectError;
@@ -31,7 +31,10 @@ pub fn objective(
     let mut e = 0.0;
     for t in targets {
         let v = poses[t.frame].velocity;
-        let vs = stab_from_world(imu.orientation[t.frame], imu.gravity[t.frame]) * v;
+        let vs = config
+            .up_axis
+            .stab_from_world(imu.orientation[t.frame], imu.gravity[t.frame])
+            * v;
         e += config.horizontal_weight
             * ((vs.x() - t.velocity[0]).powi(2) + (vs.z() - t.velocity[1]).powi(2))
             + config.vertical_weight * v.z().powi(2);
@@ -89,7 +92,10 @@ pub fn solve_dense(
     );
     let mut emit = |j: usize, cum: &DMatrix<f64>, c: &Vector3<f64>| {
         let t = targets[j];
-        let rsw = stab_from_world(imu.orientation[t.frame], imu.gravity[t.frame]).matrix();
+        let rsw = config
+            .up_axis
+            .stab_from_world(imu.orientation[t.frame], imu.gravity[t.frame])
+            .matrix();
         let rows: [(Vector3<f64>, f64, f64); 3] = [
             (rsw.row(0).transpose(), sh, t.velocity[0]),
             (rsw.row(2).transpose(), sh, t.velocity[1]),

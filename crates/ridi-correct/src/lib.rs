@@ -23,7 +23,8 @@
 //! ```
 //!
 //! where `r_j` are the target frames, `u_j` the regressed S-frame velocities `[S-x, S-z]`,
-//! `R_SW(f) = stab_from_world(q_f, g_f)`, and `e_zᵀ v_W` the world vertical velocity. Defaults
+//! `R_SW(f) = up_axis.stab_from_world(q_f, g_f)` (S as the regressor defined it,
+//! [`CorrectionConfig::up_axis`]), and `e_zᵀ v_W` the world vertical velocity. Defaults
 //! follow the paper: `w_h = w_v = 1`, `λ = 0.1`, knots every 50 frames, `v0 = 0`.
 //! [`CorrectionConfig::original_cpp`] gives the original code's weighting (100, 1, 1 on the
 //! squared terms). `E` is minimised exactly (no iteration, no approximation): see

@@ -9,7 +9,7 @@ use faer::sparse::linalg::cholesky::{
 use faer::sparse::{SparseColMatRef, SymbolicSparseColMatRef};
 use faer::{Conj, MatMut, Par, Side, Spec};
 use ridi_frames::nalgebra::{Matrix3, Vector3};
-use ridi_frames::{DeviceVec, WorldVec, stab_from_world};
+use ridi_frames::{DeviceVec, WorldVec};
 use serde::{Deserialize, Serialize};
 
 use crate::config::{CorrectionConfig, InitialVelocity};
@@ -404,12 +404,15 @@ impl Corrector {
         targets: &[VelocityTarget],
     ) -> Result<(), CorrectError> {
         let (wh, wv) = (self.config.horizontal_weight, self.config.vertical_weight);
+        let up_axis = self.config.up_axis;
         let s = &mut self.scratch;
         s.pinv.clear();
         s.pm.clear();
         let ez = Vector3::z();
         for t in targets {
-            let rsw = stab_from_world(imu.orientation[t.frame], imu.gravity[t.frame]).matrix();
+            let rsw = up_axis
+                .stab_from_world(imu.orientation[t.frame], imu.gravity[t.frame])
+                .matrix();
             let h1: Vector3<f64> = rsw.row(0).transpose();
             let h2: Vector3<f64> = rsw.row(2).transpose();
             let p = (h1 * h1.transpose() + h2 * h2.transpose()) * wh + ez * ez.transpose() * wv;

@@ -1,5 +1,6 @@
 //! The feature configuration that a model file carries.
 
+use ridi_frames::UpAxis;
 use serde::{Deserialize, Serialize};
 
 use crate::FeatureError;
@@ -35,6 +36,10 @@ pub struct FeatureConfig {
     /// Per-dimension z-scoring learned on the training set, applied to every feature computed
     /// with this configuration. `None` in the original RIDI.
     pub standardization: Option<Standardization>,
+    /// The definition of S for features and targets, and hence for the regressed velocities
+    /// ([`UpAxis::PlusY`] in the original RIDI).
+    #[serde(default)]
+    pub up_axis: UpAxis,
 }
 
 impl Default for FeatureConfig {
@@ -47,6 +52,7 @@ impl Default for FeatureConfig {
             channels: vec![Channel::Gyro, Channel::LinearAcceleration],
             truncate: 4.0,
             standardization: None,
+            up_axis: UpAxis::PlusY,
         }
     }
 }

@@ -1,7 +1,7 @@
 //! Feature windows: gyro and linear acceleration in S, smoothed, flattened time-major.
 
 use rayon::prelude::*;
-use ridi_frames::{DeviceVec, align_gravity};
+use ridi_frames::{DeviceVec, UpAxis};
 
 use crate::FeatureError;
 use crate::config::{Channel, FeatureConfig};
@@ -77,9 +77,13 @@ pub struct StabilizedChannels {
 }
 
 impl StabilizedChannels {
-    /// Rotates every frame's `channels` into S with `align_gravity(gravity[i])`. Fails on
+    /// Rotates every frame's `channels` into S with `up_axis.align(gravity[i])`. Fails on
     /// mismatched lengths, non-finite values or an empty channel list.
-    pub fn new(imu: &ImuView<'_>, channels: &[Channel]) -> Result<Self, FeatureError> {
+    pub fn new(
+        imu: &ImuView<'_>,
+        channels: &[Channel],
+        up_axis: UpAxis,
+    ) -> Result<Self, FeatureError> {
         imu.check_lengths()?;
         if channels.is_empty() {
             return Err(FeatureError::InvalidConfig(
@@ -104,7 +108,7 @@ impl StabilizedChannels {
                     let i = first + k;
                     // One matrix per frame serves all channels: cheaper than a quaternion
                     // sandwich per vector.
-                    let m = align_gravity(imu.gravity[i]).matrix();
+                    let m = up_axis.align(imu.gravity[i]).matrix();
                     for (c, out) in channels.iter().zip(row.chunks_exact_mut(3)) {
                         let v = m * imu.channel(*c)[i].vector();
                         out[0] = v.x as f32;
@@ -229,7 +233,7 @@ impl FeatureExtractor {
 
     /// The per-frame S channels of a sequence, for [`Self::features`] and [`Self::row_into`].
     pub fn stabilize(&self, imu: &ImuView<'_>) -> Result<StabilizedChannels, FeatureError> {
-        StabilizedChannels::new(imu, &self.config.channels)
+        StabilizedChannels::new(imu, &self.config.channels, self.config.up_axis)
     }
 
     /// Writes the feature of sample frame `frame` into `out` (length [`Self::dim`]): frames

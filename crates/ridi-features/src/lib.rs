@@ -4,7 +4,8 @@
 //!
 //! The feature of sample frame `f` is the window of frames `[f - window, f)` (200 in the
 //! paper) of gyro and linear acceleration, each frame rotated into its own stabilized frame S
-//! with `align_gravity(gravity[i])`, each channel smoothed inside the window by a Gaussian
+//! with `up_axis.align(gravity[i])` ([`ridi_frames::UpAxis`]; the paper's is +y,
+//! [`ridi_frames::align_gravity`]), each channel smoothed inside the window by a Gaussian
 //! (sigma 2, 17 taps, scipy's `'reflect'` borders at the window ends), then flattened
 //! time-major: row `t` of the window holds gyro x y z then linear acceleration x y z, so the
 //! feature has `window * 3 * channels` = 1200 values.

@@ -1,7 +1,7 @@
 //! Velocity targets in the stabilized frame.
 
 use rayon::prelude::*;
-use ridi_frames::{DeviceVec, StabVec, WorldFromDevice, WorldVec, align_gravity};
+use ridi_frames::{DeviceVec, StabVec, UpAxis, WorldFromDevice, WorldVec};
 
 use crate::FeatureError;
 use crate::config::FeatureConfig;
@@ -96,10 +96,11 @@ pub struct Targets {
 /// Per-frame ground-truth velocity in each frame's S, smoothed over the whole sequence:
 /// forward differences `(p[i+1] - p[i]) / (t[i+1] - t[i])` (the last frame repeats the one
 /// before; a one-frame sequence has zero velocity), rotated into the device frame with the
-/// ground-truth orientation and into S with `align_gravity(gravity[i])`, then smoothed per
+/// ground-truth orientation and into S with `up_axis.align(gravity[i])`, then smoothed per
 /// component with `sigma` frames ('reflect' borders).
 pub fn stabilized_velocity(
     gt: &GroundTruthView<'_>,
+    up_axis: UpAxis,
     sigma: f64,
     truncate: f64,
 ) -> Result<Vec<StabVec>, FeatureError> {
@@ -118,7 +119,7 @@ pub fn stabilized_velocity(
         } else {
             WorldVec::ZERO
         };
-        let v_s = align_gravity(gt.gravity[i]) * (gt.orientation[i].inverse() * v_w);
+        let v_s = up_axis.align(gt.gravity[i]) * (gt.orientation[i].inverse() * v_w);
         out.copy_from_slice(&v_s.to_array());
     });
     let mut smooth = vec![0.0f64; 3 * n];
@@ -176,7 +177,7 @@ pub fn compute_targets(
             max: n.saturating_sub(1),
         });
     }
-    let velocity = stabilized_velocity(gt, config.target_sigma, config.truncate)?;
+    let velocity = stabilized_velocity(gt, config.up_axis, config.target_sigma, config.truncate)?;
     let values = frames
         .iter()
         .map(|&f| [velocity[f].x(), velocity[f].z()])

@@ -9,7 +9,7 @@ use ridi_features::{
     Channel, FeatureConfig, FeatureError, FeatureExtractor, FeatureMatrix, ImuView, SampleSchedule,
     Standardization, StandardizationFit, compute_features,
 };
-use ridi_frames::DeviceVec;
+use ridi_frames::{DeviceVec, UpAxis};
 
 struct Imu {
     gyro: Vec<DeviceVec>,
@@ -185,6 +185,42 @@ fn each_frame_uses_its_own_gravity() {
     // Last frame (gravity along z): device y is S-forward, -z.
     let last = &x.row(0)[199 * 6..199 * 6 + 3];
     assert!(last[0].abs() < 1e-7 && last[1].abs() < 1e-7 && (last[2] + 1.0).abs() < 1e-7);
+}
+
+#[test]
+fn plus_or_minus_y_gives_an_upside_down_phone_the_upright_features() {
+    // The same motion measured by the phone turned top down about its screen normal: every
+    // device vector has x and y negated. Gravity stays within 45 degrees of +y upright.
+    let mut upright = random_imu(600, 11);
+    for g in &mut upright.gravity {
+        *g = DeviceVec::new(0.5 * g.x(), 9.8, 0.5 * g.z());
+    }
+    let turn = |v: &DeviceVec| DeviceVec::new(-v.x(), -v.y(), v.z());
+    let top_down = Imu {
+        gyro: upright.gyro.iter().map(turn).collect(),
+        linacce: upright.linacce.iter().map(turn).collect(),
+        gravity: upright.gravity.iter().map(turn).collect(),
+    };
+    let frames = [200, 377, 599];
+    let with = |axis| FeatureConfig {
+        up_axis: axis,
+        ..FeatureConfig::default()
+    };
+    let reference = compute_features(&upright.view(), &with(UpAxis::PlusY), &frames).unwrap();
+    let flipped = compute_features(&top_down.view(), &with(UpAxis::PlusOrMinusY), &frames).unwrap();
+    for r in 0..frames.len() {
+        for (a, b) in reference.row(r).iter().zip(flipped.row(r)) {
+            assert!((a - b).abs() < 1e-4, "row {r}: {a} vs {b}");
+        }
+    }
+    // The paper's S sees the top-down phone differently.
+    let plain = compute_features(&top_down.view(), &with(UpAxis::PlusY), &frames).unwrap();
+    let differs = plain
+        .row(0)
+        .iter()
+        .zip(reference.row(0))
+        .any(|(a, b)| (a - b).abs() > 0.1);
+    assert!(differs);
 }
 
 #[test]

@@ -8,7 +8,7 @@ use ridi_features::{
     stabilized_velocity,
 };
 use ridi_frames::nalgebra::Vector3;
-use ridi_frames::{DeviceVec, Rot, World, WorldFromDevice, WorldVec, gravity_in_device};
+use ridi_frames::{DeviceVec, Rot, UpAxis, World, WorldFromDevice, WorldVec, gravity_in_device};
 
 struct Walk {
     time: Vec<f64>,
@@ -82,6 +82,31 @@ fn constant_velocity_with_yawed_and_pitched_phone() {
 }
 
 #[test]
+fn plus_or_minus_y_gives_a_top_down_phone_the_upright_targets() {
+    // Upright phone pitched forward, and the same phone turned top down about its screen
+    // normal (device x and y negated): with PlusOrMinusY both get the same S velocity.
+    let pitch = WorldFromDevice::from_axis_angle(&Vector3::x_axis(), 1.2);
+    let half_turn = Rot::from_axis_angle(&Vector3::z_axis(), std::f64::consts::PI);
+    let v = WorldVec::new(0.9, -0.4, 0.0);
+    let upright = constant_walk(500, v, pitch);
+    let top_down = constant_walk(500, v, pitch * half_turn);
+    let config = FeatureConfig {
+        up_axis: UpAxis::PlusOrMinusY,
+        ..FeatureConfig::default()
+    };
+    let frames = SampleSchedule::training(&config).unwrap().frames(500);
+    let a = compute_targets(&upright.view(), &config, &frames).unwrap();
+    let b = compute_targets(&top_down.view(), &config, &frames).unwrap();
+    for (x, y) in a.values.iter().zip(&b.values) {
+        assert!(
+            (x[0] - y[0]).abs() < 1e-9 && (x[1] - y[1]).abs() < 1e-9,
+            "{x:?} vs {y:?}"
+        );
+    }
+    assert!((a.values[0][0].hypot(a.values[0][1]) - v.norm()).abs() < 1e-9);
+}
+
+#[test]
 fn forward_walk_is_negative_s_z() {
     // Phone held upright in front, screen towards the walker (device y up, z back toward the
     // person), walking along the direction the back of the phone faces (-z_I).
@@ -127,7 +152,7 @@ fn smoothing_and_rotation_match_a_naive_computation() {
         orientation,
         gravity,
     };
-    let v = stabilized_velocity(&walk.view(), 30.0, 4.0).unwrap();
+    let v = stabilized_velocity(&walk.view(), UpAxis::PlusY, 30.0, 4.0).unwrap();
     let mut comps = [vec![], vec![], vec![]];
     for i in 0..n {
         let j = if i + 1 < n { i } else { i - 1 };
@@ -161,7 +186,7 @@ fn long_sequences_are_smoothed_in_blocks_identically() {
         orientation: vec![WorldFromDevice::identity(); n],
         gravity: vec![DeviceVec::new(0.0, 0.0, 9.8); n],
     };
-    let v = stabilized_velocity(&walk.view(), 30.0, 4.0).unwrap();
+    let v = stabilized_velocity(&walk.view(), UpAxis::PlusY, 30.0, 4.0).unwrap();
     let sx: Vec<f64> = (0..n)
         .map(|i| {
             let j = if i + 1 < n { i } else { i - 1 };

@@ -1,9 +1,10 @@
 //! Gravity alignment: the stabilized-IMU frame S.
 
 use nalgebra::{Quaternion, UnitQuaternion, Vector3};
+use serde::{Deserialize, Serialize};
 
-use crate::frame::Stabilized;
-use crate::rotation::{StabFromDevice, StabFromWorld, WorldFromDevice};
+use crate::frame::{Device, Stabilized};
+use crate::rotation::{Rot, StabFromDevice, StabFromWorld, WorldFromDevice};
 use crate::vector::{DeviceVec, Vec3, WorldVec};
 
 /// Up axis of the stabilized frame S (+y, as in the original RIDI code).
@@ -48,6 +49,70 @@ pub fn align_gravity(gravity: DeviceVec) -> StabFromDevice {
         ));
     }
     StabFromDevice::from_unit_quaternion(UnitQuaternion::new_normalize(q))
+}
+
+/// Which device axis the stabilized frame S is built on: the definition of S.
+///
+/// Every S rotation of a frame depends only on that frame's gravity, so features, targets,
+/// corrections and baselines that share an `UpAxis` share one S. A model records the one it
+/// was trained with.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum UpAxis {
+    /// [`align_gravity`] at every attitude: the smallest rotation onto device +y, as in the
+    /// original RIDI code.
+    #[default]
+    PlusY,
+    /// Device +y, or device -y while the phone is upside down (gravity's direction cosine
+    /// with +y below [`UpAxis::FLIP_COSINE`]); see [`UpAxis::align`].
+    ///
+    /// Near gravity opposite to +y the smallest rotation is ill-conditioned: a small change of
+    /// gravity's horizontal part turns S's heading by a large angle, so a phone carried top
+    /// down (swung in a hanging hand, say) gets an S that spins with every swing and features
+    /// unlike any upright training data. Flipping keeps S as steady as for an upright phone.
+    PlusOrMinusY,
+}
+
+impl UpAxis {
+    /// Below this cosine between gravity and device +y (about 134 degrees), [`PlusOrMinusY`]
+    /// uses -y. Far from both poles, so that neither choice is ill-conditioned at the switch,
+    /// and far below 0, where a phone held flat (texting, reading) fluctuates.
+    ///
+    /// [`PlusOrMinusY`]: UpAxis::PlusOrMinusY
+    pub const FLIP_COSINE: f64 = -0.7;
+
+    /// The S-from-device rotation of a frame with device-frame gravity `gravity` (pointing up).
+    ///
+    /// For [`UpAxis::PlusOrMinusY`] and an upside-down phone: a half turn about device z,
+    /// which swaps +y and -y (and +x and -x), then [`align_gravity`]. An upside-down phone
+    /// thus gets the S it would have had upright with the same face towards the walker: S-x
+    /// is then device -x. The switch is a jump in S's heading; only a window in which the
+    /// phone turns over sees it.
+    pub fn align(self, gravity: DeviceVec) -> StabFromDevice {
+        if self == UpAxis::PlusOrMinusY && upside_down(gravity) {
+            let g = gravity.vector();
+            let half_turn_z =
+                Rot::<Device, Device>::from_axis_angle(&Vector3::z_axis(), std::f64::consts::PI);
+            align_gravity(DeviceVec::new(-g.x, -g.y, g.z)) * half_turn_z
+        } else {
+            align_gravity(gravity)
+        }
+    }
+
+    /// World-to-S rotation of one frame: `align(g) * q*` with this axis's [`UpAxis::align`].
+    pub fn stab_from_world(
+        self,
+        orientation: WorldFromDevice,
+        gravity: DeviceVec,
+    ) -> StabFromWorld {
+        self.align(gravity) * orientation.inverse()
+    }
+}
+
+fn upside_down(gravity: DeviceVec) -> bool {
+    let g = gravity.vector();
+    // Also false for a zero or non-finite gravity, which align_gravity maps to the identity.
+    g.y < UpAxis::FLIP_COSINE * g.norm()
 }
 
 /// World-to-S rotation of one frame: `align(g) * q*`, with `q` the device orientation and `g`

@@ -22,6 +22,11 @@
 //! is a proper half turn (the original C++ used a reflection there). Test-time world to S is
 //! [`stab_from_world`]`(q, g) = align(g) * q*`.
 //!
+//! Accurate is not well-conditioned: near that pole a small change of gravity turns S's
+//! heading by a large angle. [`UpAxis`] names the definition of S a computation uses:
+//! [`UpAxis::PlusY`] is the original's, [`UpAxis::PlusOrMinusY`] builds S on device -y while
+//! the phone is upside down.
+//!
 //! # Orientation without a magnetometer
 //!
 //! [`estimate`] is a Mahony complementary filter on gyroscope and accelerometer
@@ -71,7 +76,7 @@ pub use estimate::{
 };
 pub use frame::{Device, Frame, Stabilized, World};
 pub use gravity::{
-    STANDARD_GRAVITY, UP_S, UP_W, align_gravity, gravity_in_device, stab_from_world,
+    STANDARD_GRAVITY, UP_S, UP_W, UpAxis, align_gravity, gravity_in_device, stab_from_world,
 };
 pub use rotation::{QuatError, Rot, StabFromDevice, StabFromWorld, WorldFromDevice};
 pub use vector::{DeviceVec, StabVec, Vec3, WorldVec};

@@ -3,8 +3,8 @@
 use proptest::prelude::*;
 use ridi_frames::nalgebra::{Matrix3, Vector3};
 use ridi_frames::{
-    DeviceVec, Rot, StabFromDevice, StabFromWorld, Stabilized, UP_S, UP_W, World, WorldFromDevice,
-    align_gravity, gravity_in_device, stab_from_world,
+    Device, DeviceVec, Rot, StabFromDevice, StabFromWorld, Stabilized, UP_S, UP_W, UpAxis, World,
+    WorldFromDevice, align_gravity, gravity_in_device, stab_from_world,
 };
 
 fn vec3(range: f64) -> impl Strategy<Value = Vector3<f64>> {
@@ -148,6 +148,66 @@ proptest! {
         let d = r.angle_to(&align_gravity(g2));
         prop_assert!(d < 1e-6, "jump {d}");
     }
+}
+
+fn half_turn_about_device_z() -> Rot<Device, Device> {
+    Rot::from_axis_angle(&Vector3::z_axis(), std::f64::consts::PI)
+}
+
+proptest! {
+    #[test]
+    fn every_up_axis_maps_gravity_onto_up(g in gravity(), q in rotation(), m in 1.0..12.0f64) {
+        for axis in [UpAxis::PlusY, UpAxis::PlusOrMinusY] {
+            assert_orthonormal(&axis.align(g).matrix())?;
+            let up = axis.align(g) * up_of(g);
+            prop_assert!((up - UP_S).norm() < 1e-12, "{axis:?}: {up:?}");
+            let up = axis.stab_from_world(q, gravity_in_device(q, m)) * UP_W;
+            prop_assert!((up - UP_S).norm() < 1e-12, "{axis:?}: {up:?}");
+        }
+    }
+
+    #[test]
+    fn plus_or_minus_y_differs_only_upside_down(g in gravity()) {
+        prop_assert_eq!(UpAxis::PlusY.align(g), align_gravity(g));
+        let cosine = g.y() / g.norm();
+        let same = UpAxis::PlusOrMinusY.align(g) == align_gravity(g);
+        prop_assert_eq!(same, cosine >= UpAxis::FLIP_COSINE, "cosine {}", cosine);
+    }
+
+    #[test]
+    fn upside_down_phone_gets_the_upright_s(
+        yaw in -3.2..3.2f64,
+        tilt_x in -0.5..0.5f64,
+        tilt_z in -0.5..0.5f64,
+        m in 1.0..12.0f64,
+    ) {
+        // An upright phone (device y within 0.71 rad of up) at any heading, and the same
+        // phone turned top down about its screen normal: PlusOrMinusY gives both one S.
+        let q = Rot::<World, World>::from_axis_angle(&Vector3::z_axis(), yaw)
+            * WorldFromDevice::from_axis_angle(&Vector3::x_axis(), std::f64::consts::FRAC_PI_2)
+            * Rot::<Device, Device>::from_scaled_axis(Vector3::new(tilt_x, 0.0, tilt_z));
+        let g = gravity_in_device(q, m);
+        prop_assert!(g.y() / g.norm() > -UpAxis::FLIP_COSINE);
+        let turned = q * half_turn_about_device_z();
+        let s_upright = UpAxis::PlusOrMinusY.stab_from_world(q, g);
+        let s_turned = UpAxis::PlusOrMinusY.stab_from_world(turned, gravity_in_device(turned, m));
+        prop_assert!(s_upright.angle_to(&s_turned) < 1e-9, "{s_upright:?} vs {s_turned:?}");
+    }
+}
+
+#[test]
+fn plus_or_minus_y_is_steady_for_a_phone_top_down() {
+    // Gravity a hundredth of a radian off device -y, once towards x and once towards z: the
+    // original S turns by a quarter turn between the two, the flipped one by about 0.01 rad.
+    let eps = 0.01;
+    let a = DeviceVec::new(eps, -1.0, 0.0);
+    let b = DeviceVec::new(0.0, -1.0, eps);
+    let plus_y = UpAxis::PlusY.align(a).angle_to(&UpAxis::PlusY.align(b));
+    let flipped = UpAxis::PlusOrMinusY
+        .align(a)
+        .angle_to(&UpAxis::PlusOrMinusY.align(b));
+    assert!(plus_y > 1.0, "{plus_y}");
+    assert!(flipped < 2.0 * eps, "{flipped}");
 }
 
 #[test]

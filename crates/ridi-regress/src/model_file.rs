@@ -10,13 +10,14 @@
 //! | 4     | CRC32 of the payload                      |
 //! | n     | payload: bincode 2 (standard config, serde) of the [`Cascade`] |
 //!
-//! Version 6 stores each placement's samples as little-endian IEEE binary16 in one byte
+//! Version 7 stores each placement's samples as little-endian IEEE binary16 in one byte
 //! string: principal-component coordinates (with their residual norms, next to the projection's
 //! mean and directions) or the features themselves ([`crate::Storage`]); squared norms are
 //! recomputed on load; classifier coefficients only for the pairs a placement takes part in;
-//! an optional speed regressor per placement ([`crate::CascadeParams::speed`]).
+//! an optional speed regressor per placement ([`crate::CascadeParams::speed`]); the feature
+//! configuration with its definition of S (`up_axis`).
 //! Older files are refused with [`RegressError::UnsupportedVersion`] (retrain the model):
-//! version 5 had no speed regressor, version 4 stored every pair's coefficient for every classifier sample, version 3 the leading
+//! version 6 had no `up_axis` (its S was always the paper's), version 5 no speed regressor, version 4 stored every pair's coefficient for every classifier sample, version 3 the leading
 //! coordinates as a separate `f32` block, version 2 binary16 features only, version 1 `f32`
 //! features.
 //!
@@ -34,7 +35,7 @@ use crate::error::RegressError;
 /// File magic number.
 pub const MAGIC: [u8; 8] = *b"RIDIREG\0";
 /// Format version written and read by this build.
-pub const FORMAT_VERSION: u32 = 6;
+pub const FORMAT_VERSION: u32 = 7;
 const HEADER: usize = 8 + 4 + 8 + 4;
 /// Refuses to allocate for absurd payload lengths from a corrupt header.
 const MAX_PAYLOAD: u64 = 1 << 40;

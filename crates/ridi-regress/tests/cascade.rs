@@ -264,23 +264,23 @@ fn training_is_deterministic_and_model_files_round_trip() {
         );
     }
     let mut newer = bytes.clone();
-    newer[8..12].copy_from_slice(&7u32.to_le_bytes());
+    newer[8..12].copy_from_slice(&8u32.to_le_bytes());
     assert!(matches!(
         model_file::from_bytes(&newer),
         Err(RegressError::UnsupportedVersion {
-            found: 7,
-            supported: 6
+            found: 8,
+            supported: 7
         })
     ));
     // Versions 1 (f32 samples), 2 (half precision only), 3 (an f32 block of leading
-    // coordinates), 4 (every pair's classifier coefficient) and 5 (no speed regressor):
-    // refused with advice.
-    for v in [1u32, 2, 3, 4, 5] {
+    // coordinates), 4 (every pair's classifier coefficient), 5 (no speed regressor) and 6 (no
+    // up axis): refused with advice.
+    for v in [1u32, 2, 3, 4, 5, 6] {
         let mut older = bytes.clone();
         older[8..12].copy_from_slice(&v.to_le_bytes());
         let err = model_file::from_bytes(&older).unwrap_err();
         assert!(
-            matches!(err, RegressError::UnsupportedVersion { found, supported: 6 } if found == v)
+            matches!(err, RegressError::UnsupportedVersion { found, supported: 7 } if found == v)
         );
         assert!(err.to_string().contains("retrain"), "{err}");
     }

@@ -145,7 +145,7 @@ fn evaluate_one(seq: &Sequence, model: &Cascade, opts: &EvalOptions) -> Result<E
     let mut methods = BTreeMap::new();
     let mut traced = Vec::new();
     for &m in &opts.methods {
-        let est = trajectory(m, seq, &regressions, opts.track.correction)?;
+        let est = trajectory(m, seq, &regressions, opts.track.correction_for(model))?;
         let e = evaluate_trajectory(seq.time(), &est, &gt2, &opts.metrics)?;
         methods.insert(m.key().to_string(), e.metrics);
         traced.push((m, e.aligned));

@@ -1,6 +1,7 @@
 //! What `ridi inspect` reports about a sequence.
 
 use ridi_data::{Format, Sequence};
+use ridi_frames::UpAxis;
 use serde::Serialize;
 
 /// Summary statistics of a scalar series.
@@ -66,6 +67,9 @@ pub struct Inspection {
     pub orientation_source: Option<String>,
     /// Gravity magnitude, m/s^2.
     pub gravity_norm: Stats,
+    /// Fraction of frames with the phone upside down (gravity's cosine with device +y below
+    /// [`UpAxis::FLIP_COSINE`]), where the paper's S is ill-conditioned.
+    pub upside_down_fraction: f64,
     /// Accelerometer magnitude, m/s^2.
     pub acce_norm: Stats,
     /// Whether a magnetometer stream is present.
@@ -84,6 +88,12 @@ pub struct Inspection {
 /// Inspects `seq`, read as `format`.
 pub fn inspect(seq: &Sequence, format: Format) -> Inspection {
     let gravity_norm = Stats::of(seq.gravity().iter().map(|g| g.norm()));
+    let upside_down = seq
+        .gravity()
+        .iter()
+        .filter(|g| g.y() < UpAxis::FLIP_COSINE * g.norm())
+        .count();
+    let upside_down_fraction = upside_down as f64 / seq.len().max(1) as f64;
     let acce_norm = Stats::of(seq.acce().iter().map(|a| a.norm()));
     let rate_hz = seq.rate_hz();
     let max_gap_s = seq.max_gap();
@@ -112,6 +122,13 @@ pub fn inspect(seq: &Sequence, format: Format) -> Inspection {
             acce_norm.mean, gravity_norm.mean
         ));
     }
+    if upside_down_fraction > 0.01 {
+        warnings.push(format!(
+            "phone upside down in {:.0} % of frames: train with the default \
+             `--up-axis plus-or-minus-y`, the paper's S (`plus-y`) turns erratically there",
+            100.0 * upside_down_fraction
+        ));
+    }
     if seq.duration() < 10.0 {
         warnings.push("shorter than 10 s: too short for the paper's alignment".into());
     }
@@ -128,6 +145,7 @@ pub fn inspect(seq: &Sequence, format: Format) -> Inspection {
         max_gap_s,
         orientation_source: seq.orientation_source().map(|s| s.to_string()),
         gravity_norm,
+        upside_down_fraction,
         acce_norm,
         has_magnet: seq.magnet().is_some(),
         has_steps: seq.steps().is_some(),
@@ -170,6 +188,11 @@ impl std::fmt::Display for Inspection {
             f,
             "|gravity|:    mean {:.4}, std {:.4}, min {:.4}, max {:.4} m/s^2",
             g.mean, g.std, g.min, g.max
+        )?;
+        writeln!(
+            f,
+            "upside down:  {:.1} % of frames",
+            100.0 * self.upside_down_fraction
         )?;
         let a = &self.acce_norm;
         writeln!(

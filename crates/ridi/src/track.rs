@@ -20,7 +20,8 @@ use crate::train::imu_view;
 pub struct TrackOptions {
     /// Frames between regressions (paper: 50, the residual frames of the correction).
     pub regress_every: usize,
-    /// The correction objective (knots, lambda, weights, initial velocity).
+    /// The correction objective (knots, lambda, weights, initial velocity). Its `up_axis` is
+    /// replaced by the model's: see [`TrackOptions::correction_for`].
     pub correction: CorrectionConfig,
     /// Streaming mode (paper's online variant): a 1000-frame window corrected every 200
     /// frames, each frame's pose as known when it arrived. Otherwise one global correction.
@@ -38,6 +39,19 @@ impl Default for TrackOptions {
             correction: CorrectionConfig::default(),
             online: false,
             placement_smoothing: Some(PlacementSmoother::default()),
+        }
+    }
+}
+
+impl TrackOptions {
+    /// The correction of `model`'s regressions: [`TrackOptions::correction`] with the S its
+    /// velocities are expressed in (the model's [`FeatureConfig::up_axis`]).
+    ///
+    /// [`FeatureConfig::up_axis`]: ridi_features::FeatureConfig::up_axis
+    pub fn correction_for(&self, model: &Cascade) -> CorrectionConfig {
+        CorrectionConfig {
+            up_axis: model.feature_config().up_axis,
+            ..self.correction
         }
     }
 }
@@ -207,7 +221,12 @@ pub fn track(seq: &Sequence, model: &Cascade, opts: &TrackOptions) -> Result<Tra
         return track_online(seq, model, opts);
     }
     let regressions = regress(seq, model, opts)?;
-    correct_with(seq, &regressions, opts.correction, model.placements())
+    correct_with(
+        seq,
+        &regressions,
+        opts.correction_for(model),
+        model.placements(),
+    )
 }
 
 /// The cascade as the streaming tracker's regressor: features of the latest window, one query.
@@ -275,7 +294,7 @@ impl VelocityRegressor for CascadeRegressor<'_> {
 
 fn track_online(seq: &Sequence, model: &Cascade, opts: &TrackOptions) -> Result<Track> {
     let config = TrackerConfig {
-        correction: opts.correction,
+        correction: opts.correction_for(model),
         regress_every: opts.regress_every,
         ..TrackerConfig::default()
     };

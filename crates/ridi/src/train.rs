@@ -8,6 +8,7 @@ use ridi_features::{
     FeatureConfig, FeatureExtractor, FeatureMatrix, GroundTruthView, ImuView, SampleSchedule,
     Standardization, compute_targets,
 };
+use ridi_frames::UpAxis;
 use ridi_regress::{
     Cascade, CascadeParams, GridSpec, MatrixRef, Progress, RegressorChoice, TrainingSet,
 };
@@ -47,9 +48,10 @@ impl GridChoice {
 /// How to train. [`Default`] is the paper's method (features, cascade, paper grid) with
 /// additions measured on the Tyrex leave-one-subject-out protocol (docs/bench-accuracy.md):
 /// one turned copy of each training window, taken every [`default_step`]`(1)` = 20 frames
-/// instead of 10 (so the rows, and the training time, stay the paper's), and a speed regressor
-/// per placement. Set `turned_copies: 0`, `features.step: 10` and `cascade.speed: false` for
-/// the paper exactly.
+/// instead of 10 (so the rows, and the training time, stay the paper's), a speed regressor
+/// per placement, and S built on device -y while the phone is upside down
+/// ([`UpAxis::PlusOrMinusY`]). Set `turned_copies: 0`, `features.step: 10`,
+/// `features.up_axis: UpAxis::PlusY` and `cascade.speed: false` for the paper exactly.
 #[derive(Debug, Clone, PartialEq)]
 pub struct TrainOptions {
     /// Feature configuration (its `standardization` is filled in when `standardize` is set).
@@ -76,6 +78,7 @@ impl Default for TrainOptions {
         Self {
             features: FeatureConfig {
                 step: default_step(1),
+                up_axis: UpAxis::PlusOrMinusY,
                 ..FeatureConfig::default()
             },
             standardize: true,

@@ -3,6 +3,8 @@
 use std::path::{Path, PathBuf};
 
 use ridi::data::{ReadOptions, Sequence, load_list};
+use ridi::frames::nalgebra::Vector3;
+use ridi::frames::{DeviceVec, Rot, UpAxis};
 use ridi::regress::{NoProgress, model_file};
 use ridi::{EvalOptions, GridChoice, Method, PlacementMap, TrackOptions, TrainOptions};
 
@@ -274,4 +276,57 @@ fn turned_copies_repeat_labels_and_groups_and_keep_speeds() {
             .all(|(a, b)| a == b)
     );
     assert_eq!(data.clone().with_turned_copies(0).unwrap(), data);
+}
+
+#[test]
+fn a_phone_carried_top_down_is_tracked_like_the_upright_one() {
+    // The default model builds S on device -y while the phone is upside down. Turning a
+    // recording top down about the screen normal (device x and y negated, orientation turned
+    // with them) must then change neither regressions nor the track, batch or streaming.
+    let model = quick_model(&load("list_Guillaume.txt"));
+    assert_eq!(model.feature_config().up_axis, UpAxis::PlusOrMinusY);
+    let upright = load("list_Jakob.txt").swap_remove(1);
+    assert_eq!(upright.name(), "Jakob_Nexus5_NoDist_BackPocket");
+    let turn = |v: &Vec<DeviceVec>| -> Vec<DeviceVec> {
+        v.iter()
+            .map(|v| DeviceVec::new(-v.x(), -v.y(), v.z()))
+            .collect()
+    };
+    let half_turn = Rot::from_axis_angle(&Vector3::z_axis(), std::f64::consts::PI);
+    let mut parts = upright.parts().clone();
+    parts.gyro = turn(&parts.gyro);
+    parts.acce = turn(&parts.acce);
+    parts.linacce = turn(&parts.linacce);
+    parts.gravity = turn(&parts.gravity);
+    parts.magnet = parts.magnet.as_ref().map(turn);
+    for q in &mut parts.orientation {
+        *q = *q * half_turn;
+    }
+    let top_down = Sequence::new(parts).unwrap();
+    assert!(
+        top_down
+            .gravity()
+            .iter()
+            .all(|g| g.y() < UpAxis::FLIP_COSINE * g.norm())
+    );
+    for online in [false, true] {
+        let opts = TrackOptions {
+            online,
+            ..TrackOptions::default()
+        };
+        let a = ridi::track(&upright, &model, &opts).unwrap();
+        let b = ridi::track(&top_down, &model, &opts).unwrap();
+        for (x, y) in a.regressions.iter().zip(&b.regressions) {
+            assert_eq!(x.placement, y.placement, "online {online}");
+            let d = (x.velocity[0] - y.velocity[0]).hypot(x.velocity[1] - y.velocity[1]);
+            assert!(d < 1e-3, "online {online}: {x:?} vs {y:?}");
+        }
+        let gap = a
+            .position
+            .iter()
+            .zip(&b.position)
+            .map(|(p, q)| (*p - *q).norm())
+            .fold(0.0, f64::max);
+        assert!(gap < 0.01, "online {online}: tracks {gap} m apart");
+    }
 }
