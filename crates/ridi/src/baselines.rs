@@ -19,7 +19,7 @@ use std::str::FromStr;
 use ridi_correct::{CorrectionConfig, integrate, world_acceleration};
 use ridi_data::Sequence;
 use ridi_eval::{StepDetectorConfig, detect_steps, pdr_trajectory};
-use ridi_frames::{StabVec, WorldVec, stab_from_world};
+use ridi_frames::{StabVec, UpAxis, WorldVec};
 use serde::{Deserialize, Serialize};
 
 use crate::error::{PipelineError, Result};
@@ -100,14 +100,15 @@ impl FromStr for Method {
 }
 
 /// Heading (yaw, radians counter-clockwise from world +x) of the device's forward direction,
-/// S -z, at every frame.
+/// S -z, at every frame. S is built on device -y while the phone is upside down
+/// ([`UpAxis::PlusOrMinusY`]), where the paper's S, and so its yaw, turns erratically.
 pub fn device_heading(seq: &Sequence) -> Vec<f64> {
     let forward = StabVec::new(0.0, 0.0, -1.0);
     seq.orientation()
         .iter()
         .zip(seq.gravity())
         .map(|(&q, &g)| {
-            let f: WorldVec = stab_from_world(q, g).inverse() * forward;
+            let f: WorldVec = UpAxis::PlusOrMinusY.stab_from_world(q, g).inverse() * forward;
             f.y().atan2(f.x())
         })
         .collect()

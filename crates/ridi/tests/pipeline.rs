@@ -309,6 +309,16 @@ fn a_phone_carried_top_down_is_tracked_like_the_upright_one() {
             .iter()
             .all(|g| g.y() < UpAxis::FLIP_COSINE * g.norm())
     );
+    // PDR's heading too.
+    let (a, b) = (
+        ridi::baselines::device_heading(&upright),
+        ridi::baselines::device_heading(&top_down),
+    );
+    for (x, y) in a.iter().zip(&b) {
+        let d =
+            (x - y + std::f64::consts::PI).rem_euclid(std::f64::consts::TAU) - std::f64::consts::PI;
+        assert!(d.abs() < 1e-9, "heading {x} vs {y}");
+    }
     for online in [false, true] {
         let opts = TrackOptions {
             online,
