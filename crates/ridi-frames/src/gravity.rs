@@ -86,7 +86,7 @@ impl UpAxis {
     /// For [`UpAxis::PlusOrMinusY`] and an upside-down phone: a half turn about device z,
     /// which swaps +y and -y (and +x and -x), then [`align_gravity`]. An upside-down phone
     /// thus gets the S it would have had upright with the same face towards the walker: S-x
-    /// is then device -x. The switch is a jump in S's heading; only a window in which the
+    /// then follows device -x. The switch is a jump in S's heading; only a window in which the
     /// phone turns over sees it.
     pub fn align(self, gravity: DeviceVec) -> StabFromDevice {
         if self == UpAxis::PlusOrMinusY && upside_down(gravity) {

@@ -53,6 +53,14 @@
 //! let v_s = stab_from_world(q, g) * v_w;
 //! assert!((v_s.norm() - 1.0).abs() < 1e-12);
 //!
+//! // A phone held top down: the paper's S is ill-conditioned there, so PlusOrMinusY builds S
+//! // on device -y; gravity still lands on S-up.
+//! use ridi_frames::UpAxis;
+//! let top_down = DeviceVec::new(0.01, -9.8, 0.02);
+//! let up = UpAxis::PlusOrMinusY.align(top_down) * (top_down / top_down.norm());
+//! assert!((up - UP_S).norm() < 1e-12);
+//! assert_ne!(UpAxis::PlusOrMinusY.align(top_down), align_gravity(top_down));
+//!
 //! // A still phone tilted by 0.3 rad: the filter's tilt matches, heading starts at 0.
 //! use ridi_frames::{estimate_orientation, gravity_in_device, tilt_error, FilterConfig};
 //! let truth = WorldFromDevice::from_scaled_axis([0.3, 0.0, 0.0].into());
