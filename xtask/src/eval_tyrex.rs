@@ -24,7 +24,10 @@ use ridi::frames::UpAxis;
 use ridi::regress::{Cascade, Gamma, NoProgress};
 use ridi::track::Regressed;
 use ridi::train::ground_truth_view;
-use ridi::{EvalOptions, GridChoice, Orientation, PlacementMap, TrackOptions, TrainOptions};
+use ridi::{
+    EvalOptions, GridChoice, Orientation, PlacementMap, TrackOptions, TrainOptions,
+    apply_orientation,
+};
 
 const PEOPLE: [&str; 3] = ["Guillaume", "Jakob", "Thibaud"];
 
@@ -274,7 +277,7 @@ fn oracle_rte(seq: &Sequence, opts: &EvalOptions) -> Result<f64> {
 fn prepare(all: &[Sequence], v: &Variant) -> Result<Vec<Sequence>> {
     let mut seqs = all.to_vec();
     if v.estimated_orientation {
-        Orientation::Estimated.apply(&mut seqs)?;
+        apply_orientation(Orientation::Estimated, &mut seqs)?;
     }
     if v.groups {
         PlacementMap::tyrex_groups().apply(&mut seqs);
@@ -295,6 +298,9 @@ fn train_folds(seqs: &[Sequence], v: &Variant) -> Result<(Vec<Cascade>, f64)> {
     opts.cascade.speed = v.speed;
     opts.features.step = v.step;
     opts.features.up_axis = v.up_axis;
+    if v.estimated_orientation {
+        opts.features.orientation = Orientation::Estimated;
+    }
     let started = Instant::now();
     let models = PEOPLE
         .iter()

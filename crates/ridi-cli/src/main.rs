@@ -15,6 +15,7 @@ use ridi::frames::UpAxis;
 use ridi::regress::{Cascade, ProgressEvent, Stage, Storage, StoredAs, model_file};
 use ridi::{
     EvalOptions, GridChoice, Method, Orientation, PlacementMap, TrackOptions, TrainOptions,
+    apply_orientation,
 };
 
 #[derive(Parser)]
@@ -89,8 +90,9 @@ enum Command {
         /// Classifier C (paper: 10).
         #[arg(long, default_value_t = 10.0)]
         classifier_c: f64,
-        /// Orientation to track with: as recorded, or estimated from gyro + accelerometer
-        /// (straighter tracks where the recorded one uses the magnetometer indoors).
+        /// Orientation to train and track with: as recorded, or estimated from gyro +
+        /// accelerometer (straighter tracks where the recorded one uses the magnetometer
+        /// indoors). The model records it: `ridi track` and `ridi eval` use the same.
         #[arg(long, value_enum, default_value = "recorded")]
         orientation: OrientationArg,
         /// How the model stores its samples for prediction.
@@ -155,10 +157,6 @@ enum Command {
         /// window's own label, as in the paper.
         #[arg(long, value_name = "SECONDS", default_value_t = 10.0)]
         placement_window: f64,
-        /// Orientation to track with: as recorded, or estimated from gyro + accelerometer
-        /// (straighter tracks where the recorded one uses the magnetometer indoors).
-        #[arg(long, value_enum, default_value = "recorded")]
-        orientation: OrientationArg,
     },
     /// Evaluate RIDI and the baselines on labelled recordings: report.json, report.md, plots.
     #[command(after_help = "Examples:\n  \
@@ -197,10 +195,6 @@ enum Command {
         /// window's own label, as in the paper.
         #[arg(long, value_name = "SECONDS", default_value_t = 10.0)]
         placement_window: f64,
-        /// Orientation to track with: as recorded, or estimated from gyro + accelerometer
-        /// (straighter tracks where the recorded one uses the magnetometer indoors).
-        #[arg(long, value_enum, default_value = "recorded")]
-        orientation: OrientationArg,
     },
     /// Train on the bundled sample (two people) and evaluate on the held-out person.
     #[command(after_help = "Example:\n  ridi demo --out demo-out\n\n\
@@ -378,13 +372,14 @@ fn run(cli: Cli) -> Result<()> {
             up_axis,
         } => {
             set_jobs(jobs)?;
-            let seqs = load_lists(&list, placement_map.as_deref(), orientation.into())?;
+            let seqs = load_lists(&list, placement_map.as_deref())?;
             let mut opts = TrainOptions {
                 standardize: !no_standardize,
                 turned_copies,
                 features: FeatureConfig {
                     step: step.unwrap_or(ridi::train::default_step(turned_copies)),
                     up_axis: up_axis.into(),
+                    orientation: orientation.into(),
                     ..FeatureConfig::default()
                 },
                 ..TrainOptions::default()
@@ -409,14 +404,14 @@ fn run(cli: Cli) -> Result<()> {
             lambda,
             estimate_initial_velocity,
             placement_window,
-            orientation,
         } => {
             let model = load_model(&model)?;
             let mut loaded = ridi::read_any(&sequence, None, &ReadOptions::default())?;
             for w in &loaded.warnings {
                 eprintln!("warning: {w}");
             }
-            Orientation::from(orientation).apply(&mut loaded.sequences)?;
+            // The model's orientation, once, so that the plot shows what was tracked.
+            apply_orientation(model.feature_config().orientation, &mut loaded.sequences)?;
             let [seq] = &loaded.sequences[..] else {
                 bail!(
                     "{} holds {} sequences; convert it with `ridi convert` and track each",
@@ -457,11 +452,10 @@ fn run(cli: Cli) -> Result<()> {
             plots,
             jobs,
             placement_window,
-            orientation,
         } => {
             set_jobs(jobs)?;
             let model = load_model(&model)?;
-            let seqs = load_lists(&list, placement_map.as_deref(), orientation.into())?;
+            let seqs = load_lists(&list, placement_map.as_deref())?;
             let methods = methods
                 .iter()
                 .map(|m| m.parse::<Method>().map_err(anyhow::Error::msg))
@@ -500,16 +494,11 @@ fn set_jobs(jobs: Option<usize>) -> Result<()> {
     Ok(())
 }
 
-fn load_lists(
-    lists: &[PathBuf],
-    map: Option<&str>,
-    orientation: Orientation,
-) -> Result<Vec<Sequence>> {
+fn load_lists(lists: &[PathBuf], map: Option<&str>) -> Result<Vec<Sequence>> {
     let mut seqs = Vec::new();
     for l in lists {
         seqs.extend(ridi::data::load_list(l, &ReadOptions::default())?);
     }
-    orientation.apply(&mut seqs)?;
     if let Some(map) = map {
         PlacementMap::from_arg(map)?.apply(&mut seqs);
     }
@@ -555,6 +544,11 @@ fn print_training(model: &Cascade) {
         UpAxis::PlusOrMinusY => "device +y, or -y while upside down",
     };
     println!("stabilized frame S built on: {up}");
+    let orientation = match model.feature_config().orientation {
+        Orientation::Recorded => "as recorded",
+        Orientation::Estimated => "estimated from gyro + accelerometer",
+    };
+    println!("orientation: {orientation} (track and eval use the same)");
     match model.stored_as() {
         StoredAs::Half => println!("samples stored: {} values in half precision", model.dim()),
         StoredAs::Projected { components, energy } => println!(
@@ -717,8 +711,8 @@ fn demo(out: &Path, data: Option<PathBuf>, grid: Grid, plots: Plots) -> Result<(
         );
     }
     let map = Some("tyrex4");
-    let train = load_lists(&[train_list], map, Orientation::Recorded)?;
-    let test = load_lists(&[data.join("list_test.txt")], map, Orientation::Recorded)?;
+    let train = load_lists(&[train_list], map)?;
+    let test = load_lists(&[data.join("list_test.txt")], map)?;
     println!(
         "demo: training on {} sequences ({:.0} s), testing on {} held-out sequences",
         train.len(),

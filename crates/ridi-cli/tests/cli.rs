@@ -3,6 +3,8 @@
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
+use ridi::frames::UpAxis;
+
 fn ridi(args: &[&str]) -> Output {
     Command::new(env!("CARGO_BIN_EXE_ridi"))
         .args(args)
@@ -124,19 +126,20 @@ fn convert_train_track_and_eval() {
         "--turned-copies",
         "0",
         "--no-speed",
+        "--up-axis",
+        "plus-y",
     ]);
     assert!(out.status.success(), "{}", stderr(&out));
     let printed = String::from_utf8_lossy(&out.stdout);
     assert!(!printed.contains("speed:"), "{printed}");
+    assert!(printed.contains("S built on: device +y\n"), "{printed}");
+    assert!(printed.contains("orientation: as recorded"), "{printed}");
     let paper_model = ridi::regress::model_file::load(&paper).unwrap();
+    let default_model = ridi::regress::model_file::load(&model).unwrap();
     assert_eq!(paper_model.feature_config().step, 10);
-    assert_eq!(
-        ridi::regress::model_file::load(&model)
-            .unwrap()
-            .feature_config()
-            .step,
-        20
-    );
+    assert_eq!(default_model.feature_config().step, 20);
+    assert_eq!(paper_model.feature_config().up_axis, UpAxis::PlusY);
+    assert_eq!(default_model.feature_config().up_axis, UpAxis::PlusOrMinusY);
 
     let csv = dir.path().join("t.csv");
     let png = dir.path().join("t.png");
@@ -202,8 +205,8 @@ fn convert_train_track_and_eval() {
         stderr(&out)
     );
 
-    // The placement majority window: off with 0, refused when negative. The estimated
-    // orientation gives another trajectory from the same regressions' inputs.
+    // The placement majority window: off with 0, refused when negative. The orientation is
+    // the model's: track no longer takes --orientation.
     let plain = dir.path().join("plain.csv");
     let track_plain = |extra: &[&str]| {
         let mut args = vec![
@@ -217,11 +220,14 @@ fn convert_train_track_and_eval() {
         args.extend_from_slice(extra);
         ridi(&args)
     };
-    let out = track_plain(&["--placement-window", "0", "--orientation", "estimated"]);
+    let out = track_plain(&["--placement-window", "0"]);
     assert!(out.status.success(), "{}", stderr(&out));
-    let estimated = std::fs::read_to_string(&plain).unwrap();
-    assert_eq!(estimated.lines().count(), 4801);
-    assert_ne!(estimated, std::fs::read_to_string(&csv).unwrap());
+    let unsmoothed = std::fs::read_to_string(&plain).unwrap();
+    assert_eq!(unsmoothed.lines().count(), 4801);
+    assert_ne!(unsmoothed, std::fs::read_to_string(&csv).unwrap());
+    let out = track_plain(&["--orientation", "estimated"]);
+    assert!(!out.status.success());
+    assert!(stderr(&out).contains("--orientation"), "{}", stderr(&out));
     let out = track_plain(&["--placement-window=-1"]);
     assert!(!out.status.success());
     assert!(

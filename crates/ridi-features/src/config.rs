@@ -17,6 +17,20 @@ pub enum Channel {
     LinearAcceleration,
 }
 
+/// Which device orientation the inputs of a feature come from. Gravity, and so S and the linear
+/// acceleration, follow the orientation, so a model must see at test time what it was trained
+/// on. Extraction takes the streams it is given; the pipeline (the `ridi` crate) prepares them.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Orientation {
+    /// As recorded (RIDI: Tango or game rotation vector; Tyrex: Android rotation vector).
+    #[default]
+    Recorded,
+    /// Estimated from gyro and accelerometer (`ridi_frames::estimate_orientation`, default
+    /// filter), with gravity and linear acceleration derived from it.
+    Estimated,
+}
+
 /// Everything that determines a feature vector and a target, so that tracking computes exactly
 /// the features a model was trained on. [`Default`] is the paper's setting.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -40,6 +54,9 @@ pub struct FeatureConfig {
     /// ([`UpAxis::PlusY`] in the original RIDI).
     #[serde(default)]
     pub up_axis: UpAxis,
+    /// The orientation the inputs come from ([`Orientation::Recorded`] in the original RIDI).
+    #[serde(default)]
+    pub orientation: Orientation,
 }
 
 impl Default for FeatureConfig {
@@ -53,6 +70,7 @@ impl Default for FeatureConfig {
             truncate: 4.0,
             standardization: None,
             up_axis: UpAxis::PlusY,
+            orientation: Orientation::Recorded,
         }
     }
 }

@@ -22,6 +22,7 @@ use serde::Serialize;
 
 use crate::baselines::{Method, trajectory};
 use crate::error::{PipelineError, Result};
+use crate::orientation::oriented;
 use crate::track::{Regressed, TrackOptions, regress};
 use crate::train::ground_truth_view;
 
@@ -109,6 +110,9 @@ struct Evaluated {
 }
 
 fn evaluate_one(seq: &Sequence, model: &Cascade, opts: &EvalOptions) -> Result<Evaluated> {
+    // Baselines see the same orientation as the model.
+    let seq = oriented(seq, model.feature_config().orientation)?;
+    let seq = seq.as_ref();
     let gt = seq
         .ground_truth()
         .ok_or_else(|| PipelineError::sequence(seq.name(), "has no ground truth to evaluate"))?;

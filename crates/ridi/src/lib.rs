@@ -37,7 +37,7 @@ pub mod train;
 pub use baselines::Method;
 pub use error::{PipelineError, Result};
 pub use evaluate::{EvalOptions, Report, evaluate};
-pub use orientation::Orientation;
+pub use orientation::{Orientation, apply_orientation, oriented};
 pub use placement::PlacementMap;
 pub use source::{Loaded, read_any};
 pub use track::{Track, TrackOptions, track};

@@ -7,21 +7,14 @@
 //! magnetometer. The choice also replaces gravity and linear acceleration, so that the three
 //! stay consistent.
 
+use std::borrow::Cow;
+
 use ridi_data::{OrientationSource, Sequence};
 use ridi_frames::{FilterConfig, STANDARD_GRAVITY, estimate_orientation, gravity_in_device};
-use serde::{Deserialize, Serialize};
 
 use crate::error::{PipelineError, Result};
 
-/// Orientation used for features, correction and integration.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
-pub enum Orientation {
-    /// As recorded (RIDI: Tango or game rotation vector; Tyrex: Android rotation vector).
-    #[default]
-    Recorded,
-    /// Gyro + accelerometer complementary filter with default settings.
-    Estimated,
-}
+pub use ridi_features::Orientation;
 
 /// `seq` with its orientation replaced by a gyro + accelerometer estimate, gravity by the
 /// estimate's gravity (standard magnitude) and linear acceleration by accelerometer minus that
@@ -48,19 +41,44 @@ pub fn with_estimated_orientation(seq: &Sequence, filter: &FilterConfig) -> Resu
     Sequence::new(p).map_err(|e| PipelineError::sequence(seq.name(), e.to_string()))
 }
 
-impl Orientation {
-    /// Applies the choice to every sequence in place.
-    ///
-    /// # Errors
-    /// As [`with_estimated_orientation`].
-    pub fn apply(self, seqs: &mut [Sequence]) -> Result<()> {
-        if self == Orientation::Estimated {
-            for s in seqs.iter_mut() {
-                *s = with_estimated_orientation(s, &FilterConfig::default())?;
-            }
-        }
-        Ok(())
+/// `seq` with the orientation `choice` asks for: `seq` itself when it has it already (a recorded
+/// one, or one estimated before), else a copy with the estimate swapped in.
+///
+/// Models record the orientation they were trained with
+/// ([`FeatureConfig::orientation`](ridi_features::FeatureConfig::orientation)); training,
+/// tracking and evaluation pass their sequences through this, so that a model never sees the
+/// other orientation's gravity.
+///
+/// # Errors
+/// [`Orientation::Recorded`] for a sequence whose orientation was already replaced by an
+/// estimate (the recorded one is gone), and as [`with_estimated_orientation`].
+pub fn oriented(seq: &Sequence, choice: Orientation) -> Result<Cow<'_, Sequence>> {
+    let estimated = seq.orientation_source() == Some(OrientationSource::Estimated);
+    match (choice, estimated) {
+        (Orientation::Recorded, false) | (Orientation::Estimated, true) => Ok(Cow::Borrowed(seq)),
+        (Orientation::Estimated, false) => Ok(Cow::Owned(with_estimated_orientation(
+            seq,
+            &FilterConfig::default(),
+        )?)),
+        (Orientation::Recorded, true) => Err(PipelineError::sequence(
+            seq.name(),
+            "carries an orientation estimated from gyro and accelerometer, but the model or \
+             training options expect the recorded one (train with --orientation estimated)",
+        )),
     }
+}
+
+/// [`oriented`] for every sequence, in place.
+///
+/// # Errors
+/// As [`oriented`].
+pub fn apply_orientation(choice: Orientation, seqs: &mut [Sequence]) -> Result<()> {
+    for s in seqs.iter_mut() {
+        if let Cow::Owned(o) = oriented(s, choice)? {
+            *s = o;
+        }
+    }
+    Ok(())
 }
 
 #[cfg(test)]
@@ -75,9 +93,9 @@ mod tests {
         let mut seqs = load_list(&list, &ReadOptions::default()).unwrap();
         seqs.truncate(1);
         let before = seqs[0].clone();
-        Orientation::Recorded.apply(&mut seqs).unwrap();
+        apply_orientation(Orientation::Recorded, &mut seqs).unwrap();
         assert_eq!(seqs[0], before);
-        Orientation::Estimated.apply(&mut seqs).unwrap();
+        apply_orientation(Orientation::Estimated, &mut seqs).unwrap();
         let after = &seqs[0];
         assert_eq!(
             after.orientation_source(),
@@ -103,6 +121,18 @@ mod tests {
             cos > 10f64.to_radians().cos(),
             "tilt differs by {} deg",
             cos.acos().to_degrees()
+        );
+        // Estimated twice is estimated once; the recorded orientation cannot be asked back.
+        assert!(matches!(
+            oriented(after, Orientation::Estimated),
+            Ok(Cow::Borrowed(_))
+        ));
+        let err = oriented(after, Orientation::Recorded)
+            .unwrap_err()
+            .to_string();
+        assert!(
+            err.contains(after.name()) && err.contains("recorded"),
+            "{err}"
         );
     }
 }

@@ -13,6 +13,7 @@ use ridi_regress::{Cascade, MatrixRef};
 use serde::{Deserialize, Serialize};
 
 use crate::error::{PipelineError, Result};
+use crate::orientation::oriented;
 use crate::train::imu_view;
 
 /// How to track.
@@ -134,7 +135,10 @@ impl Track {
 
 /// Regresses placement and velocity every `opts.regress_every` frames from the first full
 /// window, in one batched pass, then smooths the placements if `opts.placement_smoothing` asks.
+/// `seq` is first given the model's orientation ([`oriented`]).
 pub fn regress(seq: &Sequence, model: &Cascade, opts: &TrackOptions) -> Result<Vec<Regressed>> {
+    let seq = oriented(seq, model.feature_config().orientation)?;
+    let seq = seq.as_ref();
     let fx = FeatureExtractor::new(model.feature_config().clone())?;
     let frames = SampleSchedule::every(fx.config(), opts.regress_every)?.frames(seq.len());
     if frames.is_empty() {
@@ -215,8 +219,10 @@ pub fn correct_with(
     })
 }
 
-/// Tracks `seq` with `model`.
+/// Tracks `seq` with `model`, in the orientation the model was trained with ([`oriented`]).
 pub fn track(seq: &Sequence, model: &Cascade, opts: &TrackOptions) -> Result<Track> {
+    let seq = oriented(seq, model.feature_config().orientation)?;
+    let seq = seq.as_ref();
     if opts.online {
         return track_online(seq, model, opts);
     }

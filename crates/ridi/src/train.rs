@@ -15,6 +15,7 @@ use ridi_regress::{
 use serde::{Deserialize, Serialize};
 
 use crate::error::{PipelineError, Result};
+use crate::orientation::oriented;
 
 /// Which regressor hyper-parameters to search.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
@@ -170,6 +171,8 @@ pub fn training_data(seqs: &[Sequence], config: &FeatureConfig) -> Result<Traini
     let per_seq: Vec<(FeatureMatrix, Vec<[f32; 2]>)> = seqs
         .par_iter()
         .map(|s| {
+            let s = oriented(s, config.orientation)?;
+            let s = s.as_ref();
             let frames = schedule.frames(s.len());
             let features = fx.features(&fx.stabilize(&imu_view(s)?)?, &frames)?;
             let targets = compute_targets(&ground_truth_view(s)?, &config, &frames)?;

@@ -6,7 +6,10 @@ use ridi::data::{ReadOptions, Sequence, load_list};
 use ridi::frames::nalgebra::Vector3;
 use ridi::frames::{DeviceVec, Rot, UpAxis};
 use ridi::regress::{NoProgress, model_file};
-use ridi::{EvalOptions, GridChoice, Method, PlacementMap, TrackOptions, TrainOptions};
+use ridi::{
+    EvalOptions, GridChoice, Method, Orientation, PlacementMap, TrackOptions, TrainOptions,
+    apply_orientation,
+};
 
 fn sample() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("../../datasets/sample")
@@ -339,4 +342,32 @@ fn a_phone_carried_top_down_is_tracked_like_the_upright_one() {
             .fold(0.0, f64::max);
         assert!(gap < 0.01, "online {online}: tracks {gap} m apart");
     }
+}
+
+#[test]
+fn a_model_tracks_in_the_orientation_it_was_trained_with() {
+    let train = load("list_Guillaume.txt");
+    let mut opts = TrainOptions::default();
+    opts.cascade.regressors = GridChoice::None.regressors();
+    opts.features.orientation = Orientation::Estimated;
+    let model = ridi::train(&train, &opts, &mut NoProgress).unwrap();
+    assert_eq!(model.feature_config().orientation, Orientation::Estimated);
+    // A recorded sequence is tracked with the estimate swapped in, exactly as one whose
+    // orientation was estimated before.
+    let seq = load("list_Jakob.txt").swap_remove(7);
+    let mut pre = vec![seq.clone()];
+    apply_orientation(Orientation::Estimated, &mut pre).unwrap();
+    let a = ridi::track(&seq, &model, &TrackOptions::default()).unwrap();
+    let b = ridi::track(&pre[0], &model, &TrackOptions::default()).unwrap();
+    assert_eq!(a.position, b.position);
+    let (report, _) = ridi::evaluate(&pre, &model, &EvalOptions::default()).unwrap();
+    assert!(report.summary["ridi"].rte_5s_m.is_finite());
+    // Recorded training options on an estimated sequence: an error naming it.
+    let err = ridi::train(&pre, &TrainOptions::default(), &mut NoProgress)
+        .unwrap_err()
+        .to_string();
+    assert!(
+        err.contains(seq.name()) && err.contains("recorded"),
+        "{err}"
+    );
 }
