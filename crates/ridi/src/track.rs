@@ -236,6 +236,13 @@ pub fn track(seq: &Sequence, model: &Cascade, opts: &TrackOptions) -> Result<Tra
 }
 
 /// The cascade as the streaming tracker's regressor: features of the latest window, one query.
+///
+/// The frames pushed must carry the orientation the model was trained with
+/// ([`FeatureConfig::orientation`](ridi_features::FeatureConfig::orientation)): [`track`] sees
+/// to that for a whole sequence; a live caller with an `Estimated` model runs the estimator on
+/// its stream first (`ridi_frames::estimate_orientation_from`, chunk by chunk from the last
+/// state) and derives gravity and linear acceleration from it as
+/// [`with_estimated_orientation`](crate::orientation::with_estimated_orientation) does.
 pub struct CascadeRegressor<'m> {
     model: &'m Cascade,
     extractor: FeatureExtractor,
