@@ -193,7 +193,8 @@ pub(crate) fn imu_slices(seq: &Sequence) -> ridi_correct::ImuSlices<'_> {
 }
 
 /// Corrects and integrates `seq` so that its velocity follows `regressions` (batch: one
-/// global solve).
+/// global solve). `seq` must carry the orientation of the model that regressed them
+/// ([`oriented`]), `config` the model's S ([`TrackOptions::correction_for`]).
 pub fn correct_with(
     seq: &Sequence,
     regressions: &[Regressed],
