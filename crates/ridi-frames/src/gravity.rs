@@ -89,7 +89,7 @@ impl UpAxis {
     /// then follows device -x. The switch is a jump in S's heading; only a window in which the
     /// phone turns over sees it.
     pub fn align(self, gravity: DeviceVec) -> StabFromDevice {
-        if self == UpAxis::PlusOrMinusY && upside_down(gravity) {
+        if self == UpAxis::PlusOrMinusY && Self::is_upside_down(gravity) {
             let g = gravity.vector();
             let half_turn_z =
                 Rot::<Device, Device>::from_axis_angle(&Vector3::z_axis(), std::f64::consts::PI);
@@ -97,6 +97,14 @@ impl UpAxis {
         } else {
             align_gravity(gravity)
         }
+    }
+
+    /// `true` when gravity (device frame, pointing up) is further than the flip threshold from
+    /// device +y ([`UpAxis::FLIP_COSINE`]): where [`UpAxis::PlusOrMinusY`] builds S on -y.
+    /// `false` for a zero or non-finite gravity, which [`align_gravity`] maps to the identity.
+    pub fn is_upside_down(gravity: DeviceVec) -> bool {
+        let g = gravity.vector();
+        g.y < Self::FLIP_COSINE * g.norm()
     }
 
     /// World-to-S rotation of one frame: `align(g) * q*` with this axis's [`UpAxis::align`].
@@ -107,12 +115,6 @@ impl UpAxis {
     ) -> StabFromWorld {
         self.align(gravity) * orientation.inverse()
     }
-}
-
-fn upside_down(gravity: DeviceVec) -> bool {
-    let g = gravity.vector();
-    // Also false for a zero or non-finite gravity, which align_gravity maps to the identity.
-    g.y < UpAxis::FLIP_COSINE * g.norm()
 }
 
 /// World-to-S rotation of one frame: `align(g) * q*`, with `q` the device orientation and `g`

@@ -67,8 +67,8 @@ pub struct Inspection {
     pub orientation_source: Option<String>,
     /// Gravity magnitude, m/s^2.
     pub gravity_norm: Stats,
-    /// Fraction of frames with the phone upside down (gravity's cosine with device +y below
-    /// [`UpAxis::FLIP_COSINE`]), where the paper's S is ill-conditioned.
+    /// Fraction of frames with the phone upside down ([`UpAxis::is_upside_down`]), where the
+    /// paper's S is ill-conditioned.
     pub upside_down_fraction: f64,
     /// Accelerometer magnitude, m/s^2.
     pub acce_norm: Stats,
@@ -91,7 +91,7 @@ pub fn inspect(seq: &Sequence, format: Format) -> Inspection {
     let upside_down = seq
         .gravity()
         .iter()
-        .filter(|g| g.y() < UpAxis::FLIP_COSINE * g.norm())
+        .filter(|&&g| UpAxis::is_upside_down(g))
         .count();
     let upside_down_fraction = upside_down as f64 / seq.len().max(1) as f64;
     let acce_norm = Stats::of(seq.acce().iter().map(|a| a.norm()));
