@@ -373,6 +373,7 @@ fn run(cli: Cli) -> Result<()> {
         } => {
             set_jobs(jobs)?;
             let seqs = load_lists(&list, placement_map.as_deref())?;
+            let defaults = TrainOptions::default();
             let mut opts = TrainOptions {
                 standardize: !no_standardize,
                 turned_copies,
@@ -380,9 +381,9 @@ fn run(cli: Cli) -> Result<()> {
                     step: step.unwrap_or(ridi::train::default_step(turned_copies)),
                     up_axis: up_axis.into(),
                     orientation: orientation.into(),
-                    ..FeatureConfig::default()
+                    ..defaults.features.clone()
                 },
-                ..TrainOptions::default()
+                ..defaults
             };
             opts.cascade.classifier_c = classifier_c;
             opts.cascade.regressors = GridChoice::from(grid).regressors();
