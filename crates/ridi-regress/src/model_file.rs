@@ -15,11 +15,13 @@
 //! mean and directions) or the features themselves ([`crate::Storage`]); squared norms are
 //! recomputed on load; classifier coefficients only for the pairs a placement takes part in;
 //! an optional speed regressor per placement ([`crate::CascadeParams::speed`]); the feature
-//! configuration with its definition of S (`up_axis`).
+//! configuration with its definition of S (`up_axis`) and the orientation its inputs come from
+//! (`orientation`).
 //! Older files are refused with [`RegressError::UnsupportedVersion`] (retrain the model):
-//! version 6 had no `up_axis` (its S was always the paper's), version 5 no speed regressor, version 4 stored every pair's coefficient for every classifier sample, version 3 the leading
-//! coordinates as a separate `f32` block, version 2 binary16 features only, version 1 `f32`
-//! features.
+//! version 6 had neither `up_axis` nor `orientation` (its S was always the paper's, its
+//! orientation whatever the caller passed), version 5 no speed regressor, version 4 stored
+//! every pair's coefficient for every classifier sample, version 3 the leading coordinates as
+//! a separate `f32` block, version 2 binary16 features only, version 1 `f32` features.
 //!
 //! The header is checked before the payload is decoded, so a newer version, a truncated file
 //! or a corrupt payload each give their own error. Encoding is deterministic (no maps, no
