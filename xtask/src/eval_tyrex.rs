@@ -39,7 +39,7 @@ struct Variant {
     groups: bool,
     standardize: bool,
     gamma: Gamma,
-    estimated_orientation: bool,
+    orientation: Orientation,
     turned_copies: usize,
     speed: bool,
     /// Training sample step in frames (paper: 10).
@@ -54,11 +54,11 @@ impl Variant {
     /// Variants with equal keys train the same models.
     fn train_key(&self) -> String {
         format!(
-            "{} {} {:?} {} {} {} {} {:?}",
+            "{} {} {:?} {:?} {} {} {} {:?}",
             self.groups,
             self.standardize,
             self.gamma,
-            self.estimated_orientation,
+            self.orientation,
             self.turned_copies,
             self.speed,
             self.step,
@@ -72,7 +72,7 @@ const PAPER: Variant = Variant {
     groups: true,
     standardize: true,
     gamma: Gamma::InverseDim,
-    estimated_orientation: false,
+    orientation: Orientation::Recorded,
     turned_copies: 0,
     speed: false,
     step: 10,
@@ -90,7 +90,7 @@ const SMOOTHED: Variant = Variant {
 const RECOMMENDED: Variant = Variant {
     name: "majority + orientation from gyro + accelerometer",
     smoothing: true,
-    estimated_orientation: true,
+    orientation: Orientation::Estimated,
     ..PAPER
 };
 
@@ -123,7 +123,7 @@ fn variants(quick: bool) -> Vec<Variant> {
         RECOMMENDED,
         Variant {
             name: "orientation from gyro + accelerometer",
-            estimated_orientation: true,
+            orientation: Orientation::Estimated,
             ..PAPER
         },
         Variant {
@@ -280,9 +280,8 @@ fn oracle_rte(seq: &Sequence, opts: &EvalOptions) -> Result<f64> {
 /// The sequences a variant trains and tests on.
 fn prepare(all: &[Sequence], v: &Variant) -> Result<Vec<Sequence>> {
     let mut seqs = all.to_vec();
-    if v.estimated_orientation {
-        apply_orientation(Orientation::Estimated, &mut seqs)?;
-    }
+    // Once here rather than in every fold's training and evaluation (which then find it done).
+    apply_orientation(v.orientation, &mut seqs)?;
     if v.groups {
         PlacementMap::tyrex_groups().apply(&mut seqs);
     }
@@ -302,9 +301,7 @@ fn train_folds(seqs: &[Sequence], v: &Variant) -> Result<(Vec<Cascade>, f64)> {
     opts.cascade.speed = v.speed;
     opts.features.step = v.step;
     opts.features.up_axis = v.up_axis;
-    if v.estimated_orientation {
-        opts.features.orientation = Orientation::Estimated;
-    }
+    opts.features.orientation = v.orientation;
     let started = Instant::now();
     let models = PEOPLE
         .iter()

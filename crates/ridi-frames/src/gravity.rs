@@ -73,6 +73,12 @@ pub enum UpAxis {
     PlusOrMinusY,
 }
 
+/// Half a turn about device z (`[w, x, y, z] = [0, 0, 0, 1]`, exactly): swaps +y and -y, and
+/// +x and -x.
+const HALF_TURN_Z: Rot<Device, Device> = Rot::from_unit_quaternion(UnitQuaternion::new_unchecked(
+    Quaternion::new(0.0, 0.0, 0.0, 1.0),
+));
+
 impl UpAxis {
     /// Below this cosine between gravity and device +y (about 134 degrees), [`PlusOrMinusY`]
     /// uses -y. Far from both poles, so that neither choice is ill-conditioned at the switch,
@@ -90,10 +96,7 @@ impl UpAxis {
     /// phone turns over sees it.
     pub fn align(self, gravity: DeviceVec) -> StabFromDevice {
         if self == UpAxis::PlusOrMinusY && Self::is_upside_down(gravity) {
-            let g = gravity.vector();
-            let half_turn_z =
-                Rot::<Device, Device>::from_axis_angle(&Vector3::z_axis(), std::f64::consts::PI);
-            align_gravity(DeviceVec::new(-g.x, -g.y, g.z)) * half_turn_z
+            align_gravity(HALF_TURN_Z * gravity) * HALF_TURN_Z
         } else {
             align_gravity(gravity)
         }
