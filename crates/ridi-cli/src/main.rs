@@ -10,6 +10,7 @@ use indicatif::{ProgressBar, ProgressStyle};
 
 use ridi::correct::PlacementSmoother;
 use ridi::data::{Format, ReadOptions, Sequence};
+use ridi::eval::{AlignWindow, EvalConfig};
 use ridi::features::FeatureConfig;
 use ridi::frames::UpAxis;
 use ridi::regress::{Cascade, ProgressEvent, Stage, Storage, StoredAs, model_file};
@@ -162,7 +163,8 @@ enum Command {
     #[command(after_help = "Examples:\n  \
         ridi eval --list datasets/sample/list_test.txt --model model.ridi --out report \
         --placement-map tyrex4\n  \
-        ridi eval --list test.txt --model model.ridi --out report --methods ridi,pdr,still\n\n\
+        ridi eval --list test.txt --model model.ridi --out report --methods ridi,pdr,still\n  \
+        ridi eval --list test.txt --model model.ridi --out report-whole --align all\n\n\
         Methods: ridi, raw, pdr, ridi_mag, ridi_ori, velocity, still.")]
     Eval {
         /// List files of the sequences to evaluate (ground truth required).
@@ -195,6 +197,11 @@ enum Command {
         /// window's own label, as in the paper.
         #[arg(long, value_name = "SECONDS", default_value_t = 10.0)]
         placement_window: f64,
+        /// Stretch every trajectory is aligned to the ground truth on (2D rigid, no scale):
+        /// its first SECONDS, as in the paper, or `all` for the whole run (a best case that
+        /// hides initial-heading errors).
+        #[arg(long, value_name = "SECONDS|all", default_value = "10", value_parser = parse_align)]
+        align: AlignWindow,
     },
     /// Train on the bundled sample (two people) and evaluate on the held-out person.
     #[command(after_help = "Example:\n  ridi demo --out demo-out\n\n\
@@ -453,6 +460,7 @@ fn run(cli: Cli) -> Result<()> {
             plots,
             jobs,
             placement_window,
+            align,
         } => {
             set_jobs(jobs)?;
             let model = load_model(&model)?;
@@ -465,7 +473,7 @@ fn run(cli: Cli) -> Result<()> {
                 placement_smoothing: placement_smoothing(placement_window)?,
                 ..TrackOptions::default()
             };
-            evaluate_and_write(&seqs, &model, methods, track, &out, plots)?;
+            evaluate_and_write(&seqs, &model, methods, track, align, &out, plots)?;
         }
         Command::Demo {
             out,
@@ -626,13 +634,17 @@ fn evaluate_and_write(
     model: &Cascade,
     methods: Vec<Method>,
     track: TrackOptions,
+    align: AlignWindow,
     out: &Path,
     plots: Plots,
 ) -> Result<ridi::Report> {
     let opts = EvalOptions {
         methods,
         track,
-        ..EvalOptions::default()
+        metrics: EvalConfig {
+            align,
+            ..EvalConfig::default()
+        },
     };
     let spinner = ProgressBar::new_spinner();
     spinner.set_message(format!("evaluating {} sequences", seqs.len()));
@@ -663,7 +675,33 @@ fn evaluate_and_write(
     Ok(report)
 }
 
+/// `--align`: seconds, or `all` for the whole run.
+fn parse_align(text: &str) -> std::result::Result<AlignWindow, String> {
+    if text.eq_ignore_ascii_case("all") {
+        return Ok(AlignWindow::All);
+    }
+    match text.parse::<f64>() {
+        Ok(s) if s.is_finite() && s > 0.0 => Ok(AlignWindow::Seconds(s)),
+        _ => Err(format!(
+            "`{text}` is neither a positive number of seconds nor `all`"
+        )),
+    }
+}
+
 fn print_summary(report: &ridi::Report) {
+    let weak = report
+        .sequences
+        .iter()
+        .filter(|s| s.alignment_extent_m < ridi::eval::WEAK_ALIGNMENT_EXTENT_M)
+        .count();
+    if weak > 0 {
+        eprintln!(
+            "warning: in {weak} of {} sequences the ground truth moves less than {} m within the \
+             alignment window, so their fitted heading is weakly determined (listed in report.md)",
+            report.sequences.len(),
+            ridi::eval::WEAK_ALIGNMENT_EXTENT_M
+        );
+    }
     println!(
         "\n{} sequences; velocity MSE S-x {:.3} S-z {:.3} (m/s)^2; placement accuracy {}",
         report.sequences.len(),
@@ -735,6 +773,7 @@ fn demo(out: &Path, data: Option<PathBuf>, grid: Grid, plots: Plots) -> Result<(
         &model,
         Method::ALL.to_vec(),
         TrackOptions::default(),
+        AlignWindow::default(),
         out,
         plots,
     )?;

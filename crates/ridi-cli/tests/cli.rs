@@ -205,6 +205,48 @@ fn convert_train_track_and_eval() {
         stderr(&out)
     );
 
+    // --align: the paper's first 10 s by default, the whole run on request; the ground truth's
+    // travel within the window is reported per sequence.
+    let ten = json["sequences"][0]["alignment_extent_m"].as_f64().unwrap();
+    assert_eq!(
+        json["config"]["align"],
+        serde_json::json!({"seconds": 10.0})
+    );
+    let whole = dir.path().join("report-whole");
+    let eval_aligned = |align: &str| {
+        let align = format!("--align={align}");
+        ridi(&[
+            "eval",
+            "--list",
+            s(&test_list),
+            "--model",
+            s(&model),
+            "--out",
+            s(&whole),
+            "--methods",
+            "ridi",
+            "--plots",
+            "none",
+            &align,
+        ])
+    };
+    let out = eval_aligned("all");
+    assert!(out.status.success(), "{}", stderr(&out));
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(whole.join("report.json")).unwrap()).unwrap();
+    assert_eq!(json["config"]["align"], serde_json::json!("all"));
+    let all = json["sequences"][0]["alignment_extent_m"].as_f64().unwrap();
+    assert!(ten > 0.0 && all > ten, "{ten} {all}");
+    for bad in ["0", "-3", "ten"] {
+        let out = eval_aligned(bad);
+        assert!(!out.status.success());
+        assert!(
+            stderr(&out).contains("neither a positive number of seconds nor `all`"),
+            "{}",
+            stderr(&out)
+        );
+    }
+
     // The placement majority window: off with 0, refused when negative. The orientation is
     // the model's: track no longer takes --orientation.
     let plain = dir.path().join("plain.csv");

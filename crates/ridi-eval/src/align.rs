@@ -212,6 +212,38 @@ pub struct AlignmentFit {
     /// True when the estimate did not move within the fit window, so only a translation was
     /// fitted (see [`fit_rigid_2d`]).
     pub degenerate: bool,
+    /// How far the ground truth moved within the fit window, metres: the largest distance of
+    /// a ground-truth point in the window from the window's first one
+    /// ([`target_extent`]). The fitted rotation is only as good as this lever: below
+    /// [`WEAK_ALIGNMENT_EXTENT_M`] it rests on a few steps, or on noise when the walker stood
+    /// still, and every later error inherits the heading error.
+    pub target_extent_m: f64,
+}
+
+impl AlignmentFit {
+    /// True when the ground truth moved less than [`WEAK_ALIGNMENT_EXTENT_M`] within the fit
+    /// window, so the fitted heading is weakly determined.
+    pub fn is_weak(&self) -> bool {
+        self.target_extent_m < WEAK_ALIGNMENT_EXTENT_M
+    }
+}
+
+/// Ground-truth travel (metres) below which an alignment's rotation counts as weakly
+/// determined ([`AlignmentFit::is_weak`]).
+///
+/// One metre is about a step and a half: over a shorter lever, an estimate off by 0.3 m at the
+/// end of the window (a normal error over 10 s) already turns the fit by 15 degrees or more.
+pub const WEAK_ALIGNMENT_EXTENT_M: f64 = 1.0;
+
+/// The largest distance of a point of `points` from the first one, metres (0 for no points).
+pub fn target_extent(points: &[[f64; 2]]) -> f64 {
+    let Some(&first) = points.first() else {
+        return 0.0;
+    };
+    points
+        .iter()
+        .map(|p| (p[0] - first[0]).hypot(p[1] - first[1]))
+        .fold(0.0, f64::max)
 }
 
 /// Fits the rigid transform taking `est` onto `gt` over the initial `window` of the timeline.
@@ -233,6 +265,7 @@ pub fn fit_alignment(
         transform,
         frames_used,
         degenerate,
+        target_extent_m: target_extent(&gt[..frames_used]),
     })
 }
 
@@ -357,6 +390,29 @@ mod tests {
         assert!((fit.transform.angle - 0.3).abs() < 1e-12);
         assert!(close(aligned[100], gt[100], 1e-12));
         assert!((aligned[300][0] - gt[300][0]).abs() > 1.0);
+    }
+
+    #[test]
+    fn extent_measures_the_ground_truth_lever_inside_the_window() {
+        // Stands (swaying by 5 cm) for the first 10 s, then walks at 1.2 m/s along y.
+        let times: Vec<f64> = (0..4000).map(|i| f64::from(i) / 200.0).collect();
+        let gt: Vec<[f64; 2]> = times
+            .iter()
+            .map(|&t| {
+                let sway = 0.05 * (2.0 * t).sin();
+                [sway, 1.2 * (t - 10.0).max(0.0)]
+            })
+            .collect();
+        let est = Rigid2::new(0.4, [3.0, -1.0]).apply_all(&gt);
+        let standing = fit_alignment(&times, &est, &gt, AlignWindow::default()).unwrap();
+        assert!((standing.target_extent_m - 0.05).abs() < 1e-6);
+        assert!(standing.is_weak());
+        let whole = fit_alignment(&times, &est, &gt, AlignWindow::All).unwrap();
+        assert!((whole.target_extent_m - 12.0).abs() < 0.01);
+        assert!(!whole.is_weak());
+        assert_eq!(target_extent(&[]), 0.0);
+        assert_eq!(target_extent(&[[4.0, 5.0]]), 0.0);
+        assert_eq!(target_extent(&[[0.0, 0.0], [3.0, 4.0], [1.0, 0.0]]), 5.0);
     }
 
     #[test]

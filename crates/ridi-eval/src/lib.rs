@@ -60,7 +60,10 @@ pub mod metrics;
 pub mod pdr;
 pub mod report;
 
-pub use align::{AlignWindow, AlignmentFit, Rigid2, align_trajectory, fit_alignment, fit_rigid_2d};
+pub use align::{
+    AlignWindow, AlignmentFit, Rigid2, WEAK_ALIGNMENT_EXTENT_M, align_trajectory, fit_alignment,
+    fit_rigid_2d, target_extent,
+};
 pub use error::{EvalError, Result};
 pub use metrics::{
     ConfusionMatrix, EvalConfig, TrajectoryEval, accuracy, ate, ate_ronin, estimate_rate_hz,

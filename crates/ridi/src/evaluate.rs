@@ -1,6 +1,7 @@
 //! Evaluation: every method on every sequence with ground truth, metrics, and the report files.
 //!
 //! `report.json` has, per sequence, `name`, `placement`, `path_length_m`,
+//! `alignment_extent_m` (how far the ground truth moved within the alignment window),
 //! `placement_accuracy`, `velocity_mse` (`[S-x, S-z]`, (m/s)^2) and `methods.<key>` with the
 //! metric keys of [`ridi_eval::TrajectoryMetrics`] (`mpe_m`, `mpe_pct`, `ate_m`, `rte_m`,
 //! `ate_ronin_m`, `rte_ronin_m`, `rte_5s_m`, `path_length_ratio`); `summary.<key>` holds the
@@ -56,6 +57,11 @@ pub struct SequenceResult {
     pub placement: Option<String>,
     /// Horizontal ground-truth path length, metres.
     pub path_length_m: f64,
+    /// How far the ground truth moved within the alignment window, metres
+    /// ([`ridi_eval::AlignmentFit::target_extent_m`]); below
+    /// [`ridi_eval::WEAK_ALIGNMENT_EXTENT_M`] the fitted heading is weakly determined and
+    /// `report.md` says so.
+    pub alignment_extent_m: f64,
     /// Fraction of regressions whose predicted placement is the sequence's label.
     pub placement_accuracy: Option<f64>,
     /// Velocity regression MSE `[S-x, S-z]`, (m/s)^2, against the smoothed ground truth.
@@ -159,6 +165,9 @@ fn evaluate_one(seq: &Sequence, model: &Cascade, opts: &EvalOptions) -> Result<E
             name: seq.name().to_string(),
             placement: seq.placement().map(str::to_string),
             path_length_m: ridi_eval::path_length(&gt2)?,
+            alignment_extent_m: ridi_eval::target_extent(
+                &gt2[..opts.metrics.align.frame_count(seq.time())?],
+            ),
             placement_accuracy,
             velocity_mse: vel_mse,
             methods,
@@ -297,6 +306,25 @@ impl Report {
             self.velocity_mse[1],
             fmt_opt(self.placement_accuracy)
         );
+        let weak: Vec<String> = self
+            .sequences
+            .iter()
+            .filter(|s| s.alignment_extent_m < ridi_eval::WEAK_ALIGNMENT_EXTENT_M)
+            .map(|s| format!("{} ({:.2} m)", s.name, s.alignment_extent_m))
+            .collect();
+        if !weak.is_empty() {
+            let _ = writeln!(
+                out,
+                "**Weakly determined alignment** in {} of {} sequences: the ground truth moves \
+                 less than {} m within the alignment window, so the fitted heading rests on \
+                 little motion and every metric inherits its error: {}. \
+                 `ridi eval --align all` shows them without it.\n",
+                weak.len(),
+                self.sequences.len(),
+                ridi_eval::WEAK_ALIGNMENT_EXTENT_M,
+                weak.join(", ")
+            );
+        }
         let _ = writeln!(out, "## Overall (mean over sequences)\n");
         let mut head = "| method |".to_string();
         let mut rule = "| --- |".to_string();
@@ -361,15 +389,16 @@ impl Report {
         let _ = writeln!(out, "\n## Velocity regression and placement per sequence\n");
         let _ = writeln!(
             out,
-            "| sequence | placement | path (m) | velocity MSE S-x | velocity MSE S-z | placement accuracy |\n| --- | --- | --- | --- | --- | --- |"
+            "| sequence | placement | path (m) | ground-truth travel in the alignment window (m) | velocity MSE S-x | velocity MSE S-z | placement accuracy |\n| --- | --- | --- | --- | --- | --- | --- |"
         );
         for s in &self.sequences {
             let _ = writeln!(
                 out,
-                "| {} | {} | {:.1} | {:.4} | {:.4} | {} |",
+                "| {} | {} | {:.1} | {:.2} | {:.4} | {:.4} | {} |",
                 s.name,
                 s.placement.as_deref().unwrap_or("-"),
                 s.path_length_m,
+                s.alignment_extent_m,
                 s.velocity_mse[0],
                 s.velocity_mse[1],
                 fmt_opt(s.placement_accuracy)

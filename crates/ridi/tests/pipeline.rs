@@ -79,6 +79,7 @@ fn train_track_and_evaluate_on_the_sample() {
         "name",
         "placement",
         "path_length_m",
+        "alignment_extent_m",
         "placement_accuracy",
         "velocity_mse",
     ] {
@@ -103,6 +104,29 @@ fn train_track_and_evaluate_on_the_sample() {
     }
     let md = std::fs::read_to_string(dir.path().join("report.md")).unwrap();
     assert!(md.contains("## Per placement") && md.contains("| ridi |"));
+    // Sequences whose ground truth hardly moves while the alignment is fitted are named, with
+    // their travel, in the warning and only there.
+    let warning = md
+        .lines()
+        .find(|l| l.starts_with("**Weakly determined alignment**"))
+        .unwrap_or("");
+    for s in &report.sequences {
+        let seq = test.iter().find(|q| q.name() == s.name).unwrap();
+        let gt = seq.ground_truth().unwrap().horizontal();
+        let frames = ridi::eval::AlignWindow::default()
+            .frame_count(seq.time())
+            .unwrap();
+        assert_eq!(
+            s.alignment_extent_m,
+            ridi::eval::target_extent(&gt[..frames])
+        );
+        let named = warning.contains(&format!("{} ({:.2} m)", s.name, s.alignment_extent_m));
+        assert_eq!(named, s.alignment_extent_m < 1.0, "{}: {warning}", s.name);
+    }
+    assert!(
+        report.sequences.iter().any(|s| s.alignment_extent_m < 1.0),
+        "the sample's test set has a run that starts standing"
+    );
 
     // Plots of one sequence.
     let files = traces[0].plot(dir.path(), "svg").unwrap();
