@@ -19,6 +19,23 @@ use ridi::{
     apply_orientation,
 };
 
+/// `println!` that ignores a closed stdout (`ridi train ... | head`): the command's results are
+/// its files, which must still be written, and printing must never abort it with a panic.
+macro_rules! outln {
+    ($($arg:tt)*) => {{
+        use std::io::Write as _;
+        let _ = writeln!(std::io::stdout(), $($arg)*);
+    }};
+}
+
+/// `print!` that ignores a closed stdout, as [`outln!`].
+macro_rules! out {
+    ($($arg:tt)*) => {{
+        use std::io::Write as _;
+        let _ = write!(std::io::stdout(), $($arg)*);
+    }};
+}
+
 #[derive(Parser)]
 #[command(
     name = "ridi",
@@ -89,7 +106,7 @@ enum Command {
         #[arg(long)]
         no_standardize: bool,
         /// Classifier C (paper: 10).
-        #[arg(long, default_value_t = 10.0)]
+        #[arg(long, default_value_t = 10.0, value_parser = positive)]
         classifier_c: f64,
         /// Orientation to train and track with: as recorded, or estimated from gyro +
         /// accelerometer (straighter tracks where the recorded one uses the magnetometer
@@ -101,12 +118,12 @@ enum Command {
         storage: StorageArg,
         /// Also train on N copies of each window turned about the vertical (features and
         /// velocity together), for phones carried at other headings than in the training
-        /// recordings; 0 for the paper.
-        #[arg(long, default_value_t = 1, value_name = "N")]
+        /// recordings; 0 for the paper, at most 32.
+        #[arg(long, default_value_t = 1, value_name = "N", value_parser = |s: &str| count(s, 0, MAX_TURNED_COPIES))]
         turned_copies: usize,
         /// Frames between training windows [default: 10 x (N + 1), N turned copies: the
         /// paper's 10 without copies, and the paper's number of rows with them].
-        #[arg(long, value_name = "FRAMES")]
+        #[arg(long, value_name = "FRAMES", value_parser = |s: &str| count(s, 1, MAX_FRAMES_APART))]
         step: Option<usize>,
         /// No speed regressor (the paper): by default each placement also regresses the speed
         /// and each regressed velocity is scaled to it, since turned training windows make the
@@ -119,7 +136,7 @@ enum Command {
         #[arg(long, value_enum, default_value = "plus-or-minus-y")]
         up_axis: UpAxisArg,
         /// Worker threads (default: all cores).
-        #[arg(long)]
+        #[arg(long, value_parser = |s: &str| count(s, 1, 4096))]
         jobs: Option<usize>,
     },
     /// Track a recording with a trained model: one pose per frame.
@@ -145,10 +162,10 @@ enum Command {
         #[arg(long)]
         plot: Option<PathBuf>,
         /// Frames between regressions.
-        #[arg(long, default_value_t = 50)]
+        #[arg(long, default_value_t = 50, value_parser = |s: &str| count(s, 1, MAX_FRAMES_APART))]
         regress_every: usize,
         /// Weight of the bias prior (paper: 0.1).
-        #[arg(long, default_value_t = 0.1)]
+        #[arg(long, default_value_t = 0.1, value_parser = non_negative)]
         lambda: f64,
         /// Estimate the initial velocity instead of assuming the walk starts at rest.
         #[arg(long)]
@@ -190,7 +207,7 @@ enum Command {
         #[arg(long, value_enum, default_value = "png")]
         plots: Plots,
         /// Worker threads (default: all cores).
-        #[arg(long)]
+        #[arg(long, value_parser = |s: &str| count(s, 1, 4096))]
         jobs: Option<usize>,
         /// Placement majority window, seconds: each regression takes the most frequent placement
         /// label within it (centred in batch, the seconds before it with --online); 0 keeps each
@@ -336,9 +353,9 @@ fn run(cli: Cli) -> Result<()> {
             for seq in &loaded.sequences {
                 let report = ridi::inspect::inspect(seq, loaded.format);
                 if json {
-                    println!("{}", serde_json::to_string_pretty(&report)?);
+                    outln!("{}", serde_json::to_string_pretty(&report)?);
                 } else {
-                    print!("{report}");
+                    out!("{report}");
                 }
             }
         }
@@ -353,14 +370,14 @@ fn run(cli: Cli) -> Result<()> {
                 eprintln!("warning: {w}");
             }
             for c in &summary.sequences {
-                println!(
+                outln!(
                     "{}  {}",
                     c.path.display(),
                     c.placement.as_deref().unwrap_or("-")
                 );
             }
             for l in &summary.lists {
-                println!("list: {}", l.display());
+                outln!("list: {}", l.display());
             }
         }
         Command::Train {
@@ -379,6 +396,7 @@ fn run(cli: Cli) -> Result<()> {
             up_axis,
         } => {
             set_jobs(jobs)?;
+            check_output(&out)?;
             let seqs = load_lists(&list, placement_map.as_deref())?;
             let defaults = TrainOptions::default();
             let mut opts = TrainOptions {
@@ -400,7 +418,7 @@ fn run(cli: Cli) -> Result<()> {
             print_training(&model);
             model_file::save(&model, &out)
                 .with_context(|| format!("cannot write {}", out.display()))?;
-            println!("model: {}", out.display());
+            outln!("model: {}", out.display());
         }
         Command::Track {
             sequence,
@@ -413,6 +431,13 @@ fn run(cli: Cli) -> Result<()> {
             estimate_initial_velocity,
             placement_window,
         } => {
+            // Every output is checked before any work, so that a bad --plot cannot leave the
+            // trajectory written and the command failed.
+            check_output(&out)?;
+            if let Some(plot) = &plot {
+                check_output(plot)?;
+                ridi::plot::PlotFormat::from_path(plot)?;
+            }
             let model = load_model(&model)?;
             let mut loaded = ridi::read_any(&sequence, None, &ReadOptions::default())?;
             for w in &loaded.warnings {
@@ -437,9 +462,10 @@ fn run(cli: Cli) -> Result<()> {
             if estimate_initial_velocity {
                 opts.correction.initial_velocity = ridi::correct::InitialVelocity::Estimate;
             }
-            let track = ridi::track(seq, &model, &opts)?;
+            let track = ridi::track(seq, &model, &opts)
+                .with_context(|| format!("cannot track {}", sequence.display()))?;
             track.write_csv(&out)?;
-            println!(
+            outln!(
                 "{}: {} frames, {} regressions -> {}",
                 seq.name(),
                 track.time.len(),
@@ -448,7 +474,7 @@ fn run(cli: Cli) -> Result<()> {
             );
             if let Some(plot) = plot {
                 plot_track(seq, &track, &plot)?;
-                println!("plot: {}", plot.display());
+                outln!("plot: {}", plot.display());
             }
         }
         Command::Eval {
@@ -481,6 +507,26 @@ fn run(cli: Cli) -> Result<()> {
             grid,
             plots,
         } => demo(&out, data, grid, plots)?,
+    }
+    Ok(())
+}
+
+/// Refuses an output path that cannot be written: its folder missing or not a folder, or the
+/// path itself a folder. Checked before long work (training, tracking) rather than after it.
+fn check_output(path: &Path) -> Result<()> {
+    let parent = match path.parent() {
+        Some(p) if !p.as_os_str().is_empty() => p,
+        _ => Path::new("."),
+    };
+    if !parent.is_dir() {
+        bail!(
+            "cannot write {}: the folder {} does not exist",
+            path.display(),
+            parent.display()
+        );
+    }
+    if path.is_dir() {
+        bail!("cannot write {}: it is a folder", path.display());
     }
     Ok(())
 }
@@ -547,20 +593,20 @@ fn train_with_progress(seqs: &[Sequence], opts: &TrainOptions) -> Result<Cascade
 }
 
 fn print_training(model: &Cascade) {
-    println!("placements: {}", model.placements().join(", "));
+    outln!("placements: {}", model.placements().join(", "));
     let up = match model.feature_config().up_axis {
         UpAxis::PlusY => "device +y",
         UpAxis::PlusOrMinusY => "device +y, or -y while upside down",
     };
-    println!("stabilized frame S built on: {up}");
+    outln!("stabilized frame S built on: {up}");
     let orientation = match model.feature_config().orientation {
         Orientation::Recorded => "as recorded",
         Orientation::Estimated => "estimated from gyro + accelerometer",
     };
-    println!("orientation: {orientation} (track and eval use the same)");
+    outln!("orientation: {orientation} (track and eval use the same)");
     match model.stored_as() {
-        StoredAs::Half => println!("samples stored: {} values in half precision", model.dim()),
-        StoredAs::Projected { components, energy } => println!(
+        StoredAs::Half => outln!("samples stored: {} values in half precision", model.dim()),
+        StoredAs::Projected { components, energy } => outln!(
             "samples stored: {components} principal coordinates of {} ({:.3} % of the variance)",
             model.dim(),
             100.0 * energy
@@ -571,7 +617,7 @@ fn print_training(model: &Cascade) {
             let speed = model
                 .speed_params(p)
                 .map_or(String::new(), |s| format!("  speed: C={} eps={}", s.0, s.1));
-            println!(
+            outln!(
                 "  {name:<12} {:>6} samples  S-x: C={} eps={}  S-z: C={} eps={}{speed}",
                 model.stored_samples(p),
                 x.0,
@@ -583,13 +629,17 @@ fn print_training(model: &Cascade) {
     }
     let rows = model.grid_results();
     if !rows.is_empty() {
-        println!("cross-validation (MSE, (m/s)^2, mean over folds):");
-        println!(
+        outln!("cross-validation (MSE, (m/s)^2, mean over folds):");
+        outln!(
             "  {:<12} {:>7} {:>8} {:>8} {:>10}",
-            "placement", "channel", "C", "epsilon", "MSE"
+            "placement",
+            "channel",
+            "C",
+            "epsilon",
+            "MSE"
         );
         for r in rows {
-            println!(
+            outln!(
                 "  {:<12} {:>7} {:>8} {:>8} {:>10.5}",
                 r.placement,
                 ["S-x", "S-z", "speed"][usize::from(r.channel.min(2))],
@@ -646,33 +696,77 @@ fn evaluate_and_write(
             ..EvalConfig::default()
         },
     };
-    let spinner = ProgressBar::new_spinner();
-    spinner.set_message(format!("evaluating {} sequences", seqs.len()));
-    spinner.enable_steady_tick(std::time::Duration::from_millis(200));
-    let (report, traces) = ridi::evaluate(seqs, model, &opts)?;
-    spinner.finish_and_clear();
-    let mut written = report.write(out)?;
     let ext = match plots {
         Plots::Png => Some("png"),
         Plots::Svg => Some("svg"),
         Plots::None => None,
     };
+    // Folders first: a folder that cannot be made fails the command before the evaluation.
+    let plot_dir = out.join("plots");
+    let dirs: &[&Path] = if ext.is_some() {
+        &[out, &plot_dir]
+    } else {
+        &[out]
+    };
+    for dir in dirs {
+        std::fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))?;
+    }
+    let spinner = ProgressBar::new_spinner();
+    spinner.set_message(format!("evaluating {} sequences", seqs.len()));
+    spinner.enable_steady_tick(std::time::Duration::from_millis(200));
+    let (report, traces) = ridi::evaluate(seqs, model, &opts)?;
+    spinner.finish_and_clear();
+    // The plots before the reports: report.json is there only when everything was written.
+    let mut written = Vec::new();
     if let Some(ext) = ext {
-        let dir = out.join("plots");
-        std::fs::create_dir_all(&dir)
-            .with_context(|| format!("cannot create {}", dir.display()))?;
         for t in &traces {
-            written.extend(t.plot(&dir, ext)?);
+            written.extend(t.plot(&plot_dir, ext)?);
         }
     }
+    written.extend(report.write(out)?);
     print_summary(&report);
-    println!(
+    outln!(
         "wrote {} files into {} (report.md, report.json{})",
         written.len(),
         out.display(),
         if ext.is_some() { ", plots/" } else { "" }
     );
     Ok(report)
+}
+
+/// Largest `--turned-copies`: copy `j` of a window is turned by `j / N` of a full turn, so a few
+/// dozen copies already cover the circle every few degrees, while each copy costs a full set of
+/// training rows (memory and time grow without limit).
+const MAX_TURNED_COPIES: usize = 32;
+
+/// Largest `--step` and `--regress-every`: one minute at 200 Hz. Windows further apart leave
+/// too few training rows, or too few regressions for the correction, to mean anything.
+const MAX_FRAMES_APART: usize = 12_000;
+
+/// A whole number in `min..=max`, for clap.
+fn count(text: &str, min: usize, max: usize) -> std::result::Result<usize, String> {
+    match text.parse::<usize>() {
+        Ok(n) if (min..=max).contains(&n) => Ok(n),
+        _ => Err(format!(
+            "`{text}` is not a whole number from {min} to {max}"
+        )),
+    }
+}
+
+/// A finite number above 0, for clap.
+fn positive(text: &str) -> std::result::Result<f64, String> {
+    match text.parse::<f64>() {
+        Ok(x) if x.is_finite() && x > 0.0 => Ok(x),
+        _ => Err(format!("`{text}` is not a finite number above 0")),
+    }
+}
+
+/// A finite number of at least 0, for clap.
+fn non_negative(text: &str) -> std::result::Result<f64, String> {
+    match text.parse::<f64>() {
+        Ok(x) if x.is_finite() && x >= 0.0 => Ok(x),
+        _ => Err(format!("`{text}` is not a finite number of at least 0")),
+    }
 }
 
 /// `--align`: seconds, or `all` for the whole run.
@@ -702,7 +796,7 @@ fn print_summary(report: &ridi::Report) {
             ridi::eval::WEAK_ALIGNMENT_EXTENT_M
         );
     }
-    println!(
+    outln!(
         "\n{} sequences; velocity MSE S-x {:.3} S-z {:.3} (m/s)^2; placement accuracy {}",
         report.sequences.len(),
         report.velocity_mse[0],
@@ -711,14 +805,19 @@ fn print_summary(report: &ridi::Report) {
             .placement_accuracy
             .map_or("-".into(), |a| format!("{a:.3}"))
     );
-    println!(
+    outln!(
         "{:<10} {:>9} {:>9} {:>9} {:>9} {:>11}",
-        "method", "RTE 5s m", "ATE m", "RTE m", "MPE m", "path ratio"
+        "method",
+        "RTE 5s m",
+        "ATE m",
+        "RTE m",
+        "MPE m",
+        "path ratio"
     );
     let opt = |v: Option<f64>| v.map_or("-".to_string(), |v| format!("{v:.3}"));
     for key in &report.methods {
         if let Some(m) = report.summary.get(key) {
-            println!(
+            outln!(
                 "{key:<10} {:>9.3} {:>9.3} {:>9.3} {:>9.3} {:>11}",
                 m.rte_5s_m,
                 m.ate_m,
@@ -752,7 +851,7 @@ fn demo(out: &Path, data: Option<PathBuf>, grid: Grid, plots: Plots) -> Result<(
     let map = Some("tyrex4");
     let train = load_lists(&[train_list], map)?;
     let test = load_lists(&[data.join("list_test.txt")], map)?;
-    println!(
+    outln!(
         "demo: training on {} sequences ({:.0} s), testing on {} held-out sequences",
         train.len(),
         train.iter().map(|s| s.duration()).sum::<f64>(),
@@ -762,7 +861,7 @@ fn demo(out: &Path, data: Option<PathBuf>, grid: Grid, plots: Plots) -> Result<(
     opts.cascade.regressors = GridChoice::from(grid).regressors();
     let started = std::time::Instant::now();
     let model = train_with_progress(&train, &opts)?;
-    println!("trained in {:.1} s", started.elapsed().as_secs_f64());
+    outln!("trained in {:.1} s", started.elapsed().as_secs_f64());
     print_training(&model);
     std::fs::create_dir_all(out).with_context(|| format!("cannot create {}", out.display()))?;
     let model_path = out.join("model.ridi");
@@ -780,14 +879,62 @@ fn demo(out: &Path, data: Option<PathBuf>, grid: Grid, plots: Plots) -> Result<(
     Ok(())
 }
 
+/// One line: the outermost context and every cause, as users asked for. Errors that already
+/// print their source in their own message are not repeated.
+fn one_line(e: &anyhow::Error) -> String {
+    let mut line = String::new();
+    for cause in e.chain() {
+        let text = cause.to_string();
+        if line.contains(&text) {
+            continue;
+        }
+        if !line.is_empty() {
+            line.push_str(": ");
+        }
+        line.push_str(&text);
+    }
+    line
+}
+
 fn main() -> ExitCode {
     match run(Cli::parse()) {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
-            // One line: the outermost context and every cause, as users asked for.
-            let causes: Vec<String> = e.chain().map(|c| c.to_string()).collect();
-            eprintln!("error: {}", causes.join(": "));
+            eprintln!("error: {}", one_line(&e));
             ExitCode::FAILURE
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// An error that prints its source in its own message, as many thiserror variants do.
+    #[derive(Debug)]
+    struct Wrapping(std::io::Error);
+
+    impl std::fmt::Display for Wrapping {
+        fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+            write!(f, "i/o error on m.ridi.tmp: {}", self.0)
+        }
+    }
+
+    impl std::error::Error for Wrapping {
+        fn source(&self) -> Option<&(dyn std::error::Error + 'static)> {
+            Some(&self.0)
+        }
+    }
+
+    #[test]
+    fn one_line_does_not_repeat_a_cause_already_in_the_message() {
+        let io = std::io::Error::new(std::io::ErrorKind::NotFound, "No such file or directory");
+        let e = anyhow::Error::new(Wrapping(io)).context("cannot write m.ridi");
+        assert_eq!(
+            one_line(&e),
+            "cannot write m.ridi: i/o error on m.ridi.tmp: No such file or directory"
+        );
+        let plain = anyhow::anyhow!("inner").context("outer");
+        assert_eq!(one_line(&plain), "outer: inner");
     }
 }

@@ -82,6 +82,84 @@ fn errors_are_one_line_with_a_non_zero_exit() {
 }
 
 #[test]
+fn a_closed_stdout_is_no_panic() {
+    // `ridi inspect ... | head -0`: the reader is gone before ridi writes.
+    let (reader, writer) = std::io::pipe().unwrap();
+    drop(reader);
+    let seq = sample().join("Jakob_Nexus5_NoDist_Texting");
+    let out = Command::new(env!("CARGO_BIN_EXE_ridi"))
+        .args(["inspect", s(&seq)])
+        .stdout(writer)
+        .stderr(std::process::Stdio::piped())
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert!(!stderr(&out).contains("panicked"), "{}", stderr(&out));
+}
+
+#[test]
+fn bad_flags_and_outputs_fail_before_any_work() {
+    let dir = tempfile::tempdir().unwrap();
+    let list = sample().join("list_Guillaume.txt");
+    let model = dir.path().join("m.ridi");
+    let train = |extra: &[&str]| {
+        let mut args = vec!["train", "--list", s(&list), "--grid", "none"];
+        args.extend_from_slice(extra);
+        ridi(&args)
+    };
+    for (flag, value, says) in [
+        ("--turned-copies", "100000", "from 0 to 32"),
+        ("--step", "0", "from 1 to 12000"),
+        ("--classifier-c", "0", "above 0"),
+        ("--classifier-c", "NaN", "above 0"),
+        ("--jobs", "0", "from 1 to 4096"),
+    ] {
+        let out = train(&["--out", s(&model), flag, value]);
+        let err = stderr(&out);
+        assert!(!out.status.success(), "{flag} {value}");
+        assert!(err.contains(flag) && err.contains(says), "{err}");
+    }
+    // The model's folder is checked before training, not after.
+    let nowhere = dir.path().join("missing/m.ridi");
+    let out = train(&["--out", s(&nowhere)]);
+    let err = stderr(&out);
+    assert!(
+        !out.status.success() && err.contains("does not exist"),
+        "{err}"
+    );
+    let printed = String::from_utf8_lossy(&out.stdout);
+    assert!(!printed.contains("placements:"), "trained first: {printed}");
+
+    let seq = sample().join("Jakob_Nexus5_NoDist_Texting");
+    let csv = dir.path().join("t.csv");
+    let track = |extra: &[&str]| {
+        let mut args = vec!["track", s(&seq), "--model", s(&model), "--out", s(&csv)];
+        args.extend_from_slice(extra);
+        ridi(&args)
+    };
+    for (flag, value, says) in [
+        ("--regress-every", "0", "from 1 to 12000"),
+        ("--lambda", "NaN", "at least 0"),
+        ("--lambda", "inf", "at least 0"),
+    ] {
+        let out = track(&[flag, value]);
+        let err = stderr(&out);
+        assert!(!out.status.success(), "{flag} {value}");
+        assert!(err.contains(flag) && err.contains(says), "{err}");
+    }
+    // A plot path that cannot be drawn to fails before the trajectory is written (the model
+    // does not even exist: the outputs are checked first).
+    let jpg = dir.path().join("t.jpg");
+    let out = track(&["--plot", s(&jpg)]);
+    let err = stderr(&out);
+    assert!(
+        !out.status.success() && err.contains("expected .svg or .png"),
+        "{err}"
+    );
+    assert!(!csv.exists());
+}
+
+#[test]
 fn convert_train_track_and_eval() {
     let dir = tempfile::tempdir().unwrap();
     let conv = dir.path().join("conv");

@@ -201,6 +201,7 @@ pub fn correct_with(
     config: CorrectionConfig,
     placement_names: &[String],
 ) -> Result<Track> {
+    check_gaps(seq, config.max_dt)?;
     let targets: Vec<VelocityTarget> = regressions
         .iter()
         .map(|r| VelocityTarget {
@@ -220,11 +221,34 @@ pub fn correct_with(
     })
 }
 
+/// Refuses a sequence with a gap longer than the correction integrates across, naming where
+/// it is. Readers accept gaps up to a second (features and training live with them); double
+/// integration does not.
+fn check_gaps(seq: &Sequence, max_dt: f64) -> Result<()> {
+    let t = seq.time();
+    match t.windows(2).position(|w| w[1] - w[0] > max_dt) {
+        None => Ok(()),
+        Some(i) => Err(PipelineError::sequence(
+            seq.name(),
+            format!(
+                "a gap of {:.3} s between frames {i} and {} ({:.3} s and {:.3} s from the \
+                 start) is longer than the {max_dt} s the correction integrates across; split \
+                 the recording at its gaps",
+                t[i + 1] - t[i],
+                i + 1,
+                t[i] - t[0],
+                t[i + 1] - t[0]
+            ),
+        )),
+    }
+}
+
 /// Tracks `seq` with `model`, in the orientation the model was trained with ([`oriented`]).
 pub fn track(seq: &Sequence, model: &Cascade, opts: &TrackOptions) -> Result<Track> {
     let seq = oriented(seq, model.feature_config().orientation)?;
     let seq = seq.as_ref();
     if opts.online {
+        check_gaps(seq, opts.correction.max_dt)?;
         return track_online(seq, model, opts);
     }
     let regressions = regress(seq, model, opts)?;
