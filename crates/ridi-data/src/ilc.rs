@@ -67,8 +67,11 @@
 //! type that go back or leave a gap longer than the validation's `max_gap_s` (repeated
 //! timestamps keep their first record), a rotation vector longer than 1, a missing accelerometer,
 //! gyroscope or rotation vector, fewer than 2 waypoints, waypoints that do not overlap the IMU
-//! data, and a last record without a line break after it (a file cut off while being written;
-//! complete files end with the `#<TAB>endTime` line).
+//! data, a last record without a line break after it (a file cut off while being written;
+//! complete files end with the `#<TAB>endTime` line), a value beyond its channel's physical
+//! bound (accelerometer, gyroscope, magnetic field, waypoint) and a record type in the wrong unit
+//! (an IMU type whose timestamps step by less than 0.1 ms, a gyroscope in deg/s, an accelerometer
+//! in g): the [`Validation`] limits, applied to each record type before resampling.
 //!
 //! # Example
 //! ```no_run
@@ -93,7 +96,9 @@ use crate::android;
 use crate::error::{DataError, Location, Result};
 use crate::options::ReadOptions;
 use crate::resample::{interpolate_rot, interpolate_vec3, uniform_timeline};
-use crate::sequence::{GroundTruth, OrientationSource, Sequence, SequenceParts, Validation};
+use crate::sequence::{
+    Channel, GroundTruth, OrientationSource, Sequence, SequenceParts, Validation,
+};
 use crate::text::{self, Nan};
 
 /// Placement label of every path unless [`IlcOptions::placement`] says otherwise.
@@ -162,12 +167,13 @@ pub struct IlcPath {
     pub floor: Option<String>,
 }
 
-/// A record type that is read: its name, the names of its values (for errors) and how many
-/// more values it may carry (the accuracy status).
+/// A record type that is read: its name, the names of its values (for errors), how many
+/// more values it may carry (the accuracy status) and the channel its values are checked as.
 struct Kind {
     name: &'static str,
     fields: &'static [&'static str],
     extra: usize,
+    channel: Option<Channel>,
 }
 
 const ACCE: usize = 0;
@@ -185,11 +191,13 @@ const KINDS: [Kind; 5] = [
             "TYPE_ACCELEROMETER z",
         ],
         extra: 1,
+        channel: Some(Channel::Acce),
     },
     Kind {
         name: "TYPE_GYROSCOPE",
         fields: &["TYPE_GYROSCOPE x", "TYPE_GYROSCOPE y", "TYPE_GYROSCOPE z"],
         extra: 1,
+        channel: Some(Channel::Gyro),
     },
     Kind {
         name: "TYPE_MAGNETIC_FIELD",
@@ -199,6 +207,7 @@ const KINDS: [Kind; 5] = [
             "TYPE_MAGNETIC_FIELD z",
         ],
         extra: 1,
+        channel: Some(Channel::Magnet),
     },
     Kind {
         name: "TYPE_ROTATION_VECTOR",
@@ -208,13 +217,38 @@ const KINDS: [Kind; 5] = [
             "TYPE_ROTATION_VECTOR z",
         ],
         extra: 1,
+        channel: None,
     },
     Kind {
         name: "TYPE_WAYPOINT",
         fields: &["TYPE_WAYPOINT x", "TYPE_WAYPOINT y"],
         extra: 0,
+        channel: Some(Channel::Position),
     },
 ];
+
+/// The path files' names: `unix_ms`, `TYPE_GYROSCOPE x`, and the record type for the whole
+/// channel; the channels built from the orientation by their sequence names (`gravity.x`).
+struct IlcFields;
+
+impl text::Fields for IlcFields {
+    fn field(&self, channel: Channel, axis: Option<usize>) -> String {
+        if channel == Channel::Time {
+            return "unix_ms".to_owned();
+        }
+        match KINDS.iter().find(|k| k.channel == Some(channel)) {
+            Some(kind) => axis
+                .and_then(|a| kind.fields.get(a))
+                .copied()
+                .unwrap_or(kind.name)
+                .to_owned(),
+            None => text::sequence_field(channel, axis),
+        }
+    }
+    fn time_unit(&self) -> &str {
+        "milliseconds"
+    }
+}
 
 /// The records of one type: times in seconds, values (unused ones 0) and their lines.
 #[derive(Default)]
@@ -330,13 +364,25 @@ pub fn parse(bytes: &[u8], path: &Path, options: &IlcOptions) -> Result<IlcPath>
             ),
         ));
     }
+    let limits = &options.validation;
     for (k, s) in streams.iter().enumerate() {
-        let gap = if k == WAYPOINT {
-            f64::INFINITY
+        // Waypoints are seconds apart: neither their gaps nor their step say anything.
+        let (gap, time) = if k == WAYPOINT {
+            (f64::INFINITY, &[][..])
         } else {
-            options.validation.max_gap_s
+            (limits.max_gap_s, &s.time[..])
         };
         text::check_time(&s.time, &s.lines, path, "unix_ms", gap)?;
+        let values = s.values.iter().copied();
+        text::check_stream(
+            limits,
+            path,
+            &s.lines,
+            &IlcFields,
+            time,
+            KINDS[k].channel,
+            values,
+        )?;
     }
 
     let rv = &streams[RV];
@@ -385,8 +431,8 @@ pub fn parse(bytes: &[u8], path: &Path, options: &IlcOptions) -> Result<IlcPath>
         steps: None,
         time,
     };
-    let sequence = Sequence::with_validation(parts, &options.validation)
-        .map_err(|e| DataError::sequence(path, e))?;
+    let sequence = Sequence::with_validation(parts, limits)
+        .map_err(|e| text::sequence_error(path, None, &IlcFields, e))?;
     Ok(IlcPath {
         sequence,
         waypoints,

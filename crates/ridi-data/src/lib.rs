@@ -3,7 +3,8 @@
 //! A [`Sequence`] is one recording on one timeline: device-frame gyro, accelerometer, linear
 //! acceleration and gravity, the device orientation (world-from-device, see `ridi-frames`),
 //! and optional ground truth and step counter. It is validated when built, so code that takes
-//! a `Sequence` can rely on equal lengths, finite values and increasing time.
+//! a `Sequence` can rely on equal lengths, finite values, increasing time, values within physical
+//! bounds and channels in plausible units ([`Validation`]).
 //!
 //! Readers and writers turn files into sequences and back; every error names the file, and
 //! parse errors the line and field too. No reader panics on malformed input.
@@ -84,7 +85,7 @@ pub use list::{ListEntry, load_list, parse_list, read_list};
 pub use options::ReadOptions;
 pub use ridi_frames;
 pub use sequence::{
-    GroundTruth, OrientationSource, Sequence, SequenceError, SequenceParts, Validation,
+    Channel, GroundTruth, OrientationSource, Sequence, SequenceError, SequenceParts, Validation,
 };
 pub use write::{
     Precision, write_atomically, write_ridi_csv, write_ridi_csv_with, write_ridi_plain,

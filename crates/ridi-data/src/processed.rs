@@ -8,7 +8,7 @@ use ridi_frames::{DeviceVec, QuatError, WorldFromDevice};
 
 use crate::error::{DataError, Location, Result};
 use crate::options::ReadOptions;
-use crate::sequence::{GroundTruth, OrientationSource, Sequence, SequenceParts};
+use crate::sequence::{Channel, GroundTruth, OrientationSource, Sequence, SequenceParts};
 use crate::text;
 
 /// The 27 columns of the RIDI processed layout, in the order the original writes them. `time`
@@ -53,6 +53,27 @@ pub(crate) const MAGNET: usize = 13;
 pub(crate) const POS: usize = 16;
 pub(crate) const ORI: usize = 19;
 pub(crate) const RV: usize = 23;
+
+/// The processed layout's names: `gyro_x`, and `gyro_x..gyro_z` for the whole channel.
+pub(crate) struct ProcessedFields;
+
+impl text::Fields for ProcessedFields {
+    fn field(&self, channel: Channel, axis: Option<usize>) -> String {
+        let first = match channel {
+            Channel::Time => return COLUMNS[TIME].to_owned(),
+            Channel::Gyro => GYRO,
+            Channel::Acce => ACCE,
+            Channel::Linacce => LINACCE,
+            Channel::Gravity => GRAV,
+            Channel::Magnet => MAGNET,
+            Channel::Position => POS,
+        };
+        text::axis_field([0, 1, 2].map(|a| COLUMNS[first + a]), axis)
+    }
+    fn time_unit(&self) -> &str {
+        "nanoseconds"
+    }
+}
 
 /// Whether a column may hold NaN: only the ground truth, where NaN on every row is how the
 /// writers say "no ground truth".
@@ -230,7 +251,7 @@ pub(crate) fn assemble(table: Table, path: &Path, opts: &ReadOptions) -> Result<
         steps: None,
     };
     Sequence::with_validation(parts, &opts.validation)
-        .map_err(|e| text::sequence_error(path, Some(&table.lines), e))
+        .map_err(|e| text::sequence_error(path, Some(&table.lines), &ProcessedFields, e))
 }
 
 #[cfg(test)]

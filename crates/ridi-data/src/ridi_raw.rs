@@ -16,6 +16,12 @@
 //! decreasing ones are an error, and so is a gap longer than the validation's `max_gap_s` in any
 //! file but `step.txt` (written only when a step is taken) and `pose.txt` (checked after
 //! trimming, on the sequence itself).
+//!
+//! Before the synchronization, each file but `step.txt` is checked against the
+//! [`Validation`] limits on its own lines: its median time step, and every value of the IMU
+//! files and the pose position against the channel's physical bound (the gyro's median
+//! magnitude too). The accelerometer's scale against gravity is checked on the sequence and
+//! reported on `acce.txt`.
 
 use std::path::{Path, PathBuf};
 
@@ -24,7 +30,9 @@ use ridi_frames::{DeviceVec, Vec3, WorldFromDevice, WorldVec};
 use crate::error::{DataError, Location, Result};
 use crate::options::ReadOptions;
 use crate::resample::{interpolate_rot, interpolate_scalar, interpolate_vec3, uniform_timeline};
-use crate::sequence::{GroundTruth, OrientationSource, Sequence, SequenceParts};
+use crate::sequence::{
+    Channel, GroundTruth, OrientationSource, Sequence, SequenceError, SequenceParts, Validation,
+};
 use crate::text;
 
 const XYZ: &[&str] = &["t", "x", "y", "z"];
@@ -43,6 +51,22 @@ pub const FILES: [(&str, &[&str]); 8] = [
     ("pose.txt", POSE),
     ("step.txt", STEP),
 ];
+
+/// The raw files' names: `t`, `x y z` (`tx ty tz` in `pose.txt`).
+struct RawFields;
+
+impl text::Fields for RawFields {
+    fn field(&self, channel: Channel, axis: Option<usize>) -> String {
+        match channel {
+            Channel::Time => "t".to_owned(),
+            Channel::Position => text::axis_field(["tx", "ty", "tz"], axis),
+            _ => text::axis_field(["x", "y", "z"], axis),
+        }
+    }
+    fn time_unit(&self) -> &str {
+        "nanoseconds"
+    }
+}
 
 /// One parsed file: times in seconds, strictly increasing, with `fields.len() - 1` values each.
 struct Records {
@@ -89,6 +113,21 @@ impl Records {
 
     fn span(&self) -> (f64, f64) {
         (self.time[0], self.time[self.time.len() - 1])
+    }
+
+    /// Checks the time step and, for `channel`, the first three values of every row.
+    fn check(&self, limits: &Validation, channel: Option<Channel>) -> Result<()> {
+        let xyz = (0..self.time.len()).map(|i| {
+            let r = self.row(i);
+            [r[0], r[1], r[2]]
+        });
+        let (path, lines) = (&self.path, &self.lines);
+        text::check_stream(limits, path, lines, &RawFields, &self.time, channel, xyz)
+    }
+
+    /// A validation failure of this file, on its line when it is about one record.
+    fn error(&self, e: SequenceError) -> DataError {
+        text::sequence_error(&self.path, Some(&self.lines), &RawFields, e)
     }
 }
 
@@ -208,6 +247,22 @@ pub fn read(folder: impl AsRef<Path>, opts: &ReadOptions) -> Result<Sequence> {
     let magnet = read_records(folder, "magnet.txt", XYZ, false, Some(gap))?;
     let pose = read_records(folder, "pose.txt", POSE, false, None)?;
     let step = read_records(folder, "step.txt", STEP, false, None)?;
+    // Each file on its own lines (`step.txt` is written only when a step is taken, and has
+    // no unit to check).
+    let checked = [
+        (Some(&gyro), Some(Channel::Gyro)),
+        (Some(&acce), Some(Channel::Acce)),
+        (Some(&linacce), Some(Channel::Linacce)),
+        (Some(&gravity), Some(Channel::Gravity)),
+        (Some(&rv), None),
+        (magnet.as_ref(), Some(Channel::Magnet)),
+        (pose.as_ref(), Some(Channel::Position)),
+    ];
+    for (records, channel) in checked {
+        if let Some(r) = records {
+            r.check(&opts.validation, channel)?;
+        }
+    }
 
     let sensors: Vec<&Records> = [&gyro, &acce, &linacce, &gravity, &rv]
         .into_iter()
@@ -283,8 +338,10 @@ pub fn read(folder: impl AsRef<Path>, opts: &ReadOptions) -> Result<Sequence> {
         ),
         None => (folder, None),
     };
-    Sequence::with_validation(parts, &opts.validation)
-        .map_err(|e| text::sequence_error(path, lines.as_deref(), e))
+    Sequence::with_validation(parts, &opts.validation).map_err(|e| match e {
+        SequenceError::AcceScale { .. } => acce.error(e),
+        _ => text::sequence_error(path, lines.as_deref(), &RawFields, e),
+    })
 }
 
 /// The pose times kept after trimming `trim` records at each end and dropping those outside

@@ -78,13 +78,151 @@ pub struct SequenceParts {
     pub steps: Option<Vec<f64>>,
 }
 
-/// Limits applied when a sequence is built.
+/// A channel of a sequence, as named in a [`SequenceError`] and given to the checks of
+/// [`Validation`].
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Channel {
+    /// Timestamps, seconds.
+    Time,
+    /// Gyroscope, rad/s.
+    Gyro,
+    /// Accelerometer with gravity, m/s^2.
+    Acce,
+    /// Linear acceleration, m/s^2.
+    Linacce,
+    /// Gravity, m/s^2.
+    Gravity,
+    /// Magnetometer, microtesla.
+    Magnet,
+    /// Ground-truth position, metres.
+    Position,
+}
+
+impl Channel {
+    /// The field name in a [`SequenceParts`] (`ground_truth.position` for the position).
+    pub fn name(self) -> &'static str {
+        match self {
+            Channel::Time => "time",
+            Channel::Gyro => "gyro",
+            Channel::Acce => "acce",
+            Channel::Linacce => "linacce",
+            Channel::Gravity => "gravity",
+            Channel::Magnet => "magnet",
+            Channel::Position => "ground_truth.position",
+        }
+    }
+
+    /// The unit of the channel in a sequence.
+    pub fn unit(self) -> &'static str {
+        match self {
+            Channel::Time => "s",
+            Channel::Gyro => "rad/s",
+            Channel::Acce | Channel::Linacce | Channel::Gravity => "m/s^2",
+            Channel::Magnet => "uT",
+            Channel::Position => "m",
+        }
+    }
+
+    /// What a value beyond [`Validation::limit`] is beyond, for messages.
+    fn beyond(self) -> &'static str {
+        match self {
+            Channel::Time => "any timestamp",
+            Channel::Gyro => "any phone gyroscope",
+            Channel::Acce | Channel::Linacce => "any phone accelerometer",
+            Channel::Gravity => "any gravity reading",
+            Channel::Magnet => "any phone magnetometer",
+            Channel::Position => "any plausible ground-truth position",
+        }
+    }
+}
+
+impl fmt::Display for Channel {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+/// A number for a message: plain with at most 3 decimals, or in scientific notation when very
+/// large or small (`1e308`, not 309 digits).
+fn short(v: f64) -> String {
+    let a = v.abs();
+    if a != 0.0 && !(1e-3..1e6).contains(&a) {
+        let s = format!("{v:.3e}");
+        let (mantissa, exp) = s.split_once('e').unwrap_or((&s, "0"));
+        let mantissa = mantissa.trim_end_matches('0').trim_end_matches('.');
+        format!("{mantissa}e{exp}")
+    } else {
+        let s = format!("{v:.3}");
+        s.trim_end_matches('0').trim_end_matches('.').to_owned()
+    }
+}
+
+/// The middle value of `v` (the upper one of an even count; NaN when empty), reordering `v`.
+fn median(v: &mut [f64]) -> f64 {
+    if v.is_empty() {
+        return f64::NAN;
+    }
+    let mid = v.len() / 2;
+    *v.select_nth_unstable_by(mid, f64::total_cmp).1
+}
+
+/// Limits applied when a sequence is built, and by the readers to each stream they parse (so
+/// that a bad value is reported on its own line, before any resampling).
+///
+/// Besides time and gravity, the defaults are hard physical bounds on single values and wide
+/// unit checks on whole channels, far from real data. Measured over the 24 bundled samples
+/// (`datasets/sample`), the 24 Tyrex runs (Nexus 5, 34 sequences once split at mocap losses,
+/// including running with the phone in the hand and in a pocket) and the 12 Indoor Location
+/// Competition walks (OPPO PBCM10), streams as read and sequences as built:
+///
+/// | statistic | real data | limit |
+/// | --- | --- | --- |
+/// | largest gyro component | 21.7 rad/s | 100 rad/s |
+/// | median \|gyro\| per recording | 0.24..4.25 rad/s | 10 rad/s |
+/// | largest accelerometer / linear acceleration component | 39.6 / 31.1 m/s^2 | 2000 m/s^2 |
+/// | largest gravity component | 9.81 m/s^2 | 20 m/s^2 |
+/// | mean \|acce\| / mean \|gravity\| | 0.99..1.87 | 0.5..3 |
+/// | largest magnetometer component | 67 uT | 10 000 uT |
+/// | largest position component | 222 m | 10^6 m |
+/// | median interval between timestamps | 5-20 ms | 0.1 ms..1 s |
+///
+/// Not caught: a gyro in deg/s on a phone lying almost still (median under 0.17 rad/s), and a
+/// linear acceleration alone in g (it has no reference magnitude: only the accelerometer is
+/// compared with gravity).
 #[derive(Debug, Clone, PartialEq)]
 pub struct Validation {
     /// Largest accepted interval between two frames, seconds.
     pub max_gap_s: f64,
     /// Accepted range of the mean gravity magnitude, m/s^2 (catches data in g or in mm/s^2).
     pub gravity_range: (f64, f64),
+    /// Largest accepted |component| of the gyro, rad/s: 100. Phone gyroscopes saturate at
+    /// about 35 rad/s (2000 deg/s); a larger value is corrupt, or degrees per second.
+    pub max_gyro: f64,
+    /// Largest accepted |component| of the accelerometer and the linear acceleration, m/s^2:
+    /// 2000 (about 200 g, far above the 16-32 g range of phone accelerometers): a larger value
+    /// is corrupt, or in mm/s^2.
+    pub max_acce: f64,
+    /// Largest accepted |component| of gravity, m/s^2: 20, twice its magnitude.
+    pub max_gravity: f64,
+    /// Largest accepted |component| of the magnetometer, microtesla: 10 000. The Earth's field
+    /// is 25-65 uT and phone magnetometers saturate at a few thousand uT; a larger value is
+    /// corrupt, or in nanotesla.
+    pub max_magnet: f64,
+    /// Largest accepted |component| of a ground-truth position, metres: 10^6 (1000 km from the
+    /// origin of a room, building or start-of-service frame).
+    pub max_position: f64,
+    /// Largest accepted median |gyro|, rad/s: 10. Real recordings stay below 4.25 (running
+    /// with the phone in a pocket); a gyro in deg/s multiplies by 57.3, so a recording with a
+    /// median rotation rate above 0.17 rad/s (10 deg/s) is caught: every one measured, whose
+    /// smallest median is 0.24 rad/s (13.6 once in deg/s).
+    pub max_median_gyro: f64,
+    /// Accepted range of mean |acce| / mean |gravity|: 0.5..3. Real data lie within 0.99..1.87
+    /// (the upper end when running); an accelerometer in g beside gravity in m/s^2 gives 0.1.
+    pub acce_gravity_ratio: (f64, f64),
+    /// Accepted range of the median interval between timestamps, seconds: 1e-4..1 (10 kHz to
+    /// 1 Hz; phone sensors deliver 5-500 Hz). Seconds or milliseconds read as nanoseconds step
+    /// by 1e-9 s or less. A unit too coarse shows as gaps instead.
+    pub time_step_range: (f64, f64),
 }
 
 impl Default for Validation {
@@ -92,8 +230,127 @@ impl Default for Validation {
         Self {
             max_gap_s: 1.0,
             gravity_range: (8.5, 11.0),
+            max_gyro: 100.0,
+            max_acce: 2000.0,
+            max_gravity: 20.0,
+            max_magnet: 1e4,
+            max_position: 1e6,
+            max_median_gyro: 10.0,
+            acce_gravity_ratio: (0.5, 3.0),
+            time_step_range: (1e-4, 1.0),
         }
     }
+}
+
+impl Validation {
+    /// Largest accepted |component| of `channel` (infinite for time).
+    pub fn limit(&self, channel: Channel) -> f64 {
+        match channel {
+            Channel::Time => f64::INFINITY,
+            Channel::Gyro => self.max_gyro,
+            Channel::Acce | Channel::Linacce => self.max_acce,
+            Channel::Gravity => self.max_gravity,
+            Channel::Magnet => self.max_magnet,
+            Channel::Position => self.max_position,
+        }
+    }
+
+    /// Checks the 3-vectors of `channel`: for the gyro the median magnitude first (so that a
+    /// gyro in deg/s is reported as such), then every component against [`Self::limit`].
+    /// Indices in the errors count the items of `values`.
+    pub fn check_channel<I>(&self, channel: Channel, values: I) -> Result<(), SequenceError>
+    where
+        I: IntoIterator<Item = [f64; 3]>,
+        I::IntoIter: Clone,
+    {
+        let values = values.into_iter();
+        if channel == Channel::Gyro {
+            let mut norms: Vec<f64> = values.clone().map(norm).collect();
+            let median = median(&mut norms);
+            if median > self.max_median_gyro {
+                return Err(SequenceError::GyroUnits {
+                    median,
+                    max: self.max_median_gyro,
+                });
+            }
+        }
+        let limit = self.limit(channel);
+        for (index, v) in values.enumerate() {
+            if let Some(axis) = v.iter().position(|c| c.abs() > limit) {
+                return Err(SequenceError::Implausible {
+                    channel,
+                    axis,
+                    index,
+                    value: v[axis],
+                    limit,
+                });
+            }
+        }
+        Ok(())
+    }
+
+    /// Checks the median interval of `time` (seconds, increasing) against
+    /// [`Self::time_step_range`]; fewer than two times pass.
+    pub fn check_time_step(&self, time: &[f64]) -> Result<(), SequenceError> {
+        let mut steps: Vec<f64> = time.windows(2).map(|w| w[1] - w[0]).collect();
+        if steps.is_empty() {
+            return Ok(());
+        }
+        let median = median(&mut steps);
+        let (min, max) = self.time_step_range;
+        if (min..=max).contains(&median) {
+            Ok(())
+        } else {
+            Err(SequenceError::TimeStep { median, min, max })
+        }
+    }
+
+    /// Checks mean |acce| against mean |gravity| (both m/s^2) with
+    /// [`Self::acce_gravity_ratio`].
+    pub fn check_acce_scale(&self, acce: f64, gravity: f64) -> Result<(), SequenceError> {
+        let (min, max) = self.acce_gravity_ratio;
+        if (min * gravity..=max * gravity).contains(&acce) {
+            Ok(())
+        } else {
+            Err(SequenceError::AcceScale {
+                acce,
+                gravity,
+                min,
+                max,
+            })
+        }
+    }
+}
+
+/// Axis names of the 3-vector channels.
+pub(crate) const AXES: [&str; 3] = ["x", "y", "z"];
+
+/// What is wrong with a value beyond its channel's bound, e.g. `1e308 m/s^2 is beyond any phone
+/// accelerometer (|value| <= 2000 m/s^2)`.
+pub(crate) fn beyond(channel: Channel, value: f64, limit: f64) -> String {
+    let unit = channel.unit();
+    format!(
+        "{} {unit} is beyond {} (|value| <= {} {unit})",
+        short(value),
+        channel.beyond(),
+        short(limit)
+    )
+}
+
+/// Device vectors as arrays, for the checks.
+fn arrays(v: &[DeviceVec]) -> impl ExactSizeIterator<Item = [f64; 3]> + Clone + '_ {
+    v.iter().map(|x| x.to_array())
+}
+
+/// Mean magnitude of 3-vectors (NaN when empty).
+fn mean_norm(values: impl ExactSizeIterator<Item = [f64; 3]>) -> f64 {
+    let n = values.len();
+    values.map(norm).sum::<f64>() / n as f64
+}
+
+/// Euclidean norm of a 3-vector.
+fn norm(v: [f64; 3]) -> f64 {
+    (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt()
 }
 
 /// Why a set of [`SequenceParts`] is not a valid sequence.
@@ -142,6 +399,66 @@ pub enum SequenceError {
         /// The limit.
         max_gap_s: f64,
     },
+    /// A value beyond the hard physical bound of its channel ([`Validation::limit`]): a
+    /// corrupt value or a wrong unit.
+    #[error("`{channel}.{}` at frame {index}: {}", AXES[*axis], beyond(*channel, *value, *limit))]
+    Implausible {
+        /// The channel.
+        channel: Channel,
+        /// 0 (x), 1 (y) or 2 (z).
+        axis: usize,
+        /// 0-based frame index.
+        index: usize,
+        /// The value.
+        value: f64,
+        /// The bound its magnitude exceeds.
+        limit: f64,
+    },
+    /// The median gyro magnitude is too large for rad/s.
+    #[error(
+        "median |gyro| {} rad/s is above {max} rad/s: gyroscope in deg/s instead of rad/s?",
+        short(*median)
+    )]
+    GyroUnits {
+        /// Median magnitude found.
+        median: f64,
+        /// The limit ([`Validation::max_median_gyro`]).
+        max: f64,
+    },
+    /// The mean accelerometer magnitude is far from the mean gravity magnitude.
+    #[error(
+        "mean |acce| {} m/s^2 is {} times mean |gravity| {} m/s^2, outside {min}..{max}: \
+         accelerometer in {}?",
+        short(*acce),
+        short(acce / gravity),
+        short(*gravity),
+        if acce < gravity { "g instead of m/s^2" } else { "another unit than m/s^2" }
+    )]
+    AcceScale {
+        /// Mean accelerometer magnitude.
+        acce: f64,
+        /// Mean gravity magnitude.
+        gravity: f64,
+        /// Lowest accepted ratio.
+        min: f64,
+        /// Highest accepted ratio.
+        max: f64,
+    },
+    /// The median interval between timestamps is outside [`Validation::time_step_range`].
+    #[error(
+        "timestamps step by {} s (median), outside {}..{} s: time in the wrong unit?",
+        short(*median),
+        short(*min),
+        short(*max)
+    )]
+    TimeStep {
+        /// Median interval, seconds.
+        median: f64,
+        /// Lower limit.
+        min: f64,
+        /// Upper limit.
+        max: f64,
+    },
     /// Mean gravity magnitude outside the plausible range: wrong units or a wrong column.
     #[error(
         "mean gravity magnitude {mean:.3} m/s^2 is outside {min}..{max}: wrong units or column?"
@@ -160,7 +477,7 @@ pub enum SequenceError {
 ///
 /// Built only through [`Sequence::new`] (or [`Sequence::with_validation`]), so every
 /// `Sequence` has equal channel lengths, finite values, strictly increasing time without long
-/// gaps and a plausible gravity magnitude.
+/// gaps, values within physical bounds and channels in plausible units (see [`Validation`]).
 #[derive(Debug, Clone, PartialEq)]
 pub struct Sequence {
     parts: SequenceParts,
@@ -253,11 +570,26 @@ impl Sequence {
                 });
             }
         }
-        let mean = parts.gravity.iter().map(|g| g.norm()).sum::<f64>() / n as f64;
+        limits.check_time_step(&parts.time)?;
+        // Single values before the means, so that one absurd value is named on its frame rather
+        // than skewing a mean; the gyro's median goes first (robust to single values), so that a
+        // gyro in deg/s is reported as such and not by its first large value.
+        limits.check_channel(Channel::Gyro, arrays(&parts.gyro))?;
+        limits.check_channel(Channel::Acce, arrays(&parts.acce))?;
+        limits.check_channel(Channel::Linacce, arrays(&parts.linacce))?;
+        limits.check_channel(Channel::Gravity, arrays(&parts.gravity))?;
+        if let Some(m) = &parts.magnet {
+            limits.check_channel(Channel::Magnet, arrays(m))?;
+        }
+        if let Some(gt) = &parts.ground_truth {
+            limits.check_channel(Channel::Position, gt.position.iter().map(|p| p.to_array()))?;
+        }
+        let mean = mean_norm(arrays(&parts.gravity));
         let (min, max) = limits.gravity_range;
         if !(min..=max).contains(&mean) {
             return Err(SequenceError::Gravity { mean, min, max });
         }
+        limits.check_acce_scale(mean_norm(arrays(&parts.acce)), mean)?;
         Ok(Self { parts })
     }
 
@@ -402,5 +734,61 @@ impl Sequence {
                 steps: p.steps.as_ref().map(|s| s[r()].to_vec()),
             },
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn numbers_in_messages_are_short() {
+        assert_eq!(short(1e308), "1e308");
+        assert_eq!(short(-5e-12), "-5e-12");
+        assert_eq!(short(4.999_999e-12), "5e-12");
+        assert_eq!(short(57.295_779_5), "57.296");
+        assert_eq!(short(2000.0), "2000");
+        assert_eq!(short(1e6), "1e6");
+        assert_eq!(short(0.0), "0");
+    }
+
+    #[test]
+    fn a_gyro_in_deg_per_s_is_named_as_such_before_any_single_value() {
+        let v = Validation::default();
+        // 2 of 3 samples at 20 rad/s: the median says deg/s, although 200 is also too large.
+        let gyro = [[0.0, 0.0, 20.0], [200.0, 0.0, 0.0], [0.0, 20.0, 0.0]];
+        let e = v.check_channel(Channel::Gyro, gyro).unwrap_err();
+        assert!(
+            matches!(e, SequenceError::GyroUnits { median: 20.0, .. }),
+            "{e}"
+        );
+        let gyro = [[0.0, 0.0, 0.2], [0.0, -200.0, 0.0], [0.0, 0.3, 0.0]];
+        let e = v.check_channel(Channel::Gyro, gyro).unwrap_err();
+        assert_eq!(
+            e.to_string(),
+            "`gyro.y` at frame 1: -200 rad/s is beyond any phone gyroscope (|value| <= 100 rad/s)"
+        );
+    }
+
+    #[test]
+    fn time_steps_and_accelerometer_scale_have_wide_bands() {
+        let v = Validation::default();
+        v.check_time_step(&[0.0, 0.005, 0.01]).unwrap();
+        v.check_time_step(&[0.0]).unwrap();
+        assert!(matches!(
+            v.check_time_step(&[0.0, 5e-12, 1e-11]),
+            Err(SequenceError::TimeStep { .. })
+        ));
+        v.check_acce_scale(1.87 * 9.8, 9.8).unwrap();
+        let e = v.check_acce_scale(1.0, 9.80665).unwrap_err().to_string();
+        assert!(
+            e.contains("0.102 times") && e.contains("in g instead"),
+            "{e}"
+        );
+        let e = v
+            .check_acce_scale(9806.65, 9.80665)
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("in another unit"), "{e}");
     }
 }

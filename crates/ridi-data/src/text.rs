@@ -4,7 +4,7 @@
 use std::path::Path;
 
 use crate::error::{DataError, Location, Result};
-use crate::sequence::SequenceError;
+use crate::sequence::{AXES, Channel, SequenceError, Validation, beyond};
 
 /// Reads a whole file; the readers parse from memory because one pass over a byte slice is much
 /// faster than buffered line reading with a `String` per line.
@@ -177,22 +177,98 @@ pub(crate) fn check_time(
     Ok(())
 }
 
-/// Turns a validation failure into an error naming the file and, when the failure is about one
-/// frame and `lines` maps frames to lines, that line.
-pub(crate) fn sequence_error(path: &Path, lines: Option<&[usize]>, e: SequenceError) -> DataError {
-    let (index, field) = match &e {
-        SequenceError::NotFinite { index, field } => (*index, *field),
+/// How a file names the channels of a sequence, for the errors of [`sequence_error`].
+pub(crate) trait Fields {
+    /// The file's name of `axis` (0..3) of `channel`, or of the whole channel (`None`).
+    fn field(&self, channel: Channel, axis: Option<usize>) -> String;
+    /// The unit of the file's timestamps (`nanoseconds`), for the hint of a wrong time step.
+    fn time_unit(&self) -> &str;
+}
+
+/// The name of `axis` among `axes`, or `first..last` for the whole channel (`None`).
+pub(crate) fn axis_field(axes: [&str; 3], axis: Option<usize>) -> String {
+    match axis {
+        Some(a) => axes[a].to_owned(),
+        None => format!("{}..{}", axes[0], axes[2]),
+    }
+}
+
+/// The name of a channel in a [`Sequence`](crate::Sequence) (`gravity`, `gravity.x`): for the
+/// channels a reader derives rather than reads.
+pub(crate) fn sequence_field(channel: Channel, axis: Option<usize>) -> String {
+    match axis {
+        Some(a) => format!("{channel}.{}", AXES[a]),
+        None => channel.name().to_owned(),
+    }
+}
+
+/// Turns a validation failure into an error naming the file, the field (`fields` says how the
+/// file names it) and, when the failure is about one frame and `lines` maps frames to lines,
+/// that line. Whole-channel failures (units, time step) name the file and the field.
+pub(crate) fn sequence_error(
+    path: &Path,
+    lines: Option<&[usize]>,
+    fields: &dyn Fields,
+    e: SequenceError,
+) -> DataError {
+    let whole = |channel, message: String| {
+        let at = Location::file(path).with_field(fields.field(channel, None));
+        DataError::format(at, message)
+    };
+    let (index, field, message) = match &e {
+        SequenceError::NotFinite { index, field } => (*index, (*field).to_owned(), e.to_string()),
         SequenceError::TimeNotIncreasing { index, .. } | SequenceError::Gap { index, .. } => {
-            (*index, "time")
+            (*index, "time".to_owned(), e.to_string())
+        }
+        &SequenceError::Implausible {
+            channel,
+            axis,
+            index,
+            value,
+            limit,
+        } => (
+            index,
+            fields.field(channel, Some(axis)),
+            beyond(channel, value, limit),
+        ),
+        SequenceError::GyroUnits { .. } => return whole(Channel::Gyro, e.to_string()),
+        SequenceError::AcceScale { .. } => return whole(Channel::Acce, e.to_string()),
+        SequenceError::TimeStep { .. } => {
+            let unit = fields.time_unit();
+            return whole(Channel::Time, format!("{e} (this format expects {unit})"));
         }
         _ => return DataError::sequence(path, e),
     };
     match lines.and_then(|l| l.get(index)) {
-        Some(&line) => {
-            DataError::format(Location::line(path, line).with_field(field), e.to_string())
-        }
+        Some(&line) => DataError::format(Location::line(path, line).with_field(field), message),
+        None if matches!(e, SequenceError::Implausible { .. }) => DataError::format(
+            Location::file(path).with_field(field),
+            format!("frame {index}: {message}"),
+        ),
         None => DataError::sequence(path, e),
     }
+}
+
+/// Checks one stream a reader parsed from `path`, before any resampling: the median step of
+/// `time` (empty: not checked), then, for a `channel`, every 3-vector of `values` against the
+/// channel's limits. Errors name the file and the field, and the line of a single bad value.
+pub(crate) fn check_stream<I>(
+    limits: &Validation,
+    path: &Path,
+    lines: &[usize],
+    fields: &dyn Fields,
+    time: &[f64],
+    channel: Option<Channel>,
+    values: I,
+) -> Result<()>
+where
+    I: IntoIterator<Item = [f64; 3]>,
+    I::IntoIter: Clone,
+{
+    limits
+        .check_time_step(time)
+        .and_then(|()| channel.map_or(Ok(()), |c| limits.check_channel(c, values)))
+        .map_err(|e| sequence_error(path, Some(lines), fields, e))
 }
 
 #[cfg(test)]

@@ -42,6 +42,14 @@
 //! folder with `_part1`, `_part2`, ... when there are several; each split and each dropped part
 //! is reported in [`TyrexRead::warnings`].
 //!
+//! # Errors
+//! Every error names the file, and the line and field when one is to blame. The accelerometer,
+//! gyroscope and rotation vector files are checked against the [`Validation`] limits before
+//! resampling: their median time step (seconds: milliseconds step by 5 s), and every
+//! accelerometer and gyroscope value against its physical bound (the gyro's median magnitude
+//! too); the accelerometer's scale against gravity is checked on each sequence and reported on
+//! `accelerometer.txt`.
+//!
 //! # Example
 //! ```no_run
 //! use ridi_data::tyrex::{self, TyrexOptions};
@@ -69,7 +77,9 @@ use crate::error::{DataError, Location, Result};
 use crate::mat::{MatFile, MatValue, dims_text};
 use crate::options::ReadOptions;
 use crate::resample::{interpolate_rot, interpolate_vec3, uniform_timeline};
-use crate::sequence::{GroundTruth, OrientationSource, Sequence, SequenceParts, Validation};
+use crate::sequence::{
+    Channel, GroundTruth, OrientationSource, Sequence, SequenceError, SequenceParts, Validation,
+};
 use crate::text::{self, Nan};
 
 /// Mocap frame rate assumed when a `.mat` has no `FrameRate` (the Tyrex captures are 60 Hz).
@@ -357,12 +367,53 @@ fn body_channels<'a>(
     Ok((Box::new(get), frames))
 }
 
+/// The Tyrex files' names: `t` (seconds), `ax ay az`, `wx wy wz`; the channels built from the
+/// orientation and the mocap by their sequence names (`gravity.x`).
+struct TyrexFields;
+
+impl text::Fields for TyrexFields {
+    fn field(&self, channel: Channel, axis: Option<usize>) -> String {
+        let axes = match channel {
+            Channel::Time => return "t".to_owned(),
+            Channel::Acce => ["ax", "ay", "az"],
+            Channel::Gyro => ["wx", "wy", "wz"],
+            _ => return text::sequence_field(channel, axis),
+        };
+        text::axis_field(axes, axis)
+    }
+    fn time_unit(&self) -> &str {
+        "seconds"
+    }
+}
+
 /// One phone stream: sample times (strictly increasing), values and their line numbers.
 struct Stream<T> {
     path: PathBuf,
     time: Vec<f64>,
     values: Vec<T>,
     lines: Vec<usize>,
+}
+
+impl<T> Stream<T> {
+    /// Checks the time step and, for `channel`, every value as the 3-vector `xyz` gives.
+    fn check(
+        &self,
+        limits: &Validation,
+        channel: Option<Channel>,
+        xyz: impl Fn(&T) -> [f64; 3] + Clone,
+    ) -> Result<()> {
+        let values = self.values.iter().map(xyz);
+        let (path, lines) = (&self.path, &self.lines);
+        text::check_stream(
+            limits,
+            path,
+            lines,
+            &TyrexFields,
+            &self.time,
+            channel,
+            values,
+        )
+    }
 }
 
 /// Reads a whitespace-separated table whose rows have one of the `widths` (time included),
@@ -586,6 +637,10 @@ pub fn read(dir: impl AsRef<Path>, options: &TyrexOptions) -> Result<TyrexRead> 
     let rv = read_rotation_vector(&dir.join("rotation-vector.txt"))?;
     let device_model = read_model(&dir.join("record.properties"))?;
 
+    let limits = &options.validation;
+    acce.check(limits, Some(Channel::Acce), |v| v.to_array())?;
+    gyro.check(limits, Some(Channel::Gyro), |v| v.to_array())?;
+    rv.check(limits, None, |_| [0.0; 3])?;
     if let Some(w) = clipping(&acce) {
         warnings.push(w);
     }
@@ -684,8 +739,14 @@ pub fn read(dir: impl AsRef<Path>, options: &TyrexOptions) -> Result<TyrexRead> 
             steps: None,
             time,
         };
-        let seq = Sequence::with_validation(parts, &options.validation)
-            .map_err(|e| DataError::sequence(dir, e))?;
+        let seq = Sequence::with_validation(parts, limits).map_err(|e| {
+            // The accelerometer's scale is the one check the streams could not make alone.
+            let path = match e {
+                SequenceError::AcceScale { .. } => &acce.path,
+                _ => dir,
+            };
+            text::sequence_error(path, None, &TyrexFields, e)
+        })?;
         sequences.push(seq);
     }
     Ok(TyrexRead {

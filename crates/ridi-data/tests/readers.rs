@@ -10,39 +10,8 @@ use ridi_data::{
     read_sequence, ridi_csv, ridi_plain, ridi_raw, write_ridi_csv, write_ridi_plain,
 };
 
-/// Asserts that `r` failed with a message containing every one of `parts`.
-#[track_caller]
-fn assert_err<T: std::fmt::Debug>(r: Result<T, DataError>, parts: &[&str]) -> DataError {
-    let e = r.expect_err("expected an error");
-    let msg = e.to_string();
-    for p in parts {
-        assert!(msg.contains(p), "`{msg}` should contain `{p}`");
-    }
-    e
-}
-
 fn opts() -> ReadOptions {
     ReadOptions::default()
-}
-
-/// `valid_csv` text with cell `col` (0 = pandas index) of 1-based `line` replaced by `value`.
-fn with_cell(text: &str, line: usize, col: usize, value: &str) -> String {
-    edit_rows(text, |n, cells| {
-        if n == line {
-            cells[col] = value.to_owned();
-        }
-    })
-}
-
-fn edit_rows(text: &str, mut f: impl FnMut(usize, &mut Vec<String>)) -> String {
-    let mut out = String::new();
-    for (i, l) in text.lines().enumerate() {
-        let mut cells: Vec<String> = l.split(',').map(str::to_owned).collect();
-        f(i + 1, &mut cells);
-        out.push_str(&cells.join(","));
-        out.push('\n');
-    }
-    out
 }
 
 fn csv_string() -> String {
@@ -388,22 +357,6 @@ fn raw_folder_without_pose_is_uniform_200_hz_without_ground_truth() {
     assert_eq!(seq.len(), 70);
     assert!((seq.rate_hz() - 200.0).abs() < 1e-6);
     assert_eq!(seq.time()[0], T0_NS as f64 / 1e9);
-}
-
-fn raw_with(
-    edit: impl FnOnce(&mut Vec<(&'static str, String)>),
-) -> (tempfile::TempDir, ridi_data::Result<Sequence>) {
-    let dir = tempfile::tempdir().unwrap();
-    let mut files = raw_files(60, true);
-    edit(&mut files);
-    write_files(dir.path(), &files);
-    let r = ridi_raw::read(dir.path(), &raw_options());
-    (dir, r)
-}
-
-fn edit_file(files: &mut [(&'static str, String)], name: &str, f: impl FnOnce(&str) -> String) {
-    let entry = files.iter_mut().find(|(n, _)| *n == name).unwrap();
-    entry.1 = f(&entry.1);
 }
 
 #[test]

@@ -155,3 +155,354 @@ proptest! {
         let _ = ridi_raw::read(dir.path(), &opts);
     }
 }
+
+// ---- implausible values: refused with the file, line and field --------------------------
+
+/// Degrees per second in radians per second.
+const DEG: f64 = 57.295_779_513_082_32;
+
+fn csv_text() -> String {
+    String::from_utf8(CSV.clone()).unwrap()
+}
+
+fn parse_csv(text: &str) -> ridi_data::Result<ridi_data::Sequence> {
+    ridi_csv::parse(text.as_bytes(), Path::new("walk/data.csv"), &opts())
+}
+
+/// `f` applied to the numbers in `cells` (data rows only: the header is line 1).
+fn scale(cells: &mut [String], f: impl Fn(f64) -> f64) {
+    for c in cells {
+        *c = f(c.trim().parse::<f64>().unwrap()).to_string();
+    }
+}
+
+/// The csv fixture with `f` applied to columns `cols` (0 = the pandas index) of every data row.
+fn csv_scaled(cols: std::ops::Range<usize>, f: impl Fn(f64) -> f64) -> String {
+    edit_rows(&csv_text(), |line, cells| {
+        if line > 1 {
+            scale(&mut cells[cols.clone()], &f);
+        }
+    })
+}
+
+#[test]
+fn csv_gyro_in_degrees_per_second_is_refused() {
+    assert_err(
+        parse_csv(&csv_scaled(2..5, |v| v * DEG)),
+        &[
+            "walk/data.csv: field `gyro_x..gyro_z`: median |gyro| ",
+            "rad/s is above 10 rad/s: gyroscope in deg/s instead of rad/s?",
+        ],
+    );
+}
+
+#[test]
+fn csv_accelerometer_in_g_is_refused() {
+    // `acce` and `linacce` in g, gravity in m/s^2.
+    assert_err(
+        parse_csv(&csv_scaled(5..11, |v| v / 9.80665)),
+        &[
+            "walk/data.csv: field `acce_x..acce_z`: mean |acce| 1 m/s^2 is 0.102 times mean \
+             |gravity| 9.807 m/s^2, outside 0.5..3: accelerometer in g instead of m/s^2?",
+        ],
+    );
+}
+
+#[test]
+fn csv_time_in_seconds_or_milliseconds_is_refused() {
+    for (divisor, step) in [(1e9, "e-12 s (median)"), (1e6, "by 5e-9 s (median)")] {
+        let text = csv_scaled(1..2, |ns| {
+            let t = ns / divisor;
+            // Milliseconds as integers, like a recorder would write them.
+            if divisor == 1e6 { t.round() } else { t }
+        });
+        assert_err(
+            parse_csv(&text),
+            &[
+                "walk/data.csv: field `time`: timestamps step by ",
+                step,
+                "outside 1e-4..1 s: time in the wrong unit? (this format expects nanoseconds)",
+            ],
+        );
+    }
+}
+
+#[test]
+fn csv_one_absurd_value_names_its_line_and_column() {
+    let cases = [
+        (
+            4,
+            2,
+            "1e300",
+            "data.csv:4: field `gyro_x`: 1e300 rad/s is beyond any phone gyroscope (|value| <= 100 rad/s)",
+        ),
+        (
+            5,
+            6,
+            "1e308",
+            "data.csv:5: field `acce_y`: 1e308 m/s^2 is beyond any phone accelerometer (|value| <= 2000 m/s^2)",
+        ),
+        (
+            6,
+            10,
+            "-5000",
+            "data.csv:6: field `linacce_z`: -5000 m/s^2 is beyond any phone accelerometer",
+        ),
+        (
+            7,
+            11,
+            "25",
+            "data.csv:7: field `grav_x`: 25 m/s^2 is beyond any gravity reading (|value| <= 20 m/s^2)",
+        ),
+        (
+            8,
+            15,
+            "1e5",
+            "data.csv:8: field `magnet_y`: 100000 uT is beyond any phone magnetometer (|value| <= 10000 uT)",
+        ),
+        (
+            9,
+            17,
+            "1e300",
+            "data.csv:9: field `pos_x`: 1e300 m is beyond any plausible ground-truth position (|value| <= 1e6 m)",
+        ),
+    ];
+    for (line, col, value, expected) in cases {
+        assert_err(
+            parse_csv(&with_cell(&csv_text(), line, col, value)),
+            &[expected],
+        );
+    }
+}
+
+#[test]
+fn plain_one_absurd_value_names_its_line_and_column() {
+    let text = String::from_utf8(PLAIN.clone()).unwrap();
+    // Line 1 is `N 27`; no index column, so acce_x is the fifth cell.
+    let text = edit_cells(&text, '\t', |line, cells| {
+        if line == 6 {
+            cells[4] = "-1e308".into();
+        }
+    });
+    assert_err(
+        ridi_plain::parse(text.as_bytes(), Path::new("data_plain.txt"), &opts()),
+        &["data_plain.txt:6: field `acce_x`: -1e308 m/s^2 is beyond any phone accelerometer"],
+    );
+}
+
+/// `f` applied to the values (not the time) of every data row of a raw file.
+fn raw_scaled(f: impl Fn(f64) -> f64 + Copy) -> impl FnOnce(&str) -> String {
+    move |text| {
+        edit_cells(text, ' ', |_, cells| {
+            if !cells[0].starts_with('#') {
+                scale(&mut cells[1..], f);
+            }
+        })
+    }
+}
+
+#[test]
+fn raw_gyro_in_degrees_per_second_is_refused() {
+    // A steady turn of 35 deg/s, written in deg/s.
+    let (_d, r) = raw_with(|f| {
+        edit_file(f, "gyro.txt", raw_scaled(|_| 35.0));
+    });
+    assert_err(
+        r,
+        &[
+            "gyro.txt: field `x..z`: median |gyro| 60.622 rad/s is above 10 rad/s: gyroscope in deg/s",
+        ],
+    );
+}
+
+#[test]
+fn raw_accelerometer_in_g_is_refused() {
+    let (_d, r) = raw_with(|f| {
+        edit_file(f, "acce.txt", raw_scaled(|v| v / 9.80665));
+        edit_file(f, "linacce.txt", raw_scaled(|v| v / 9.80665));
+    });
+    assert_err(
+        r,
+        &[
+            "acce.txt: field `x..z`: mean |acce| 1.0",
+            "accelerometer in g instead of m/s^2?",
+        ],
+    );
+}
+
+#[test]
+fn raw_time_in_seconds_is_refused() {
+    let (_d, r) = raw_with(|f| {
+        edit_file(f, "gyro.txt", |text| {
+            edit_cells(text, ' ', |_, cells| {
+                if !cells[0].starts_with('#') {
+                    scale(&mut cells[..1], |ns| ns / 1e9);
+                }
+            })
+        });
+    });
+    assert_err(
+        r,
+        &[
+            "gyro.txt: field `t`: timestamps step by 5e-12 s (median)",
+            "(this format expects nanoseconds)",
+        ],
+    );
+}
+
+#[test]
+fn raw_one_absurd_value_names_its_file_line_and_field() {
+    let cases = [
+        (
+            "gyro.txt",
+            3,
+            1,
+            "1e300",
+            "gyro.txt:3: field `x`: 1e300 rad/s is beyond any phone gyroscope",
+        ),
+        (
+            "acce.txt",
+            4,
+            2,
+            "1e308",
+            "acce.txt:4: field `y`: 1e308 m/s^2 is beyond any phone accelerometer",
+        ),
+        (
+            "linacce.txt",
+            5,
+            3,
+            "-3000",
+            "linacce.txt:5: field `z`: -3000 m/s^2 is beyond any phone accelerometer",
+        ),
+        (
+            "gravity.txt",
+            6,
+            1,
+            "-25",
+            "gravity.txt:6: field `x`: -25 m/s^2 is beyond any gravity reading",
+        ),
+        (
+            "magnet.txt",
+            7,
+            2,
+            "2e4",
+            "magnet.txt:7: field `y`: 20000 uT is beyond any phone magnetometer",
+        ),
+        (
+            "pose.txt",
+            8,
+            1,
+            "1e300",
+            "pose.txt:8: field `tx`: 1e300 m is beyond any plausible ground-truth position",
+        ),
+    ];
+    for (file, line, col, value, expected) in cases {
+        let (_d, r) = raw_with(|f| {
+            edit_file(f, file, |text| {
+                edit_cells(text, ' ', |n, cells| {
+                    if n == line {
+                        cells[col] = value.into();
+                    }
+                })
+            });
+        });
+        assert_err(r, &[expected]);
+    }
+}
+
+fn ilc_text() -> String {
+    String::from_utf8(ILC.to_vec()).unwrap()
+}
+
+fn parse_ilc(text: &str) -> ridi_data::Result<ilc::IlcPath> {
+    ilc::parse(
+        text.as_bytes(),
+        Path::new("site/path.txt"),
+        &IlcOptions::default(),
+    )
+}
+
+/// The ILC fixture with `f` applied to the three values of every `kind` record.
+fn ilc_scaled(kind: &str, f: impl Fn(f64) -> f64) -> String {
+    edit_cells(&ilc_text(), '\t', |_, cells| {
+        if cells.get(1).map(String::as_str) == Some(kind) {
+            scale(&mut cells[2..5], &f);
+        }
+    })
+}
+
+#[test]
+fn ilc_gyro_in_degrees_per_second_is_refused() {
+    assert_err(
+        parse_ilc(&ilc_scaled("TYPE_GYROSCOPE", |v| v * DEG)),
+        &[
+            "site/path.txt: field `TYPE_GYROSCOPE`: median |gyro| ",
+            "gyroscope in deg/s instead of rad/s?",
+        ],
+    );
+}
+
+#[test]
+fn ilc_accelerometer_in_g_is_refused() {
+    assert_err(
+        parse_ilc(&ilc_scaled("TYPE_ACCELEROMETER", |v| v / 9.80665)),
+        &[
+            "site/path.txt: field `TYPE_ACCELEROMETER`: mean |acce| 1.0",
+            "accelerometer in g instead of m/s^2?",
+        ],
+    );
+}
+
+#[test]
+fn ilc_time_in_seconds_is_refused() {
+    let text = edit_cells(&ilc_text(), '\t', |_, cells| {
+        if !cells[0].starts_with('#') {
+            scale(&mut cells[..1], |ms| ms / 1000.0);
+        }
+    });
+    assert_err(
+        parse_ilc(&text),
+        &[
+            "site/path.txt: field `unix_ms`: timestamps step by 2e-5 s (median)",
+            "(this format expects milliseconds)",
+        ],
+    );
+}
+
+#[test]
+fn ilc_one_absurd_value_names_its_line_and_field() {
+    let cases = [
+        (
+            7,
+            2,
+            "1e308",
+            "path.txt:7: field `TYPE_ACCELEROMETER x`: 1e308 m/s^2 is beyond any phone accelerometer",
+        ),
+        (
+            8,
+            4,
+            "-1e300",
+            "path.txt:8: field `TYPE_GYROSCOPE z`: -1e300 rad/s is beyond any phone gyroscope",
+        ),
+        (
+            9,
+            3,
+            "1e5",
+            "path.txt:9: field `TYPE_MAGNETIC_FIELD y`: 100000 uT is beyond any phone magnetometer",
+        ),
+        (
+            2,
+            2,
+            "1e300",
+            "path.txt:2: field `TYPE_WAYPOINT x`: 1e300 m is beyond any plausible ground-truth position",
+        ),
+    ];
+    for (line, col, value, expected) in cases {
+        let text = edit_cells(&ilc_text(), '\t', |n, cells| {
+            if n == line {
+                cells[col] = value.into();
+            }
+        });
+        assert_err(parse_ilc(&text), &[expected]);
+    }
+}

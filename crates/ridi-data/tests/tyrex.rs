@@ -418,6 +418,80 @@ fn text_errors_name_file_line_and_field() {
     );
 }
 
+/// `f` applied to the columns `cols` of every row of a phone file.
+fn scale_columns(text: &str, cols: std::ops::Range<usize>, f: impl Fn(f64) -> f64) -> String {
+    let mut out = String::new();
+    for l in text.lines() {
+        let mut c: Vec<String> = l.split(' ').map(str::to_owned).collect();
+        for v in &mut c[cols.clone()] {
+            *v = f(v.parse().unwrap()).to_string();
+        }
+        writeln!(out, "{}", c.join(" ")).unwrap();
+    }
+    out
+}
+
+#[test]
+fn implausible_values_and_units_name_file_line_and_field() {
+    let fx = Fixture::standard();
+    fx.edit("gyroscope-calibrated.txt", |s| {
+        scale_columns(s, 1..4, f64::to_degrees)
+    });
+    assert_err(
+        &fx,
+        &[
+            "gyroscope-calibrated.txt: field `wx..wz`: median |gyro| 17.189 rad/s is above 10 rad/s: \
+           gyroscope in deg/s instead of rad/s?",
+        ],
+    );
+
+    let fx = Fixture::standard();
+    fx.edit("accelerometer.txt", |s| {
+        scale_columns(s, 1..4, |v| v / STANDARD_GRAVITY)
+    });
+    assert_err(
+        &fx,
+        &[
+            "accelerometer.txt: field `ax..az`: mean |acce| 1 m/s^2 is 0.102 times mean |gravity|",
+            "accelerometer in g instead of m/s^2?",
+        ],
+    );
+
+    // Milliseconds where seconds are expected.
+    let fx = Fixture::standard();
+    fx.edit("accelerometer.txt", |s| {
+        scale_columns(s, 0..1, |t| t * 1000.0)
+    });
+    assert_err(
+        &fx,
+        &[
+            "accelerometer.txt: field `t`: timestamps step by 5 s (median), outside 1e-4..1 s: \
+           time in the wrong unit? (this format expects seconds)",
+        ],
+    );
+
+    let fx = Fixture::standard();
+    fx.edit("accelerometer.txt", |s| {
+        replace_line(s, 3, "0.013 1e308 0.0 9.8")
+    });
+    assert_err(
+        &fx,
+        &[
+            "accelerometer.txt:3: field `ax`: 1e308 m/s^2 is beyond any phone accelerometer \
+           (|value| <= 2000 m/s^2)",
+        ],
+    );
+
+    let fx = Fixture::standard();
+    fx.edit("gyroscope-calibrated.txt", |s| {
+        replace_line(s, 4, "0.019 0.0 -1e300 0.3")
+    });
+    assert_err(
+        &fx,
+        &["gyroscope-calibrated.txt:4: field `wy`: -1e300 rad/s is beyond any phone gyroscope"],
+    );
+}
+
 fn with_mat(vars: Vec<(String, V)>) -> Fixture {
     let fx = Fixture::standard();
     let vars: Vec<(&str, V)> = vars.iter().map(|(n, v)| (n.as_str(), v.clone())).collect();

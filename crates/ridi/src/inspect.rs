@@ -116,10 +116,17 @@ pub fn inspect(seq: &Sequence, format: Format) -> Inspection {
             gravity_norm.mean
         ));
     }
+    // Reading refuses ratios outside `acce_gravity_ratio` (an accelerometer in g gives 0.1);
+    // within it, a mismatch is worth a look (running reaches 1.9).
     if (acce_norm.mean - gravity_norm.mean).abs() > 0.5 {
+        let (min, max) = ridi_data::Validation::default().acce_gravity_ratio;
         warnings.push(format!(
-            "accelerometer mean magnitude {:.3} m/s^2 differs from gravity's {:.3}",
-            acce_norm.mean, gravity_norm.mean
+            "accelerometer mean magnitude {:.3} m/s^2 is {:.2} times gravity's {:.3}: large \
+             accelerations (running) or a scale error? (reading refuses ratios outside \
+             {min}..{max})",
+            acce_norm.mean,
+            acce_norm.mean / gravity_norm.mean,
+            gravity_norm.mean
         ));
     }
     if upside_down_fraction > 0.01 {
