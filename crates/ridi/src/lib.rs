@@ -12,9 +12,9 @@
 //! | [`eval`] | `ridi-eval` | alignment, MPE/ATE/RTE, reports |
 //!
 //! Pipeline modules: [`source`] reads any supported layout, [`convert`] writes the RIDI
-//! layout with list files, [`lists`] reads list files for training and evaluation with the
-//! labels they need, [`inspect`] summarizes a recording, [`orientation`] swaps in an
-//! orientation estimated from gyro and accelerometer.
+//! layout with list files (all or nothing, through [`staging`]), [`lists`] reads list files
+//! for training and evaluation with the labels they need, [`inspect`] summarizes a recording,
+//! [`orientation`] swaps in an orientation estimated from gyro and accelerometer.
 
 pub use ridi_correct as correct;
 pub use ridi_data as data;
@@ -33,6 +33,7 @@ pub mod orientation;
 pub mod placement;
 pub mod plot;
 pub mod source;
+pub mod staging;
 pub mod track;
 pub mod train;
 
