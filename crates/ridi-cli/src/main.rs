@@ -15,8 +15,8 @@ use ridi::features::FeatureConfig;
 use ridi::frames::UpAxis;
 use ridi::regress::{Cascade, ProgressEvent, Stage, Storage, StoredAs, model_file};
 use ridi::{
-    EvalOptions, GridChoice, Method, Orientation, PlacementMap, TrackOptions, TrainOptions,
-    apply_orientation,
+    EvalOptions, GridChoice, Method, Orientation, PlacementMap, Purpose, TrackOptions,
+    TrainOptions, apply_orientation,
 };
 
 /// `println!` that ignores a closed stdout (`ridi train ... | head`): the command's results are
@@ -397,7 +397,7 @@ fn run(cli: Cli) -> Result<()> {
         } => {
             set_jobs(jobs)?;
             check_output(&out)?;
-            let seqs = load_lists(&list, placement_map.as_deref())?;
+            let seqs = load_lists(&list, placement_map.as_deref(), Purpose::Training)?;
             let defaults = TrainOptions::default();
             let mut opts = TrainOptions {
                 standardize: !no_standardize,
@@ -490,7 +490,7 @@ fn run(cli: Cli) -> Result<()> {
         } => {
             set_jobs(jobs)?;
             let model = load_model(&model)?;
-            let seqs = load_lists(&list, placement_map.as_deref())?;
+            let seqs = load_lists(&list, placement_map.as_deref(), Purpose::Evaluation)?;
             let methods = methods
                 .iter()
                 .map(|m| m.parse::<Method>().map_err(anyhow::Error::msg))
@@ -549,15 +549,14 @@ fn set_jobs(jobs: Option<usize>) -> Result<()> {
     Ok(())
 }
 
-fn load_lists(lists: &[PathBuf], map: Option<&str>) -> Result<Vec<Sequence>> {
-    let mut seqs = Vec::new();
-    for l in lists {
-        seqs.extend(ridi::data::load_list(l, &ReadOptions::default())?);
-    }
-    if let Some(map) = map {
-        PlacementMap::from_arg(map)?.apply(&mut seqs);
-    }
-    Ok(seqs)
+fn load_lists(lists: &[PathBuf], map: Option<&str>, purpose: Purpose) -> Result<Vec<Sequence>> {
+    let map = map.map(PlacementMap::from_arg).transpose()?;
+    Ok(ridi::load_lists(
+        lists,
+        map.as_ref(),
+        purpose,
+        &ReadOptions::default(),
+    )?)
 }
 
 fn load_model(path: &Path) -> Result<Cascade> {
@@ -783,6 +782,9 @@ fn parse_align(text: &str) -> std::result::Result<AlignWindow, String> {
 }
 
 fn print_summary(report: &ridi::Report) {
+    for w in &report.warnings {
+        eprintln!("warning: {w}");
+    }
     let weak = report
         .sequences
         .iter()
@@ -849,8 +851,8 @@ fn demo(out: &Path, data: Option<PathBuf>, grid: Grid, plots: Plots) -> Result<(
         );
     }
     let map = Some("tyrex4");
-    let train = load_lists(&[train_list], map)?;
-    let test = load_lists(&[data.join("list_test.txt")], map)?;
+    let train = load_lists(&[train_list], map, Purpose::Training)?;
+    let test = load_lists(&[data.join("list_test.txt")], map, Purpose::Evaluation)?;
     outln!(
         "demo: training on {} sequences ({:.0} s), testing on {} held-out sequences",
         train.len(),

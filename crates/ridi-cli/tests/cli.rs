@@ -1,5 +1,6 @@
 //! The `ridi` binary as a user runs it: outputs, exit codes and one-line errors.
 
+use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
@@ -129,6 +130,29 @@ fn bad_flags_and_outputs_fail_before_any_work() {
     );
     let printed = String::from_utf8_lossy(&out.stdout);
     assert!(!printed.contains("placements:"), "trained first: {printed}");
+    // A label the placement map does not know is named with its list file and line.
+    let typo = dir.path().join("typo.txt");
+    let swing = sample().join("Guillaume_Nexus5_NoDist_Swinging");
+    let texting = sample().join("Guillaume_Nexus5_NoDist_Texting");
+    std::fs::write(
+        &typo,
+        format!("{},Texting\n{},Swingin\n", s(&texting), s(&swing)),
+    )
+    .unwrap();
+    let out = ridi(&[
+        "train",
+        "--list",
+        s(&typo),
+        "--out",
+        s(&model),
+        "--placement-map",
+        "tyrex4",
+    ]);
+    let err = stderr(&out);
+    assert!(
+        !out.status.success() && err.contains("typo.txt:2: field `placement`: placement `Swingin`"),
+        "{err}"
+    );
 
     let seq = sample().join("Jakob_Nexus5_NoDist_Texting");
     let csv = dir.path().join("t.csv");
@@ -355,4 +379,154 @@ fn convert_train_track_and_eval() {
         "{}",
         stderr(&out)
     );
+}
+
+// ---- bad input: one-line errors naming the file, nothing partly written ------------------
+
+/// The one-line error of a failed run.
+fn error(o: &Output) -> String {
+    assert!(!o.status.success());
+    let err = String::from_utf8_lossy(&o.stderr).into_owned();
+    assert_eq!(err.lines().count(), 1, "{err}");
+    err
+}
+
+/// A RIDI raw folder of 2000 frames at 200 Hz (more than the 800 pose records dropped at each
+/// end), the phone still and upright, with gravity `g` m/s^2; `skip` files left out.
+fn raw_folder(dir: &Path, g: f64, skip: &[&str]) {
+    std::fs::create_dir_all(dir).unwrap();
+    let rows = |header: &str, values: &str| {
+        let mut text = format!("# {header}\n");
+        for i in 0..2000i64 {
+            let _ = writeln!(text, "{} {values}", 1_000_000_000_000 + 5_000_000 * i);
+        }
+        text
+    };
+    let files = [
+        ("gyro.txt", rows("t x y z", "0 0 0")),
+        ("acce.txt", rows("t x y z", &format!("0 {g} 0"))),
+        ("linacce.txt", rows("t x y z", "0 0 0")),
+        ("gravity.txt", rows("t x y z", &format!("0 {g} 0"))),
+        ("orientation.txt", rows("t x y z w", "0 0 0 1")),
+        ("pose.txt", rows("t tx ty tz qx qy qz qw", "0 0 0 0 0 0 1")),
+    ];
+    for (name, text) in files {
+        if !skip.contains(&name) {
+            std::fs::write(dir.join(name), text).unwrap();
+        }
+    }
+}
+
+#[test]
+fn raw_folders_name_the_file_to_blame() {
+    let dir = tempfile::tempdir().unwrap();
+    let raw = dir.path().join("raw");
+    raw_folder(&raw, 9.81, &[]);
+    let out = ridi(&["inspect", s(&raw)]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+
+    std::fs::remove_file(raw.join("gyro.txt")).unwrap();
+    let conv = dir.path().join("conv");
+    for args in [
+        vec!["inspect", s(&raw)],
+        vec!["convert", s(&raw), "--from", "ridi-raw", "--out", s(&conv)],
+    ] {
+        let err = error(&ridi(&args));
+        assert!(
+            err.contains(&format!(
+                "{}: RIDI raw folder without gyro.txt",
+                raw.display()
+            )),
+            "{err}"
+        );
+    }
+    assert!(!dir.path().join("conv").exists());
+
+    let in_g = dir.path().join("in_g");
+    raw_folder(&in_g, 1.0, &[]);
+    let err = error(&ridi(&["inspect", s(&in_g)]));
+    assert!(
+        err.contains(&format!(
+            "{}: mean gravity magnitude 1.000 m/s^2 is outside 8.5..11",
+            in_g.join("gravity.txt").display()
+        )) && !err.contains("pose.txt"),
+        "{err}"
+    );
+}
+
+#[test]
+fn convert_writes_all_or_nothing() {
+    let dir = tempfile::tempdir().unwrap();
+    let src = dir.path().join("src");
+    let texting = sample().join("Thibaud_Nexus5_NoDist_Texting");
+    for name in ["a_seq", "b_seq", "c_seq"] {
+        let out = ridi(&["convert", s(&texting), "--out", s(&dir.path().join("tmp"))]);
+        assert!(out.status.success());
+        let from = dir
+            .path()
+            .join("tmp/Thibaud_Nexus5_NoDist_Texting/processed/data.csv");
+        std::fs::create_dir_all(src.join(name).join("processed")).unwrap();
+        let mut text = std::fs::read_to_string(&from).unwrap();
+        if name == "b_seq" {
+            let mut lines: Vec<String> = text.lines().map(str::to_string).collect();
+            let mut cells: Vec<&str> = lines[300].split(',').collect();
+            cells[3] = "NaN";
+            lines[300] = cells.join(",");
+            text = lines.join("\n") + "\n";
+        }
+        std::fs::write(src.join(name).join("processed/data.csv"), text).unwrap();
+    }
+    let conv = dir.path().join("conv");
+    let err = error(&ridi(&["convert", s(&src), "--out", s(&conv)]));
+    assert!(
+        err.contains("b_seq/processed/data.csv:301: field `gyro_y`"),
+        "{err}"
+    );
+    assert!(!conv.exists());
+
+    // The source of another format than --from says what it is and what was expected.
+    let csv = dir
+        .path()
+        .join("tmp/Thibaud_Nexus5_NoDist_Texting/processed/data.csv");
+    let err = error(&ridi(&[
+        "convert",
+        s(&csv),
+        "--from",
+        "tyrex",
+        "--out",
+        s(&conv),
+    ]));
+    assert!(
+        err.contains(
+            "data.csv: not a Tyrex folder (it is a RIDI processed csv): a Tyrex run is a folder"
+        ) && !err.contains("entity not found"),
+        "{err}"
+    );
+    assert!(!conv.exists());
+}
+
+#[test]
+fn empty_lists_are_errors() {
+    let dir = tempfile::tempdir().unwrap();
+    let list = dir.path().join("empty.txt");
+    std::fs::write(&list, "# nothing here yet\n").unwrap();
+    let model = dir.path().join("m.ridi");
+    let err = error(&ridi(&[
+        "train",
+        "--list",
+        s(&list),
+        "--out",
+        s(&model),
+        "--grid",
+        "none",
+    ]));
+    assert!(
+        err.contains(&format!("{}: no sequences listed", list.display())),
+        "{err}"
+    );
+    assert!(!model.exists());
 }

@@ -35,6 +35,34 @@ impl fmt::Display for Format {
     }
 }
 
+impl Format {
+    /// What a source of this format looks like, for errors about a source that is not one.
+    pub fn layout(self) -> &'static str {
+        match self {
+            Format::RidiCsv => {
+                "a RIDI processed csv is a `data.csv` (or `.csv.gz`) with the RIDI columns, or a \
+                 folder holding one (or `processed/data.csv`)"
+            }
+            Format::RidiPlain => {
+                "a RIDI `data_plain.txt` starts with `N 27`, then N tab-separated rows"
+            }
+            Format::RidiRaw => {
+                "a RIDI raw folder holds gyro.txt, acce.txt, linacce.txt, gravity.txt and \
+                 orientation.txt (and optionally magnet.txt, pose.txt, step.txt)"
+            }
+            Format::Tyrex => {
+                "a Tyrex run is a folder <Person>_<Phone>_<Dist>_<Motion> with \
+                 accelerometer.txt, gyroscope-calibrated.txt, rotation-vector.txt and \
+                 timeAlignment.txt; a Tyrex root holds the runs in datasets/android/"
+            }
+            Format::Ilc => {
+                "an Indoor Location Competition path file is a `.txt` of \
+                 `unix_ms<TAB>TYPE_...` records"
+            }
+        }
+    }
+}
+
 /// What [`detect`] found: the format and the file or folder its reader takes.
 fn locate(path: &Path) -> Result<(Format, PathBuf)> {
     if path.is_file() {
@@ -80,11 +108,13 @@ fn locate(path: &Path) -> Result<(Format, PathBuf)> {
             return Ok((format, path.join(rel)));
         }
     }
-    if has("gyro.txt") && has("acce.txt") {
-        return Ok((Format::RidiRaw, path.to_path_buf()));
-    }
-    if has("accelerometer.txt") && has("gyroscope-calibrated.txt") {
+    // Any of the files a format's folder must have makes it one: its reader then names the
+    // others it lacks.
+    if has("accelerometer.txt") || has("gyroscope-calibrated.txt") {
         return Ok((Format::Tyrex, path.to_path_buf()));
+    }
+    if ridi_raw::looks_like(path) {
+        return Ok((Format::RidiRaw, path.to_path_buf()));
     }
     Err(DataError::format(
         Location::file(path),
@@ -101,8 +131,9 @@ fn locate(path: &Path) -> Result<(Format, PathBuf)> {
 /// [`ilc::looks_like_path_file`]) and a `data_plain.txt` otherwise; either may be
 /// gzip-compressed (`*.csv.gz`, `*.txt.gz`). Folders, first match wins: `processed/data.csv`
 /// (or `.csv.gz`), `data.csv` (or `.csv.gz`), `processed/data_plain.txt`, `data_plain.txt`, a
-/// RIDI raw folder (`gyro.txt` and `acce.txt`), a Tyrex folder (`accelerometer.txt` and
-/// `gyroscope-calibrated.txt`).
+/// Tyrex folder (`accelerometer.txt` or `gyroscope-calibrated.txt`), a RIDI raw folder (any
+/// of [`ridi_raw::REQUIRED`]). A folder with only some of the files its format needs is
+/// detected as that format, and reading it names the files it lacks.
 pub fn detect(path: impl AsRef<Path>) -> Result<Format> {
     locate(path.as_ref()).map(|(f, _)| f)
 }

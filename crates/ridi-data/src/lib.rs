@@ -18,7 +18,7 @@
 //! | RIDI raw recorder folder (`gyro.txt`, `acce.txt`, ..., `pose.txt`) | [`ridi_raw::read`] | |
 //! | Tyrex smartphone benchmark folder (Android text files, Qualisys `.mat` ground truth) | [`tyrex::read`] | |
 //! | Indoor Location Competition 2.0 path file (`unix_ms<TAB>TYPE_...` records, waypoints) | [`ilc::read`] | |
-//! | dataset list file (`path,placement` per line) | [`read_list`], [`load_list`] | |
+//! | dataset list file (`path,placement` per line) | [`read_list`], [`load_list`], [`load_entries`] | |
 //!
 //! [`detect`] tells the format of a file or folder and [`read_sequence`] reads any of them
 //! (a Tyrex run only when it is not split into parts). [`ReadOptions`] holds the validation limits and the
@@ -81,7 +81,7 @@ mod write;
 
 pub use detect::{Format, detect, read_sequence};
 pub use error::{DataError, Location, Result};
-pub use list::{ListEntry, load_list, parse_list, read_list};
+pub use list::{ListEntry, load_entries, load_list, parse_list, read_list};
 pub use options::ReadOptions;
 pub use ridi_frames;
 pub use sequence::{

@@ -3,7 +3,7 @@
 //! One entry per line, `path,placement`: the path is absolute or relative to the list file's
 //! folder, the placement (e.g. `body`, `handheld`, `bag`, `leg`) is optional (`path` alone or
 //! `path,`). Blank lines and lines starting with `#` are skipped. Surrounding spaces are
-//! trimmed.
+//! trimmed. A list that lists no sequence is an error.
 
 use std::path::{Path, PathBuf};
 
@@ -20,8 +20,17 @@ pub struct ListEntry {
     pub path: PathBuf,
     /// Placement label, when given.
     pub placement: Option<String>,
+    /// The list file, for error messages.
+    pub list: PathBuf,
     /// 1-based line of the list file, for error messages.
     pub line: usize,
+}
+
+impl ListEntry {
+    /// The list file and line of this entry, for errors about the sequence it lists.
+    pub fn location(&self) -> Location {
+        Location::line(&self.list, self.line)
+    }
 }
 
 /// Reads a list file. Only the syntax is checked; [`load_list`] checks that the sequences
@@ -32,7 +41,8 @@ pub fn read_list(path: impl AsRef<Path>) -> Result<Vec<ListEntry>> {
 }
 
 /// Parses the content of a list file; `path` is the list file itself (relative entries are
-/// resolved against its folder, errors name it).
+/// resolved against its folder, errors name it). A list without any entry (empty, or only
+/// comments and blank lines) is an error: "no sequences listed".
 pub fn parse_list(bytes: &[u8], path: &Path) -> Result<Vec<ListEntry>> {
     let base = path.parent().unwrap_or(Path::new(""));
     let mut entries = Vec::new();
@@ -65,8 +75,15 @@ pub fn parse_list(bytes: &[u8], path: &Path) -> Result<Vec<ListEntry>> {
         entries.push(ListEntry {
             path: base.join(entry),
             placement: placement.map(str::to_owned),
+            list: path.to_path_buf(),
             line,
         });
+    }
+    if entries.is_empty() {
+        return Err(DataError::format(
+            Location::file(path),
+            "no sequences listed (expected `path,placement` lines)",
+        ));
     }
     Ok(entries)
 }
@@ -77,22 +94,27 @@ pub fn parse_list(bytes: &[u8], path: &Path) -> Result<Vec<ListEntry>> {
 /// Every entry is checked to exist before any is read, so a typo fails fast with the list file
 /// and line; errors while reading a sequence name that sequence's file.
 pub fn load_list(path: impl AsRef<Path>, opts: &ReadOptions) -> Result<Vec<Sequence>> {
-    let path = path.as_ref();
-    let entries = read_list(path)?;
-    for e in &entries {
+    load_entries(&read_list(path)?, opts)
+}
+
+/// Reads the sequences of `entries` (from [`read_list`], of one or several list files), in
+/// order, as [`load_list`] does: every path is checked to exist before any is read, and the
+/// placement is the entry's when it gives one.
+pub fn load_entries(entries: &[ListEntry], opts: &ReadOptions) -> Result<Vec<Sequence>> {
+    for e in entries {
         if !e.path.exists() {
             return Err(DataError::format(
-                Location::line(path, e.line).with_field("path"),
+                e.location().with_field("path"),
                 format!("sequence `{}` does not exist", e.path.display()),
             ));
         }
     }
     entries
-        .into_iter()
+        .iter()
         .map(|e| {
             let mut seq = read_sequence(&e.path, opts)?;
             if e.placement.is_some() {
-                seq.set_placement(e.placement);
+                seq.set_placement(e.placement.clone());
             }
             Ok(seq)
         })

@@ -1,9 +1,10 @@
 //! Reader of RIDI raw recorder folders.
 //!
 //! A folder holds `gyro.txt`, `acce.txt`, `linacce.txt`, `gravity.txt` and `orientation.txt`
-//! (required) and `magnet.txt`, `pose.txt`, `step.txt` (optional; a file with no rows counts as
-//! absent). Each starts with a `#` header line (any `#` line is skipped), then space-separated
-//! rows `t_ns values...`: `x y z` for the IMU files, `x y z w` for the game rotation vector in
+//! ([`REQUIRED`]: a folder with only some of them is an error naming those it lacks) and
+//! `magnet.txt`, `pose.txt`, `step.txt` (optional; a file with no rows counts as absent). Each
+//! starts with a `#` header line (any `#` line is skipped), then space-separated rows
+//! `t_ns values...`: `x y z` for the IMU files, `x y z w` for the game rotation vector in
 //! `orientation.txt`, `tx ty tz qx qy qz qw` for the Tango pose, `count` for `step.txt`. Extra
 //! trailing values are ignored; fewer are an error.
 //!
@@ -15,7 +16,8 @@
 //! there is no ground truth. Repeated timestamps within a file keep their first record;
 //! decreasing ones are an error, and so is a gap longer than the validation's `max_gap_s` in any
 //! file but `step.txt` (written only when a step is taken) and `pose.txt` (checked after
-//! trimming, on the sequence itself).
+//! trimming, on the sequence itself). A failed check of an interpolated stream (such as a mean
+//! gravity magnitude in the wrong units) names that stream's file.
 //!
 //! Before the synchronization, each file but `step.txt` is checked against the
 //! [`Validation`] limits on its own lines: its median time step, and every value of the IMU
@@ -66,6 +68,40 @@ impl text::Fields for RawFields {
     fn time_unit(&self) -> &str {
         "nanoseconds"
     }
+}
+
+/// The files a raw folder must have.
+pub const REQUIRED: [&str; 5] = [
+    "gyro.txt",
+    "acce.txt",
+    "linacce.txt",
+    "gravity.txt",
+    "orientation.txt",
+];
+
+/// Whether `folder` holds any of the [`REQUIRED`] files: a RIDI raw folder, complete or not
+/// (the reader names what is missing).
+pub fn looks_like(folder: &Path) -> bool {
+    REQUIRED.iter().any(|f| folder.join(f).is_file())
+}
+
+/// Fails naming every [`REQUIRED`] file `folder` lacks.
+fn check_required(folder: &Path) -> Result<()> {
+    let missing: Vec<&str> = REQUIRED
+        .into_iter()
+        .filter(|f| !folder.join(f).is_file())
+        .collect();
+    if missing.is_empty() {
+        return Ok(());
+    }
+    Err(DataError::format(
+        Location::file(folder),
+        format!(
+            "RIDI raw folder without {}: it needs {}",
+            missing.join(", "),
+            REQUIRED.join(", ")
+        ),
+    ))
 }
 
 /// One parsed file: times in seconds, strictly increasing, with `fields.len() - 1` values each.
@@ -204,14 +240,7 @@ fn read_records(
     max_gap_s: Option<f64>,
 ) -> Result<Option<Records>> {
     let path = folder.join(name);
-    if !path.exists() {
-        if required {
-            return Err(DataError::format(
-                Location::file(&path),
-                "missing: a RIDI raw folder needs gyro.txt, acce.txt, linacce.txt, gravity.txt \
-                 and orientation.txt",
-            ));
-        }
+    if !required && !path.exists() {
         return Ok(None);
     }
     let rec = parse_records(&text::read_file(&path)?, &path, fields, max_gap_s)?;
@@ -235,9 +264,11 @@ fn required(
 }
 
 /// Reads a RIDI raw recorder folder into a sequence named after the folder, with the game
-/// rotation vector as orientation source.
+/// rotation vector as orientation source. A folder lacking [`REQUIRED`] files is an error naming
+/// every one it lacks.
 pub fn read(folder: impl AsRef<Path>, opts: &ReadOptions) -> Result<Sequence> {
     let folder = folder.as_ref();
+    check_required(folder)?;
     let gap = opts.validation.max_gap_s;
     let gyro = required(folder, "gyro.txt", XYZ, gap)?;
     let acce = required(folder, "acce.txt", XYZ, gap)?;
@@ -331,17 +362,40 @@ pub fn read(folder: impl AsRef<Path>, opts: &ReadOptions) -> Result<Sequence> {
             .map(|s| interpolate_scalar(&s.time, &s.values, &time)),
         time,
     };
-    let (path, lines): (&Path, Option<Vec<usize>>) = match &pose {
-        Some(p) => (
-            &p.path,
-            Some(pose_rows.iter().map(|&i| p.lines[i]).collect()),
-        ),
-        None => (folder, None),
-    };
-    Sequence::with_validation(parts, &opts.validation).map_err(|e| match e {
-        SequenceError::AcceScale { .. } => acce.error(e),
-        _ => text::sequence_error(path, lines.as_deref(), &RawFields, e),
+    Sequence::with_validation(parts, &opts.validation).map_err(|e| match (&e, stream_file(&e)) {
+        (SequenceError::AcceScale { .. }, _) => acce.error(e),
+        // Interpolated onto the pose times: the file, but no line, is to blame.
+        (_, Some(name)) => text::sequence_error(&folder.join(name), None, &RawFields, e),
+        (_, None) => match &pose {
+            Some(p) => {
+                let lines: Vec<usize> = pose_rows.iter().map(|&i| p.lines[i]).collect();
+                text::sequence_error(&p.path, Some(&lines), &RawFields, e)
+            }
+            None => text::sequence_error(folder, None, &RawFields, e),
+        },
     })
+}
+
+/// The file of the sensor stream a validation failure is about, when it is about one (the
+/// timeline and the ground truth are the pose file's).
+fn stream_file(e: &SequenceError) -> Option<&'static str> {
+    let field = match e {
+        SequenceError::Gravity { .. } => "gravity",
+        SequenceError::NotFinite { field, .. } | SequenceError::LengthMismatch { field, .. } => {
+            field
+        }
+        _ => return None,
+    };
+    match field {
+        "gyro" => Some("gyro.txt"),
+        "acce" => Some("acce.txt"),
+        "linacce" => Some("linacce.txt"),
+        "gravity" => Some("gravity.txt"),
+        "magnet" => Some("magnet.txt"),
+        "orientation" => Some("orientation.txt"),
+        "steps" => Some("step.txt"),
+        _ => None,
+    }
 }
 
 /// The pose times kept after trimming `trim` records at each end and dropping those outside

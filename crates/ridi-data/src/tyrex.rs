@@ -216,7 +216,20 @@ pub fn list_sequences(root: impl AsRef<Path>) -> Result<Vec<PathBuf>> {
     ]
     .into_iter()
     .find(|p| p.is_dir())
-    .ok_or_else(|| DataError::io(root, std::io::ErrorKind::NotFound.into()))?;
+    .ok_or_else(|| {
+        DataError::format(
+            Location::file(root),
+            format!(
+                "not a Tyrex run or root ({}): {}",
+                if root.exists() {
+                    "not a folder"
+                } else {
+                    "no such file or folder"
+                },
+                crate::Format::Tyrex.layout()
+            ),
+        )
+    })?;
     let entries = std::fs::read_dir(&base).map_err(|e| DataError::io(&base, e))?;
     let mut out = Vec::new();
     for entry in entries {

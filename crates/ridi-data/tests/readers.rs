@@ -362,7 +362,10 @@ fn raw_folder_without_pose_is_uniform_200_hz_without_ground_truth() {
 #[test]
 fn raw_bad_files_name_file_line_and_field() {
     let (_d, r) = raw_with(|f| f.retain(|(n, _)| *n != "acce.txt"));
-    assert_err(r, &["acce.txt", "missing"]);
+    assert_err(
+        r,
+        &["RIDI raw folder without acce.txt: it needs gyro.txt, acce.txt"],
+    );
     let (_d, r) = raw_with(|f| edit_file(f, "linacce.txt", |_| "# t x y z\n".into()));
     assert_err(r, &["linacce.txt", "has no data rows"]);
     let (_d, r) = raw_with(|f| edit_file(f, "gyro.txt", |s| s.replacen(" 0.1 ", " 0.1 \n", 1)));
@@ -406,8 +409,69 @@ fn raw_bad_files_name_file_line_and_field() {
     let (_d, r) =
         raw_with(|f| edit_file(f, "pose.txt", |s| s.replace(" 0 0 0 1\n", " 0 0 0 NaN\n")));
     assert_err(r, &["pose.txt:2: field `qw`", "not a finite number"]);
-    let (_d, r) = raw_with(|f| edit_file(f, "gravity.txt", |s| s.replace(" 9.8 ", " 1 ")));
-    assert_err(r, &["pose.txt", "gravity magnitude"]);
+}
+
+#[test]
+fn partial_folders_are_detected_and_name_what_they_lack() {
+    // Detected as a raw folder from the files it has; reading names those it lacks.
+    let dir = tempfile::tempdir().unwrap();
+    let raw = dir.path().join("raw");
+    let mut files = raw_files(60, true);
+    files.retain(|(n, _)| !["gyro.txt", "orientation.txt"].contains(n));
+    write_files(&raw, &files);
+    assert_eq!(detect(&raw).unwrap(), Format::RidiRaw);
+    let e = assert_err(read_sequence(&raw, &raw_options()), &[]);
+    assert_eq!(
+        e.to_string(),
+        format!(
+            "{}: RIDI raw folder without gyro.txt, orientation.txt: it needs gyro.txt, acce.txt, \
+             linacce.txt, gravity.txt, orientation.txt",
+            raw.display()
+        )
+    );
+    // Only the pose: not recognisably raw.
+    let pose_only = dir.path().join("pose_only");
+    write_files(&pose_only, &[("pose.txt", "# t\n".into())]);
+    assert_err(detect(&pose_only), &["not a known dataset folder"]);
+
+    let tyrex = dir.path().join("Jakob_Nexus5_NoDist_Texting");
+    write_files(&tyrex, &[("accelerometer.txt", "0 0 0 9.8\n".into())]);
+    assert_eq!(detect(&tyrex).unwrap(), Format::Tyrex);
+    assert_err(
+        read_sequence(&tyrex, &opts()),
+        &["gyroscope-calibrated.txt"],
+    );
+    // A file is no Tyrex root: say what one looks like.
+    assert_err(
+        ridi_data::tyrex::list_sequences(tyrex.join("accelerometer.txt")),
+        &[
+            "accelerometer.txt: not a Tyrex run or root (not a folder): a Tyrex run is a folder",
+            "datasets/android/",
+        ],
+    );
+}
+
+#[test]
+fn raw_validation_failures_name_the_stream_file() {
+    // Gravity in g: the mean magnitude check blames gravity.txt, not the pose clock.
+    let (d, r) = raw_with(|f| edit_file(f, "gravity.txt", |s| s.replace(" 9.8 ", " 1 ")));
+    let e = assert_err(r, &["gravity magnitude 1.000 m/s^2 is outside"]);
+    let msg = e.to_string();
+    assert!(
+        msg.starts_with(&format!("{}: ", d.path().join("gravity.txt").display())),
+        "{msg}"
+    );
+    assert!(!msg.contains("pose.txt"), "{msg}");
+    // Without a pose file too.
+    let (d, r) = raw_with(|f| {
+        f.retain(|(n, _)| *n != "pose.txt");
+        edit_file(f, "gravity.txt", |s| s.replace(" 9.8 ", " 1 "));
+    });
+    let msg = assert_err(r, &["gravity magnitude"]).to_string();
+    assert!(
+        msg.starts_with(&d.path().join("gravity.txt").display().to_string()),
+        "{msg}"
+    );
 }
 
 // ---- detection and lists -----------------------------------------------------------------
@@ -500,6 +564,35 @@ fn list_files_parse_comments_paths_and_placements() {
         &["train.txt:1: field `placement`"],
     );
     assert_err(read_list("/definitely/not/here.txt"), &["here.txt"]);
+}
+
+#[test]
+fn list_entries_know_their_list_and_line() {
+    let list = Path::new("/data/lists/train.txt");
+    let entries = parse_list(b"# split\nseq_a,body\n\nseq_b\n", list).unwrap();
+    assert!(entries.iter().all(|e| e.list == list));
+    assert_eq!(entries[1].location().to_string(), "/data/lists/train.txt:4");
+}
+
+#[test]
+fn lists_without_sequences_are_errors() {
+    let dir = tempfile::tempdir().unwrap();
+    let list = dir.path().join("empty.txt");
+    for text in ["", "\n\n", "# only a comment\n\n# another\n"] {
+        std::fs::write(&list, text).unwrap();
+        let e = assert_err(read_list(&list), &[]);
+        assert_eq!(
+            e.to_string(),
+            format!(
+                "{}: no sequences listed (expected `path,placement` lines)",
+                list.display()
+            )
+        );
+        assert_err(
+            load_list(&list, &opts()),
+            &["empty.txt", "no sequences listed"],
+        );
+    }
 }
 
 #[test]

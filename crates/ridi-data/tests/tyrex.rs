@@ -290,10 +290,12 @@ fn lists_sequence_folders_from_the_root() {
     );
     let e = tyrex::list_sequences(fx.root.join("datasets/qualisys")).unwrap_err();
     assert!(e.to_string().contains("no Tyrex sequence folder"), "{e}");
-    assert!(matches!(
-        tyrex::list_sequences(fx.root.join("nowhere")),
-        Err(DataError::Io { .. })
-    ));
+    let e = tyrex::list_sequences(fx.root.join("nowhere")).unwrap_err();
+    assert!(
+        e.to_string()
+            .contains("nowhere: not a Tyrex run or root (no such file or folder)"),
+        "{e}"
+    );
 }
 
 #[test]

@@ -9,7 +9,8 @@ use ridi_data::{
 };
 use ridi_data::{ilc, tyrex};
 
-use crate::source::read_any;
+use crate::source::{is_a, not_a, read_any};
+use crate::staging::Staging;
 
 /// One sequence written by [`convert`].
 #[derive(Debug, Clone, PartialEq)]
@@ -40,49 +41,68 @@ type Written = (Vec<Converted>, Vec<String>);
 
 /// The sources under `source`: one sequence, the runs of a Tyrex root, the sequences one
 /// level below a folder (a RIDI dataset folder), or else the Indoor Location Competition path
-/// files in the folder and its sub-folders.
+/// files in the folder and its sub-folders. With `from`, only sources of that format: a
+/// `source` of another format is an error saying so.
 fn sources(source: &Path, from: Option<Format>) -> Result<Vec<PathBuf>, DataError> {
-    let detected = detect(source).ok();
-    if from.is_none_or(|f| f == Format::Tyrex) {
-        if detected == Some(Format::Tyrex) {
-            return Ok(vec![source.to_path_buf()]);
-        }
-        if let Ok(runs) = tyrex::list_sequences(source) {
-            return Ok(runs);
-        }
-        if from == Some(Format::Tyrex) {
-            return tyrex::list_sequences(source);
-        }
-    }
-    if from == Some(Format::Ilc) && detected != Some(Format::Ilc) {
-        return ilc::list_paths(source);
-    }
-    if detected.is_some() {
+    let Some(want) = from else {
+        return detected_sources(source);
+    };
+    if is_a(source, want) {
         return Ok(vec![source.to_path_buf()]);
+    }
+    if detect(source).is_ok() || !source.is_dir() {
+        return Err(not_a(source, want));
+    }
+    match want {
+        Format::Tyrex => tyrex::list_sequences(source),
+        Format::Ilc => ilc::list_paths(source),
+        _ => {
+            let found = sub_folders(source, |p| is_a(p, want))?;
+            if found.is_empty() {
+                return Err(DataError::format(
+                    Location::file(source),
+                    format!("no {want} here or one level below: {}", want.layout()),
+                ));
+            }
+            Ok(found)
+        }
+    }
+}
+
+/// [`sources`] without a format given: whatever is detected.
+fn detected_sources(source: &Path) -> Result<Vec<PathBuf>, DataError> {
+    if detect(source).is_ok() {
+        return Ok(vec![source.to_path_buf()]);
+    }
+    if let Ok(runs) = tyrex::list_sequences(source) {
+        return Ok(runs);
     }
     if !source.is_dir() {
         // Say why the file is not a sequence rather than that it is not a folder.
         return detect(source).map(|_| vec![source.to_path_buf()]);
     }
-    let entries = std::fs::read_dir(source).map_err(|e| DataError::io(source, e))?;
-    let mut found = Vec::new();
-    for entry in entries {
-        let path = entry.map_err(|e| DataError::io(source, e))?.path();
-        if path.is_dir() && detect(&path).is_ok_and(|f| from.is_none_or(|want| want == f)) {
-            found.push(path);
-        }
+    let found = sub_folders(source, |p| detect(p).is_ok())?;
+    if !found.is_empty() {
+        return Ok(found);
     }
-    if found.is_empty() {
-        if from.is_none()
-            && let Ok(paths) = ilc::list_paths(source)
-        {
-            return Ok(paths);
-        }
-        return Err(DataError::format(
+    ilc::list_paths(source).map_err(|_| {
+        DataError::format(
             Location::file(source),
             "no sequence found: expected a RIDI data.csv, data_plain.txt or raw folder, a Tyrex \
              folder or root, a folder of those, or Indoor Location Competition path files",
-        ));
+        )
+    })
+}
+
+/// The folders directly in `dir` that `keep` accepts, sorted.
+fn sub_folders(dir: &Path, keep: impl Fn(&Path) -> bool) -> Result<Vec<PathBuf>, DataError> {
+    let entries = std::fs::read_dir(dir).map_err(|e| DataError::io(dir, e))?;
+    let mut found = Vec::new();
+    for entry in entries {
+        let path = entry.map_err(|e| DataError::io(dir, e))?.path();
+        if path.is_dir() && keep(&path) {
+            found.push(path);
+        }
     }
     found.sort();
     Ok(found)
@@ -96,13 +116,20 @@ fn tyrex_subject(name: &str) -> Option<&str> {
         _ => name,
     };
     tyrex::motion_of(run)?;
-    name.split('_').next()
+    let mut parts = run.split('_');
+    let person = parts.next();
+    // `<Person>_<Phone>_<Dist>_<Motion>`: a bare motion (`texting.csv`) names no person.
+    (parts.count() >= 3).then_some(person).flatten()
 }
 
 /// Converts every sequence under `source` into `<out>/<name>/processed/data.csv` and writes
 /// list files (`name,placement` per line, relative to `out`): `list_all.txt`, and for Tyrex
 /// sources one `list_<person>.txt` per person. The placement of a Tyrex run is its motion name,
 /// that of an Indoor Location Competition path `hand`.
+///
+/// All or nothing: every source is read and validated, and its files written to a staging
+/// folder in `out`, before any is moved into place; on an error `out` is left as it was (a
+/// folder `out` or its parents created for the conversion is removed again).
 pub fn convert(
     source: &Path,
     out: &Path,
@@ -110,20 +137,19 @@ pub fn convert(
     opts: &ReadOptions,
 ) -> Result<ConvertSummary, DataError> {
     let dirs = sources(source, from)?;
+    let staging = Staging::new(out)?;
     let results: Vec<Result<Written, DataError>> = dirs
         .par_iter()
         .map(|dir| {
-            let loaded = read_any(dir, from.filter(|_| dirs.len() == 1), opts)?;
+            let loaded = read_any(dir, from, opts)?;
             let mut written = Vec::new();
             for seq in &loaded.sequences {
-                let folder = out.join(seq.name()).join("processed");
-                std::fs::create_dir_all(&folder).map_err(|e| DataError::io(&folder, e))?;
-                let path = folder.join("data.csv");
-                write_ridi_csv(seq, &path)?;
+                let rel = Path::new(seq.name()).join("processed").join("data.csv");
+                write_ridi_csv(seq, staging.file(&rel)?)?;
                 written.push(Converted {
                     name: seq.name().to_string(),
                     placement: seq.placement().map(str::to_string),
-                    path,
+                    path: out.join(rel),
                     frames: seq.len(),
                 });
             }
@@ -152,16 +178,17 @@ pub fn convert(
     }
     let mut written_lists = Vec::new();
     for (key, entries) in &lists {
-        let path = out.join(format!("list_{key}.txt"));
-        write_atomically(&path, |w| {
+        let name = format!("list_{key}.txt");
+        write_atomically(&staging.file(Path::new(&name))?, |w| {
             writeln!(w, "# written by `ridi convert {}`", source.display())?;
             for c in entries {
                 writeln!(w, "{},{}", c.name, c.placement.as_deref().unwrap_or(""))?;
             }
             Ok(())
         })?;
-        written_lists.push(path);
+        written_lists.push(out.join(name));
     }
+    staging.commit()?;
     summary.lists = written_lists;
     Ok(summary)
 }
@@ -179,6 +206,7 @@ mod tests {
         );
         assert_eq!(tyrex_subject("dan_body1"), None);
         assert_eq!(tyrex_subject("x_Texting_partly"), None);
+        assert_eq!(tyrex_subject("texting"), None);
     }
 
     #[test]
@@ -202,8 +230,10 @@ mod tests {
         assert_eq!(sources(&want[1], None).unwrap(), &want[1..]);
         let e = sources(&floor.join("notes.txt"), Some(Format::Ilc)).unwrap_err();
         assert!(
-            e.to_string()
-                .contains("no Indoor Location Competition path file"),
+            e.to_string().contains(
+                "notes.txt: not an Indoor Location Competition path file (it is a RIDI \
+                 data_plain.txt): an Indoor Location Competition path file is a `.txt`"
+            ),
             "{e}"
         );
         let e = sources(&floor.join("floor_info.json"), None).unwrap_err();

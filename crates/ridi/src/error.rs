@@ -35,6 +35,9 @@ pub enum PipelineError {
         /// What is missing.
         message: String,
     },
+    /// A stage was given no sequence at all.
+    #[error("no sequences to {0}")]
+    NoSequences(&'static str),
     /// A file the pipeline writes or reads itself (models, reports, placement maps).
     #[error("{}: {message}", path.display())]
     File {

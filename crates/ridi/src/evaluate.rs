@@ -5,7 +5,8 @@
 //! `placement_accuracy`, `velocity_mse` (`[S-x, S-z]`, (m/s)^2) and `methods.<key>` with the
 //! metric keys of [`ridi_eval::TrajectoryMetrics`] (`mpe_m`, `mpe_pct`, `ate_m`, `rte_m`,
 //! `ate_ronin_m`, `rte_ronin_m`, `rte_5s_m`, `path_length_ratio`); `summary.<key>` holds the
-//! means over sequences. Method keys are those of [`Method::key`].
+//! means over sequences; `warnings` what the numbers do not say (see [`placement_warnings`]).
+//! Method keys are those of [`Method::key`].
 
 use std::collections::{BTreeMap, BTreeSet};
 use std::fmt::Write as _;
@@ -106,6 +107,9 @@ pub struct Report {
     pub config: EvalConfig,
     /// Methods in report order.
     pub methods: Vec<String>,
+    /// Things to know before reading the numbers, one sentence each ([`placement_warnings`]);
+    /// also in `report.md`.
+    pub warnings: Vec<String>,
 }
 
 struct Evaluated {
@@ -193,13 +197,38 @@ fn evaluate_one(seq: &Sequence, model: &Cascade, opts: &EvalOptions) -> Result<E
     })
 }
 
+/// One warning per sequence whose placement label is not one of the model's classes: the
+/// classifier cannot predict it, so its placement accuracy is 0 (its trajectories are still
+/// worth evaluating). For example: "placement `swing` of Thibaud_Nexus5_NoDist_Swinging is not
+/// one of the model's classes (hand, pocket): its placement accuracy is 0".
+pub fn placement_warnings(seqs: &[Sequence], model: &Cascade) -> Vec<String> {
+    let classes = model.placements();
+    seqs.iter()
+        .filter_map(|s| {
+            let label = s.placement()?;
+            (!classes.iter().any(|c| c == label)).then(|| {
+                format!(
+                    "placement `{label}` of {} is not one of the model's classes ({}): its \
+                     placement accuracy is 0",
+                    s.name(),
+                    classes.join(", ")
+                )
+            })
+        })
+        .collect()
+}
+
 /// Evaluates every method of `opts` on every sequence (ground truth required), in parallel.
-/// Returns the report and the traces for plots, in sequence order.
+/// Returns the report (with [`placement_warnings`] in its `warnings` when a method uses the
+/// model) and the traces for plots, in sequence order. No sequence is an error.
 pub fn evaluate(
     seqs: &[Sequence],
     model: &Cascade,
     opts: &EvalOptions,
 ) -> Result<(Report, Vec<Traces>)> {
+    if seqs.is_empty() {
+        return Err(PipelineError::NoSequences("evaluate"));
+    }
     let done: Vec<Evaluated> = seqs
         .par_iter()
         .map(|s| evaluate_one(s, model, opts))
@@ -254,6 +283,12 @@ pub fn evaluate(
             placement_confusion,
             config: opts.metrics,
             methods: opts.methods.iter().map(|m| m.key().to_string()).collect(),
+            // Without regressions there is no placement accuracy to warn about.
+            warnings: if opts.methods.iter().any(|m| m.needs_model()) {
+                placement_warnings(seqs, model)
+            } else {
+                Vec::new()
+            },
         },
         traces,
     ))
@@ -306,6 +341,9 @@ impl Report {
             self.velocity_mse[1],
             fmt_opt(self.placement_accuracy)
         );
+        for w in &self.warnings {
+            let _ = writeln!(out, "**Warning**: {w}.\n");
+        }
         let weak: Vec<String> = self
             .sequences
             .iter()

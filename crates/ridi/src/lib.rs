@@ -12,8 +12,9 @@
 //! | [`eval`] | `ridi-eval` | alignment, MPE/ATE/RTE, reports |
 //!
 //! Pipeline modules: [`source`] reads any supported layout, [`convert`] writes the RIDI
-//! layout with list files, [`inspect`] summarizes a recording, [`orientation`] swaps in an
-//! orientation estimated from gyro and accelerometer.
+//! layout with list files (all or nothing, through [`staging`]), [`lists`] reads list files
+//! for training and evaluation with the labels they need, [`inspect`] summarizes a recording,
+//! [`orientation`] swaps in an orientation estimated from gyro and accelerometer.
 
 pub use ridi_correct as correct;
 pub use ridi_data as data;
@@ -27,16 +28,19 @@ pub mod convert;
 mod error;
 pub mod evaluate;
 pub mod inspect;
+pub mod lists;
 pub mod orientation;
 pub mod placement;
 pub mod plot;
 pub mod source;
+pub mod staging;
 pub mod track;
 pub mod train;
 
 pub use baselines::Method;
 pub use error::{PipelineError, Result};
 pub use evaluate::{EvalOptions, Report, evaluate};
+pub use lists::{Purpose, load_lists};
 pub use orientation::{Orientation, apply_orientation, oriented};
 pub use placement::PlacementMap;
 pub use source::{Loaded, read_any};

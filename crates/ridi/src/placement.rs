@@ -1,17 +1,20 @@
 //! Placement labels: grouping fine labels (e.g. the Tyrex motion names) into the classes a model
 //! is trained on.
 
-use std::collections::BTreeMap;
+use std::collections::{BTreeMap, BTreeSet};
 use std::path::Path;
 
-use ridi_data::Sequence;
+use ridi_data::{DataError, Location, Sequence};
 
 use crate::error::{PipelineError, Result};
 
-/// Maps placement labels to class names; labels it does not name pass through unchanged.
+/// Maps placement labels to class names. Every label in use must be in the map, or be one of
+/// its classes: [`PlacementMap::class_at`] is an error for any other.
 #[derive(Debug, Clone, Default, PartialEq, Eq)]
 pub struct PlacementMap {
     map: BTreeMap<String, String>,
+    /// `tyrex4`, or the map file, for error messages.
+    name: String,
 }
 
 impl PlacementMap {
@@ -34,16 +37,19 @@ impl PlacementMap {
                 .iter()
                 .map(|(a, b)| (a.to_string(), b.to_string()))
                 .collect(),
+            name: "tyrex4".into(),
         }
     }
 
-    /// Reads `label,class` lines (`#` comments and blank lines skipped).
+    /// Reads `label,class` lines (`#` comments and blank lines skipped). A label given two
+    /// different classes, and a file without any entry, are errors.
     pub fn read(path: &Path) -> Result<Self> {
-        let text = std::fs::read_to_string(path).map_err(|e| PipelineError::File {
+        let error = |message: String| PipelineError::File {
             path: path.to_path_buf(),
-            message: e.to_string(),
-        })?;
-        let mut map = BTreeMap::new();
+            message,
+        };
+        let text = std::fs::read_to_string(path).map_err(|e| error(e.to_string()))?;
+        let mut map: BTreeMap<String, (String, usize)> = BTreeMap::new();
         for (i, line) in text.lines().enumerate() {
             let line = line.trim();
             if line.is_empty() || line.starts_with('#') {
@@ -53,13 +59,24 @@ impl PlacementMap {
                 .split_once(',')
                 .map(|(a, b)| (a.trim(), b.trim()))
                 .filter(|(a, b)| !a.is_empty() && !b.is_empty() && !b.contains(','))
-                .ok_or_else(|| PipelineError::File {
-                    path: path.to_path_buf(),
-                    message: format!("line {}: expected `label,class`", i + 1),
-                })?;
-            map.insert(label.to_string(), class.to_string());
+                .ok_or_else(|| error(format!("line {}: expected `label,class`", i + 1)))?;
+            if let Some((first, at)) = map.get(label)
+                && first != class
+            {
+                return Err(error(format!(
+                    "line {}: `{label}` is mapped to `{class}` here but to `{first}` on line {at}",
+                    i + 1
+                )));
+            }
+            map.insert(label.to_string(), (class.to_string(), i + 1));
         }
-        Ok(Self { map })
+        if map.is_empty() {
+            return Err(error("no `label,class` entry in the placement map".into()));
+        }
+        Ok(Self {
+            map: map.into_iter().map(|(l, (c, _))| (l, c)).collect(),
+            name: path.display().to_string(),
+        })
     }
 
     /// `tyrex4` for [`Self::tyrex_groups`], otherwise a file for [`Self::read`].
@@ -71,16 +88,47 @@ impl PlacementMap {
         }
     }
 
-    /// The class of `label`.
-    pub fn class_of<'a>(&'a self, label: &'a str) -> &'a str {
-        self.map.get(label).map(String::as_str).unwrap_or(label)
+    /// The classes of the map, sorted.
+    fn classes(&self) -> BTreeSet<&str> {
+        self.map.values().map(String::as_str).collect()
     }
 
-    /// Relabels every sequence.
+    /// The class of `label`, when the map has it; a class of the map is its own class (an
+    /// Indoor Location Competition path is labelled `hand`, say).
+    pub fn class_of<'a>(&'a self, label: &'a str) -> Option<&'a str> {
+        match self.map.get(label) {
+            Some(class) => Some(class),
+            None => self.classes().contains(label).then_some(label),
+        }
+    }
+
+    /// The class of `label`, the placement of the sequence listed at `at`; a label the map does
+    /// not have is an error naming `at`, the label and the labels and classes the map has.
+    pub fn class_at<'a>(&'a self, label: &'a str, at: Location) -> Result<&'a str> {
+        self.class_of(label).ok_or_else(|| {
+            let labels: Vec<&str> = self.map.keys().map(String::as_str).collect();
+            let classes: Vec<&str> = self.classes().into_iter().collect();
+            DataError::format(
+                at.with_field("placement"),
+                format!(
+                    "placement `{label}` is not in the placement map {} (labels {}; classes {})",
+                    self.name,
+                    labels.join(", "),
+                    classes.join(", ")
+                ),
+            )
+            .into()
+        })
+    }
+
+    /// Relabels every sequence whose label the map has; others keep theirs (load list files
+    /// with [`crate::lists::load_lists`], which refuses labels the map does not have).
     pub fn apply(&self, seqs: &mut [Sequence]) {
         for s in seqs {
-            let class = s.placement().map(|p| self.class_of(p).to_string());
-            s.set_placement(class);
+            if let Some(class) = s.placement().and_then(|p| self.class_of(p)) {
+                let class = class.to_string();
+                s.set_placement(Some(class));
+            }
         }
     }
 }
@@ -93,22 +141,57 @@ mod tests {
     fn tyrex_groups_cover_every_motion() {
         let m = PlacementMap::tyrex_groups();
         for motion in ridi_data::tyrex::MOTIONS {
-            assert_ne!(m.class_of(motion), motion, "{motion} has no group");
+            assert!(m.class_of(motion).is_some(), "{motion} has no group");
         }
-        assert_eq!(m.class_of("bag"), "bag");
+        assert_eq!(m.class_of("bag"), None);
+        assert_eq!(m.class_of("hand"), Some("hand"));
+        let err = m
+            .class_at("Swingin", Location::line("list.txt", 4))
+            .unwrap_err()
+            .to_string();
+        assert_eq!(
+            err,
+            "list.txt:4: field `placement`: placement `Swingin` is not in the placement map \
+             tyrex4 (labels AR, BackPocket, FrontPocket, Phoning, RunningHand, RunningPocket, \
+             Swinging, Texting; classes hand, pocket, running, swing)"
+        );
     }
 
     #[test]
     fn map_files_are_parsed_and_checked() {
         let dir = tempfile::tempdir().unwrap();
         let good = dir.path().join("map.txt");
-        std::fs::write(&good, "# fine to coarse\nTexting, hand\n\nSwinging,swing\n").unwrap();
+        std::fs::write(
+            &good,
+            "# fine to coarse\nTexting, hand\n\nSwinging,swing\nTexting,hand\n",
+        )
+        .unwrap();
         let m = PlacementMap::read(&good).unwrap();
-        assert_eq!(m.class_of("Texting"), "hand");
-        assert_eq!(m.class_of("Swinging"), "swing");
+        assert_eq!(m.class_of("Texting"), Some("hand"));
+        assert_eq!(m.class_of("Swinging"), Some("swing"));
+        let err = m
+            .class_at("BackPocket", Location::line("l.txt", 2))
+            .unwrap_err()
+            .to_string();
+        assert!(
+            err.contains("`BackPocket` is not in the placement map")
+                && err.contains("map.txt (labels Swinging, Texting; classes hand, swing)"),
+            "{err}"
+        );
+
         let bad = dir.path().join("bad.txt");
-        std::fs::write(&bad, "Texting\n").unwrap();
-        let err = PlacementMap::read(&bad).unwrap_err().to_string();
-        assert!(err.contains("bad.txt") && err.contains("line 1"), "{err}");
+        for (text, want) in [
+            ("Texting\n", "bad.txt: line 1: expected `label,class`"),
+            (
+                "Texting,hand\nBackPocket,pocket\nTexting,pocket\n",
+                "bad.txt: line 3: `Texting` is mapped to `pocket` here but to `hand` on line 1",
+            ),
+            ("", "bad.txt: no `label,class` entry"),
+            ("# nothing\n\n", "bad.txt: no `label,class` entry"),
+        ] {
+            std::fs::write(&bad, text).unwrap();
+            let err = PlacementMap::read(&bad).unwrap_err().to_string();
+            assert!(err.contains(want), "{text:?}: {err}");
+        }
     }
 }

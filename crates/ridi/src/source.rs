@@ -3,7 +3,7 @@
 use std::path::Path;
 
 use ridi_data::tyrex::{self, TyrexOptions};
-use ridi_data::{DataError, Format, ReadOptions, Sequence, detect, read_sequence};
+use ridi_data::{DataError, Format, Location, ReadOptions, Sequence, detect, read_sequence};
 
 /// Sequences read from one source, with the format they came in.
 #[derive(Debug, Clone)]
@@ -16,17 +16,59 @@ pub struct Loaded {
     pub warnings: Vec<String>,
 }
 
+/// Whether `path` is, by itself, one source of the format `want`. A folder with any RIDI raw
+/// file is a raw folder even when it also holds `processed/data.csv` (as RIDI capture folders
+/// do), and `data_plain.txt` counts as a RIDI processed csv.
+pub(crate) fn is_a(path: &Path, want: Format) -> bool {
+    match want {
+        Format::RidiRaw => path.is_dir() && ridi_data::ridi_raw::looks_like(path),
+        Format::RidiCsv | Format::RidiPlain => {
+            matches!(detect(path), Ok(Format::RidiCsv | Format::RidiPlain))
+        }
+        Format::Tyrex | Format::Ilc => detect(path).is_ok_and(|f| f == want),
+    }
+}
+
+/// The error for a source given as `want` that is not one: what it is instead, when it is
+/// something known, and what a `want` looks like.
+pub(crate) fn not_a(path: &Path, want: Format) -> DataError {
+    let found = match detect(path) {
+        Ok(found) => format!(" (it is {})", with_article(&found.to_string())),
+        Err(_) if !path.exists() => " (no such file or folder)".to_string(),
+        Err(_) => String::new(),
+    };
+    DataError::format(
+        Location::file(path),
+        format!(
+            "not {}{found}: {}",
+            with_article(&want.to_string()),
+            want.layout()
+        ),
+    )
+}
+
+/// `a name` or `an name`.
+fn with_article(name: &str) -> String {
+    let vowel = name.starts_with(|c: char| "AEIOUaeiou".contains(c));
+    format!("{} {name}", if vowel { "an" } else { "a" })
+}
+
 /// Reads the sequence(s) at `path`: a RIDI `data.csv`, `data_plain.txt`, RIDI raw folder,
 /// Tyrex sequence folder or Indoor Location Competition path file. `from` forces a format
-/// instead of detecting it.
+/// instead of detecting it: a source that is not one is an error saying what it is and what
+/// the format looks like; a folder read as a RIDI raw folder names the raw files it lacks.
 pub fn read_any(
     path: &Path,
     from: Option<Format>,
     opts: &ReadOptions,
 ) -> Result<Loaded, DataError> {
     let format = match from {
-        Some(f) => f,
         None => detect(path)?,
+        Some(Format::RidiCsv | Format::RidiPlain) if is_a(path, Format::RidiCsv) => detect(path)?,
+        Some(want) if is_a(path, want) => want,
+        // A folder of nothing known, read as a raw folder: the reader names the files it lacks.
+        Some(Format::RidiRaw) if path.is_dir() && detect(path).is_err() => Format::RidiRaw,
+        Some(want) => return Err(not_a(path, want)),
     };
     match format {
         Format::Tyrex => {
@@ -37,22 +79,15 @@ pub fn read_any(
                 warnings: read.warnings,
             })
         }
-        _ => {
-            // A forced format must match what is there; a detected one does by construction.
-            if from.is_some() {
-                let found = detect(path)?;
-                if found != format {
-                    return Err(DataError::format(
-                        ridi_data::Location::file(path),
-                        format!("expected a {format}, found a {found}"),
-                    ));
-                }
-            }
-            Ok(Loaded {
-                format,
-                sequences: vec![read_sequence(path, opts)?],
-                warnings: Vec::new(),
-            })
-        }
+        Format::RidiRaw => Ok(Loaded {
+            format,
+            sequences: vec![ridi_data::ridi_raw::read(path, opts)?],
+            warnings: Vec::new(),
+        }),
+        _ => Ok(Loaded {
+            format,
+            sequences: vec![read_sequence(path, opts)?],
+            warnings: Vec::new(),
+        }),
     }
 }

@@ -150,6 +150,9 @@ pub fn ground_truth_view(seq: &Sequence) -> Result<GroundTruthView<'_>> {
 /// Features and targets of every sequence at the training schedule of `config` (standardization
 /// in `config` is ignored: it is learned from this data).
 pub fn training_data(seqs: &[Sequence], config: &FeatureConfig) -> Result<TrainingData> {
+    if seqs.is_empty() {
+        return Err(PipelineError::NoSequences("train on"));
+    }
     let config = FeatureConfig {
         standardization: None,
         ..config.clone()

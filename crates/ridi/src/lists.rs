@@ -1,0 +1,99 @@
+//! List files for training and evaluation: the sequences with the labels those need, checked
+//! where a user can fix them, at the list file and line.
+
+use std::path::Path;
+
+use ridi_data::{DataError, ListEntry, ReadOptions, Sequence, load_entries, read_list};
+
+use crate::error::Result;
+use crate::placement::PlacementMap;
+
+/// What the listed sequences are for, and so what each must have.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Purpose {
+    /// Training: ground truth and a placement label.
+    Training,
+    /// Evaluation: ground truth; a placement label is optional (without one a sequence has no
+    /// placement accuracy).
+    Evaluation,
+}
+
+impl Purpose {
+    fn name(self) -> &'static str {
+        match self {
+            Purpose::Training => "training",
+            Purpose::Evaluation => "evaluation",
+        }
+    }
+}
+
+/// Reads the sequences of the list files `lists`, in order, for `purpose`, and relabels their
+/// placements with `map` when given. Every error names the list file and line of the sequence
+/// concerned:
+///
+/// - a list that lists nothing ("no sequences listed"), or a listed path that does not exist;
+/// - a placement label `map` does not have (at the first sequence with that label; the labels
+///   written in the lists are checked before any sequence is read);
+/// - for training, a sequence without a placement label (neither in the list nor from its
+///   source, as a Tyrex run's motion);
+/// - a sequence without ground truth.
+pub fn load_lists(
+    lists: &[impl AsRef<Path>],
+    map: Option<&PlacementMap>,
+    purpose: Purpose,
+    opts: &ReadOptions,
+) -> Result<Vec<Sequence>> {
+    let mut entries = Vec::new();
+    for list in lists {
+        entries.extend(read_list(list)?);
+    }
+    if let Some(map) = map {
+        for e in &entries {
+            if let Some(label) = &e.placement {
+                map.class_at(label, e.location())?;
+            }
+        }
+    }
+    let mut seqs = load_entries(&entries, opts)?;
+    for (seq, entry) in seqs.iter_mut().zip(&entries) {
+        check(seq, entry, map, purpose)?;
+    }
+    Ok(seqs)
+}
+
+/// Checks one listed sequence for `purpose` and maps its placement.
+fn check(
+    seq: &mut Sequence,
+    entry: &ListEntry,
+    map: Option<&PlacementMap>,
+    purpose: Purpose,
+) -> Result<()> {
+    if seq.ground_truth().is_none() {
+        return Err(DataError::format(
+            entry.location(),
+            format!(
+                "sequence `{}` has no ground truth, which {} needs",
+                seq.name(),
+                purpose.name()
+            ),
+        )
+        .into());
+    }
+    match (seq.placement(), map) {
+        (None, _) if purpose == Purpose::Training => Err(DataError::format(
+            entry.location().with_field("placement"),
+            format!(
+                "sequence `{}` has no placement label, which training needs (give it after the \
+                 path: `path,placement`)",
+                seq.name()
+            ),
+        )
+        .into()),
+        (Some(label), Some(map)) => {
+            let class = map.class_at(label, entry.location())?.to_string();
+            seq.set_placement(Some(class));
+            Ok(())
+        }
+        _ => Ok(()),
+    }
+}

@@ -1,0 +1,172 @@
+//! `ridi convert` on bad input: a failed conversion leaves nothing behind, and a source of
+//! another format than the one given says what it is and what was expected.
+
+use std::path::{Path, PathBuf};
+
+use ridi::convert::convert;
+use ridi::data::{Format, ReadOptions, read_sequence, write_ridi_csv, write_ridi_plain};
+
+fn seq(name: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../../datasets/sample")
+        .join(name)
+}
+
+/// A folder of three RIDI captures, the second with a NaN on line 301 of its data.csv.
+fn three_sources(dir: &Path) -> PathBuf {
+    let src = dir.join("src");
+    let s = read_sequence(
+        seq("Thibaud_Nexus5_NoDist_Texting"),
+        &ReadOptions::default(),
+    )
+    .unwrap();
+    for name in ["a_seq", "b_seq", "c_seq"] {
+        let folder = src.join(name).join("processed");
+        std::fs::create_dir_all(&folder).unwrap();
+        write_ridi_csv(&s, folder.join("data.csv")).unwrap();
+    }
+    let bad = src.join("b_seq/processed/data.csv");
+    let text = std::fs::read_to_string(&bad).unwrap();
+    let mut lines: Vec<String> = text.lines().map(str::to_string).collect();
+    let mut cells: Vec<&str> = lines[300].split(',').collect();
+    cells[3] = "NaN";
+    lines[300] = cells.join(",");
+    std::fs::write(&bad, lines.join("\n") + "\n").unwrap();
+    src
+}
+
+fn files_under(dir: &Path) -> Vec<String> {
+    let mut out = Vec::new();
+    if dir.is_dir() {
+        for e in std::fs::read_dir(dir).unwrap() {
+            let p = e.unwrap().path();
+            out.push(p.display().to_string());
+            out.extend(files_under(&p));
+        }
+    }
+    out.sort();
+    out
+}
+
+#[test]
+fn a_bad_source_leaves_no_conversion_behind() {
+    let dir = tempfile::tempdir().unwrap();
+    let src = three_sources(dir.path());
+    let opts = ReadOptions::default();
+    // A new output folder (and its parent) is not left behind.
+    let out = dir.path().join("new/conv");
+    let e = convert(&src, &out, None, &opts).unwrap_err().to_string();
+    assert!(
+        e.contains("b_seq/processed/data.csv:301: field `gyro_y`"),
+        "{e}"
+    );
+    assert!(!dir.path().join("new").exists());
+    // An existing one keeps what it had, and only that.
+    let out = dir.path().join("conv");
+    std::fs::create_dir_all(out.join("a_seq/processed")).unwrap();
+    std::fs::write(out.join("a_seq/processed/data.csv"), "old").unwrap();
+    std::fs::write(out.join("notes.txt"), "mine").unwrap();
+    let before = files_under(&out);
+    assert!(convert(&src, &out, None, &opts).is_err());
+    assert_eq!(files_under(&out), before);
+    assert_eq!(
+        std::fs::read_to_string(out.join("a_seq/processed/data.csv")).unwrap(),
+        "old"
+    );
+    // Without the bad source, everything is written, replacing the old file.
+    std::fs::remove_dir_all(src.join("b_seq")).unwrap();
+    let summary = convert(&src, &out, None, &opts).unwrap();
+    assert_eq!(summary.sequences.len(), 2);
+    assert_eq!(summary.lists, [out.join("list_all.txt")]);
+    let names: Vec<String> = files_under(&out)
+        .iter()
+        .map(|p| p.strip_prefix(&*out.to_string_lossy()).unwrap().to_string())
+        .collect();
+    assert_eq!(
+        names,
+        [
+            "/a_seq",
+            "/a_seq/processed",
+            "/a_seq/processed/data.csv",
+            "/c_seq",
+            "/c_seq/processed",
+            "/c_seq/processed/data.csv",
+            "/list_all.txt",
+            "/notes.txt"
+        ]
+    );
+    assert!(read_sequence(out.join("a_seq"), &opts).is_ok());
+}
+
+#[test]
+fn a_source_of_another_format_than_given_says_what_it_is_and_what_was_expected() {
+    let dir = tempfile::tempdir().unwrap();
+    let opts = ReadOptions::default();
+    let csv = dir.path().join("texting.csv");
+    let s = read_sequence(seq("Thibaud_Nexus5_NoDist_Texting"), &opts).unwrap();
+    write_ridi_csv(&s, &csv).unwrap();
+    let out = dir.path().join("c");
+    // The error of converting `source` as `from`, which must contain `want`.
+    let fails = |source: &Path, from: Format, want: &str| {
+        let e = convert(source, &out, Some(from), &opts)
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains(want), "{e}");
+        e
+    };
+    let e = fails(
+        &csv,
+        Format::Tyrex,
+        "texting.csv: not a Tyrex folder (it is a RIDI processed csv): a Tyrex run is a folder",
+    );
+    assert!(
+        e.contains("accelerometer.txt") && e.contains("datasets/android/"),
+        "{e}"
+    );
+    fails(
+        &csv,
+        Format::RidiRaw,
+        "not a RIDI raw folder (it is a RIDI processed csv): a RIDI raw folder holds gyro.txt",
+    );
+    fails(
+        &csv,
+        Format::Ilc,
+        "not an Indoor Location Competition path file (it is a RIDI processed csv)",
+    );
+    // A sample capture folder is a RIDI csv, not a raw folder: nothing raw in it.
+    fails(
+        &seq("Thibaud_Nexus5_NoDist_Texting"),
+        Format::RidiRaw,
+        "not a RIDI raw folder (it is a RIDI processed csv)",
+    );
+    fails(
+        &dir.path().join("nowhere"),
+        Format::Tyrex,
+        "nowhere: not a Tyrex folder (no such file or folder): a Tyrex run is",
+    );
+    // An empty folder given as raw names every raw file it lacks.
+    let empty = dir.path().join("empty");
+    std::fs::create_dir_all(&empty).unwrap();
+    let e = ridi::read_any(&empty, Some(Format::RidiRaw), &opts)
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains(
+            "RIDI raw folder without gyro.txt, acce.txt, linacce.txt, gravity.txt, orientation.txt"
+        ),
+        "{e}"
+    );
+    // The failures left nothing; the right format converts, and `ridi-csv` takes a
+    // data_plain.txt too.
+    assert!(!out.exists());
+    let plain = dir.path().join("plain/data_plain.txt");
+    std::fs::create_dir_all(plain.parent().unwrap()).unwrap();
+    write_ridi_plain(&s, &plain).unwrap();
+    for source in [&csv, &plain] {
+        let summary = convert(source, &out, Some(Format::RidiCsv), &opts).unwrap();
+        assert_eq!(summary.sequences[0].frames, s.len());
+    }
+    let files = files_under(&out);
+    assert_eq!(files.len(), 7, "{files:?}");
+    assert!(!files.iter().any(|f| f.contains("staging")), "{files:?}");
+}
