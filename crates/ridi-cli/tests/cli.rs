@@ -103,8 +103,8 @@ fn bad_flags_and_outputs_fail_before_any_work() {
     let dir = tempfile::tempdir().unwrap();
     let list = sample().join("list_Guillaume.txt");
     let model = dir.path().join("m.ridi");
-    let train = |extra: &[&str]| {
-        let mut args = vec!["train", "--list", s(&list), "--grid", "none"];
+    let train = |list: &Path, extra: &[&str]| {
+        let mut args = vec!["train", "--list", s(list), "--grid", "none"];
         args.extend_from_slice(extra);
         ridi(&args)
     };
@@ -115,14 +115,14 @@ fn bad_flags_and_outputs_fail_before_any_work() {
         ("--classifier-c", "NaN", "above 0"),
         ("--jobs", "0", "from 1 to 4096"),
     ] {
-        let out = train(&["--out", s(&model), flag, value]);
+        let out = train(&list, &["--out", s(&model), flag, value]);
         let err = stderr(&out);
         assert!(!out.status.success(), "{flag} {value}");
         assert!(err.contains(flag) && err.contains(says), "{err}");
     }
     // The model's folder is checked before training, not after.
     let nowhere = dir.path().join("missing/m.ridi");
-    let out = train(&["--out", s(&nowhere)]);
+    let out = train(&list, &["--out", s(&nowhere)]);
     let err = stderr(&out);
     assert!(
         !out.status.success() && err.contains("does not exist"),
@@ -139,15 +139,7 @@ fn bad_flags_and_outputs_fail_before_any_work() {
         format!("{},Texting\n{},Swingin\n", s(&texting), s(&swing)),
     )
     .unwrap();
-    let out = ridi(&[
-        "train",
-        "--list",
-        s(&typo),
-        "--out",
-        s(&model),
-        "--placement-map",
-        "tyrex4",
-    ]);
+    let out = train(&typo, &["--out", s(&model), "--placement-map", "tyrex4"]);
     let err = stderr(&out);
     assert!(
         !out.status.success() && err.contains("typo.txt:2: field `placement`: placement `Swingin`"),
