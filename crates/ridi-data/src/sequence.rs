@@ -185,6 +185,7 @@ fn median(v: &mut [f64]) -> f64 {
 /// | largest magnetometer component | 67 uT | 10 000 uT |
 /// | largest position component | 222 m | 10^6 m |
 /// | median interval between timestamps | 5-20 ms | 0.1 ms..1 s |
+/// | median ground-truth speed per Tyrex run | 0.17..2.33 m/s | 20 m/s |
 ///
 /// Not caught: a gyro in deg/s on a phone lying almost still (median under 0.17 rad/s), and a
 /// linear acceleration alone in g (it has no reference magnitude: only the accelerometer is
@@ -223,6 +224,10 @@ pub struct Validation {
     /// 1 Hz; phone sensors deliver 5-500 Hz). Seconds or milliseconds read as nanoseconds step
     /// by 1e-9 s or less. A unit too coarse shows as gaps instead.
     pub time_step_range: (f64, f64),
+    /// Largest accepted median speed of the ground truth, m/s: 20 (72 km/h). Pedestrians walk
+    /// at 1-2 m/s and run at 3-5; positions in millimetres or centimetres read as metres move
+    /// 100-1000 times faster, which the bound on single positions cannot see.
+    pub max_median_speed: f64,
 }
 
 impl Default for Validation {
@@ -238,6 +243,7 @@ impl Default for Validation {
             max_median_gyro: 10.0,
             acce_gravity_ratio: (0.5, 3.0),
             time_step_range: (1e-4, 1.0),
+            max_median_speed: 20.0,
         }
     }
 }
@@ -302,6 +308,28 @@ impl Validation {
             Ok(())
         } else {
             Err(SequenceError::TimeStep { median, min, max })
+        }
+    }
+
+    /// Checks the median speed of `position` over `time` (seconds, increasing) against
+    /// [`Self::max_median_speed`]; fewer than two frames pass.
+    pub fn check_speed(&self, time: &[f64], position: &[WorldVec]) -> Result<(), SequenceError> {
+        let mut speeds: Vec<f64> = time
+            .windows(2)
+            .zip(position.windows(2))
+            .map(|(t, p)| (p[1] - p[0]).norm() / (t[1] - t[0]))
+            .collect();
+        if speeds.is_empty() {
+            return Ok(());
+        }
+        let median = median(&mut speeds);
+        if median > self.max_median_speed {
+            Err(SequenceError::GroundTruthSpeed {
+                median,
+                max: self.max_median_speed,
+            })
+        } else {
+            Ok(())
         }
     }
 
@@ -444,6 +472,18 @@ pub enum SequenceError {
         /// Highest accepted ratio.
         max: f64,
     },
+    /// The ground truth moves too fast for a pedestrian: positions in another unit than metres.
+    #[error(
+        "the ground truth moves at a median {} m/s, above {max} m/s: positions in mm or cm \
+         instead of metres?",
+        short(*median)
+    )]
+    GroundTruthSpeed {
+        /// Median speed found, m/s.
+        median: f64,
+        /// The limit ([`Validation::max_median_speed`]).
+        max: f64,
+    },
     /// The median interval between timestamps is outside [`Validation::time_step_range`].
     #[error(
         "timestamps step by {} s (median), outside {}..{} s: time in the wrong unit?",
@@ -583,6 +623,7 @@ impl Sequence {
         }
         if let Some(gt) = &parts.ground_truth {
             limits.check_channel(Channel::Position, gt.position.iter().map(|p| p.to_array()))?;
+            limits.check_speed(&parts.time, &gt.position)?;
         }
         let mean = mean_norm(arrays(&parts.gravity));
         let (min, max) = limits.gravity_range;

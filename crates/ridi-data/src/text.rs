@@ -233,6 +233,7 @@ pub(crate) fn sequence_error(
         ),
         SequenceError::GyroUnits { .. } => return whole(Channel::Gyro, e.to_string()),
         SequenceError::AcceScale { .. } => return whole(Channel::Acce, e.to_string()),
+        SequenceError::GroundTruthSpeed { .. } => return whole(Channel::Position, e.to_string()),
         SequenceError::TimeStep { .. } => {
             let unit = fields.time_unit();
             return whole(Channel::Time, format!("{e} (this format expects {unit})"));

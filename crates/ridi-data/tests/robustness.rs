@@ -209,6 +209,21 @@ fn csv_accelerometer_in_g_is_refused() {
 }
 
 #[test]
+fn csv_positions_in_millimetres_are_refused() {
+    let header = csv_text().lines().next().unwrap().to_owned();
+    let pos_x = header.split(',').position(|c| c == "pos_x").unwrap();
+    assert_err(
+        parse_csv(&csv_scaled(pos_x..pos_x + 3, |v| v * 1000.0)),
+        &[
+            "walk/data.csv: field `pos_x..pos_z`: the ground truth moves at a median ",
+            "m/s, above 20 m/s: positions in mm or cm instead of metres?",
+        ],
+    );
+    // In metres the same walk passes.
+    parse_csv(&csv_text()).unwrap();
+}
+
+#[test]
 fn csv_time_in_seconds_or_milliseconds_is_refused() {
     for (divisor, step) in [(1e9, "e-12 s (median)"), (1e6, "by 5e-9 s (median)")] {
         let text = csv_scaled(1..2, |ns| {
