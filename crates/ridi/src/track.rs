@@ -201,7 +201,6 @@ pub fn correct_with(
     config: CorrectionConfig,
     placement_names: &[String],
 ) -> Result<Track> {
-    check_gaps(seq, config.max_dt)?;
     let targets: Vec<VelocityTarget> = regressions
         .iter()
         .map(|r| VelocityTarget {
@@ -223,8 +222,9 @@ pub fn correct_with(
 
 /// Refuses a sequence with a gap longer than the correction integrates across, naming where
 /// it is. Readers accept gaps up to a second (features and training live with them); double
-/// integration does not.
-fn check_gaps(seq: &Sequence, max_dt: f64) -> Result<()> {
+/// integration does not. Called once per sequence by [`track`] and the evaluation, before
+/// the corrections (which would refuse the gap too, by frame only).
+pub(crate) fn check_gaps(seq: &Sequence, max_dt: f64) -> Result<()> {
     let t = seq.time();
     match t.windows(2).position(|w| w[1] - w[0] > max_dt) {
         None => Ok(()),
@@ -247,8 +247,8 @@ fn check_gaps(seq: &Sequence, max_dt: f64) -> Result<()> {
 pub fn track(seq: &Sequence, model: &Cascade, opts: &TrackOptions) -> Result<Track> {
     let seq = oriented(seq, model.feature_config().orientation)?;
     let seq = seq.as_ref();
+    check_gaps(seq, opts.correction.max_dt)?;
     if opts.online {
-        check_gaps(seq, opts.correction.max_dt)?;
         return track_online(seq, model, opts);
     }
     let regressions = regress(seq, model, opts)?;
