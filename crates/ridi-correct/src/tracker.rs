@@ -245,6 +245,9 @@ pub struct Update {
     pub frame: u64,
     /// Its pose, as known now (including a revision applied at this frame).
     pub pose: Pose,
+    /// The bias applied to new frames from here on, device frame ([`Tracker::bias`] after
+    /// this sample).
+    pub bias: DeviceVec,
     /// Set when a regression was scheduled at this frame.
     pub regression: Option<RegressionOutcome>,
     /// Set when a correction was started, applied, or skipped at this frame.
@@ -576,6 +579,7 @@ impl<R: VelocityRegressor> Tracker<R> {
         Ok(Update {
             frame,
             pose,
+            bias: self.bias,
             regression,
             correction,
             restarted,

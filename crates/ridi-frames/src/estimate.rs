@@ -168,28 +168,15 @@ pub fn initial_orientation(up: DeviceVec) -> WorldFromDevice {
 ///
 /// Time must not decrease; steps longer than [`FilterConfig::max_dt`] are clamped to it and
 /// repeated time stamps integrate nothing. Zero accelerometer samples skip the gravity
-/// correction. Empty input gives an empty output.
+/// correction. Empty input gives an empty output. The same as pushing every sample through an
+/// [`OrientationFilter`] and finishing it.
 pub fn estimate_orientation(
     time: &[f64],
     gyro: &[DeviceVec],
     acce: &[DeviceVec],
     config: &FilterConfig,
 ) -> Result<Vec<WorldFromDevice>, EstimateError> {
-    config.validate()?;
-    check_inputs(time, gyro, acce)?;
-    if time.is_empty() {
-        return Ok(Vec::new());
-    }
-    let mean_up =
-        mean_leading_nonzero(acce, config.init_samples).ok_or(EstimateError::NoGravity)?;
-    run_filter(
-        initial_orientation(mean_up),
-        mean_up.norm(),
-        time,
-        gyro,
-        acce,
-        config,
-    )
+    run_batch(OrientationFilter::new(*config)?, time, gyro, acce)
 }
 
 /// Like [`estimate_orientation`] but starting from a given orientation (for instance the last
@@ -203,13 +190,20 @@ pub fn estimate_orientation_from(
     acce: &[DeviceVec],
     config: &FilterConfig,
 ) -> Result<Vec<WorldFromDevice>, EstimateError> {
-    config.validate()?;
-    check_inputs(time, gyro, acce)?;
-    let reference_norm = mean_leading_nonzero(acce, config.init_samples).map_or(0.0, |g| g.norm());
-    run_filter(initial, reference_norm, time, gyro, acce, config)
+    run_batch(
+        OrientationFilter::starting_at(initial, *config)?,
+        time,
+        gyro,
+        acce,
+    )
 }
 
-fn check_inputs(time: &[f64], gyro: &[DeviceVec], acce: &[DeviceVec]) -> Result<(), EstimateError> {
+fn run_batch(
+    mut filter: OrientationFilter,
+    time: &[f64],
+    gyro: &[DeviceVec],
+    acce: &[DeviceVec],
+) -> Result<Vec<WorldFromDevice>, EstimateError> {
     for (what, len) in [("gyro", gyro.len()), ("acce", acce.len())] {
         if len != time.len() {
             return Err(EstimateError::LengthMismatch {
@@ -219,30 +213,220 @@ fn check_inputs(time: &[f64], gyro: &[DeviceVec], acce: &[DeviceVec]) -> Result<
             });
         }
     }
+    let mut out = Vec::with_capacity(time.len());
     for i in 0..time.len() {
-        if !time[i].is_finite() {
-            return Err(EstimateError::NonFinite {
-                what: "time",
-                index: i,
-            });
-        }
-        if !gyro[i].is_finite() {
-            return Err(EstimateError::NonFinite {
-                what: "gyro",
-                index: i,
-            });
-        }
-        if !acce[i].is_finite() {
-            return Err(EstimateError::NonFinite {
-                what: "acce",
-                index: i,
-            });
-        }
-        if i > 0 && time[i] < time[i - 1] {
-            return Err(EstimateError::TimeDecreases { index: i });
-        }
+        filter.push(time[i], gyro[i], acce[i], &mut out)?;
     }
-    Ok(())
+    filter.finish(&mut out)?;
+    Ok(out)
+}
+
+/// The estimator of [`estimate_orientation`], one sample at a time, for live streams.
+///
+/// The first orientation needs the initial tilt, the mean of the first
+/// [`FilterConfig::init_samples`] nonzero accelerometer samples, so samples are held until
+/// that many have arrived (0.1 s at 200 Hz with the default 20) and then come out together;
+/// from then on each [`push`](Self::push) gives the orientation of its own sample.
+/// [`finish`](Self::finish) releases samples still held at the end of a stream. Pushing a
+/// whole recording and finishing gives exactly [`estimate_orientation`]'s result, whatever
+/// the chunking.
+///
+/// ```
+/// use ridi_frames::{DeviceVec, FilterConfig, OrientationFilter};
+///
+/// let mut filter = OrientationFilter::new(FilterConfig::default())?;
+/// let mut orientations = Vec::new();
+/// for i in 0..400 {
+///     // A phone lying flat and still, at 200 Hz.
+///     let (gyro, acce) = (DeviceVec::ZERO, DeviceVec::new(0.0, 0.0, 9.81));
+///     filter.push(i as f64 * 0.005, gyro, acce, &mut orientations)?;
+/// }
+/// filter.finish(&mut orientations)?;
+/// assert_eq!(orientations.len(), 400);
+/// # Ok::<(), ridi_frames::EstimateError>(())
+/// ```
+#[derive(Debug, Clone)]
+pub struct OrientationFilter {
+    config: FilterConfig,
+    /// The caller's starting orientation ([`Self::starting_at`]); otherwise the initial tilt.
+    start: Option<WorldFromDevice>,
+    /// Samples waiting for the initial tilt: time, gyro, acce.
+    pending: Vec<(f64, DeviceVec, DeviceVec)>,
+    pending_nonzero: usize,
+    running: Option<Running>,
+    /// Samples accepted so far (for error indices) and the last one's time.
+    count: usize,
+    last_time: Option<f64>,
+}
+
+#[derive(Debug, Clone, Copy)]
+struct Running {
+    q: UnitQuaternion<f64>,
+    integral: Vector3<f64>,
+    reference_norm: f64,
+    time: f64,
+    gyro: DeviceVec,
+    acce: DeviceVec,
+}
+
+impl OrientationFilter {
+    /// A filter starting from [`initial_orientation`] of its first samples.
+    ///
+    /// # Errors
+    /// [`EstimateError::InvalidConfig`] for gains or limits out of range.
+    pub fn new(config: FilterConfig) -> Result<Self, EstimateError> {
+        config.validate()?;
+        Ok(Self {
+            config,
+            start: None,
+            pending: Vec::new(),
+            pending_nonzero: 0,
+            running: None,
+            count: 0,
+            last_time: None,
+        })
+    }
+
+    /// A filter starting from `initial` (as [`estimate_orientation_from`]).
+    ///
+    /// # Errors
+    /// As [`Self::new`].
+    pub fn starting_at(
+        initial: WorldFromDevice,
+        config: FilterConfig,
+    ) -> Result<Self, EstimateError> {
+        Ok(Self {
+            start: Some(initial),
+            ..Self::new(config)?
+        })
+    }
+
+    /// Adds one sample and appends the orientations that became known to `out`: none while
+    /// the initial tilt is being gathered, then the held ones, then one per sample.
+    ///
+    /// # Errors
+    /// A non-finite field or a time before the previous sample's; the sample is dropped and
+    /// the filter unchanged. Indices in errors count the samples accepted before.
+    pub fn push(
+        &mut self,
+        time: f64,
+        gyro: DeviceVec,
+        acce: DeviceVec,
+        out: &mut Vec<WorldFromDevice>,
+    ) -> Result<(), EstimateError> {
+        let index = self.count;
+        for (what, ok) in [
+            ("time", time.is_finite()),
+            ("gyro", gyro.is_finite()),
+            ("acce", acce.is_finite()),
+        ] {
+            if !ok {
+                return Err(EstimateError::NonFinite { what, index });
+            }
+        }
+        if self.last_time.is_some_and(|t| time < t) {
+            return Err(EstimateError::TimeDecreases { index });
+        }
+        self.count += 1;
+        self.last_time = Some(time);
+        if let Some(r) = &mut self.running {
+            out.push(r.step(time, gyro, acce, &self.config));
+            return Ok(());
+        }
+        self.pending.push((time, gyro, acce));
+        if acce.norm() > 0.0 {
+            self.pending_nonzero += 1;
+        }
+        if self.pending_nonzero >= self.config.init_samples {
+            self.release(out)?;
+        }
+        Ok(())
+    }
+
+    /// Releases the samples still held (a stream shorter than the initial tilt needs).
+    ///
+    /// # Errors
+    /// [`EstimateError::NoGravity`] when every sample held has a zero accelerometer reading
+    /// and the filter has no starting orientation of its own.
+    pub fn finish(&mut self, out: &mut Vec<WorldFromDevice>) -> Result<(), EstimateError> {
+        if self.running.is_none() && !self.pending.is_empty() {
+            self.release(out)?;
+        }
+        Ok(())
+    }
+
+    /// The latest orientation, once the filter runs.
+    pub fn orientation(&self) -> Option<WorldFromDevice> {
+        self.running.map(|r| Rot::from_unit_quaternion(r.q))
+    }
+
+    fn release(&mut self, out: &mut Vec<WorldFromDevice>) -> Result<(), EstimateError> {
+        let acce: Vec<DeviceVec> = self.pending.iter().map(|p| p.2).collect();
+        let mean_up = mean_leading_nonzero(&acce, self.config.init_samples);
+        let initial = match (self.start, mean_up) {
+            (Some(q), _) => q,
+            (None, Some(up)) => initial_orientation(up),
+            (None, None) => return Err(EstimateError::NoGravity),
+        };
+        let (time, gyro, acce) = self.pending[0];
+        let mut r = Running {
+            q: *initial.quaternion(),
+            integral: Vector3::zeros(),
+            reference_norm: mean_up.map_or(0.0, |g| g.norm()),
+            time,
+            gyro,
+            acce,
+        };
+        out.push(initial);
+        for &(t, g, a) in &self.pending[1..] {
+            out.push(r.step(t, g, a, &self.config));
+        }
+        self.running = Some(r);
+        self.pending = Vec::new();
+        Ok(())
+    }
+}
+
+impl Running {
+    /// Advances from the previous sample to this one and returns this one's orientation.
+    fn step(
+        &mut self,
+        time: f64,
+        gyro: DeviceVec,
+        acce: DeviceVec,
+        config: &FilterConfig,
+    ) -> WorldFromDevice {
+        let dt = (time - self.time).clamp(0.0, config.max_dt);
+        let a = *self.acce.vector();
+        let a_norm = a.norm();
+        let usable = a_norm > 0.0
+            && self.reference_norm > 0.0
+            && (a_norm - self.reference_norm).abs() <= config.accel_tolerance * self.reference_norm;
+        let mut correction = Vector3::zeros();
+        if usable {
+            let up_est = self.q.inverse_transform_vector(UP_W.vector());
+            // measured x estimated: a rotation rate about this axis turns the estimated up
+            // toward the measured one (Mahony's error term). Scaling by the reference norm
+            // instead of normalizing keeps it linear in `a`: the mean of a / g_ref is the
+            // gravity direction under zero-mean motion, the mean of a / |a| is not.
+            let e = (a / self.reference_norm).cross(&up_est);
+            if config.ki > 0.0 && e.norm() <= config.integral_max_error {
+                self.integral += e * (config.ki * dt);
+                let m = self.integral.norm();
+                if m > config.max_bias {
+                    self.integral *= config.max_bias / m;
+                }
+            }
+            correction = e * config.kp;
+        }
+        // Trapezoidal gyro: exact for a constant rate, second order for a varying one.
+        let omega = (self.gyro.vector() + gyro.vector()) * 0.5 + self.integral + correction;
+        self.q *= UnitQuaternion::from_scaled_axis(omega * dt);
+        // Renormalizing each step keeps rounding from accumulating over long recordings.
+        self.q = UnitQuaternion::new_normalize(self.q.into_inner());
+        (self.time, self.gyro, self.acce) = (time, gyro, acce);
+        Rot::from_unit_quaternion(self.q)
+    }
 }
 
 fn mean_leading_nonzero(acce: &[DeviceVec], count: usize) -> Option<DeviceVec> {
@@ -254,57 +438,6 @@ fn mean_leading_nonzero(acce: &[DeviceVec], count: usize) -> Option<DeviceVec> {
     }
     // Samples pointing in opposite directions could cancel: then there is no usable up.
     (n > 0 && sum.norm() > 0.0).then(|| sum / n as f64)
-}
-
-fn run_filter(
-    initial: WorldFromDevice,
-    reference_norm: f64,
-    time: &[f64],
-    gyro: &[DeviceVec],
-    acce: &[DeviceVec],
-    config: &FilterConfig,
-) -> Result<Vec<WorldFromDevice>, EstimateError> {
-    let n = time.len();
-    let mut out = Vec::with_capacity(n);
-    if n == 0 {
-        return Ok(out);
-    }
-    let mut q: UnitQuaternion<f64> = *initial.quaternion();
-    let mut integral = Vector3::zeros();
-    let up_w = *UP_W.vector();
-    out.push(initial);
-    for k in 0..n - 1 {
-        let dt = (time[k + 1] - time[k]).clamp(0.0, config.max_dt);
-        let a = *acce[k].vector();
-        let a_norm = a.norm();
-        let usable = a_norm > 0.0
-            && reference_norm > 0.0
-            && (a_norm - reference_norm).abs() <= config.accel_tolerance * reference_norm;
-        let mut correction = Vector3::zeros();
-        if usable {
-            let up_est = q.inverse_transform_vector(&up_w);
-            // measured x estimated: a rotation rate about this axis turns the estimated up
-            // toward the measured one (Mahony's error term). Scaling by the reference norm
-            // instead of normalizing keeps it linear in `a`: the mean of a / g_ref is the
-            // gravity direction under zero-mean motion, the mean of a / |a| is not.
-            let e = (a / reference_norm).cross(&up_est);
-            if config.ki > 0.0 && e.norm() <= config.integral_max_error {
-                integral += e * (config.ki * dt);
-                let m = integral.norm();
-                if m > config.max_bias {
-                    integral *= config.max_bias / m;
-                }
-            }
-            correction = e * config.kp;
-        }
-        // Trapezoidal gyro: exact for a constant rate, second order for a varying one.
-        let omega = (gyro[k].vector() + gyro[k + 1].vector()) * 0.5 + integral + correction;
-        q *= UnitQuaternion::from_scaled_axis(omega * dt);
-        // Renormalizing each step keeps rounding from accumulating over long recordings.
-        q = UnitQuaternion::new_normalize(q.into_inner());
-        out.push(Rot::from_unit_quaternion(q));
-    }
-    Ok(out)
 }
 
 /// Tilt error between an estimated and a true orientation, radians in [0, pi]: the angle
@@ -641,6 +774,87 @@ mod tests {
         assert!((yaw(&est[2]) - 0.01).abs() < 1e-12);
         assert!((yaw(&est[3]) - (0.01 + cfg.max_dt)).abs() < 1e-12);
         assert!((yaw(&est[4]) - (0.02 + cfg.max_dt)).abs() < 1e-12);
+    }
+
+    #[test]
+    fn streaming_equals_batch_whatever_the_chunks() {
+        // A wobbling, turning phone whose first samples read zero (a sensor starting up).
+        let n = 900;
+        let t = times(n, 200.0);
+        let gyro: Vec<DeviceVec> = t
+            .iter()
+            .map(|&ti| DeviceVec::new(0.3 * (2.0 * ti).sin(), 0.1, 0.5 + 0.2 * ti.cos()))
+            .collect();
+        let acce: Vec<DeviceVec> = t
+            .iter()
+            .enumerate()
+            .map(|(i, &ti)| {
+                if i < 7 {
+                    DeviceVec::ZERO
+                } else {
+                    DeviceVec::new((5.0 * ti).sin(), 1.0 + 0.2 * ti, G)
+                }
+            })
+            .collect();
+        let cfg = FilterConfig::default();
+        let batch = estimate_orientation(&t, &gyro, &acce, &cfg).unwrap();
+        for chunk in [1, 3, 26, 27, 1000] {
+            let mut filter = OrientationFilter::new(cfg).unwrap();
+            let mut out = Vec::new();
+            for (c, range) in (0..n).collect::<Vec<_>>().chunks(chunk).enumerate() {
+                for &i in range {
+                    filter.push(t[i], gyro[i], acce[i], &mut out).unwrap();
+                }
+                // Nothing comes out before the initial tilt is known: 7 zero samples and
+                // 20 nonzero ones.
+                let pushed = (c * chunk + range.len()).min(n);
+                assert_eq!(
+                    out.len(),
+                    if pushed < 27 { 0 } else { pushed },
+                    "chunk {chunk}"
+                );
+            }
+            filter.finish(&mut out).unwrap();
+            assert_eq!(out, batch, "chunk {chunk}");
+            assert_eq!(filter.orientation(), batch.last().copied());
+        }
+        // A stream shorter than the initial tilt needs comes out at `finish`.
+        let mut filter = OrientationFilter::new(cfg).unwrap();
+        let mut out = Vec::new();
+        for i in 0..15 {
+            filter.push(t[i], gyro[i], acce[i], &mut out).unwrap();
+        }
+        assert!(out.is_empty() && filter.orientation().is_none());
+        filter.finish(&mut out).unwrap();
+        assert_eq!(
+            out,
+            estimate_orientation(&t[..15], &gyro[..15], &acce[..15], &cfg).unwrap()
+        );
+        // A refused sample leaves the filter as it was: the stream goes on as if never sent.
+        let mut filter = OrientationFilter::starting_at(batch[0], cfg).unwrap();
+        let mut out = Vec::new();
+        for i in 0..n {
+            if i == 400 {
+                let bad = DeviceVec::new(f64::NAN, 0.0, 0.0);
+                assert_eq!(
+                    filter.push(t[i], bad, acce[i], &mut out),
+                    Err(EstimateError::NonFinite {
+                        what: "gyro",
+                        index: 400
+                    })
+                );
+                assert_eq!(
+                    filter.push(t[i - 2], gyro[i], acce[i], &mut out),
+                    Err(EstimateError::TimeDecreases { index: 400 })
+                );
+            }
+            filter.push(t[i], gyro[i], acce[i], &mut out).unwrap();
+        }
+        filter.finish(&mut out).unwrap();
+        assert_eq!(
+            out,
+            estimate_orientation_from(batch[0], &t, &gyro, &acce, &cfg).unwrap()
+        );
     }
 
     #[test]

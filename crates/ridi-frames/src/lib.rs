@@ -31,7 +31,8 @@
 //!
 //! [`estimate`] is a Mahony complementary filter on gyroscope and accelerometer
 //! ([`estimate_orientation`], gains in [`FilterConfig`]) for recordings without a usable
-//! orientation. It starts with heading 0 ([`initial_orientation`]). [`tilt_error`],
+//! orientation; [`OrientationFilter`] is the same filter one sample at a time, for live
+//! streams. It starts with heading 0 ([`initial_orientation`]). [`tilt_error`],
 //! [`heading_difference`] and [`orientation_errors`] compare any orientation track with a
 //! reference (e.g. motion capture): tilt error in the device frame, heading drift as the yaw of
 //! the relative rotation.
@@ -78,7 +79,7 @@ mod rotation;
 mod vector;
 
 pub use estimate::{
-    EstimateError, FilterConfig, OrientationErrors, estimate_orientation,
+    EstimateError, FilterConfig, OrientationErrors, OrientationFilter, estimate_orientation,
     estimate_orientation_from, heading_difference, initial_orientation, orientation_errors,
     tilt_error,
 };

@@ -24,6 +24,12 @@ pub enum PipelineError {
     /// Orientation estimation.
     #[error("orientation: {0}")]
     Orientation(#[from] ridi_frames::EstimateError),
+    /// The streaming tracker refused a sample or its configuration.
+    #[error("tracking: {0}")]
+    Track(#[from] ridi_correct::TrackError),
+    /// A live stream's sample lacks what the model needs.
+    #[error("live tracking: {0}")]
+    Live(String),
     /// Drawing a plot.
     #[error("plot: {0}")]
     Plot(#[from] crate::plot::PlotError),

@@ -14,7 +14,8 @@
 //! Pipeline modules: [`source`] reads any supported layout, [`convert`] writes the RIDI
 //! layout with list files (all or nothing, through [`staging`]), [`lists`] reads list files
 //! for training and evaluation with the labels they need, [`inspect`] summarizes a recording,
-//! [`orientation`] swaps in an orientation estimated from gyro and accelerometer.
+//! [`orientation`] swaps in an orientation estimated from gyro and accelerometer, [`live`]
+//! tracks a stream sample by sample.
 
 pub use ridi_correct as correct;
 pub use ridi_data as data;
@@ -29,6 +30,7 @@ mod error;
 pub mod evaluate;
 pub mod inspect;
 pub mod lists;
+pub mod live;
 pub mod orientation;
 pub mod placement;
 pub mod plot;
@@ -41,6 +43,7 @@ pub use baselines::Method;
 pub use error::{PipelineError, Result};
 pub use evaluate::{EvalOptions, Report, evaluate};
 pub use lists::{Purpose, load_lists};
+pub use live::{LiveSample, LiveTracker, Recorded};
 pub use orientation::{Orientation, apply_orientation, oriented};
 pub use placement::PlacementMap;
 pub use source::{Loaded, read_any};

@@ -10,7 +10,10 @@
 use std::borrow::Cow;
 
 use ridi_data::{OrientationSource, Sequence};
-use ridi_frames::{FilterConfig, STANDARD_GRAVITY, estimate_orientation, gravity_in_device};
+use ridi_frames::{
+    DeviceVec, FilterConfig, STANDARD_GRAVITY, WorldFromDevice, estimate_orientation,
+    gravity_in_device,
+};
 
 use crate::error::{PipelineError, Result};
 
@@ -26,19 +29,24 @@ pub fn with_estimated_orientation(seq: &Sequence, filter: &FilterConfig) -> Resu
     let q = estimate_orientation(seq.time(), seq.gyro(), seq.acce(), filter)
         .map_err(|e| PipelineError::sequence(seq.name(), format!("orientation estimate: {e}")))?;
     let mut p = seq.clone().into_parts();
-    p.gravity = q
+    (p.gravity, p.linacce) = q
         .iter()
-        .map(|&q| gravity_in_device(q, STANDARD_GRAVITY))
-        .collect();
-    p.linacce = p
-        .acce
-        .iter()
-        .zip(&p.gravity)
-        .map(|(&a, &g)| a - g)
-        .collect();
+        .zip(&p.acce)
+        .map(|(&q, &a)| estimated_gravity_and_linacce(q, a))
+        .unzip();
     p.orientation = q;
     p.orientation_source = Some(OrientationSource::Estimated);
     Sequence::new(p).map_err(|e| PipelineError::sequence(seq.name(), e.to_string()))
+}
+
+/// Gravity (standard magnitude, the estimate's up direction) and linear acceleration
+/// (accelerometer minus that gravity) of one sample with an estimated orientation `q`.
+pub(crate) fn estimated_gravity_and_linacce(
+    q: WorldFromDevice,
+    acce: DeviceVec,
+) -> (DeviceVec, DeviceVec) {
+    let gravity = gravity_in_device(q, STANDARD_GRAVITY);
+    (gravity, acce - gravity)
 }
 
 /// `seq` with the orientation `choice` asks for: `seq` itself when it has it already (a recorded

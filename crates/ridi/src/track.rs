@@ -2,17 +2,15 @@
 
 use std::path::Path;
 
-use ridi_correct::{
-    CorrectionConfig, FrameWindow, PlacementSmoother, Regression, Sample, Tracker, TrackerConfig,
-    TrailingMajority, VelocityRegressor, VelocityTarget, correct,
-};
+use ridi_correct::{CorrectionConfig, PlacementSmoother, VelocityTarget, correct};
 use ridi_data::{Sequence, write_atomically};
-use ridi_features::{FeatureExtractor, ImuView, SampleSchedule};
+use ridi_features::{FeatureExtractor, Orientation, SampleSchedule};
 use ridi_frames::{DeviceVec, WorldVec};
 use ridi_regress::{Cascade, MatrixRef};
 use serde::{Deserialize, Serialize};
 
 use crate::error::{PipelineError, Result};
+use crate::live::{LiveSample, LiveTracker};
 use crate::orientation::oriented;
 use crate::train::imu_view;
 
@@ -245,12 +243,17 @@ pub(crate) fn check_gaps(seq: &Sequence, max_dt: f64) -> Result<()> {
 
 /// Tracks `seq` with `model`, in the orientation the model was trained with ([`oriented`]).
 pub fn track(seq: &Sequence, model: &Cascade, opts: &TrackOptions) -> Result<Track> {
-    let seq = oriented(seq, model.feature_config().orientation)?;
-    let seq = seq.as_ref();
     check_gaps(seq, opts.correction.max_dt)?;
     if opts.online {
+        // The live tracker estimates an estimated orientation on the stream itself; a
+        // recorded one must still be there.
+        if model.feature_config().orientation == Orientation::Recorded {
+            oriented(seq, Orientation::Recorded)?;
+        }
         return track_online(seq, model, opts);
     }
+    let seq = oriented(seq, model.feature_config().orientation)?;
+    let seq = seq.as_ref();
     let regressions = regress(seq, model, opts)?;
     correct_with(
         seq,
@@ -260,113 +263,21 @@ pub fn track(seq: &Sequence, model: &Cascade, opts: &TrackOptions) -> Result<Tra
     )
 }
 
-/// The cascade as the streaming tracker's regressor: features of the latest window, one query.
-///
-/// The frames pushed must carry the orientation the model was trained with
-/// ([`FeatureConfig::orientation`](ridi_features::FeatureConfig::orientation)): [`track`] sees
-/// to that for a whole sequence; a live caller with an `Estimated` model runs the estimator on
-/// its stream first (`ridi_frames::estimate_orientation_from`, chunk by chunk from the last
-/// state) and derives gravity and linear acceleration from it as
-/// [`with_estimated_orientation`](crate::orientation::with_estimated_orientation) does.
-pub struct CascadeRegressor<'m> {
-    model: &'m Cascade,
-    extractor: FeatureExtractor,
-    row: Vec<f32>,
-    majority: Option<TrailingMajority>,
-    /// Every regression made, for reports.
-    pub made: Vec<Regressed>,
-}
-
-impl<'m> CascadeRegressor<'m> {
-    /// A regressor over `model`; with `smoothing`, each placement becomes the majority label of
-    /// the window's length of regressions before it (the streaming form of the batch vote).
-    pub fn new(model: &'m Cascade, smoothing: Option<PlacementSmoother>) -> Result<Self> {
-        let extractor = FeatureExtractor::new(model.feature_config().clone())?;
-        let row = vec![0.0; extractor.dim()];
-        Ok(Self {
-            model,
-            extractor,
-            row,
-            majority: smoothing.map(|s| s.trailing(model.placements().len())),
-            made: Vec::new(),
-        })
-    }
-}
-
-impl VelocityRegressor for CascadeRegressor<'_> {
-    fn window_len(&self) -> usize {
-        // One more than the feature window: the feature of the regressed (last) frame covers
-        // the frames before it, as in batch tracking.
-        self.extractor.config().window + 1
-    }
-
-    fn regress(
-        &mut self,
-        frames: &FrameWindow<'_>,
-    ) -> std::result::Result<Option<Regression>, ridi_correct::RegressError> {
-        let imu = ImuView::new(frames.gyro, frames.linacce, frames.gravity)?;
-        let stab = self.extractor.stabilize(&imu)?;
-        let len = frames.len();
-        self.extractor.row_into(&stab, len - 1, &mut self.row)?;
-        let mut p = self.model.predict_one(&self.row)?;
-        if let Some(m) = &mut self.majority {
-            let label = m.push(frames.time[len - 1], p.placement);
-            if label != p.placement {
-                let row = MatrixRef::new(&self.row, self.row.len())?;
-                p.velocity = self.model.predict_with_placement(row, label)?[0];
-                p.placement = label;
-            }
-        }
-        let velocity = [p.velocity[0] as f64, p.velocity[1] as f64];
-        self.made.push(Regressed {
-            frame: frames.last_frame() as usize,
-            placement: p.placement,
-            velocity,
-        });
-        Ok(Some(Regression {
-            velocity,
-            label: Some(p.placement as u32),
-        }))
-    }
-}
-
 fn track_online(seq: &Sequence, model: &Cascade, opts: &TrackOptions) -> Result<Track> {
-    let config = TrackerConfig {
-        correction: opts.correction_for(model),
-        regress_every: opts.regress_every,
-        ..TrackerConfig::default()
-    };
-    let mut regressor = CascadeRegressor::new(model, opts.placement_smoothing)?;
-    let mut tracker = Tracker::new(config, &mut regressor)
-        .map_err(|e| PipelineError::sequence(seq.name(), e.to_string()))?;
-    let n = seq.len();
-    let (mut position, mut velocity, mut bias) = (
-        Vec::with_capacity(n),
-        Vec::with_capacity(n),
-        Vec::with_capacity(n),
-    );
-    for i in 0..n {
-        let sample = Sample {
-            time: seq.time()[i],
-            gyro: seq.gyro()[i],
-            linacce: seq.linacce()[i],
-            gravity: seq.gravity()[i],
-            orientation: seq.orientation()[i],
-        };
-        let update = tracker
-            .push(&sample)
+    let mut live = LiveTracker::new(model, opts)?;
+    let mut updates = Vec::with_capacity(seq.len());
+    for i in 0..seq.len() {
+        live.push(&LiveSample::of_frame(seq, i), &mut updates)
             .map_err(|e| PipelineError::sequence(seq.name(), format!("frame {i}: {e}")))?;
-        position.push(update.pose.position);
-        velocity.push(update.pose.velocity);
-        bias.push(tracker.bias());
     }
-    drop(tracker);
+    live.finish(&mut updates)
+        .map_err(|e| PipelineError::sequence(seq.name(), e.to_string()))?;
     Ok(Track {
         time: seq.time().to_vec(),
-        position,
-        velocity,
-        bias,
-        regressions: regressor.made,
+        position: updates.iter().map(|u| u.pose.position).collect(),
+        velocity: updates.iter().map(|u| u.pose.velocity).collect(),
+        bias: updates.iter().map(|u| u.bias).collect(),
+        regressions: live.regressions().to_vec(),
         placement_names: model.placements().to_vec(),
     })
 }

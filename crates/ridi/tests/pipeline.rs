@@ -2,13 +2,15 @@
 
 use std::path::{Path, PathBuf};
 
+use ridi::correct::{Sample, Tracker, TrackerConfig};
 use ridi::data::{ReadOptions, Sequence, load_list};
 use ridi::frames::nalgebra::Vector3;
 use ridi::frames::{DeviceVec, Rot, UpAxis};
+use ridi::live::CascadeRegressor;
 use ridi::regress::{NoProgress, model_file};
 use ridi::{
-    EvalOptions, GridChoice, Method, Orientation, PlacementMap, TrackOptions, TrainOptions,
-    apply_orientation,
+    EvalOptions, GridChoice, LiveSample, LiveTracker, Method, Orientation, PlacementMap,
+    TrackOptions, TrainOptions, apply_orientation,
 };
 
 fn sample() -> PathBuf {
@@ -424,6 +426,35 @@ fn a_model_tracks_in_the_orientation_it_was_trained_with() {
     let a = ridi::track(&seq, &model, &TrackOptions::default()).unwrap();
     let b = ridi::track(&pre[0], &model, &TrackOptions::default()).unwrap();
     assert_eq!(a.position, b.position);
+    // Online, the live tracker estimates the orientation on the stream: the same poses as the
+    // streaming tracker fed the batch estimate.
+    let online = TrackOptions {
+        online: true,
+        ..TrackOptions::default()
+    };
+    let a = ridi::track(&seq, &model, &online).unwrap();
+    let config = TrackerConfig {
+        correction: online.correction_for(&model),
+        regress_every: online.regress_every,
+        ..TrackerConfig::default()
+    };
+    let regressor = CascadeRegressor::new(&model, online.placement_smoothing).unwrap();
+    let mut tracker = Tracker::new(config, regressor).unwrap();
+    let e = &pre[0];
+    for i in 0..e.len() {
+        let u = tracker
+            .push(&Sample {
+                time: e.time()[i],
+                gyro: e.gyro()[i],
+                linacce: e.linacce()[i],
+                gravity: e.gravity()[i],
+                orientation: e.orientation()[i],
+            })
+            .unwrap();
+        assert_eq!(u.pose.position, a.position[i], "frame {i}");
+        assert_eq!(u.bias, a.bias[i], "frame {i}");
+    }
+    assert_eq!(tracker.regressor().made, a.regressions);
     let (report, _) = ridi::evaluate(&pre, &model, &EvalOptions::default()).unwrap();
     assert!(report.summary["ridi"].rte_5s_m.is_finite());
     // Recorded training options on an estimated sequence: an error naming it.
@@ -434,4 +465,90 @@ fn a_model_tracks_in_the_orientation_it_was_trained_with() {
         err.contains(seq.name()) && err.contains("recorded"),
         "{err}"
     );
+}
+
+#[test]
+fn a_live_stream_gets_its_poses_sample_by_sample() {
+    let seq = load("list_Jakob.txt").swap_remove(7);
+    let sample = |i: usize, recorded: bool| LiveSample {
+        recorded: LiveSample::of_frame(&seq, i).recorded.filter(|_| recorded),
+        ..LiveSample::of_frame(&seq, i)
+    };
+    let opts = TrackOptions {
+        online: true,
+        ..TrackOptions::default()
+    };
+    let train = load("list_Guillaume.txt");
+
+    // Recorded orientation: one update per sample, the poses of `ridi track --online`; a
+    // sample without the recorded orientation is refused, naming what is missing.
+    let model = quick_model(&train);
+    let whole = ridi::track(&seq, &model, &opts).unwrap();
+    let mut live = LiveTracker::new(&model, &opts).unwrap();
+    let mut updates = Vec::new();
+    let err = live
+        .push(&sample(0, false), &mut updates)
+        .unwrap_err()
+        .to_string();
+    assert!(err.contains("recorded orientation"), "{err}");
+    for i in 0..seq.len() {
+        updates.clear();
+        live.push(&sample(i, true), &mut updates).unwrap();
+        assert_eq!(updates.len(), 1);
+        assert_eq!(updates[0].pose.position, whole.position[i]);
+    }
+    updates.clear();
+    live.finish(&mut updates).unwrap();
+    assert!(updates.is_empty());
+    assert_eq!(live.regressions(), whole.regressions.as_slice());
+
+    // Estimated orientation: the first 20 frames wait for the initial tilt, then the stream
+    // gives one pose per sample; refused samples (time going back, a gap, NaN) change nothing.
+    let mut opts_est = TrainOptions::default();
+    opts_est.cascade.regressors = GridChoice::None.regressors();
+    opts_est.features.orientation = Orientation::Estimated;
+    let model = ridi::train(&train, &opts_est, &mut NoProgress).unwrap();
+    let whole = ridi::track(&seq, &model, &opts).unwrap();
+    let mut live = LiveTracker::new(&model, &opts).unwrap();
+    let mut positions = Vec::new();
+    let mut updates = Vec::new();
+    for i in 0..seq.len() {
+        if i == 500 {
+            let mut back = sample(i, false);
+            back.time = seq.time()[i - 1];
+            let err = live.push(&back, &mut updates).unwrap_err().to_string();
+            assert!(err.contains("not after"), "{err}");
+            let mut gap = sample(i, false);
+            gap.time += 0.5;
+            let err = live.push(&gap, &mut updates).unwrap_err().to_string();
+            assert!(err.contains("gap"), "{err}");
+            let mut nan = sample(i, false);
+            nan.gyro = DeviceVec::new(f64::NAN, 0.0, 0.0);
+            assert!(live.push(&nan, &mut updates).is_err());
+        }
+        updates.clear();
+        live.push(&sample(i, false), &mut updates).unwrap();
+        let expected = match i {
+            ..19 => 0,
+            19 => 20,
+            _ => 1,
+        };
+        assert_eq!(updates.len(), expected, "sample {i}");
+        positions.extend(updates.iter().map(|u| u.pose.position));
+    }
+    updates.clear();
+    live.finish(&mut updates).unwrap();
+    assert!(updates.is_empty());
+    assert_eq!(positions, whole.position);
+
+    // A stream shorter than the initial tilt needs comes out at the end.
+    let mut live = LiveTracker::new(&model, &opts).unwrap();
+    updates.clear();
+    for i in 0..10 {
+        live.push(&sample(i, false), &mut updates).unwrap();
+    }
+    assert!(updates.is_empty());
+    live.finish(&mut updates).unwrap();
+    assert_eq!(updates.len(), 10);
+    assert!(updates.iter().all(|u| u.pose.position.is_finite()));
 }

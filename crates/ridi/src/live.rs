@@ -1,0 +1,314 @@
+//! Tracking a live stream: one sample in, its pose out, with the model's orientation.
+//!
+//! [`LiveTracker`] is the streaming tracker of `ridi-correct` with a trained cascade as its
+//! regressor and, for models trained on an orientation estimated from gyro and accelerometer
+//! ([`Orientation::Estimated`]), the same estimator running on the stream
+//! ([`OrientationFilter`]), so a live caller hands over what the phone measures and gets what
+//! `ridi track --online` would give for the same recording.
+
+use std::collections::VecDeque;
+
+use ridi_correct::{
+    FrameWindow, PlacementSmoother, Regression, Sample, TrackError, Tracker, TrackerConfig,
+    TrailingMajority, Update, VelocityRegressor,
+};
+use ridi_data::Sequence;
+use ridi_features::{FeatureExtractor, ImuView, Orientation};
+use ridi_frames::{DeviceVec, FilterConfig, OrientationFilter, WorldFromDevice};
+use ridi_regress::{Cascade, MatrixRef};
+
+use crate::error::{PipelineError, Result};
+use crate::orientation::estimated_gravity_and_linacce;
+use crate::track::{Regressed, TrackOptions};
+
+/// The cascade as the streaming tracker's regressor: features of the latest window, one query.
+///
+/// The frames pushed must carry the orientation the model was trained with
+/// ([`FeatureConfig::orientation`](ridi_features::FeatureConfig::orientation));
+/// [`LiveTracker`] sees to that.
+pub struct CascadeRegressor<'m> {
+    model: &'m Cascade,
+    extractor: FeatureExtractor,
+    row: Vec<f32>,
+    majority: Option<TrailingMajority>,
+    /// Every regression made, for reports.
+    pub made: Vec<Regressed>,
+}
+
+impl<'m> CascadeRegressor<'m> {
+    /// A regressor over `model`; with `smoothing`, each placement becomes the majority label of
+    /// the window's length of regressions before it (the streaming form of the batch vote).
+    pub fn new(model: &'m Cascade, smoothing: Option<PlacementSmoother>) -> Result<Self> {
+        let extractor = FeatureExtractor::new(model.feature_config().clone())?;
+        let row = vec![0.0; extractor.dim()];
+        Ok(Self {
+            model,
+            extractor,
+            row,
+            majority: smoothing.map(|s| s.trailing(model.placements().len())),
+            made: Vec::new(),
+        })
+    }
+}
+
+impl VelocityRegressor for CascadeRegressor<'_> {
+    fn window_len(&self) -> usize {
+        // One more than the feature window: the feature of the regressed (last) frame covers
+        // the frames before it, as in batch tracking.
+        self.extractor.config().window + 1
+    }
+
+    fn regress(
+        &mut self,
+        frames: &FrameWindow<'_>,
+    ) -> std::result::Result<Option<Regression>, ridi_correct::RegressError> {
+        let imu = ImuView::new(frames.gyro, frames.linacce, frames.gravity)?;
+        let stab = self.extractor.stabilize(&imu)?;
+        let len = frames.len();
+        self.extractor.row_into(&stab, len - 1, &mut self.row)?;
+        let mut p = self.model.predict_one(&self.row)?;
+        if let Some(m) = &mut self.majority {
+            let label = m.push(frames.time[len - 1], p.placement);
+            if label != p.placement {
+                let row = MatrixRef::new(&self.row, self.row.len())?;
+                p.velocity = self.model.predict_with_placement(row, label)?[0];
+                p.placement = label;
+            }
+        }
+        let velocity = [p.velocity[0] as f64, p.velocity[1] as f64];
+        self.made.push(Regressed {
+            frame: frames.last_frame() as usize,
+            placement: p.placement,
+            velocity,
+        });
+        Ok(Some(Regression {
+            velocity,
+            label: Some(p.placement as u32),
+        }))
+    }
+}
+
+/// What the phone's operating system reports besides gyro and accelerometer: its orientation
+/// (Android's game rotation vector, Tango) and the gravity and linear acceleration derived from
+/// it, all as `ridi_data::Sequence` holds them.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Recorded {
+    /// World-from-device orientation.
+    pub orientation: WorldFromDevice,
+    /// Gravity (pointing up), device frame, m/s².
+    pub gravity: DeviceVec,
+    /// Linear acceleration, device frame, m/s².
+    pub linacce: DeviceVec,
+}
+
+/// One sample of a live stream.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct LiveSample {
+    /// Timestamp, seconds, increasing.
+    pub time: f64,
+    /// Angular rate, device frame, rad/s.
+    pub gyro: DeviceVec,
+    /// Accelerometer (including gravity, reading up at rest), device frame, m/s².
+    pub acce: DeviceVec,
+    /// The recorded orientation: required by a model trained on it
+    /// ([`Orientation::Recorded`]); a model with an estimated orientation ignores it and
+    /// estimates its own from `gyro` and `acce`.
+    pub recorded: Option<Recorded>,
+}
+
+impl LiveSample {
+    /// Frame `frame` of a recording, with its recorded orientation: to play a recording back
+    /// as a stream.
+    ///
+    /// # Panics
+    /// When `frame` is not below `seq.len()`.
+    pub fn of_frame(seq: &Sequence, frame: usize) -> Self {
+        Self {
+            time: seq.time()[frame],
+            gyro: seq.gyro()[frame],
+            acce: seq.acce()[frame],
+            recorded: Some(Recorded {
+                orientation: seq.orientation()[frame],
+                gravity: seq.gravity()[frame],
+                linacce: seq.linacce()[frame],
+            }),
+        }
+    }
+}
+
+/// Tracks a live stream with a trained model: push samples as they arrive, get each frame's
+/// pose (the streaming tracker's [`Update`]).
+///
+/// With a model trained on the recorded orientation, every push gives its own frame's update.
+/// With an estimated orientation, the first frames wait until the estimator knows the initial
+/// tilt (the first 20 nonzero accelerometer samples, 0.1 s at 200 Hz) and then come out
+/// together; [`finish`](Self::finish) releases what a stream too short for that leaves.
+/// Pushing a whole recording gives exactly the poses of `ridi track --online`
+/// ([`track`](crate::track()) with [`TrackOptions::online`]), which runs through this type.
+///
+/// A refused sample (non-finite field, time not after the previous sample's, a gap the
+/// correction cannot integrate across) leaves the tracker as it was.
+///
+/// ```
+/// use ridi::data::{ReadOptions, load_list};
+/// use ridi::regress::NoProgress;
+/// use ridi::{LiveSample, LiveTracker, PlacementMap, TrackOptions, TrainOptions};
+///
+/// let sample = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../datasets/sample");
+/// let mut train = load_list(sample.join("list_Guillaume.txt"), &ReadOptions::default())?;
+/// PlacementMap::tyrex_groups().apply(&mut train);
+/// let mut opts = TrainOptions::default();
+/// opts.cascade.regressors = ridi::GridChoice::None.regressors();
+/// let model = ridi::train(&train, &opts, &mut NoProgress)?;
+///
+/// // A recording played back as if it arrived live.
+/// let stream = &load_list(sample.join("list_Jakob.txt"), &ReadOptions::default())?[0];
+/// let mut live = LiveTracker::new(&model, &TrackOptions::default())?;
+/// let mut updates = Vec::new();
+/// for i in 0..stream.len() {
+///     live.push(&LiveSample::of_frame(stream, i), &mut updates)?;
+/// }
+/// live.finish(&mut updates)?;
+/// assert_eq!(updates.len(), stream.len());
+/// let end = updates.last().unwrap().pose.position;
+/// println!("walked to ({:.1}, {:.1}) m", end.x(), end.y());
+/// # Ok::<(), Box<dyn std::error::Error>>(())
+/// ```
+pub struct LiveTracker<'m> {
+    tracker: Tracker<CascadeRegressor<'m>>,
+    estimator: Option<Estimator>,
+}
+
+/// The orientation estimate of a stream, and the samples waiting for it.
+struct Estimator {
+    filter: OrientationFilter,
+    waiting: VecDeque<(f64, DeviceVec, DeviceVec)>,
+    orientations: Vec<WorldFromDevice>,
+    last_time: Option<f64>,
+    max_dt: f64,
+    reject_gaps: bool,
+}
+
+impl<'m> LiveTracker<'m> {
+    /// A tracker with `model`, configured as `opts` configures [`track`](crate::track()) (its
+    /// `online` flag aside: this is the online form).
+    ///
+    /// # Errors
+    /// A configuration the tracker refuses, or a model whose features cannot be extracted.
+    pub fn new(model: &'m Cascade, opts: &TrackOptions) -> Result<Self> {
+        let config = TrackerConfig {
+            correction: opts.correction_for(model),
+            regress_every: opts.regress_every,
+            ..TrackerConfig::default()
+        };
+        let regressor = CascadeRegressor::new(model, opts.placement_smoothing)?;
+        let tracker = Tracker::new(config, regressor)?;
+        let estimator = match model.feature_config().orientation {
+            Orientation::Recorded => None,
+            Orientation::Estimated => Some(Estimator {
+                filter: OrientationFilter::new(FilterConfig::default())?,
+                waiting: VecDeque::new(),
+                orientations: Vec::new(),
+                last_time: None,
+                max_dt: config.correction.max_dt,
+                reject_gaps: config.gap_policy == ridi_correct::GapPolicy::Reject,
+            }),
+        };
+        Ok(Self { tracker, estimator })
+    }
+
+    /// Adds one sample and appends to `out` the updates of the frames whose pose became known
+    /// (one, except while an estimated orientation starts up).
+    ///
+    /// # Errors
+    /// A refused sample ([`TrackError`], [`ridi_frames::EstimateError`]), or a recorded model
+    /// given a sample without its recorded orientation; the tracker is unchanged.
+    pub fn push(&mut self, sample: &LiveSample, out: &mut Vec<Update>) -> Result<()> {
+        let Some(est) = &mut self.estimator else {
+            let r = sample.recorded.ok_or_else(|| {
+                PipelineError::Live(
+                    "the model was trained on the recorded orientation, but the sample has \
+                     none (give `recorded`, or train with --orientation estimated)"
+                        .into(),
+                )
+            })?;
+            let update = self.tracker.push(&Sample {
+                time: sample.time,
+                gyro: sample.gyro,
+                linacce: r.linacce,
+                gravity: r.gravity,
+                orientation: r.orientation,
+            })?;
+            out.push(update);
+            return Ok(());
+        };
+        // The tracker's own checks, made before the estimator holds the sample: a sample it
+        // would refuse later could no longer be taken back.
+        if let Some(prev) = est.last_time {
+            let dt = sample.time - prev;
+            if dt <= 0.0 {
+                return Err(TrackError::TimeNotIncreasing {
+                    time: sample.time,
+                    previous: prev,
+                }
+                .into());
+            }
+            if dt > est.max_dt && est.reject_gaps {
+                return Err(TrackError::Gap {
+                    dt,
+                    max_dt: est.max_dt,
+                }
+                .into());
+            }
+        }
+        est.filter
+            .push(sample.time, sample.gyro, sample.acce, &mut est.orientations)?;
+        est.last_time = Some(sample.time);
+        est.waiting
+            .push_back((sample.time, sample.gyro, sample.acce));
+        self.drain(out)
+    }
+
+    /// Ends the stream: appends the updates of frames still waiting for an estimated
+    /// orientation.
+    ///
+    /// # Errors
+    /// [`ridi_frames::EstimateError::NoGravity`] when every sample waiting has a zero
+    /// accelerometer reading.
+    pub fn finish(&mut self, out: &mut Vec<Update>) -> Result<()> {
+        if let Some(est) = &mut self.estimator {
+            est.filter.finish(&mut est.orientations)?;
+        }
+        self.drain(out)
+    }
+
+    /// Every regression made so far.
+    pub fn regressions(&self) -> &[Regressed] {
+        &self.tracker.regressor().made
+    }
+
+    /// The streaming tracker underneath (statistics, buffered poses, the current bias).
+    pub fn tracker(&self) -> &Tracker<CascadeRegressor<'m>> {
+        &self.tracker
+    }
+
+    /// Feeds the tracker every waiting sample whose orientation is known.
+    fn drain(&mut self, out: &mut Vec<Update>) -> Result<()> {
+        let Some(est) = &mut self.estimator else {
+            return Ok(());
+        };
+        // One orientation per sample given, in order: the oldest waiting samples are known.
+        let known = est.orientations.len().min(est.waiting.len());
+        for (q, (time, gyro, acce)) in est.orientations.drain(..).zip(est.waiting.drain(..known)) {
+            let (gravity, linacce) = estimated_gravity_and_linacce(q, acce);
+            out.push(self.tracker.push(&Sample {
+                time,
+                gyro,
+                linacce,
+                gravity,
+                orientation: q,
+            })?);
+        }
+        Ok(())
+    }
+}
