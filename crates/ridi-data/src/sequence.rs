@@ -188,8 +188,9 @@ fn median(v: &mut [f64]) -> f64 {
 /// | median ground-truth speed per Tyrex run | 0.17..2.33 m/s | 20 m/s |
 ///
 /// Not caught: a gyro in deg/s on a phone lying almost still (median under 0.17 rad/s), and a
-/// linear acceleration alone in g (it has no reference magnitude: only the accelerometer is
-/// compared with gravity).
+/// linear acceleration alone in g on a phone that hardly moves (RMS of accelerometer minus
+/// gravity under [`LINACCE_SCALE_MIN_RMS`]; there is then too little of it to judge, and too
+/// little to matter).
 #[derive(Debug, Clone, PartialEq)]
 pub struct Validation {
     /// Largest accepted interval between two frames, seconds.
@@ -224,6 +225,12 @@ pub struct Validation {
     /// 1 Hz; phone sensors deliver 5-500 Hz). Seconds or milliseconds read as nanoseconds step
     /// by 1e-9 s or less. A unit too coarse shows as gaps instead.
     pub time_step_range: (f64, f64),
+    /// Accepted range of the scale that best takes the linear acceleration onto accelerometer
+    /// minus gravity (least squares over all frames): 0.5..2. Android's linear acceleration
+    /// is that difference (scale 1); one in g beside the others in m/s^2 gives 9.8, one in
+    /// mm/s^2 gives 0.001. Judged only when the RMS of accelerometer minus gravity is at
+    /// least [`LINACCE_SCALE_MIN_RMS`].
+    pub linacce_scale_range: (f64, f64),
     /// Largest accepted median speed of the ground truth, m/s: 20 (72 km/h). Pedestrians walk
     /// at 1-2 m/s and run at 3-5; positions in millimetres or centimetres read as metres move
     /// 100-1000 times faster, which the bound on single positions cannot see.
@@ -242,6 +249,7 @@ impl Default for Validation {
             max_position: 1e6,
             max_median_gyro: 10.0,
             acce_gravity_ratio: (0.5, 3.0),
+            linacce_scale_range: (0.5, 2.0),
             time_step_range: (1e-4, 1.0),
             max_median_speed: 20.0,
         }
@@ -348,7 +356,42 @@ impl Validation {
             })
         }
     }
+
+    /// Checks the linear acceleration's scale against accelerometer minus gravity (all in the
+    /// same frame, one triple per frame) with [`Self::linacce_scale_range`]; passes when that
+    /// difference is too small to judge ([`LINACCE_SCALE_MIN_RMS`]).
+    pub fn check_linacce_scale<I>(&self, frames: I) -> Result<(), SequenceError>
+    where
+        I: IntoIterator<Item = ([f64; 3], [f64; 3], [f64; 3])>,
+    {
+        let (mut dl, mut ll, mut dd, mut n) = (0.0, 0.0, 0.0, 0usize);
+        for (acce, gravity, linacce) in frames {
+            for k in 0..3 {
+                let d = acce[k] - gravity[k];
+                dl += d * linacce[k];
+                ll += linacce[k] * linacce[k];
+                dd += d * d;
+            }
+            n += 1;
+        }
+        if n == 0 || (dd / n as f64).sqrt() < LINACCE_SCALE_MIN_RMS {
+            return Ok(());
+        }
+        // acce - gravity ~ scale * linacce; an all-zero linear acceleration is no scale at all.
+        let scale = if ll > 0.0 { dl / ll } else { f64::INFINITY };
+        let (min, max) = self.linacce_scale_range;
+        if (min..=max).contains(&scale) {
+            Ok(())
+        } else {
+            Err(SequenceError::LinacceScale { scale, min, max })
+        }
+    }
 }
+
+/// Smallest RMS of accelerometer minus gravity, m/s^2, at which [`Validation::check_linacce_scale`]
+/// judges the linear acceleration's scale: a phone lying still has mostly sensor noise there,
+/// whose fit says nothing (walking gives 1-14 m/s^2).
+pub const LINACCE_SCALE_MIN_RMS: f64 = 0.5;
 
 /// Axis names of the 3-vector channels.
 pub(crate) const AXES: [&str; 3] = ["x", "y", "z"];
@@ -470,6 +513,21 @@ pub enum SequenceError {
         /// Lowest accepted ratio.
         min: f64,
         /// Highest accepted ratio.
+        max: f64,
+    },
+    /// The linear acceleration does not match accelerometer minus gravity in size.
+    #[error(
+        "accelerometer minus gravity is {} times the linear acceleration (least squares), \
+         outside {min}..{max}: linear acceleration in {}?",
+        short(*scale),
+        if *scale > 5.0 && *scale < 20.0 { "g instead of m/s^2" } else { "another unit than m/s^2, or another column" }
+    )]
+    LinacceScale {
+        /// The fitted scale.
+        scale: f64,
+        /// Lowest accepted scale.
+        min: f64,
+        /// Highest accepted scale.
         max: f64,
     },
     /// The ground truth moves too fast for a pedestrian: positions in another unit than metres.
@@ -631,6 +689,12 @@ impl Sequence {
             return Err(SequenceError::Gravity { mean, min, max });
         }
         limits.check_acce_scale(mean_norm(arrays(&parts.acce)), mean)?;
+        limits.check_linacce_scale(
+            arrays(&parts.acce)
+                .zip(arrays(&parts.gravity))
+                .zip(arrays(&parts.linacce))
+                .map(|((a, g), l)| (a, g, l)),
+        )?;
         Ok(Self { parts })
     }
 
@@ -809,6 +873,42 @@ mod tests {
             e.to_string(),
             "`gyro.y` at frame 1: -200 rad/s is beyond any phone gyroscope (|value| <= 100 rad/s)"
         );
+    }
+
+    #[test]
+    fn the_linear_acceleration_scale_is_judged_on_a_moving_phone_only() {
+        let v = Validation::default();
+        let g = [0.0, 0.0, 9.8];
+        let frames = |motion: f64, scale: f64| {
+            (0..100).map(move |i| {
+                let m = [
+                    motion * (i as f64 * 0.3).sin(),
+                    motion * (i as f64 * 0.7).cos(),
+                    0.0,
+                ];
+                let acce = [m[0] + g[0], m[1] + g[1], m[2] + g[2]];
+                (acce, g, [m[0] / scale, m[1] / scale, m[2] / scale])
+            })
+        };
+        v.check_linacce_scale(frames(2.0, 1.0)).unwrap();
+        let e = v.check_linacce_scale(frames(2.0, 9.80665)).unwrap_err();
+        assert!(
+            matches!(e, SequenceError::LinacceScale { scale, .. } if (scale - 9.80665).abs() < 1e-9),
+            "{e}"
+        );
+        assert!(
+            e.to_string()
+                .ends_with("linear acceleration in g instead of m/s^2?"),
+            "{e}"
+        );
+        let e = v.check_linacce_scale(frames(2.0, 1e-3)).unwrap_err();
+        assert!(e.to_string().contains("another unit than m/s^2"), "{e}");
+        // All zero while the phone moves: no linear acceleration at all.
+        let zero = frames(2.0, 1.0).map(|(a, g, _)| (a, g, [0.0; 3]));
+        assert!(v.check_linacce_scale(zero).is_err());
+        // A phone lying still (sensor noise only) is not judged, whatever the unit.
+        v.check_linacce_scale(frames(0.05, 9.80665)).unwrap();
+        v.check_linacce_scale(std::iter::empty()).unwrap();
     }
 
     #[test]

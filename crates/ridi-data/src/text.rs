@@ -233,6 +233,7 @@ pub(crate) fn sequence_error(
         ),
         SequenceError::GyroUnits { .. } => return whole(Channel::Gyro, e.to_string()),
         SequenceError::AcceScale { .. } => return whole(Channel::Acce, e.to_string()),
+        SequenceError::LinacceScale { .. } => return whole(Channel::Linacce, e.to_string()),
         SequenceError::GroundTruthSpeed { .. } => return whole(Channel::Position, e.to_string()),
         SequenceError::TimeStep { .. } => {
             let unit = fields.time_unit();

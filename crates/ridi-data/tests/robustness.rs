@@ -209,6 +209,20 @@ fn csv_accelerometer_in_g_is_refused() {
 }
 
 #[test]
+fn csv_linear_acceleration_alone_in_g_is_refused() {
+    assert_err(
+        parse_csv(&csv_scaled(8..11, |v| v / 9.80665)),
+        &[
+            "walk/data.csv: field `linacce_x..linacce_z`: accelerometer minus gravity is 9.807 \
+             times the linear acceleration (least squares), outside 0.5..2: linear acceleration \
+             in g instead of m/s^2?",
+        ],
+    );
+    // Off by a factor of 1.5 (a lagging filter, say) is still a linear acceleration.
+    assert!(parse_csv(&csv_scaled(8..11, |v| v * 1.5)).is_ok());
+}
+
+#[test]
 fn csv_positions_in_millimetres_are_refused() {
     let header = csv_text().lines().next().unwrap().to_owned();
     let pos_x = header.split(',').position(|c| c == "pos_x").unwrap();
@@ -341,6 +355,23 @@ fn raw_accelerometer_in_g_is_refused() {
         &[
             "acce.txt: field `x..z`: mean |acce| 1.0",
             "accelerometer in g instead of m/s^2?",
+        ],
+    );
+}
+
+#[test]
+fn raw_linear_acceleration_alone_in_g_is_refused() {
+    // The fixture's phone hardly moves: add 2 m/s^2 on every axis so there is something to
+    // judge, then write the linear acceleration in g.
+    let (_d, r) = raw_with(|f| {
+        edit_file(f, "acce.txt", raw_scaled(|v| v + 2.0));
+        edit_file(f, "linacce.txt", raw_scaled(|v| (v + 2.0) / 9.80665));
+    });
+    assert_err(
+        r,
+        &[
+            "linacce.txt: field `x..z`: accelerometer minus gravity is",
+            "linear acceleration in g instead of m/s^2?",
         ],
     );
 }
