@@ -85,8 +85,8 @@ pub use list::{ListEntry, load_entries, load_list, parse_list, read_list};
 pub use options::ReadOptions;
 pub use ridi_frames;
 pub use sequence::{
-    Channel, GroundTruth, LINACCE_SCALE_MIN_RMS, OrientationSource, Sequence, SequenceError,
-    SequenceParts, Validation,
+    Channel, GYRO_SCALE_MIN_RATE, GroundTruth, LINACCE_SCALE_MIN_RMS, OrientationSource, Sequence,
+    SequenceError, SequenceParts, Validation,
 };
 pub use write::{
     Precision, write_atomically, write_ridi_csv, write_ridi_csv_with, write_ridi_plain,

@@ -365,6 +365,7 @@ pub fn read(folder: impl AsRef<Path>, opts: &ReadOptions) -> Result<Sequence> {
     Sequence::with_validation(parts, &opts.validation).map_err(|e| match (&e, stream_file(&e)) {
         (SequenceError::AcceScale { .. }, _) => acce.error(e),
         (SequenceError::LinacceScale { .. }, _) => linacce.error(e),
+        (SequenceError::GyroScale { .. }, _) => gyro.error(e),
         // Interpolated onto the pose times: the file, but no line, is to blame.
         (_, Some(name)) => text::sequence_error(&folder.join(name), None, &RawFields, e),
         (_, None) => match &pose {

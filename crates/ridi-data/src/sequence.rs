@@ -187,8 +187,9 @@ fn median(v: &mut [f64]) -> f64 {
 /// | median interval between timestamps | 5-20 ms | 0.1 ms..1 s |
 /// | median ground-truth speed per Tyrex run | 0.17..2.33 m/s | 20 m/s |
 ///
-/// Not caught: a gyro in deg/s on a phone lying almost still (median under 0.17 rad/s), and a
-/// linear acceleration alone in g on a phone that hardly moves (RMS of accelerometer minus
+/// Not caught: a gyro in deg/s on a phone that hardly turns (median |gyro| under 0.17 rad/s
+/// and the orientation turning at under [`GYRO_SCALE_MIN_RATE`] RMS), and a linear
+/// acceleration alone in g on a phone that hardly moves (RMS of accelerometer minus
 /// gravity under [`LINACCE_SCALE_MIN_RMS`]; there is then too little of it to judge, and too
 /// little to matter).
 #[derive(Debug, Clone, PartialEq)]
@@ -225,6 +226,12 @@ pub struct Validation {
     /// 1 Hz; phone sensors deliver 5-500 Hz). Seconds or milliseconds read as nanoseconds step
     /// by 1e-9 s or less. A unit too coarse shows as gaps instead.
     pub time_step_range: (f64, f64),
+    /// Accepted range of the scale that best takes the rotation rate of the orientation onto
+    /// the gyro's (magnitudes, least squares over consecutive frames): 0.25..4. Real
+    /// recordings give 0.93-1.0 (Tyrex) and 0.57-0.98 (competition walks, a noisier rotation
+    /// vector at 50 Hz); a gyro in deg/s gives 57, a gyro of zeros 0. Judged only when the
+    /// orientation turns at least [`GYRO_SCALE_MIN_RATE`] (RMS).
+    pub gyro_scale_range: (f64, f64),
     /// Accepted range of the scale that best takes the linear acceleration onto accelerometer
     /// minus gravity (least squares over all frames): 0.5..2. Android's linear acceleration
     /// is that difference (scale 1); one in g beside the others in m/s^2 gives 9.8, one in
@@ -250,6 +257,7 @@ impl Default for Validation {
             max_median_gyro: 10.0,
             acce_gravity_ratio: (0.5, 3.0),
             linacce_scale_range: (0.5, 2.0),
+            gyro_scale_range: (0.25, 4.0),
             time_step_range: (1e-4, 1.0),
             max_median_speed: 20.0,
         }
@@ -357,6 +365,41 @@ impl Validation {
         }
     }
 
+    /// Checks the gyro against the rotation rate of `orientation` over `time` with
+    /// [`Self::gyro_scale_range`]; passes when the orientation hardly turns
+    /// ([`GYRO_SCALE_MIN_RATE`]). Magnitudes only, so that an orientation given for another
+    /// device frame than the gyro's still compares.
+    pub fn check_gyro_scale(
+        &self,
+        time: &[f64],
+        gyro: &[DeviceVec],
+        orientation: &[WorldFromDevice],
+    ) -> Result<(), SequenceError> {
+        let (mut gw, mut ww, mut n) = (0.0, 0.0, 0usize);
+        for k in 1..time.len().min(gyro.len()).min(orientation.len()) {
+            let dt = time[k] - time[k - 1];
+            if dt <= 0.0 {
+                continue;
+            }
+            let w = orientation[k - 1].angle_to(&orientation[k]) / dt;
+            // The rate between two frames is the mean of their gyro readings.
+            let g = ((*gyro[k - 1].vector() + *gyro[k].vector()) * 0.5).norm();
+            gw += g * w;
+            ww += w * w;
+            n += 1;
+        }
+        if n == 0 || (ww / n as f64).sqrt() < GYRO_SCALE_MIN_RATE {
+            return Ok(());
+        }
+        let scale = gw / ww;
+        let (min, max) = self.gyro_scale_range;
+        if (min..=max).contains(&scale) {
+            Ok(())
+        } else {
+            Err(SequenceError::GyroScale { scale, min, max })
+        }
+    }
+
     /// Checks the linear acceleration's scale against accelerometer minus gravity (all in the
     /// same frame, one triple per frame) with [`Self::linacce_scale_range`]; passes when that
     /// difference is too small to judge ([`LINACCE_SCALE_MIN_RMS`]).
@@ -387,6 +430,11 @@ impl Validation {
         }
     }
 }
+
+/// Smallest RMS rotation rate of the orientation, rad/s, at which
+/// [`Validation::check_gyro_scale`] judges the gyro's scale (the Tyrex and competition walks
+/// turn at 0.5-2.6 rad/s RMS).
+pub const GYRO_SCALE_MIN_RATE: f64 = 0.1;
 
 /// Smallest RMS of accelerometer minus gravity, m/s^2, at which [`Validation::check_linacce_scale`]
 /// judges the linear acceleration's scale: a phone lying still has mostly sensor noise there,
@@ -513,6 +561,25 @@ pub enum SequenceError {
         /// Lowest accepted ratio.
         min: f64,
         /// Highest accepted ratio.
+        max: f64,
+    },
+    /// The gyro does not turn as fast as the orientation.
+    #[error(
+        "the gyro turns {} times as fast as the orientation (least squares over frames), \
+         outside {min}..{max}: {}?",
+        short(*scale),
+        if *scale > 20.0 && *scale < 200.0 {
+            "gyroscope in deg/s instead of rad/s"
+        } else {
+            "a gyro in another unit, or of another recording or device"
+        }
+    )]
+    GyroScale {
+        /// The fitted scale.
+        scale: f64,
+        /// Lowest accepted scale.
+        min: f64,
+        /// Highest accepted scale.
         max: f64,
     },
     /// The linear acceleration does not match accelerometer minus gravity in size.
@@ -689,6 +756,7 @@ impl Sequence {
             return Err(SequenceError::Gravity { mean, min, max });
         }
         limits.check_acce_scale(mean_norm(arrays(&parts.acce)), mean)?;
+        limits.check_gyro_scale(&parts.time, &parts.gyro, &parts.orientation)?;
         limits.check_linacce_scale(
             arrays(&parts.acce)
                 .zip(arrays(&parts.gravity))
@@ -873,6 +941,42 @@ mod tests {
             e.to_string(),
             "`gyro.y` at frame 1: -200 rad/s is beyond any phone gyroscope (|value| <= 100 rad/s)"
         );
+    }
+
+    #[test]
+    fn the_gyro_scale_is_judged_on_a_turning_phone_only() {
+        let v = Validation::default();
+        // A slow turn of 0.15 rad/s (8.6 deg/s): below the median bound even in deg/s.
+        let turn = |rate: f64, gyro_scale: f64| {
+            let time: Vec<f64> = (0..400).map(|i| i as f64 * 0.005).collect();
+            let orientation: Vec<WorldFromDevice> = time
+                .iter()
+                .map(|&t| {
+                    WorldFromDevice::from_scaled_axis(ridi_frames::nalgebra::Vector3::new(
+                        0.0,
+                        0.0,
+                        rate * t,
+                    ))
+                })
+                .collect();
+            let gyro = vec![DeviceVec::new(0.0, 0.0, rate * gyro_scale); time.len()];
+            v.check_gyro_scale(&time, &gyro, &orientation)
+        };
+        turn(0.15, 1.0).unwrap();
+        let e = turn(0.15, 180.0 / std::f64::consts::PI).unwrap_err();
+        assert!(
+            matches!(e, SequenceError::GyroScale { scale, .. } if (scale - 57.29578).abs() < 1e-3),
+            "{e}"
+        );
+        assert!(
+            e.to_string()
+                .ends_with("gyroscope in deg/s instead of rad/s?"),
+            "{e}"
+        );
+        let e = turn(0.15, 0.0).unwrap_err();
+        assert!(e.to_string().contains("another recording or device"), "{e}");
+        // Turning at 0.05 rad/s is too little to judge, whatever the gyro says.
+        turn(0.05, 57.3).unwrap();
     }
 
     #[test]

@@ -231,7 +231,9 @@ pub(crate) fn sequence_error(
             fields.field(channel, Some(axis)),
             beyond(channel, value, limit),
         ),
-        SequenceError::GyroUnits { .. } => return whole(Channel::Gyro, e.to_string()),
+        SequenceError::GyroUnits { .. } | SequenceError::GyroScale { .. } => {
+            return whole(Channel::Gyro, e.to_string());
+        }
         SequenceError::AcceScale { .. } => return whole(Channel::Acce, e.to_string()),
         SequenceError::LinacceScale { .. } => return whole(Channel::Linacce, e.to_string()),
         SequenceError::GroundTruthSpeed { .. } => return whole(Channel::Position, e.to_string()),

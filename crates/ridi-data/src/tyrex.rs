@@ -756,6 +756,7 @@ pub fn read(dir: impl AsRef<Path>, options: &TyrexOptions) -> Result<TyrexRead> 
             // The accelerometer's scale is the one check the streams could not make alone.
             let path = match e {
                 SequenceError::AcceScale { .. } => &acce.path,
+                SequenceError::GyroScale { .. } => &gyro.path,
                 _ => dir,
             };
             text::sequence_error(path, None, &TyrexFields, e)

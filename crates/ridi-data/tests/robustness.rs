@@ -197,6 +197,27 @@ fn csv_gyro_in_degrees_per_second_is_refused() {
 }
 
 #[test]
+fn csv_gyro_that_does_not_turn_with_the_orientation_is_refused() {
+    // The fixture's orientation turns at about 0.7 rad/s; a gyro column of zeros (a sensor
+    // that was not recorded, filled in) passes every bound on its own.
+    let text = edit_rows(&csv_text(), |line, cells| {
+        if line > 1 {
+            for c in &mut cells[2..5] {
+                *c = "0".into();
+            }
+        }
+    });
+    assert_err(
+        parse_csv(&text),
+        &[
+            "walk/data.csv: field `gyro_x..gyro_z`: the gyro turns 0 times as fast as the \
+             orientation (least squares over frames), outside 0.25..4: a gyro in another unit, \
+             or of another recording or device?",
+        ],
+    );
+}
+
+#[test]
 fn csv_accelerometer_in_g_is_refused() {
     // `acce` and `linacce` in g, gravity in m/s^2.
     assert_err(
