@@ -49,7 +49,8 @@ fn sequence() -> Sequence {
     Sequence::new(SequenceParts {
         name: "bench".into(),
         placement: None,
-        gyro: wave(0.071),
+        // Scaled to about the rate the orientation turns at, as the readers check.
+        gyro: wave(0.071).into_iter().map(|g| g * 0.25).collect(),
         acce: linacce.iter().zip(&gravity).map(|(a, g)| *a + *g).collect(),
         linacce,
         gravity,
