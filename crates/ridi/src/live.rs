@@ -9,8 +9,8 @@
 use std::collections::VecDeque;
 
 use ridi_correct::{
-    FrameWindow, PlacementSmoother, Regression, Sample, TrackError, Tracker, TrackerConfig,
-    TrailingMajority, Update, VelocityRegressor,
+    FrameWindow, GapPolicy, PlacementSmoother, Regression, Sample, TrackError, Tracker,
+    TrackerConfig, TrailingMajority, Update, VelocityRegressor,
 };
 use ridi_data::Sequence;
 use ridi_features::{FeatureExtractor, ImuView, Orientation};
@@ -146,8 +146,11 @@ impl LiveSample {
 /// Pushing a whole recording gives exactly the poses of `ridi track --online`
 /// ([`track`](crate::track()) with [`TrackOptions::online`]), which runs through this type.
 ///
-/// A refused sample (non-finite field, time not after the previous sample's, a gap the
-/// correction cannot integrate across) leaves the tracker as it was.
+/// A refused sample (non-finite field, time not after the previous sample's) leaves the
+/// tracker as it was. A gap longer than the correction integrates across (its `max_dt`, 0.1 s:
+/// a dropped sensor buffer, say) starts a new segment ([`GapPolicy::Restart`]): the position is
+/// held, velocity and bias start over, and the update says
+/// [`restarted`](Update::restarted). (`ridi track` refuses such a gap in a recording instead.)
 ///
 /// ```
 /// use ridi::data::{ReadOptions, load_list};
@@ -185,8 +188,6 @@ struct Estimator {
     waiting: VecDeque<(f64, DeviceVec, DeviceVec)>,
     orientations: Vec<WorldFromDevice>,
     last_time: Option<f64>,
-    max_dt: f64,
-    reject_gaps: bool,
 }
 
 impl<'m> LiveTracker<'m> {
@@ -199,6 +200,7 @@ impl<'m> LiveTracker<'m> {
         let config = TrackerConfig {
             correction: opts.correction_for(model),
             regress_every: opts.regress_every,
+            gap_policy: GapPolicy::Restart,
             ..TrackerConfig::default()
         };
         let regressor = CascadeRegressor::new(model, opts.placement_smoothing)?;
@@ -210,8 +212,6 @@ impl<'m> LiveTracker<'m> {
                 waiting: VecDeque::new(),
                 orientations: Vec::new(),
                 last_time: None,
-                max_dt: config.correction.max_dt,
-                reject_gaps: config.gap_policy == ridi_correct::GapPolicy::Reject,
             }),
         };
         Ok(Self { tracker, estimator })
@@ -242,24 +242,16 @@ impl<'m> LiveTracker<'m> {
             out.push(update);
             return Ok(());
         };
-        // The tracker's own checks, made before the estimator holds the sample: a sample it
+        // The tracker's own check, made before the estimator holds the sample: a sample it
         // would refuse later could no longer be taken back.
-        if let Some(prev) = est.last_time {
-            let dt = sample.time - prev;
-            if dt <= 0.0 {
-                return Err(TrackError::TimeNotIncreasing {
-                    time: sample.time,
-                    previous: prev,
-                }
-                .into());
+        if let Some(previous) = est.last_time
+            && sample.time <= previous
+        {
+            return Err(TrackError::TimeNotIncreasing {
+                time: sample.time,
+                previous,
             }
-            if dt > est.max_dt && est.reject_gaps {
-                return Err(TrackError::Gap {
-                    dt,
-                    max_dt: est.max_dt,
-                }
-                .into());
-            }
+            .into());
         }
         est.filter
             .push(sample.time, sample.gyro, sample.acce, &mut est.orientations)?;
