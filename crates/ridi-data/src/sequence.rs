@@ -296,19 +296,31 @@ impl Validation {
                 });
             }
         }
-        let limit = self.limit(channel);
         for (index, v) in values.enumerate() {
-            if let Some(axis) = v.iter().position(|c| c.abs() > limit) {
-                return Err(SequenceError::Implausible {
-                    channel,
-                    axis,
-                    index,
-                    value: v[axis],
-                    limit,
-                });
-            }
+            self.check_value(channel, index, v)?;
         }
         Ok(())
+    }
+
+    /// Checks one 3-vector of `channel`, frame `index`, against [`Self::limit`] (for a stream
+    /// checked as it arrives; a whole channel's statistics need [`Self::check_channel`]).
+    pub fn check_value(
+        &self,
+        channel: Channel,
+        index: usize,
+        v: [f64; 3],
+    ) -> Result<(), SequenceError> {
+        let limit = self.limit(channel);
+        match v.iter().position(|c| c.abs() > limit) {
+            Some(axis) => Err(SequenceError::Implausible {
+                channel,
+                axis,
+                index,
+                value: v[axis],
+                limit,
+            }),
+            None => Ok(()),
+        }
     }
 
     /// Checks the median interval of `time` (seconds, increasing) against

@@ -12,7 +12,7 @@ use ridi_correct::{
     FrameWindow, GapPolicy, PlacementSmoother, Regression, Sample, TrackError, Tracker,
     TrackerConfig, TrailingMajority, Update, VelocityRegressor,
 };
-use ridi_data::Sequence;
+use ridi_data::{Channel, Sequence, Validation};
 use ridi_features::{FeatureExtractor, ImuView, Orientation};
 use ridi_frames::{DeviceVec, FilterConfig, OrientationFilter, WorldFromDevice};
 use ridi_regress::{Cascade, MatrixRef};
@@ -146,7 +146,8 @@ impl LiveSample {
 /// Pushing a whole recording gives exactly the poses of `ridi track --online`
 /// ([`track`](crate::track()) with [`TrackOptions::online`]), which runs through this type.
 ///
-/// A refused sample (non-finite field, time not after the previous sample's) leaves the
+/// A refused sample (a non-finite field, a value no phone sensor gives as the readers'
+/// [`Validation::limit`]s define it, a time not after the previous sample's) leaves the
 /// tracker as it was. A gap longer than the correction integrates across (its `max_dt`, 0.1 s:
 /// a dropped sensor buffer, say) starts a new segment ([`GapPolicy::Restart`]): the position is
 /// held, velocity and bias start over, and the update says
@@ -180,6 +181,7 @@ impl LiveSample {
 pub struct LiveTracker<'m> {
     tracker: Tracker<CascadeRegressor<'m>>,
     estimator: Option<Estimator>,
+    limits: Validation,
 }
 
 /// The orientation estimate of a stream, and the samples waiting for it.
@@ -214,7 +216,11 @@ impl<'m> LiveTracker<'m> {
                 last_time: None,
             }),
         };
-        Ok(Self { tracker, estimator })
+        Ok(Self {
+            tracker,
+            estimator,
+            limits: Validation::default(),
+        })
     }
 
     /// Adds one sample and appends to `out` the updates of the frames whose pose became known
@@ -224,6 +230,7 @@ impl<'m> LiveTracker<'m> {
     /// A refused sample ([`TrackError`], [`ridi_frames::EstimateError`]), or a recorded model
     /// given a sample without its recorded orientation; the tracker is unchanged.
     pub fn push(&mut self, sample: &LiveSample, out: &mut Vec<Update>) -> Result<()> {
+        self.check_values(sample)?;
         let Some(est) = &mut self.estimator else {
             let r = sample.recorded.ok_or_else(|| {
                 PipelineError::Live(
@@ -272,6 +279,34 @@ impl<'m> LiveTracker<'m> {
             est.filter.finish(&mut est.orientations)?;
         }
         self.drain(out)
+    }
+
+    /// Refuses a value no phone sensor gives (the readers' [`Validation::limit`]s: a corrupt
+    /// sample, or mm/s^2 for m/s^2), naming the field, the sample and its time. NaN passes
+    /// here and is refused, by field, where it would be used.
+    fn check_values(&self, sample: &LiveSample) -> Result<()> {
+        let index = self.accepted();
+        let recorded = sample.recorded.as_ref();
+        let vectors = [
+            (Channel::Gyro, Some(sample.gyro)),
+            (Channel::Acce, Some(sample.acce)),
+            (Channel::Gravity, recorded.map(|r| r.gravity)),
+            (Channel::Linacce, recorded.map(|r| r.linacce)),
+        ];
+        for (channel, v) in vectors {
+            if let Some(v) = v {
+                self.limits
+                    .check_value(channel, index, v.to_array())
+                    .map_err(|e| PipelineError::Live(format!("{e} (t = {} s)", sample.time)))?;
+            }
+        }
+        Ok(())
+    }
+
+    /// Samples accepted so far: in the tracker, or waiting for their orientation.
+    fn accepted(&self) -> usize {
+        let waiting = self.estimator.as_ref().map_or(0, |e| e.waiting.len());
+        self.tracker.stats().frames as usize + waiting
     }
 
     /// Every regression made so far.

@@ -521,6 +521,14 @@ fn a_live_stream_gets_its_poses_sample_by_sample() {
             let mut nan = sample(i, false);
             nan.gyro = DeviceVec::new(f64::NAN, 0.0, 0.0);
             assert!(live.push(&nan, &mut updates).is_err());
+            let mut mm = sample(i, false);
+            mm.acce = mm.acce * 1000.0;
+            let err = live.push(&mm, &mut updates).unwrap_err().to_string();
+            assert!(
+                err.contains("`acce.z` at frame 500")
+                    && err.contains("beyond any phone accelerometer"),
+                "{err}"
+            );
         }
         updates.clear();
         live.push(&sample(i, false), &mut updates).unwrap();
