@@ -355,6 +355,11 @@ impl OrientationFilter {
         Ok(())
     }
 
+    /// Time of the latest sample accepted, if any.
+    pub fn last_time(&self) -> Option<f64> {
+        self.last_time
+    }
+
     /// The latest orientation, once the filter runs.
     pub fn orientation(&self) -> Option<WorldFromDevice> {
         self.running.map(|r| Rot::from_unit_quaternion(r.q))

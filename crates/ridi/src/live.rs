@@ -189,7 +189,6 @@ struct Estimator {
     filter: OrientationFilter,
     waiting: VecDeque<(f64, DeviceVec, DeviceVec)>,
     orientations: Vec<WorldFromDevice>,
-    last_time: Option<f64>,
 }
 
 impl<'m> LiveTracker<'m> {
@@ -213,7 +212,6 @@ impl<'m> LiveTracker<'m> {
                 filter: OrientationFilter::new(FilterConfig::default())?,
                 waiting: VecDeque::new(),
                 orientations: Vec::new(),
-                last_time: None,
             }),
         };
         Ok(Self {
@@ -251,7 +249,7 @@ impl<'m> LiveTracker<'m> {
         };
         // The tracker's own check, made before the estimator holds the sample: a sample it
         // would refuse later could no longer be taken back.
-        if let Some(previous) = est.last_time
+        if let Some(previous) = est.filter.last_time()
             && sample.time <= previous
         {
             return Err(TrackError::TimeNotIncreasing {
@@ -262,7 +260,6 @@ impl<'m> LiveTracker<'m> {
         }
         est.filter
             .push(sample.time, sample.gyro, sample.acce, &mut est.orientations)?;
-        est.last_time = Some(sample.time);
         est.waiting
             .push_back((sample.time, sample.gyro, sample.acce));
         self.drain(out)
