@@ -172,9 +172,9 @@ pub fn run(opts: Options) -> Result<()> {
     figures.extend(time_demo(&target.join("release/ridi"), &root, opts.quick)?);
 
     // The accuracy protocol's reference variant, where the Tyrex data are present (full mode).
-    let shared = root.join("../shared/data/raw/tyrex-attitude-smartphones");
+    let shared = root.join(xtask::DEFAULT_TYREX);
     if !opts.quick && shared.is_dir() {
-        eprintln!("bench: accuracy protocol (eval-tyrex --quick)");
+        eprintln!("bench: accuracy protocol (eval tyrex --quick)");
         let out = target.join("bench-accuracy.md");
         crate::eval_tyrex::run(Some(shared), Some(out.clone()), true, None)?;
         eprintln!("bench: accuracy report in {}", out.display());

@@ -1,4 +1,4 @@
-//! `cargo xtask eval-tyrex`: the accuracy protocol of ridi-rs on the 24 Tyrex Nexus 5 runs.
+//! `cargo xtask eval tyrex`: the accuracy protocol of ridi-rs on the 24 Tyrex Nexus 5 runs.
 //!
 //! Leave one subject out: train on two people, test on the third, three folds, so every run
 //! is tested once by a model that never saw its person. Runs split at long mocap or sensor gaps
@@ -582,19 +582,26 @@ pub fn run(
     only: Option<String>,
 ) -> Result<PathBuf> {
     let root = xtask::workspace_root();
-    let data = data.unwrap_or_else(|| root.join("../shared/data/raw/tyrex-attitude-smartphones"));
     let out = out.unwrap_or_else(|| root.join("docs/bench-accuracy.md"));
+    let chosen: Vec<Variant> = variants(quick)
+        .into_iter()
+        .filter(|v| only.as_deref().is_none_or(|o| v.name.contains(o)))
+        .collect();
+    if chosen.is_empty() {
+        let names: Vec<&str> = variants(quick).iter().map(|v| v.name).collect();
+        anyhow::bail!(
+            "no variant's name contains {:?}; the variants: {}",
+            only.unwrap_or_default(),
+            names.join("; ")
+        );
+    }
+    let data = xtask::tyrex_root(data)?;
     let started = Instant::now();
     let all = load(&data).with_context(|| format!("reading Tyrex data in {}", data.display()))?;
     let mut rows = Vec::new();
     // Sequences and models of the previous variant, kept while the next one shares them
     // (`prepare` depends only on what the training key holds).
     let mut shared: Option<(String, Vec<Sequence>, Vec<Cascade>, f64)> = None;
-    let chosen: Vec<Variant> = variants(quick)
-        .into_iter()
-        .filter(|v| only.as_deref().is_none_or(|o| v.name.contains(o)))
-        .collect();
-    anyhow::ensure!(!chosen.is_empty(), "no variant matches {only:?}");
     for v in chosen {
         if shared.as_ref().is_none_or(|s| s.0 != v.train_key()) {
             drop(shared.take()); // free the previous models first
@@ -613,7 +620,7 @@ pub fn run(
     );
     let _ = writeln!(
         md,
-        "Command: `cargo xtask eval-tyrex{}{}` ({:.0} s in all on a 2-core machine shared with other work). \
+        "Command: `cargo xtask eval tyrex{}{}` ({:.0} s in all on a 2-core machine shared with other work). \
          {} test sequences (24 runs; runs split at long mocap or sensor gaps count once per part). \
          Train on two people, test on the third, three folds; C = 10, epsilon = 0.01 without grid \
          search unless a variant searches; \

@@ -9,9 +9,28 @@ pub mod manifest;
 
 use std::path::PathBuf;
 
+/// Where the Tyrex data are by default, relative to the workspace root: the shared data folder
+/// beside the checkout.
+pub const DEFAULT_TYREX: &str = "../shared/data/raw/tyrex-attitude-smartphones";
+
 /// The workspace root, fixed at build time: xtask always runs from this checkout, and the
 /// defaults (manifest, datasets folder) must not depend on the caller's working directory.
 pub fn workspace_root() -> PathBuf {
     let here = PathBuf::from(env!("CARGO_MANIFEST_DIR"));
     here.parent().map(PathBuf::from).unwrap_or(here)
+}
+
+/// The Tyrex root a task reads: `data`, or [`DEFAULT_TYREX`] beside the workspace.
+///
+/// # Errors
+/// The folder does not exist: the message says how to pass or install one.
+pub fn tyrex_root(data: Option<PathBuf>) -> anyhow::Result<PathBuf> {
+    let data = data.unwrap_or_else(|| workspace_root().join(DEFAULT_TYREX));
+    anyhow::ensure!(
+        data.is_dir(),
+        "Tyrex data folder {} not found: pass --data <tyrex root> (`cargo xtask fetch tyrex` \
+         installs one in datasets/tyrex)",
+        data.display()
+    );
+    Ok(data)
 }

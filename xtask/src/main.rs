@@ -2,7 +2,7 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 
 use anyhow::Result;
-use clap::{Parser, Subcommand};
+use clap::{Args, Parser, Subcommand};
 
 mod bench;
 mod eval_orientation;
@@ -49,22 +49,16 @@ enum Task {
     /// Print the sha256sum list of every file under a folder (sorted), e.g. to regenerate
     /// datasets/<name>.sha256.
     Checksums { folder: PathBuf },
-    /// The accuracy protocol: leave-one-subject-out on the 24 Tyrex Nexus 5 runs, every method,
-    /// and one variant per open choice of the paper; writes docs/bench-accuracy.md.
-    EvalTyrex {
-        /// Tyrex root [default: <workspace>/../shared/data/raw/tyrex-attitude-smartphones].
-        #[arg(long, value_name = "DIR")]
-        data: Option<PathBuf>,
-        /// Report to write [default: <workspace>/docs/bench-accuracy.md].
-        #[arg(long, value_name = "FILE")]
-        out: Option<PathBuf>,
-        /// Only the reference variant.
-        #[arg(long)]
-        quick: bool,
-        /// Only the variants whose name contains this text (e.g. "turned").
-        #[arg(long, value_name = "TEXT")]
-        only: Option<String>,
-    },
+    /// Accuracy protocols on the Tyrex data: `eval tyrex` (RIDI and its baselines) and
+    /// `eval orientation` (the orientation estimator).
+    #[command(subcommand)]
+    Eval(Eval),
+    /// Same as `eval tyrex` (the name of earlier versions).
+    #[command(hide = true)]
+    EvalTyrex(TyrexArgs),
+    /// Same as `eval orientation` (the name of earlier versions).
+    #[command(hide = true)]
+    EvalOrientation(OrientationArgs),
     /// Rebuild the bundled sample (datasets/sample) from the Tyrex data: 24 s of every Nexus 5
     /// run, RIDI processed layout, gzip + f32, with list files.
     Sample {
@@ -73,17 +67,6 @@ enum Task {
         data: Option<PathBuf>,
         /// Output folder [default: <workspace>/datasets/sample].
         #[arg(long, value_name = "DIR")]
-        out: Option<PathBuf>,
-    },
-    /// Compare the gyro + accelerometer orientation estimator (default gains and a kp/ki
-    /// sweep) and the Android rotation vector with the Tyrex motion capture, and write a
-    /// markdown report.
-    EvalOrientation {
-        /// Tyrex root [default: <workspace>/../shared/data/raw/tyrex-attitude-smartphones].
-        #[arg(long, value_name = "DIR")]
-        data: Option<PathBuf>,
-        /// Report to write [default: <workspace>/docs/bench-orientation.md].
-        #[arg(long, value_name = "FILE")]
         out: Option<PathBuf>,
     },
     /// Run the benchmark set (criterion benches, correction latency, `ridi demo`), write a JSON
@@ -99,6 +82,43 @@ enum Task {
         #[arg(long)]
         update_baseline: bool,
     },
+}
+
+#[derive(Subcommand)]
+enum Eval {
+    /// The accuracy protocol: leave-one-subject-out on the 24 Tyrex Nexus 5 runs, every method,
+    /// and one variant per open choice of the paper; writes docs/bench-accuracy.md.
+    Tyrex(TyrexArgs),
+    /// Compare the gyro + accelerometer orientation estimator (default gains and a kp/ki
+    /// sweep) and the Android rotation vector with the Tyrex motion capture, and write a
+    /// markdown report.
+    Orientation(OrientationArgs),
+}
+
+#[derive(Args)]
+struct TyrexArgs {
+    /// Tyrex root [default: <workspace>/../shared/data/raw/tyrex-attitude-smartphones].
+    #[arg(long, value_name = "DIR")]
+    data: Option<PathBuf>,
+    /// Report to write [default: <workspace>/docs/bench-accuracy.md].
+    #[arg(long, value_name = "FILE")]
+    out: Option<PathBuf>,
+    /// Only the reference variant.
+    #[arg(long)]
+    quick: bool,
+    /// Only the variants whose name contains this text (e.g. "turned").
+    #[arg(long, value_name = "TEXT")]
+    only: Option<String>,
+}
+
+#[derive(Args)]
+struct OrientationArgs {
+    /// Tyrex root [default: <workspace>/../shared/data/raw/tyrex-attitude-smartphones].
+    #[arg(long, value_name = "DIR")]
+    data: Option<PathBuf>,
+    /// Report to write [default: <workspace>/docs/bench-orientation.md].
+    #[arg(long, value_name = "FILE")]
+    out: Option<PathBuf>,
 }
 
 fn main() -> ExitCode {
@@ -162,25 +182,18 @@ fn run(cli: Cli) -> Result<()> {
             let list = checksum::list_tree(&folder)?;
             print!("{}", checksum::format_list(&list));
         }
-        Task::EvalTyrex {
-            data,
-            out,
-            quick,
-            only,
-        } => {
-            let out = eval_tyrex::run(data, out, quick, only)?;
+        Task::Eval(Eval::Tyrex(args)) | Task::EvalTyrex(args) => {
+            let out = eval_tyrex::run(args.data, args.out, args.quick, args.only)?;
+            println!("wrote {}", out.display());
+        }
+        Task::Eval(Eval::Orientation(args)) | Task::EvalOrientation(args) => {
+            let out = eval_orientation::run(args.data, args.out)?;
             println!("wrote {}", out.display());
         }
         Task::Sample { data, out } => {
-            let root = xtask::workspace_root();
-            let data =
-                data.unwrap_or_else(|| root.join("../shared/data/raw/tyrex-attitude-smartphones"));
-            let out = out.unwrap_or_else(|| root.join("datasets/sample"));
+            let data = xtask::tyrex_root(data)?;
+            let out = out.unwrap_or_else(|| xtask::workspace_root().join("datasets/sample"));
             sample::build(&data, &out)?;
-            println!("wrote {}", out.display());
-        }
-        Task::EvalOrientation { data, out } => {
-            let out = eval_orientation::run(data, out)?;
             println!("wrote {}", out.display());
         }
         Task::Bench {
