@@ -13,10 +13,10 @@ use ridi::data::{Format, ReadOptions, Sequence};
 use ridi::eval::{AlignWindow, EvalConfig};
 use ridi::features::FeatureConfig;
 use ridi::frames::UpAxis;
-use ridi::regress::{Cascade, ProgressEvent, Stage, Storage, StoredAs, model_file};
+use ridi::regress::{Cascade, ProgressEvent, RegressError, Stage, Storage, StoredAs, model_file};
 use ridi::{
-    EvalOptions, GridChoice, Method, Orientation, PlacementMap, Purpose, TrackOptions,
-    TrainOptions, apply_orientation,
+    EvalOptions, GridChoice, Method, Orientation, PipelineError, PlacementMap, Purpose,
+    TrackOptions, TrainOptions, apply_orientation,
 };
 
 /// `println!` that ignores a closed stdout (`ridi train ... | head`): the command's results are
@@ -86,7 +86,8 @@ enum Command {
         ridi train --list datasets/sample/list_train.txt --out model.ridi --grid small \
         --placement-map tyrex4\n  \
         ridi train --list ridi/list_train_publish_v2.txt --out ridi.model --grid paper --jobs 2\n  \
-        ridi train --list list.txt --out paper.ridi --turned-copies 0 --no-speed --up-axis plus-y   (the paper exactly)\n\n\
+        ridi train --list list.txt --out paper.ridi --turned-copies 0 --no-speed --up-axis plus-y   (the paper's cascade; \
+        add --no-standardize for the original's raw features)\n\n\
         Every sequence needs ground truth and a placement (the list's second column).")]
     Train {
         /// List files (`path,placement` per line); several are concatenated.
@@ -173,7 +174,7 @@ enum Command {
         /// Placement majority window, seconds: each regression takes the most frequent placement
         /// label within it (centred in batch, the seconds before it with --online); 0 keeps each
         /// window's own label, as in the paper.
-        #[arg(long, value_name = "SECONDS", default_value_t = 10.0)]
+        #[arg(long, value_name = "SECONDS", default_value_t = 10.0, value_parser = non_negative)]
         placement_window: f64,
     },
     /// Evaluate RIDI and the baselines on labelled recordings: report.json, report.md, plots.
@@ -210,9 +211,8 @@ enum Command {
         #[arg(long, value_parser = |s: &str| count(s, 1, 4096))]
         jobs: Option<usize>,
         /// Placement majority window, seconds: each regression takes the most frequent placement
-        /// label within it (centred in batch, the seconds before it with --online); 0 keeps each
-        /// window's own label, as in the paper.
-        #[arg(long, value_name = "SECONDS", default_value_t = 10.0)]
+        /// label within it, centred on it; 0 keeps each window's own label, as in the paper.
+        #[arg(long, value_name = "SECONDS", default_value_t = 10.0, value_parser = non_negative)]
         placement_window: f64,
         /// Stretch every trajectory is aligned to the ground truth on (2D rigid, no scale):
         /// its first SECONDS, as in the paper, or `all` for the whole run (a best case that
@@ -347,11 +347,12 @@ fn run(cli: Cli) -> Result<()> {
         Command::Inspect { sequence, json } => {
             let opts = ReadOptions::default();
             let loaded = ridi::read_any(&sequence, None, &opts)?;
-            for w in &loaded.warnings {
-                eprintln!("warning: {w}");
-            }
             for seq in &loaded.sequences {
-                let report = ridi::inspect::inspect(seq, loaded.format);
+                let mut report = ridi::inspect::inspect(seq, loaded.format);
+                // The reader's warnings (gaps, splits, dropped parts) belong to every part read.
+                report
+                    .warnings
+                    .splice(0..0, loaded.warnings.iter().cloned());
                 if json {
                     outln!("{}", serde_json::to_string_pretty(&report)?);
                 } else {
@@ -397,6 +398,14 @@ fn run(cli: Cli) -> Result<()> {
         } => {
             set_jobs(jobs)?;
             check_output(&out)?;
+            let mut inputs: Vec<PathBuf> = list.clone();
+            for l in &list {
+                // Unreadable lists are reported by load_lists below, with their line.
+                if let Ok(entries) = ridi::data::read_list(l) {
+                    inputs.extend(entries.into_iter().map(|e| e.path));
+                }
+            }
+            check_not_input(&out, &inputs)?;
             let seqs = load_lists(&list, placement_map.as_deref(), Purpose::Training)?;
             let defaults = TrainOptions::default();
             let mut opts = TrainOptions {
@@ -414,7 +423,21 @@ fn run(cli: Cli) -> Result<()> {
             opts.cascade.regressors = GridChoice::from(grid).regressors();
             opts.cascade.storage = storage.into();
             opts.cascade.speed = !no_speed;
-            let model = train_with_progress(&seqs, &opts)?;
+            let model = train_with_progress(&seqs, &opts).map_err(|e| {
+                let folds = matches!(
+                    e.downcast_ref::<PipelineError>(),
+                    Some(PipelineError::Regress(RegressError::NotEnoughData(m)))
+                        if m.contains("cross-validation")
+                );
+                if folds {
+                    e.context(
+                        "the grid search cross-validates over each placement's sequences \
+                         (`--grid none` trains without it)",
+                    )
+                } else {
+                    e
+                }
+            })?;
             print_training(&model);
             model_file::save(&model, &out)
                 .with_context(|| format!("cannot write {}", out.display()))?;
@@ -433,9 +456,12 @@ fn run(cli: Cli) -> Result<()> {
         } => {
             // Every output is checked before any work, so that a bad --plot cannot leave the
             // trajectory written and the command failed.
+            let inputs = [sequence.clone(), model.clone()];
             check_output(&out)?;
+            check_not_input(&out, &inputs)?;
             if let Some(plot) = &plot {
                 check_output(plot)?;
+                check_not_input(plot, &inputs)?;
                 ridi::plot::PlotFormat::from_path(plot)?;
             }
             let model = load_model(&model)?;
@@ -455,7 +481,7 @@ fn run(cli: Cli) -> Result<()> {
             let mut opts = TrackOptions {
                 regress_every,
                 online,
-                placement_smoothing: placement_smoothing(placement_window)?,
+                placement_smoothing: placement_smoothing(placement_window),
                 ..TrackOptions::default()
             };
             opts.correction.lambda = lambda;
@@ -489,17 +515,21 @@ fn run(cli: Cli) -> Result<()> {
             align,
         } => {
             set_jobs(jobs)?;
+            check_output_folder(&out)?;
+            let mut chosen: Vec<Method> = Vec::new();
+            for m in &methods {
+                let m = m.parse::<Method>().map_err(anyhow::Error::msg)?;
+                if !chosen.contains(&m) {
+                    chosen.push(m);
+                }
+            }
             let model = load_model(&model)?;
             let seqs = load_lists(&list, placement_map.as_deref(), Purpose::Evaluation)?;
-            let methods = methods
-                .iter()
-                .map(|m| m.parse::<Method>().map_err(anyhow::Error::msg))
-                .collect::<Result<Vec<_>>>()?;
             let track = TrackOptions {
-                placement_smoothing: placement_smoothing(placement_window)?,
+                placement_smoothing: placement_smoothing(placement_window),
                 ..TrackOptions::default()
             };
-            evaluate_and_write(&seqs, &model, methods, track, align, &out, plots)?;
+            evaluate_and_write(&seqs, &model, chosen, track, align, &out, plots)?;
         }
         Command::Demo {
             out,
@@ -531,12 +561,50 @@ fn check_output(path: &Path) -> Result<()> {
     Ok(())
 }
 
-/// `--placement-window`: 0 turns the majority vote off.
-fn placement_smoothing(window_s: f64) -> Result<Option<PlacementSmoother>> {
-    if !(window_s.is_finite() && window_s >= 0.0) {
-        bail!("--placement-window must be a number of seconds >= 0, got {window_s}");
+/// Refuses an output folder that exists as something else (a file), before any work.
+fn check_output_folder(dir: &Path) -> Result<()> {
+    if dir.exists() && !dir.is_dir() {
+        bail!(
+            "cannot write into {}: it is a file, not a folder",
+            dir.display()
+        );
     }
-    Ok((window_s > 0.0).then_some(PlacementSmoother { window_s }))
+    Ok(())
+}
+
+/// Refuses an output that would overwrite what the command reads: one of `inputs`, or a file
+/// a sequence folder among them is read from (data files, `.txt` streams, `.mat` ground
+/// truth). Other files may sit beside a recording, e.g. its trajectory.
+fn check_not_input(out: &Path, inputs: &[PathBuf]) -> Result<()> {
+    let Ok(target) = out.canonicalize() else {
+        return Ok(()); // not there yet: nothing to overwrite
+    };
+    let read_from_folders = target.file_name().is_some_and(|name| {
+        let name = name.to_string_lossy();
+        name == "data.csv"
+            || name == "data.csv.gz"
+            || name.ends_with(".txt")
+            || name.ends_with(".mat")
+    });
+    for input in inputs {
+        let Ok(source) = input.canonicalize() else {
+            continue;
+        };
+        if target == source || (read_from_folders && source.is_dir() && target.starts_with(&source))
+        {
+            bail!(
+                "cannot write {}: the command reads it (from {}); choose another output",
+                out.display(),
+                input.display()
+            );
+        }
+    }
+    Ok(())
+}
+
+/// `--placement-window` (checked by clap: finite, at least 0): 0 turns the majority vote off.
+fn placement_smoothing(window_s: f64) -> Option<PlacementSmoother> {
+    (window_s > 0.0).then_some(PlacementSmoother { window_s })
 }
 
 fn set_jobs(jobs: Option<usize>) -> Result<()> {
@@ -722,15 +790,49 @@ fn evaluate_and_write(
             written.extend(t.plot(&plot_dir, ext)?);
         }
     }
+    let stale = remove_stale_plots(&plot_dir, &written)?;
     written.extend(report.write(out)?);
     print_summary(&report);
     outln!(
-        "wrote {} files into {} (report.md, report.json{})",
+        "wrote {} files into {} (report.md, report.json{}){}",
         written.len(),
         out.display(),
-        if ext.is_some() { ", plots/" } else { "" }
+        if ext.is_some() { ", plots/" } else { "" },
+        if stale > 0 {
+            format!("; removed {stale} plots of an earlier evaluation from plots/")
+        } else {
+            String::new()
+        }
     );
     Ok(report)
+}
+
+/// Removes the plots an earlier evaluation left in `dir` that this one did not write (other
+/// sequences, the other format, or `--plots none`), so that the folder matches the report.
+/// Only files named like `ridi eval`'s plots are touched; `dir` goes if that empties it.
+fn remove_stale_plots(dir: &Path, written: &[PathBuf]) -> Result<usize> {
+    let Ok(entries) = std::fs::read_dir(dir) else {
+        return Ok(0);
+    };
+    let mut removed = 0;
+    for entry in entries {
+        let path = entry
+            .with_context(|| format!("cannot list {}", dir.display()))?
+            .path();
+        let name = path.file_name().unwrap_or_default().to_string_lossy();
+        let ours = [".trajectory.", ".velocity."]
+            .iter()
+            .any(|k| name.contains(k))
+            && (name.ends_with(".png") || name.ends_with(".svg"));
+        if ours && path.is_file() && !written.contains(&path) {
+            std::fs::remove_file(&path)
+                .with_context(|| format!("cannot remove {}", path.display()))?;
+            removed += 1;
+        }
+    }
+    // Only succeeds when nothing else is in the folder.
+    let _ = std::fs::remove_dir(dir);
+    Ok(removed)
 }
 
 /// Largest `--turned-copies`: copy `j` of a window is turned by `j / N` of a full turn, so a few
@@ -850,6 +952,7 @@ fn demo(out: &Path, data: Option<PathBuf>, grid: Grid, plots: Plots) -> Result<(
             data.display()
         );
     }
+    check_output_folder(out)?;
     let map = Some("tyrex4");
     let train = load_lists(&[train_list], map, Purpose::Training)?;
     let test = load_lists(&[data.join("list_test.txt")], map, Purpose::Evaluation)?;

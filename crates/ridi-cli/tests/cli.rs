@@ -146,6 +146,17 @@ fn bad_flags_and_outputs_fail_before_any_work() {
         "{err}"
     );
 
+    // One recording of a placement cannot be cross-validated: the error says what to do.
+    let single = dir.path().join("single.txt");
+    std::fs::write(&single, format!("{},Texting\n", s(&texting))).unwrap();
+    let out = ridi(&["train", "--list", s(&single), "--out", s(&model)]);
+    let err = stderr(&out);
+    assert!(
+        !out.status.success() && err.contains("`--grid none` trains without it"),
+        "{err}"
+    );
+    assert_eq!(err.lines().count(), 1, "{err}");
+
     let seq = sample().join("Jakob_Nexus5_NoDist_Texting");
     let csv = dir.path().join("t.csv");
     let track = |extra: &[&str]| {
@@ -299,6 +310,107 @@ fn convert_train_track_and_eval() {
         stderr(&out)
     );
 
+    // Evaluating again into the same folder: the plots of sequences no longer evaluated go,
+    // a method given twice is evaluated once, and --plots none leaves no plots/ behind.
+    let one = dir.path().join("one.txt");
+    std::fs::write(&one, format!("{},Texting\n", s(&test_seq))).unwrap();
+    let eval_one = |out: &Path, extra: &[&str]| {
+        let mut args = vec![
+            "eval",
+            "--list",
+            s(&one),
+            "--model",
+            s(&model),
+            "--out",
+            s(out),
+        ];
+        args.extend_from_slice(extra);
+        ridi(&args)
+    };
+    let methods = ["--methods", "ridi,ridi,still", "--placement-map", "tyrex4"];
+    let before = std::fs::read_dir(report.join("plots")).unwrap().count();
+    let out = eval_one(&report, &[&methods[..], &["--plots", "svg"]].concat());
+    assert!(out.status.success(), "{}", stderr(&out));
+    let printed = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        printed.contains(&format!(
+            "removed {} plots of an earlier evaluation",
+            before - 2
+        )),
+        "{printed}"
+    );
+    assert_eq!(std::fs::read_dir(report.join("plots")).unwrap().count(), 2);
+    let json_one: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(report.join("report.json")).unwrap())
+            .unwrap();
+    assert_eq!(json_one["methods"], serde_json::json!(["ridi", "still"]));
+    let out = eval_one(&report, &[&methods[..], &["--plots", "none"]].concat());
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert!(!report.join("plots").exists());
+    // An output folder that is a file fails before any work.
+    let out = eval_one(&csv, &[]);
+    assert!(
+        !out.status.success() && stderr(&out).contains("it is a file, not a folder"),
+        "{}",
+        stderr(&out)
+    );
+
+    // No output may overwrite an input: the recording, the model, a list, or a file a
+    // sequence folder is read from; the inputs stay as they were.
+    let recording = dir.path().join("v.csv.gz");
+    std::fs::copy(test_seq.join("processed/data.csv.gz"), &recording).unwrap();
+    let folder = dir.path().join("seq");
+    std::fs::create_dir_all(folder.join("processed")).unwrap();
+    std::fs::copy(&recording, folder.join("processed/data.csv.gz")).unwrap();
+    let model_bytes = std::fs::read(&model).unwrap();
+    let recording_bytes = std::fs::read(&recording).unwrap();
+    for (input, output) in [
+        (&recording, &recording),
+        (&recording, &model),
+        (&folder, &folder.join("processed/data.csv.gz")),
+    ] {
+        let out = ridi(&["track", s(input), "--model", s(&model), "--out", s(output)]);
+        assert!(
+            !out.status.success() && stderr(&out).contains("the command reads it"),
+            "{}",
+            stderr(&out)
+        );
+    }
+    let out = ridi(&[
+        "train",
+        "--list",
+        s(&one),
+        "--out",
+        s(&one),
+        "--grid",
+        "none",
+    ]);
+    assert!(
+        !out.status.success() && stderr(&out).contains("the command reads it"),
+        "{}",
+        stderr(&out)
+    );
+    assert_eq!(std::fs::read(&model).unwrap(), model_bytes);
+    assert_eq!(std::fs::read(&recording).unwrap(), recording_bytes);
+    assert!(
+        std::fs::read_to_string(&one)
+            .unwrap()
+            .ends_with(",Texting\n")
+    );
+    // Beside a recording is fine, and so is a second run over its own output.
+    let beside = folder.join("trajectory.csv");
+    for run in ["first", "second"] {
+        let out = ridi(&[
+            "track",
+            s(&folder),
+            "--model",
+            s(&model),
+            "--out",
+            s(&beside),
+        ]);
+        assert!(out.status.success(), "{run}: {}", stderr(&out));
+    }
+
     // --align: the paper's first 10 s by default, the whole run on request; the ground truth's
     // travel within the window is reported per sequence.
     let ten = json["sequences"][0]["alignment_extent_m"].as_f64().unwrap();
@@ -364,13 +476,16 @@ fn convert_train_track_and_eval() {
     let out = track_plain(&["--orientation", "estimated"]);
     assert!(!out.status.success());
     assert!(stderr(&out).contains("--orientation"), "{}", stderr(&out));
-    let out = track_plain(&["--placement-window=-1"]);
-    assert!(!out.status.success());
-    assert!(
-        stderr(&out).contains("--placement-window must be a number of seconds >= 0"),
-        "{}",
-        stderr(&out)
-    );
+    // A bad value is a usage error like any other flag's (exit code 2), for each command.
+    for bad in ["-1", "nan", "inf"] {
+        let out = track_plain(&[&format!("--placement-window={bad}")]);
+        assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
+        assert!(
+            stderr(&out).contains(&format!("invalid value '{bad}' for '--placement-window")),
+            "{}",
+            stderr(&out)
+        );
+    }
 }
 
 // ---- bad input: one-line errors naming the file, nothing partly written ------------------

@@ -93,7 +93,8 @@ pub fn assign_folds(
     distinct.dedup();
     if distinct.len() < 2 {
         return Err(RegressError::NotEnoughData(format!(
-            "cross-validation by sequence needs at least 2 sequences, found {}",
+            "cross-validation by sequence needs at least 2 sequences, found {} (with one, train \
+             with fixed C and epsilon instead of a search)",
             distinct.len()
         )));
     }

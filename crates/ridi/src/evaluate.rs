@@ -25,7 +25,7 @@ use serde::Serialize;
 use crate::baselines::{Method, trajectory};
 use crate::error::{PipelineError, Result};
 use crate::orientation::oriented;
-use crate::track::{Regressed, TrackOptions, check_gaps, regress};
+use crate::track::{Regressed, TrackOptions, check_trackable, regress};
 use crate::train::ground_truth_view;
 
 /// What to evaluate and how.
@@ -127,7 +127,7 @@ fn evaluate_one(seq: &Sequence, model: &Cascade, opts: &EvalOptions) -> Result<E
         .ground_truth()
         .ok_or_else(|| PipelineError::sequence(seq.name(), "has no ground truth to evaluate"))?;
     let gt2 = gt.horizontal();
-    check_gaps(seq, opts.track.correction.max_dt)?;
+    check_trackable(seq, model, opts.track.correction.max_dt)?;
     let regressions: Vec<Regressed> = if opts.methods.iter().any(|m| m.needs_model()) {
         regress(seq, model, &opts.track)?
     } else {

@@ -4,6 +4,8 @@ use ridi_data::{Format, Sequence};
 use ridi_frames::UpAxis;
 use serde::Serialize;
 
+use crate::track::{RATE_HZ, RATE_TOLERANCE};
+
 /// Summary statistics of a scalar series.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 pub struct Stats {
@@ -98,9 +100,10 @@ pub fn inspect(seq: &Sequence, format: Format) -> Inspection {
     let rate_hz = seq.rate_hz();
     let max_gap_s = seq.max_gap();
     let mut warnings = Vec::new();
-    if !(195.0..=205.0).contains(&rate_hz) {
+    if (rate_hz - RATE_HZ).abs() > RATE_TOLERANCE * RATE_HZ {
         warnings.push(format!(
-            "rate {rate_hz:.1} Hz: RIDI models are trained at about 200 Hz"
+            "rate {rate_hz:.1} Hz: train, track and eval need {RATE_HZ} Hz (within {:.0} %)",
+            RATE_TOLERANCE * 100.0
         ));
     }
     if rate_hz > 0.0 && max_gap_s > 5.0 / rate_hz {

@@ -4,7 +4,7 @@ use std::path::Path;
 
 use ridi_correct::{CorrectionConfig, PlacementSmoother, VelocityTarget, correct};
 use ridi_data::{Sequence, write_atomically};
-use ridi_features::{FeatureExtractor, Orientation, SampleSchedule};
+use ridi_features::{FeatureConfig, FeatureExtractor, Orientation, SampleSchedule};
 use ridi_frames::{DeviceVec, WorldVec};
 use ridi_regress::{Cascade, MatrixRef};
 use serde::{Deserialize, Serialize};
@@ -222,7 +222,7 @@ pub fn correct_with(
 /// it is. Readers accept gaps up to a second (features and training live with them); double
 /// integration does not. Called once per sequence by [`track`] and the evaluation, before
 /// the corrections (which would refuse the gap too, by frame only).
-pub(crate) fn check_gaps(seq: &Sequence, max_dt: f64) -> Result<()> {
+fn check_gaps(seq: &Sequence, max_dt: f64) -> Result<()> {
     let t = seq.time();
     match t.windows(2).position(|w| w[1] - w[0] > max_dt) {
         None => Ok(()),
@@ -241,9 +241,59 @@ pub(crate) fn check_gaps(seq: &Sequence, max_dt: f64) -> Result<()> {
     }
 }
 
+/// The IMU rate every model assumes: feature windows, sample steps, regressions and
+/// correction knots are all counted in frames of a 200 Hz stream.
+pub const RATE_HZ: f64 = 200.0;
+
+/// How far a sequence's mean rate may be from [`RATE_HZ`], as a fraction, for training,
+/// tracking and evaluation (Android's fastest sensor rate varies by a few percent between
+/// phones; half or twice the rate would make a one-second window half or two seconds long).
+pub const RATE_TOLERANCE: f64 = 0.1;
+
+/// Refuses a sequence whose frames do not fit the model's frame counts: a mean rate outside
+/// [`RATE_HZ`] ± [`RATE_TOLERANCE`], or no frame with a whole feature window before it (the
+/// trajectory would be plain double integration, and its metrics meaningless).
+pub(crate) fn check_frames(seq: &Sequence, config: &FeatureConfig) -> Result<()> {
+    let n = seq.len();
+    if n <= config.window {
+        return Err(PipelineError::sequence(
+            seq.name(),
+            format!(
+                "has {n} frames ({:.2} s): no velocity can be regressed before a whole feature \
+                 window of {} frames ({:.1} s at {RATE_HZ} Hz)",
+                seq.duration(),
+                config.window,
+                config.window as f64 / RATE_HZ
+            ),
+        ));
+    }
+    let rate = seq.rate_hz();
+    if (rate - RATE_HZ).abs() > RATE_TOLERANCE * RATE_HZ {
+        return Err(PipelineError::sequence(
+            seq.name(),
+            format!(
+                "has a mean rate of {rate:.1} Hz; models count windows and knots in frames of a \
+                 {RATE_HZ} Hz stream (within {:.0} %): resample it to {RATE_HZ} Hz",
+                RATE_TOLERANCE * 100.0
+            ),
+        ));
+    }
+    Ok(())
+}
+
+/// [`check_frames`] and [`check_gaps`]: what tracking and evaluation need of a sequence.
+pub(crate) fn check_trackable(seq: &Sequence, model: &Cascade, max_dt: f64) -> Result<()> {
+    check_frames(seq, model.feature_config())?;
+    check_gaps(seq, max_dt)
+}
+
 /// Tracks `seq` with `model`, in the orientation the model was trained with ([`oriented`]).
+///
+/// # Errors
+/// Besides the stages' own: a sequence at another rate than [`RATE_HZ`] (± [`RATE_TOLERANCE`]),
+/// shorter than one feature window, or with a gap longer than the correction's `max_dt`.
 pub fn track(seq: &Sequence, model: &Cascade, opts: &TrackOptions) -> Result<Track> {
-    check_gaps(seq, opts.correction.max_dt)?;
+    check_trackable(seq, model, opts.correction.max_dt)?;
     if opts.online {
         // The live tracker estimates an estimated orientation on the stream itself; a
         // recorded one must still be there.

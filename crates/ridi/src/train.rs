@@ -16,6 +16,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::error::{PipelineError, Result};
 use crate::orientation::oriented;
+use crate::track::check_frames;
 
 /// Which regressor hyper-parameters to search.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
@@ -174,6 +175,7 @@ pub fn training_data(seqs: &[Sequence], config: &FeatureConfig) -> Result<Traini
     let per_seq: Vec<(FeatureMatrix, Vec<[f32; 2]>)> = seqs
         .par_iter()
         .map(|s| {
+            check_frames(s, &config)?;
             let s = oriented(s, config.orientation)?;
             let s = s.as_ref();
             let frames = schedule.frames(s.len());

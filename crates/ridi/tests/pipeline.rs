@@ -562,3 +562,70 @@ fn a_live_stream_gets_its_poses_sample_by_sample() {
     assert_eq!(updates.len(), 10);
     assert!(updates.iter().all(|u| u.pose.position.is_finite()));
 }
+
+/// Every other frame: the same walk recorded at half the rate.
+fn every_other_frame(seq: &Sequence) -> Sequence {
+    fn keep<T: Clone>(v: &[T]) -> Vec<T> {
+        v.iter().step_by(2).cloned().collect()
+    }
+    let mut p = seq.parts().clone();
+    p.time = keep(&p.time);
+    p.gyro = keep(&p.gyro);
+    p.acce = keep(&p.acce);
+    p.linacce = keep(&p.linacce);
+    p.gravity = keep(&p.gravity);
+    p.magnet = p.magnet.as_deref().map(keep);
+    p.orientation = keep(&p.orientation);
+    if let Some(gt) = &mut p.ground_truth {
+        gt.position = keep(&gt.position);
+        gt.orientation = keep(&gt.orientation);
+    }
+    Sequence::new(p).unwrap()
+}
+
+#[test]
+fn another_rate_or_less_than_a_window_is_refused_by_name() {
+    let model = quick_model(&load("list_Guillaume.txt"));
+    let seq = load("list_Thibaud.txt").remove(0);
+    let name = seq.name().to_string();
+    let opts = TrackOptions::default();
+    let eval = EvalOptions::default();
+
+    // 200 frames: not one frame has a whole window before it.
+    let short = seq.slice(0..200);
+    let err = ridi::track(&short, &model, &opts).unwrap_err().to_string();
+    assert!(
+        err.contains(&name) && err.contains("has 200 frames") && err.contains("feature window"),
+        "{err}"
+    );
+    let err = ridi::evaluate(std::slice::from_ref(&short), &model, &eval)
+        .unwrap_err()
+        .to_string();
+    assert!(
+        err.contains(&name) && err.contains("has 200 frames"),
+        "{err}"
+    );
+    assert!(ridi::track(&seq.slice(0..201), &model, &opts).is_ok());
+
+    // 100 Hz: each 200-frame window would be two seconds long.
+    let half = every_other_frame(&seq);
+    assert!((half.rate_hz() - 100.0).abs() < 0.1, "{}", half.rate_hz());
+    for err in [
+        ridi::track(&half, &model, &opts).unwrap_err().to_string(),
+        ridi::evaluate(std::slice::from_ref(&half), &model, &eval)
+            .unwrap_err()
+            .to_string(),
+        ridi::train(
+            std::slice::from_ref(&half),
+            &TrainOptions::default(),
+            &mut NoProgress,
+        )
+        .unwrap_err()
+        .to_string(),
+    ] {
+        assert!(
+            err.contains(&name) && err.contains("100.0 Hz") && err.contains("resample"),
+            "{err}"
+        );
+    }
+}
