@@ -52,6 +52,54 @@ fn inspect_prints_text_and_json() {
     );
     let warnings = json["warnings"].to_string();
     assert!(warnings.contains("upside down"), "{warnings}");
+
+    // The reader's own warnings are in the report too (here: a Tyrex run of an unknown
+    // motion, 20 s of a phone lying still), in text and JSON alike.
+    let dir = tempfile::tempdir().unwrap();
+    let run = dir.path().join("Ann_Nexus5_NoDist_Dancing");
+    std::fs::create_dir_all(&run).unwrap();
+    for (file, values) in [
+        ("accelerometer.txt", "0.0 0.0 9.80665"),
+        ("gyroscope-calibrated.txt", "0.0 0.0 0.0"),
+        ("rotation-vector.txt", "0.0 0.0 0.0 1.0 0.17"),
+    ] {
+        let rows: String = (0..4000)
+            .map(|k| format!("{:.9} {values}\n", 0.003 + k as f64 * 0.005))
+            .collect();
+        std::fs::write(run.join(file), rows).unwrap();
+    }
+    let out = ridi(&["inspect", s(&run), "--json"]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let json: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let warnings = json["warnings"].to_string();
+    assert!(
+        warnings.contains("does not end in a known motion"),
+        "{warnings}"
+    );
+    let out = ridi(&["inspect", s(&run)]);
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert_eq!(
+        text.matches("does not end in a known motion").count(),
+        1,
+        "{text}"
+    );
+
+    // One frame: no rate to speak of, and nothing to do with it.
+    let one = dir.path().join("one.csv");
+    let seq = ridi::data::read_sequence(
+        sample().join("Jakob_Nexus5_NoDist_Texting"),
+        &ridi::data::ReadOptions::default(),
+    )
+    .unwrap();
+    ridi::data::write_ridi_csv(&seq.slice(0..1), &one).unwrap();
+    let out = ridi(&["inspect", s(&one)]);
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        out.status.success() && text.contains("a single frame: no rate, nothing to train"),
+        "{text}{}",
+        stderr(&out)
+    );
+    assert!(!text.contains("-0.00"), "{text}");
 }
 
 #[test]

@@ -208,12 +208,29 @@ fn ground_truth(table: &Table, path: &Path) -> Result<Option<GroundTruth>> {
         return Ok(None);
     }
     for (r, &line) in table.rows.iter().zip(&table.lines) {
-        if let Some(k) = gt(r).iter().position(|v| v.is_nan()) {
-            return Err(DataError::format(
-                Location::line(path, line).with_field(COLUMNS[POS + k]),
-                "ground truth is NaN here but present on other rows (all NaN means none)",
-            ));
-        }
+        let Some(k) = gt(r).iter().position(|v| v.is_nan()) else {
+            continue;
+        };
+        let (nan, given): (Vec<usize>, Vec<usize>) =
+            (0..gt(r).len()).partition(|&j| gt(r)[j].is_nan());
+        let names = |js: &[usize]| -> String {
+            let names: Vec<&str> = js.iter().map(|&j| COLUMNS[POS + j]).collect();
+            names.join(", ")
+        };
+        let message = if given.is_empty() {
+            "ground truth is NaN here but present on other rows (all NaN means none)".to_string()
+        } else {
+            format!(
+                "ground truth is incomplete: {} NaN but {} given (give every ground-truth \
+                 column, or NaN in all of them on every row for none)",
+                names(&nan),
+                names(&given)
+            )
+        };
+        return Err(DataError::format(
+            Location::line(path, line).with_field(COLUMNS[POS + k]),
+            message,
+        ));
     }
     Ok(Some(GroundTruth {
         position: vec3::<ridi_frames::World>(&table.rows, POS),

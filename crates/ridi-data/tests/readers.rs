@@ -139,10 +139,26 @@ fn csv_nan_and_inf_are_rejected_outside_ground_truth() {
 
 #[test]
 fn csv_partial_nan_ground_truth_is_an_error() {
+    // One NaN cell: the row names what it lacks and what it has.
     let text = with_cell(&csv_string(), 9, 21, "nan");
     assert_err(
         parse_csv(&text),
-        &["data.csv:9: field `ori_x`", "NaN here but present"],
+        &[
+            "data.csv:9: field `ori_x`",
+            "ground truth is incomplete: ori_x NaN but pos_x, pos_y, pos_z, ori_w, ori_y, ori_z given",
+        ],
+    );
+    // A whole row NaN among rows with ground truth.
+    let mut text = csv_string();
+    for col in 17..24 {
+        text = with_cell(&text, 9, col, "nan");
+    }
+    assert_err(
+        parse_csv(&text),
+        &[
+            "data.csv:9: field `pos_x`",
+            "NaN here but present on other rows",
+        ],
     );
 }
 

@@ -53,20 +53,37 @@ fn sources(source: &Path, from: Option<Format>) -> Result<Vec<PathBuf>, DataErro
     if detect(source).is_ok() || !source.is_dir() {
         return Err(not_a(source, want));
     }
-    match want {
+    let found = match want {
         Format::Tyrex => tyrex::list_sequences(source),
         Format::Ilc => ilc::list_paths(source),
-        _ => {
-            let found = sub_folders(source, |p| is_a(p, want))?;
+        _ => sub_folders(source, |p| is_a(p, want)).and_then(|found| {
             if found.is_empty() {
-                return Err(DataError::format(
+                Err(DataError::format(
                     Location::file(source),
                     format!("no {want} here or one level below: {}", want.layout()),
-                ));
+                ))
+            } else {
+                Ok(found)
             }
-            Ok(found)
+        }),
+    };
+    // A folder of another format: say what it holds rather than only what it lacks.
+    found.map_err(|e| match detected_sources(source) {
+        Ok(other) if !other.is_empty() => {
+            let what =
+                detect(&other[0]).map_or_else(|_| "sequences".to_string(), |f| f.to_string());
+            DataError::format(
+                Location::file(source),
+                format!(
+                    "no {want} here, but {} source(s) of another format (the first, {}, is a \
+                     {what}): convert without --from, or with that format",
+                    other.len(),
+                    other[0].display()
+                ),
+            )
         }
-    }
+        _ => e,
+    })
 }
 
 /// [`sources`] without a format given: whatever is detected.
@@ -108,6 +125,47 @@ fn sub_folders(dir: &Path, keep: impl Fn(&Path) -> bool) -> Result<Vec<PathBuf>,
     Ok(found)
 }
 
+/// Placement labels that list files directly in a `source` folder give its sequences (the
+/// RIDI layout keeps them there, not in the data), by canonical sequence path. Files that are
+/// not list files (a licence, notes) are skipped; a sequence two lists label differently keeps
+/// the first label (lists by name), with a warning.
+fn labels_from_lists(source: &Path) -> (BTreeMap<PathBuf, String>, Vec<String>) {
+    let mut labels = BTreeMap::new();
+    let mut warnings = Vec::new();
+    let Ok(entries) = std::fs::read_dir(source) else {
+        return (labels, warnings);
+    };
+    let mut lists: Vec<PathBuf> = entries
+        .filter_map(|e| e.ok().map(|e| e.path()))
+        .filter(|p| p.is_file() && p.extension().is_some_and(|e| e == "txt"))
+        .collect();
+    lists.sort();
+    for list in lists {
+        let Ok(entries) = ridi_data::read_list(&list) else {
+            continue;
+        };
+        for e in entries {
+            let (Some(label), Ok(path)) = (e.placement, e.path.canonicalize()) else {
+                continue;
+            };
+            match labels.get(&path) {
+                None => {
+                    labels.insert(path, label);
+                }
+                Some(first) if *first != label => warnings.push(format!(
+                    "{}:{}: placement `{label}` of {} differs from `{first}` in an earlier \
+                     list: kept `{first}`",
+                    list.display(),
+                    e.line,
+                    e.path.display()
+                )),
+                Some(_) => {}
+            }
+        }
+    }
+    (labels, warnings)
+}
+
 /// The person of a Tyrex run name `<Person>_<Phone>_<Dist>_<Motion>`, also for the parts
 /// of a split run (`..._<Motion>_part2`).
 fn tyrex_subject(name: &str) -> Option<&str> {
@@ -125,7 +183,8 @@ fn tyrex_subject(name: &str) -> Option<&str> {
 /// Converts every sequence under `source` into `<out>/<name>/processed/data.csv` and writes
 /// list files (`name,placement` per line, relative to `out`): `list_all.txt`, and for Tyrex
 /// sources one `list_<person>.txt` per person. The placement of a Tyrex run is its motion name,
-/// that of an Indoor Location Competition path `hand`.
+/// that of an Indoor Location Competition path `hand`, that of a RIDI sequence the label list
+/// files directly in `source` give it (none otherwise).
 ///
 /// All or nothing: every source is read and validated, and its files written to a staging
 /// folder in `out`, before any is moved into place; on an error `out` is left as it was (a
@@ -137,18 +196,23 @@ pub fn convert(
     opts: &ReadOptions,
 ) -> Result<ConvertSummary, DataError> {
     let dirs = sources(source, from)?;
+    let (labels, mut label_warnings) = labels_from_lists(source);
     let staging = Staging::new(out)?;
     let results: Vec<Result<Written, DataError>> = dirs
         .par_iter()
         .map(|dir| {
             let loaded = read_any(dir, from, opts)?;
             let mut written = Vec::new();
+            let listed = dir.canonicalize().ok().and_then(|d| labels.get(&d));
             for seq in &loaded.sequences {
                 let rel = Path::new(seq.name()).join("processed").join("data.csv");
                 write_ridi_csv(seq, staging.file(&rel)?)?;
                 written.push(Converted {
                     name: seq.name().to_string(),
-                    placement: seq.placement().map(str::to_string),
+                    placement: seq
+                        .placement()
+                        .or(listed.map(String::as_str))
+                        .map(str::to_string),
                     path: out.join(rel),
                     frames: seq.len(),
                 });
@@ -162,6 +226,7 @@ pub fn convert(
         })
         .collect();
     let mut summary = ConvertSummary::default();
+    summary.warnings.append(&mut label_warnings);
     for r in results {
         let (written, warnings) = r?;
         summary.sequences.extend(written);

@@ -100,7 +100,9 @@ pub fn inspect(seq: &Sequence, format: Format) -> Inspection {
     let rate_hz = seq.rate_hz();
     let max_gap_s = seq.max_gap();
     let mut warnings = Vec::new();
-    if (rate_hz - RATE_HZ).abs() > RATE_TOLERANCE * RATE_HZ {
+    if seq.len() < 2 {
+        warnings.push("a single frame: no rate, nothing to train, track or evaluate".into());
+    } else if (rate_hz - RATE_HZ).abs() > RATE_TOLERANCE * RATE_HZ {
         warnings.push(format!(
             "rate {rate_hz:.1} Hz: train, track and eval need {RATE_HZ} Hz (within {:.0} %)",
             RATE_TOLERANCE * 100.0
@@ -164,7 +166,8 @@ pub fn inspect(seq: &Sequence, format: Format) -> Inspection {
         } else {
             0.0
         },
-        path_length_m: seq.path_length(),
+        // `+ 0.0` turns the -0.0 of a path without steps into 0.0 for printing.
+        path_length_m: seq.path_length().map(|l| l + 0.0),
         warnings,
     }
 }

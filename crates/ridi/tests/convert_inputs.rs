@@ -12,19 +12,25 @@ fn seq(name: &str) -> PathBuf {
         .join(name)
 }
 
-/// A folder of three RIDI captures, the second with a NaN on line 301 of its data.csv.
-fn three_sources(dir: &Path) -> PathBuf {
+/// `dir/src` with one RIDI capture (a copy of a sample run) per name.
+fn sources_named(dir: &Path, names: &[&str]) -> PathBuf {
     let src = dir.join("src");
     let s = read_sequence(
         seq("Thibaud_Nexus5_NoDist_Texting"),
         &ReadOptions::default(),
     )
     .unwrap();
-    for name in ["a_seq", "b_seq", "c_seq"] {
+    for name in names {
         let folder = src.join(name).join("processed");
         std::fs::create_dir_all(&folder).unwrap();
         write_ridi_csv(&s, folder.join("data.csv")).unwrap();
     }
+    src
+}
+
+/// A folder of three RIDI captures, the second with a NaN on line 301 of its data.csv.
+fn three_sources(dir: &Path) -> PathBuf {
+    let src = sources_named(dir, &["a_seq", "b_seq", "c_seq"]);
     let bad = src.join("b_seq/processed/data.csv");
     let text = std::fs::read_to_string(&bad).unwrap();
     let mut lines: Vec<String> = text.lines().map(str::to_string).collect();
@@ -169,4 +175,56 @@ fn a_source_of_another_format_than_given_says_what_it_is_and_what_was_expected()
     let files = files_under(&out);
     assert_eq!(files.len(), 7, "{files:?}");
     assert!(!files.iter().any(|f| f.contains("staging")), "{files:?}");
+}
+
+#[test]
+fn list_labels_in_the_source_carry_over_and_a_folder_of_another_format_is_named() {
+    let dir = tempfile::tempdir().unwrap();
+    let opts = ReadOptions::default();
+    let src = sources_named(dir.path(), &["walk_a", "walk_b", "walk_c"]);
+    // The RIDI layout keeps labels in list files beside the sequences; a licence is no list,
+    // and a second list that disagrees keeps the first label with a warning.
+    std::fs::write(src.join("LICENCE.txt"), "Permission is granted...\n").unwrap();
+    std::fs::write(src.join("list_a.txt"), "walk_a,Texting\nwalk_b,Pocket\n").unwrap();
+    std::fs::write(src.join("list_b.txt"), "# other\nwalk_b,Swinging\n").unwrap();
+
+    let out = dir.path().join("out");
+    let summary = convert(&src, &out, None, &opts).unwrap();
+    let labels: Vec<(&str, Option<&str>)> = summary
+        .sequences
+        .iter()
+        .map(|c| (c.name.as_str(), c.placement.as_deref()))
+        .collect();
+    assert_eq!(
+        labels,
+        [
+            ("walk_a", Some("Texting")),
+            ("walk_b", Some("Pocket")),
+            ("walk_c", None)
+        ]
+    );
+    assert!(
+        summary.warnings.iter().any(
+            |w| w.contains("list_b.txt:2: placement `Swinging`") && w.contains("kept `Pocket`")
+        ),
+        "{:?}",
+        summary.warnings
+    );
+    let list = std::fs::read_to_string(out.join("list_all.txt")).unwrap();
+    assert!(
+        list.contains("\nwalk_a,Texting\nwalk_b,Pocket\nwalk_c,\n"),
+        "{list}"
+    );
+
+    // Asked for another format, the folder says what it holds.
+    for from in [Format::Tyrex, Format::Ilc, Format::RidiRaw] {
+        let e = convert(&src, &dir.path().join("x"), Some(from), &opts)
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("but 3 source(s) of another format")
+                && e.contains("is a RIDI processed csv"),
+            "{e}"
+        );
+    }
 }
