@@ -17,7 +17,6 @@ use ridi_frames::{
     Device, DeviceVec, FilterConfig, Rot, WorldFromDevice, estimate_orientation, orientation_errors,
 };
 
-/// Tyrex root, relative to the workspace root.
 /// Report path, relative to the workspace root.
 pub const DEFAULT_OUT: &str = "docs/bench-orientation.md";
 /// Shorter parts give a drift slope dominated by noise, so they are not evaluated.

@@ -20,12 +20,22 @@ pub fn workspace_root() -> PathBuf {
     here.parent().map(PathBuf::from).unwrap_or(here)
 }
 
-/// The Tyrex root a task reads: `data`, or [`DEFAULT_TYREX`] beside the workspace.
+/// The Tyrex root a task reads: `data`; without it [`DEFAULT_TYREX`] beside the workspace, or
+/// else `datasets/tyrex`, where `cargo xtask fetch tyrex` installs it.
 ///
 /// # Errors
 /// The folder does not exist: the message says how to pass or install one.
 pub fn tyrex_root(data: Option<PathBuf>) -> anyhow::Result<PathBuf> {
-    let data = data.unwrap_or_else(|| workspace_root().join(DEFAULT_TYREX));
+    let root = workspace_root();
+    let data = data.unwrap_or_else(|| {
+        let shared = root.join(DEFAULT_TYREX);
+        let fetched = root.join("datasets/tyrex");
+        if !shared.is_dir() && fetched.is_dir() {
+            fetched
+        } else {
+            shared
+        }
+    });
     anyhow::ensure!(
         data.is_dir(),
         "Tyrex data folder {} not found: pass --data <tyrex root> (`cargo xtask fetch tyrex` \

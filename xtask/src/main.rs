@@ -62,7 +62,8 @@ enum Task {
     /// Rebuild the bundled sample (datasets/sample) from the Tyrex data: 24 s of every Nexus 5
     /// run, RIDI processed layout, gzip + f32, with list files.
     Sample {
-        /// Tyrex root [default: <workspace>/../shared/data/raw/tyrex-attitude-smartphones].
+        /// Tyrex root [default: <workspace>/../shared/data/raw/tyrex-attitude-smartphones, else
+        /// <workspace>/datasets/tyrex from `cargo xtask fetch tyrex`].
         #[arg(long, value_name = "DIR")]
         data: Option<PathBuf>,
         /// Output folder [default: <workspace>/datasets/sample].
@@ -97,7 +98,8 @@ enum Eval {
 
 #[derive(Args)]
 struct TyrexArgs {
-    /// Tyrex root [default: <workspace>/../shared/data/raw/tyrex-attitude-smartphones].
+    /// Tyrex root [default: <workspace>/../shared/data/raw/tyrex-attitude-smartphones, else
+    /// <workspace>/datasets/tyrex from `cargo xtask fetch tyrex`].
     #[arg(long, value_name = "DIR")]
     data: Option<PathBuf>,
     /// Report to write [default: <workspace>/docs/bench-accuracy.md].
@@ -113,7 +115,8 @@ struct TyrexArgs {
 
 #[derive(Args)]
 struct OrientationArgs {
-    /// Tyrex root [default: <workspace>/../shared/data/raw/tyrex-attitude-smartphones].
+    /// Tyrex root [default: <workspace>/../shared/data/raw/tyrex-attitude-smartphones, else
+    /// <workspace>/datasets/tyrex from `cargo xtask fetch tyrex`].
     #[arg(long, value_name = "DIR")]
     data: Option<PathBuf>,
     /// Report to write [default: <workspace>/docs/bench-orientation.md].

@@ -402,10 +402,12 @@ fn run(cli: Cli) -> Result<()> {
             for l in &list {
                 // Unreadable lists are reported by load_lists below, with their line.
                 if let Ok(entries) = ridi::data::read_list(l) {
-                    inputs.extend(entries.into_iter().map(|e| e.path));
+                    inputs.extend(read_files(
+                        &entries.into_iter().map(|e| e.path).collect::<Vec<_>>(),
+                    ));
                 }
             }
-            check_not_input(&out, &inputs)?;
+            check_not_input(&out, &inputs, &[])?;
             let seqs = load_lists(&list, placement_map.as_deref(), Purpose::Training)?;
             let defaults = TrainOptions::default();
             let mut opts = TrainOptions {
@@ -456,12 +458,12 @@ fn run(cli: Cli) -> Result<()> {
         } => {
             // Every output is checked before any work, so that a bad --plot cannot leave the
             // trajectory written and the command failed.
-            let inputs = [sequence.clone(), model.clone()];
+            let inputs = read_files(&[sequence.clone(), model.clone()]);
             check_output(&out)?;
-            check_not_input(&out, &inputs)?;
+            check_not_input(&out, &inputs, &[])?;
             if let Some(plot) = &plot {
                 check_output(plot)?;
-                check_not_input(plot, &inputs)?;
+                check_not_input(plot, &inputs, &[&out])?;
                 ridi::plot::PlotFormat::from_path(plot)?;
             }
             let model = load_model(&model)?;
@@ -572,34 +574,45 @@ fn check_output_folder(dir: &Path) -> Result<()> {
     Ok(())
 }
 
-/// Refuses an output that would overwrite what the command reads: one of `inputs`, or a file
-/// a sequence folder among them is read from (data files, `.txt` streams, `.mat` ground
-/// truth). Other files may sit beside a recording, e.g. its trajectory.
-fn check_not_input(out: &Path, inputs: &[PathBuf]) -> Result<()> {
-    let Ok(target) = out.canonicalize() else {
-        return Ok(()); // not there yet: nothing to overwrite
+/// The files a command reads from `paths`: a sequence given as a folder stands for the files
+/// its reader takes ([`ridi::data::source_files`]); anything else for itself.
+fn read_files(paths: &[PathBuf]) -> Vec<PathBuf> {
+    paths
+        .iter()
+        .flat_map(|p| ridi::data::source_files(p).unwrap_or_else(|_| vec![p.clone()]))
+        .collect()
+}
+
+/// Refuses an output that would overwrite what the command reads (`inputs`, from
+/// [`read_files`]) or another of its outputs (`others`). Files beside a recording that its
+/// reader does not take, e.g. a trajectory, may be written.
+fn check_not_input(out: &Path, inputs: &[PathBuf], others: &[&Path]) -> Result<()> {
+    let Some(target) = resolved(out) else {
+        return Ok(()); // its folder is missing: check_output says so
     };
-    let read_from_folders = target.file_name().is_some_and(|name| {
-        let name = name.to_string_lossy();
-        name == "data.csv"
-            || name == "data.csv.gz"
-            || name.ends_with(".txt")
-            || name.ends_with(".mat")
-    });
-    for input in inputs {
-        let Ok(source) = input.canonicalize() else {
-            continue;
-        };
-        if target == source || (read_from_folders && source.is_dir() && target.starts_with(&source))
-        {
-            bail!(
-                "cannot write {}: the command reads it (from {}); choose another output",
-                out.display(),
-                input.display()
-            );
-        }
+    if let Some(input) = inputs.iter().find(|i| resolved(i) == Some(target.clone())) {
+        bail!(
+            "cannot write {}: the command reads it ({}); choose another output",
+            out.display(),
+            input.display()
+        );
+    }
+    if others.iter().any(|o| resolved(o) == Some(target.clone())) {
+        bail!("cannot write {}: it is given as two outputs", out.display());
     }
     Ok(())
+}
+
+/// `path` with its folder resolved (links, `..`), whether or not the file exists yet.
+fn resolved(path: &Path) -> Option<PathBuf> {
+    if let Ok(p) = path.canonicalize() {
+        return Some(p);
+    }
+    let parent = match path.parent() {
+        Some(p) if !p.as_os_str().is_empty() => p,
+        _ => Path::new("."),
+    };
+    Some(parent.canonicalize().ok()?.join(path.file_name()?))
 }
 
 /// `--placement-window` (checked by clap: finite, at least 0): 0 turns the majority vote off.
@@ -790,8 +803,8 @@ fn evaluate_and_write(
             written.extend(t.plot(&plot_dir, ext)?);
         }
     }
-    let stale = remove_stale_plots(&plot_dir, &written)?;
     written.extend(report.write(out)?);
+    let stale = remove_stale_plots(&plot_dir, &written)?;
     print_summary(&report);
     outln!(
         "wrote {} files into {} (report.md, report.json{}){}",

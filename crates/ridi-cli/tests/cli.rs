@@ -412,12 +412,17 @@ fn convert_train_track_and_eval() {
     std::fs::copy(&recording, folder.join("processed/data.csv.gz")).unwrap();
     let model_bytes = std::fs::read(&model).unwrap();
     let recording_bytes = std::fs::read(&recording).unwrap();
+    let track_to = |input: &Path, out: &Path, extra: &[&str]| {
+        let mut args = vec!["track", s(input), "--model", s(&model), "--out", s(out)];
+        args.extend_from_slice(extra);
+        ridi(&args)
+    };
     for (input, output) in [
         (&recording, &recording),
         (&recording, &model),
         (&folder, &folder.join("processed/data.csv.gz")),
     ] {
-        let out = ridi(&["track", s(input), "--model", s(&model), "--out", s(output)]);
+        let out = track_to(input, output, &[]);
         assert!(
             !out.status.success() && stderr(&out).contains("the command reads it"),
             "{}",
@@ -445,17 +450,20 @@ fn convert_train_track_and_eval() {
             .unwrap()
             .ends_with(",Texting\n")
     );
-    // Beside a recording is fine, and so is a second run over its own output.
-    let beside = folder.join("trajectory.csv");
+    // A trajectory and its plot in the same file would overwrite each other.
+    let both = dir.path().join("both.svg");
+    std::fs::write(&both, "").unwrap();
+    let out = track_to(&folder, &both, &["--plot", s(&both)]);
+    assert!(
+        !out.status.success() && stderr(&out).contains("it is given as two outputs"),
+        "{}",
+        stderr(&out)
+    );
+    // Beside a recording is fine, whatever the extension, and so is a second run over its
+    // own output.
+    let beside = folder.join("trajectory.txt");
     for run in ["first", "second"] {
-        let out = ridi(&[
-            "track",
-            s(&folder),
-            "--model",
-            s(&model),
-            "--out",
-            s(&beside),
-        ]);
+        let out = track_to(&folder, &beside, &[]);
         assert!(out.status.success(), "{run}: {}", stderr(&out));
     }
 

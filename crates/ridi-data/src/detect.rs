@@ -6,7 +6,7 @@ use std::path::{Path, PathBuf};
 use crate::error::{DataError, Location, Result};
 use crate::options::ReadOptions;
 use crate::sequence::Sequence;
-use crate::{ilc, ridi_csv, ridi_plain, ridi_raw};
+use crate::{ilc, ridi_csv, ridi_plain, ridi_raw, tyrex};
 
 /// The dataset formats ridi-data knows.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
@@ -122,6 +122,35 @@ fn locate(path: &Path) -> Result<(Format, PathBuf)> {
          a RIDI raw folder (gyro.txt, acce.txt, ...) or a Tyrex folder (accelerometer.txt, \
          gyroscope-calibrated.txt)",
     ))
+}
+
+/// The files a read of `path` takes data from: the file itself, or for a folder those of its
+/// detected format that exist (a Tyrex run: its text files and its `.mat` ground truth beside
+/// the `android` folder). What a command's output must not overwrite.
+///
+/// # Errors
+/// As [`detect`]: `path` is no sequence of a known format.
+pub fn source_files(path: impl AsRef<Path>) -> Result<Vec<PathBuf>> {
+    let (format, at) = locate(path.as_ref())?;
+    let mut files = match format {
+        Format::RidiCsv | Format::RidiPlain | Format::Ilc => return Ok(vec![at]),
+        Format::RidiRaw => ridi_raw::FILES
+            .iter()
+            .map(|(name, _)| at.join(name))
+            .collect(),
+        Format::Tyrex => {
+            let entries = std::fs::read_dir(&at).map_err(|e| DataError::io(&at, e))?;
+            let mut files = Vec::new();
+            for entry in entries {
+                files.push(entry.map_err(|e| DataError::io(&at, e))?.path());
+            }
+            files.extend(tyrex::mat_path(&at));
+            files
+        }
+    };
+    files.retain(|f| f.is_file());
+    files.sort();
+    Ok(files)
 }
 
 /// Detects the format of a file or folder.

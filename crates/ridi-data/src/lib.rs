@@ -79,7 +79,7 @@ mod text;
 pub mod tyrex;
 mod write;
 
-pub use detect::{Format, detect, read_sequence};
+pub use detect::{Format, detect, read_sequence, source_files};
 pub use error::{DataError, Location, Result};
 pub use list::{ListEntry, load_entries, load_list, parse_list, read_list};
 pub use options::ReadOptions;

@@ -868,6 +868,18 @@ impl Sequence {
         }
     }
 
+    /// The stream's rate, Hz: one over the median interval between frames, which gaps do not
+    /// change (0 for a single frame). [`Sequence::rate_hz`] is the mean, gaps included.
+    pub fn median_rate_hz(&self) -> f64 {
+        let mut dt: Vec<f64> = self.parts.time.windows(2).map(|w| w[1] - w[0]).collect();
+        if dt.is_empty() {
+            return 0.0;
+        }
+        let mid = dt.len() / 2;
+        let (_, median, _) = dt.select_nth_unstable_by(mid, f64::total_cmp);
+        1.0 / *median
+    }
+
     /// Longest interval between two frames, seconds (0 for a single frame).
     pub fn max_gap(&self) -> f64 {
         self.parts

@@ -709,3 +709,36 @@ fn gzipped_f32_files_are_written_and_read_back_transparently() {
         .to_string();
     assert!(err.contains("data.csv.gz") && err.contains("gzip"), "{err}");
 }
+
+#[test]
+fn source_files_are_what_the_readers_take() {
+    let dir = tempfile::tempdir().unwrap();
+    // A raw capture folder that also holds processed/data.csv: the processed file is read.
+    let folder = dir.path().join("hang_leg1");
+    write_files(&folder, &raw_files(100, true));
+    std::fs::write(folder.join("notes.txt"), "not read").unwrap();
+    let raw: Vec<_> = [
+        "acce.txt",
+        "gravity.txt",
+        "gyro.txt",
+        "linacce.txt",
+        "magnet.txt",
+        "orientation.txt",
+        "pose.txt",
+        "step.txt",
+    ]
+    .iter()
+    .map(|n| folder.join(n))
+    .collect();
+    assert_eq!(ridi_data::source_files(&folder).unwrap(), raw);
+    std::fs::create_dir_all(folder.join("processed")).unwrap();
+    std::fs::write(folder.join("processed/data.csv"), csv_string()).unwrap();
+    std::fs::write(folder.join("trajectory.csv"), "").unwrap();
+    assert_eq!(
+        ridi_data::source_files(&folder).unwrap(),
+        [folder.join("processed/data.csv")]
+    );
+    let file = folder.join("processed/data.csv");
+    assert_eq!(ridi_data::source_files(&file).unwrap(), std::slice::from_ref(&file));
+    assert!(ridi_data::source_files(dir.path().join("nope")).is_err());
+}

@@ -655,3 +655,12 @@ fn read_ground_truth_gives_mocap_rate_frames() {
     assert!((v.y() - 1.0).abs() < 1e-12);
     assert!(track.pose[10].is_none() && track.pose[11].is_none());
 }
+
+#[test]
+fn source_files_of_a_run_include_its_ground_truth_beside_the_android_folder() {
+    let fx = Fixture::standard();
+    let files = ridi_data::source_files(&fx.dir).unwrap();
+    assert!(files.contains(&fx.mat), "{files:?}");
+    assert!(files.contains(&fx.dir.join("accelerometer.txt")), "{files:?}");
+    assert!(files.contains(&fx.dir.join("rotation-vector.txt")), "{files:?}");
+}

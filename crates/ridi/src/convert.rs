@@ -9,7 +9,7 @@ use ridi_data::{
 };
 use ridi_data::{ilc, tyrex};
 
-use crate::source::{is_a, not_a, read_any};
+use crate::source::{is_a, not_a, read_any, with_article};
 use crate::staging::Staging;
 
 /// One sequence written by [`convert`].
@@ -70,12 +70,14 @@ fn sources(source: &Path, from: Option<Format>) -> Result<Vec<PathBuf>, DataErro
     // A folder of another format: say what it holds rather than only what it lacks.
     found.map_err(|e| match detected_sources(source) {
         Ok(other) if !other.is_empty() => {
-            let what =
-                detect(&other[0]).map_or_else(|_| "sequences".to_string(), |f| f.to_string());
+            let what = detect(&other[0]).map_or_else(
+                |_| "a sequence".to_string(),
+                |f| with_article(&f.to_string()),
+            );
             DataError::format(
                 Location::file(source),
                 format!(
-                    "no {want} here, but {} source(s) of another format (the first, {}, is a \
+                    "no {want} here, but {} source(s) of another format (the first, {}, is \
                      {what}): convert without --from, or with that format",
                     other.len(),
                     other[0].display()
@@ -125,29 +127,53 @@ fn sub_folders(dir: &Path, keep: impl Fn(&Path) -> bool) -> Result<Vec<PathBuf>,
     Ok(found)
 }
 
-/// Placement labels that list files directly in a `source` folder give its sequences (the
-/// RIDI layout keeps them there, not in the data), by canonical sequence path. Files that are
-/// not list files (a licence, notes) are skipped; a sequence two lists label differently keeps
-/// the first label (lists by name), with a warning.
-fn labels_from_lists(source: &Path) -> (BTreeMap<PathBuf, String>, Vec<String>) {
-    let mut labels = BTreeMap::new();
-    let mut warnings = Vec::new();
+/// Labels that list files give the sequences of a source folder.
+#[derive(Debug, Default)]
+struct ListLabels {
+    /// Placement by canonical sequence folder.
+    labels: BTreeMap<PathBuf, String>,
+    /// The list files read.
+    lists: Vec<PathBuf>,
+    warnings: Vec<String>,
+}
+
+/// Placement labels that list files directly in a `source` folder (`list*.txt`) give its
+/// sequences: the RIDI layout keeps them there, not in the data. A file that does not parse
+/// as a list is skipped; an entry may name the sequence folder or its `processed/` file; a
+/// sequence two lists label differently keeps the first label (lists by name), with a warning.
+fn labels_from_lists(source: &Path) -> ListLabels {
+    let mut out = ListLabels::default();
     let Ok(entries) = std::fs::read_dir(source) else {
-        return (labels, warnings);
+        return out;
     };
     let mut lists: Vec<PathBuf> = entries
         .filter_map(|e| e.ok().map(|e| e.path()))
-        .filter(|p| p.is_file() && p.extension().is_some_and(|e| e == "txt"))
+        .filter(|p| {
+            let name = p.file_name().unwrap_or_default().to_string_lossy();
+            p.is_file() && name.starts_with("list") && name.ends_with(".txt")
+        })
         .collect();
     lists.sort();
+    let (labels, warnings) = (&mut out.labels, &mut out.warnings);
     for list in lists {
         let Ok(entries) = ridi_data::read_list(&list) else {
             continue;
         };
+        out.lists.push(list.clone());
         for e in entries {
-            let (Some(label), Ok(path)) = (e.placement, e.path.canonicalize()) else {
+            let (Some(label), Ok(mut path)) = (e.placement, e.path.canonicalize()) else {
                 continue;
             };
+            // `<sequence>/processed/data.csv` labels `<sequence>`.
+            if path.is_file() {
+                let folder = match path.parent() {
+                    Some(p) if p.ends_with("processed") => p.parent(),
+                    other => other,
+                };
+                if let Some(folder) = folder {
+                    path = folder.to_path_buf();
+                }
+            }
             match labels.get(&path) {
                 None => {
                     labels.insert(path, label);
@@ -163,7 +189,36 @@ fn labels_from_lists(source: &Path) -> (BTreeMap<PathBuf, String>, Vec<String>) 
             }
         }
     }
-    (labels, warnings)
+    out
+}
+
+/// Refuses a conversion whose outputs would replace a file it read: a source file, or a list
+/// that labelled the sources (e.g. `--out` the source folder itself).
+fn check_overwrites(
+    sources: &[PathBuf],
+    lists: &[PathBuf],
+    sequences: &[Converted],
+    written_lists: &[PathBuf],
+) -> Result<(), DataError> {
+    let mut inputs: Vec<PathBuf> = lists.to_vec();
+    for s in sources {
+        inputs.extend(ridi_data::source_files(s).unwrap_or_else(|_| vec![s.clone()]));
+    }
+    let inputs: Vec<PathBuf> = inputs
+        .iter()
+        .filter_map(|p| p.canonicalize().ok())
+        .collect();
+    let outputs = sequences.iter().map(|c| &c.path).chain(written_lists);
+    for out in outputs {
+        if out.canonicalize().is_ok_and(|o| inputs.contains(&o)) {
+            return Err(DataError::format(
+                Location::file(out),
+                "the conversion reads this file and would replace it: choose an --out outside \
+                 the source",
+            ));
+        }
+    }
+    Ok(())
 }
 
 /// The person of a Tyrex run name `<Person>_<Phone>_<Dist>_<Motion>`, also for the parts
@@ -196,7 +251,8 @@ pub fn convert(
     opts: &ReadOptions,
 ) -> Result<ConvertSummary, DataError> {
     let dirs = sources(source, from)?;
-    let (labels, mut label_warnings) = labels_from_lists(source);
+    let listed = labels_from_lists(source);
+    let labels = &listed.labels;
     let staging = Staging::new(out)?;
     let results: Vec<Result<Written, DataError>> = dirs
         .par_iter()
@@ -226,7 +282,7 @@ pub fn convert(
         })
         .collect();
     let mut summary = ConvertSummary::default();
-    summary.warnings.append(&mut label_warnings);
+    summary.warnings.extend(listed.warnings.iter().cloned());
     for r in results {
         let (written, warnings) = r?;
         summary.sequences.extend(written);
@@ -253,6 +309,7 @@ pub fn convert(
         })?;
         written_lists.push(out.join(name));
     }
+    check_overwrites(&dirs, &listed.lists, &summary.sequences, &written_lists)?;
     staging.commit()?;
     summary.lists = written_lists;
     Ok(summary)

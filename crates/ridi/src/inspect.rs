@@ -100,12 +100,22 @@ pub fn inspect(seq: &Sequence, format: Format) -> Inspection {
     let rate_hz = seq.rate_hz();
     let max_gap_s = seq.max_gap();
     let mut warnings = Vec::new();
+    let median_rate = seq.median_rate_hz();
+    let window = ridi_features::FeatureConfig::default().window;
     if seq.len() < 2 {
         warnings.push("a single frame: no rate, nothing to train, track or evaluate".into());
-    } else if (rate_hz - RATE_HZ).abs() > RATE_TOLERANCE * RATE_HZ {
+    } else if (median_rate - RATE_HZ).abs() > RATE_TOLERANCE * RATE_HZ {
         warnings.push(format!(
-            "rate {rate_hz:.1} Hz: train, track and eval need {RATE_HZ} Hz (within {:.0} %)",
+            "rate {median_rate:.1} Hz (median frame interval): train, track and eval need \
+             {RATE_HZ} Hz (within {:.0} %)",
             RATE_TOLERANCE * 100.0
+        ));
+    }
+    if (2..=window).contains(&seq.len()) {
+        warnings.push(format!(
+            "{} frames: no whole feature window ({window} frames) before any of them, nothing \
+             to train, track or evaluate",
+            seq.len()
         ));
     }
     if rate_hz > 0.0 && max_gap_s > 5.0 / rate_hz {

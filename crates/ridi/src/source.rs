@@ -48,7 +48,7 @@ pub(crate) fn not_a(path: &Path, want: Format) -> DataError {
 }
 
 /// `a name` or `an name`.
-fn with_article(name: &str) -> String {
+pub(crate) fn with_article(name: &str) -> String {
     let vowel = name.starts_with(|c: char| "AEIOUaeiou".contains(c));
     format!("{} {name}", if vowel { "an" } else { "a" })
 }

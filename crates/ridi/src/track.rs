@@ -250,9 +250,10 @@ pub const RATE_HZ: f64 = 200.0;
 /// phones; half or twice the rate would make a one-second window half or two seconds long).
 pub const RATE_TOLERANCE: f64 = 0.1;
 
-/// Refuses a sequence whose frames do not fit the model's frame counts: a mean rate outside
-/// [`RATE_HZ`] ± [`RATE_TOLERANCE`], or no frame with a whole feature window before it (the
-/// trajectory would be plain double integration, and its metrics meaningless).
+/// Refuses a sequence whose frames do not fit the model's frame counts: a rate (one over the
+/// median frame interval, so that gaps do not count) outside [`RATE_HZ`] ± [`RATE_TOLERANCE`],
+/// or no frame with a whole feature window before it (the trajectory would be plain double
+/// integration, and its metrics meaningless).
 pub(crate) fn check_frames(seq: &Sequence, config: &FeatureConfig) -> Result<()> {
     let n = seq.len();
     if n <= config.window {
@@ -267,13 +268,14 @@ pub(crate) fn check_frames(seq: &Sequence, config: &FeatureConfig) -> Result<()>
             ),
         ));
     }
-    let rate = seq.rate_hz();
+    let rate = seq.median_rate_hz();
     if (rate - RATE_HZ).abs() > RATE_TOLERANCE * RATE_HZ {
         return Err(PipelineError::sequence(
             seq.name(),
             format!(
-                "has a mean rate of {rate:.1} Hz; models count windows and knots in frames of a \
-                 {RATE_HZ} Hz stream (within {:.0} %): resample it to {RATE_HZ} Hz",
+                "has a rate of {rate:.1} Hz (median frame interval); models count windows and \
+                 knots in frames of a {RATE_HZ} Hz stream (within {:.0} %): resample it to \
+                 {RATE_HZ} Hz",
                 RATE_TOLERANCE * 100.0
             ),
         ));
@@ -281,10 +283,10 @@ pub(crate) fn check_frames(seq: &Sequence, config: &FeatureConfig) -> Result<()>
     Ok(())
 }
 
-/// [`check_frames`] and [`check_gaps`]: what tracking and evaluation need of a sequence.
+/// [`check_gaps`] and [`check_frames`]: what tracking and evaluation need of a sequence.
 pub(crate) fn check_trackable(seq: &Sequence, model: &Cascade, max_dt: f64) -> Result<()> {
-    check_frames(seq, model.feature_config())?;
-    check_gaps(seq, max_dt)
+    check_gaps(seq, max_dt)?;
+    check_frames(seq, model.feature_config())
 }
 
 /// Tracks `seq` with `model`, in the orientation the model was trained with ([`oriented`]).

@@ -216,6 +216,26 @@ fn list_labels_in_the_source_carry_over_and_a_folder_of_another_format_is_named(
         "{list}"
     );
 
+    // Converting into the source folder would replace the lists it read: refused, and the
+    // folder stays as it was.
+    let before = std::fs::read_to_string(src.join("list_a.txt")).unwrap();
+    let e = convert(&src, &src, None, &opts).unwrap_err().to_string();
+    assert!(
+        e.contains("the conversion reads this file and would replace it"),
+        "{e}"
+    );
+    assert_eq!(
+        std::fs::read_to_string(src.join("list_a.txt")).unwrap(),
+        before
+    );
+    assert!(!src.join("list_all.txt").exists());
+    let left: Vec<_> = std::fs::read_dir(&src)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .filter(|n| n.starts_with(".ridi-staging"))
+        .collect();
+    assert!(left.is_empty(), "{left:?}");
+
     // Asked for another format, the folder says what it holds.
     for from in [Format::Tyrex, Format::Ilc, Format::RidiRaw] {
         let e = convert(&src, &dir.path().join("x"), Some(from), &opts)

@@ -605,7 +605,59 @@ fn another_rate_or_less_than_a_window_is_refused_by_name() {
         err.contains(&name) && err.contains("has 200 frames"),
         "{err}"
     );
+    let online = TrackOptions {
+        online: true,
+        ..opts
+    };
+    let err = ridi::track(&short, &model, &online)
+        .unwrap_err()
+        .to_string();
+    assert!(err.contains("has 200 frames"), "{err}");
     assert!(ridi::track(&seq.slice(0..201), &model, &opts).is_ok());
+
+    // Phones differ by a few percent: 190 and 210 Hz pass, 179 and 221 Hz do not.
+    let at_rate = |hz: f64| {
+        let mut p = seq.parts().clone();
+        let t0 = p.time[0];
+        for t in &mut p.time {
+            *t = t0 + (*t - t0) * 200.0 / hz;
+        }
+        Sequence::new(p).unwrap()
+    };
+    for hz in [190.0, 210.0] {
+        assert!(ridi::track(&at_rate(hz), &model, &opts).is_ok(), "{hz} Hz");
+    }
+    for hz in [179.0, 221.0] {
+        let err = ridi::track(&at_rate(hz), &model, &opts)
+            .unwrap_err()
+            .to_string();
+        assert!(err.contains(&format!("{hz:.1} Hz")), "{err}");
+    }
+
+    // Gaps do not lower the rate: a 200 Hz recording with 0.9 s gaps trains, and tracking
+    // names the gap, which the correction cannot integrate across.
+    let keep: Vec<usize> = (0..seq.len()).filter(|i| i % 800 >= 180).collect();
+    fn pick<T: Copy>(v: &[T], keep: &[usize]) -> Vec<T> {
+        keep.iter().map(|&i| v[i]).collect()
+    }
+    let mut p = seq.parts().clone();
+    p.time = pick(&p.time, &keep);
+    p.gyro = pick(&p.gyro, &keep);
+    p.acce = pick(&p.acce, &keep);
+    p.linacce = pick(&p.linacce, &keep);
+    p.gravity = pick(&p.gravity, &keep);
+    p.orientation = pick(&p.orientation, &keep);
+    p.magnet = p.magnet.as_deref().map(|m| pick(m, &keep));
+    if let Some(gt) = &mut p.ground_truth {
+        gt.position = pick(&gt.position, &keep);
+        gt.orientation = pick(&gt.orientation, &keep);
+    }
+    let gappy = Sequence::new(p).unwrap();
+    assert!(gappy.rate_hz() < 170.0 && (gappy.median_rate_hz() - 200.0).abs() < 0.1);
+    let features = TrainOptions::default().features;
+    assert!(ridi::train::training_data(std::slice::from_ref(&gappy), &features).is_ok());
+    let err = ridi::track(&gappy, &model, &opts).unwrap_err().to_string();
+    assert!(err.contains("a gap of 0.905 s"), "{err}");
 
     // 100 Hz: each 200-frame window would be two seconds long.
     let half = every_other_frame(&seq);
