@@ -81,6 +81,8 @@ pub use integrate::{Integrator, Pose, corrected_acceleration, integrate, world_a
 pub use knots::{BiasCurve, Knots};
 pub use placement::{PlacementFilter, PlacementSmoother, TrailingMajority};
 pub use regressor::{FrameWindow, RegressError, Regression, VelocityRegressor};
+/// The frame types the inputs are built from.
+pub use ridi_frames;
 pub use solve::{Correction, Corrector, Trajectory, correct};
 pub use tracker::{
     CorrectionOutcome, GapPolicy, MAX_BUFFER, RegressionOutcome, Revision, Sample, Segment,

@@ -1,6 +1,6 @@
 //! The interface between the tracker and a velocity regressor.
 
-use ridi_frames::{DeviceVec, WorldFromDevice};
+use ridi_frames::{DeviceVec, UpAxis, WorldFromDevice};
 
 /// A view of the most recent frames of the stream, oldest first, one entry per frame in
 /// each slice. The last frame is the one to regress.
@@ -54,11 +54,20 @@ pub type RegressError = Box<dyn std::error::Error + Send + Sync>;
 /// A source of regressed velocities for the [`Tracker`](crate::Tracker): the SVR cascade in
 /// production, test doubles in tests.
 pub trait VelocityRegressor {
-    /// How many of the most recent frames [`regress`](Self::regress) needs. The tracker only
-    /// asks for a regression once a segment holds that many frames, and always passes exactly
-    /// that many, the last being the frame regressed. RIDI's features use the 200 frames
-    /// *before* the sample frame: such a regressor asks for 201 and ignores the last one.
+    /// How many of the most recent frames [`regress`](Self::regress) needs, at least 1 (the
+    /// tracker refuses 0). The tracker only asks for a regression once a segment holds that
+    /// many frames, and always passes exactly that many, the last being the frame regressed.
+    /// RIDI's features use the 200 frames *before* the sample frame: such a regressor asks for
+    /// 201 and ignores the last one.
     fn window_len(&self) -> usize;
+
+    /// The stabilized frame S the regressed velocities are in, when the regressor knows it (a
+    /// trained model does). The tracker refuses a correction configured for another
+    /// ([`CorrectionConfig::up_axis`](crate::CorrectionConfig::up_axis)): its velocities would
+    /// be read in the wrong frame. `None` (the default): the caller vouches for the match.
+    fn up_axis(&self) -> Option<UpAxis> {
+        None
+    }
 
     /// The velocity at the last frame of `frames`. `Ok(None)` means "no estimate here" (the
     /// frame is skipped silently); an error is reported in the tracker's update and the frame
@@ -70,6 +79,9 @@ impl<R: VelocityRegressor + ?Sized> VelocityRegressor for Box<R> {
     fn window_len(&self) -> usize {
         (**self).window_len()
     }
+    fn up_axis(&self) -> Option<UpAxis> {
+        (**self).up_axis()
+    }
     fn regress(&mut self, frames: &FrameWindow<'_>) -> Result<Option<Regression>, RegressError> {
         (**self).regress(frames)
     }
@@ -78,6 +90,9 @@ impl<R: VelocityRegressor + ?Sized> VelocityRegressor for Box<R> {
 impl<R: VelocityRegressor + ?Sized> VelocityRegressor for &mut R {
     fn window_len(&self) -> usize {
         (**self).window_len()
+    }
+    fn up_axis(&self) -> Option<UpAxis> {
+        (**self).up_axis()
     }
     fn regress(&mut self, frames: &FrameWindow<'_>) -> Result<Option<Regression>, RegressError> {
         (**self).regress(frames)

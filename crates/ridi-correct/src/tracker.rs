@@ -397,6 +397,20 @@ impl<R: VelocityRegressor> Tracker<R> {
                 "the regressor's window must be at most 2^22 frames",
             ));
         }
+        if regressor.window_len() == 0 {
+            return Err(TrackError::InvalidConfig(
+                "the regressor's window must be at least 1 frame (the frame regressed)",
+            ));
+        }
+        if regressor
+            .up_axis()
+            .is_some_and(|a| a != config.correction.up_axis)
+        {
+            return Err(TrackError::InvalidConfig(
+                "the regressor's velocities are in another stabilized frame than the \
+                 correction's: set the correction's up_axis to the model's",
+            ));
+        }
         let cap = config
             .window
             .max(regressor.window_len().max(1))

@@ -73,6 +73,9 @@ fn a_single_window_over_everything_is_the_batch_solve() {
         correct_every: 800,
         ..Default::default()
     };
+    // A regressor must look at the frame it regresses at least.
+    let err = Tracker::new(config, Truth::new(&w, 0)).unwrap_err();
+    assert!(err.to_string().contains("at least 1 frame"), "{err}");
     let mut tracker = Tracker::new(config, Truth::new(&w, 1)).unwrap();
     let (updates, err) = tracker.push_all(&samples(&w));
     assert!(err.is_none());

@@ -739,6 +739,9 @@ fn source_files_are_what_the_readers_take() {
         [folder.join("processed/data.csv")]
     );
     let file = folder.join("processed/data.csv");
-    assert_eq!(ridi_data::source_files(&file).unwrap(), std::slice::from_ref(&file));
+    assert_eq!(
+        ridi_data::source_files(&file).unwrap(),
+        std::slice::from_ref(&file)
+    );
     assert!(ridi_data::source_files(dir.path().join("nope")).is_err());
 }

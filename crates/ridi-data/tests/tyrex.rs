@@ -661,6 +661,12 @@ fn source_files_of_a_run_include_its_ground_truth_beside_the_android_folder() {
     let fx = Fixture::standard();
     let files = ridi_data::source_files(&fx.dir).unwrap();
     assert!(files.contains(&fx.mat), "{files:?}");
-    assert!(files.contains(&fx.dir.join("accelerometer.txt")), "{files:?}");
-    assert!(files.contains(&fx.dir.join("rotation-vector.txt")), "{files:?}");
+    assert!(
+        files.contains(&fx.dir.join("accelerometer.txt")),
+        "{files:?}"
+    );
+    assert!(
+        files.contains(&fx.dir.join("rotation-vector.txt")),
+        "{files:?}"
+    );
 }

@@ -97,5 +97,7 @@ pub use features::{
 };
 pub use gaussian::{gaussian_filter1d, gaussian_kernel};
 pub use matrix::FeatureMatrix;
+/// The frame types the inputs are built from.
+pub use ridi_frames;
 pub use targets::{GroundTruthView, Targets, compute_targets, stabilized_velocity};
 pub use turn::{TurnedRows, YawTurn, turned_copies};

@@ -115,6 +115,10 @@ pub use grid::{GridRow, GridSpec};
 pub use kernel::Rbf;
 pub use matrix::{Matrix, MatrixRef};
 pub use progress::{NoProgress, Progress, ProgressEvent, Stage};
+/// The feature configuration a model stores ([`Cascade::feature_config`]).
+pub use ridi_features;
 pub use smo::SmoSettings;
 pub use svc::{Svc, SvcParams};
 pub use svr::{FitInfo, Svr, SvrParams};
+/// The versions the [`linfa_impl`] adapters are built against.
+pub use {linfa, ndarray};

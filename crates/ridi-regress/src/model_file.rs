@@ -131,7 +131,8 @@ fn io_err(path: &Path) -> impl FnOnce(std::io::Error) -> RegressError + '_ {
 }
 
 /// Writes the model atomically: temporary file in the same directory, `fsync`, rename.
-pub fn save(model: &Cascade, path: &Path) -> Result<(), RegressError> {
+pub fn save(model: &Cascade, path: impl AsRef<Path>) -> Result<(), RegressError> {
+    let path = path.as_ref();
     let bytes = to_bytes(model)?;
     let dir = match path.parent() {
         Some(d) if !d.as_os_str().is_empty() => d.to_path_buf(),
@@ -155,7 +156,8 @@ pub fn save(model: &Cascade, path: &Path) -> Result<(), RegressError> {
 }
 
 /// Reads and validates a model file.
-pub fn load(path: &Path) -> Result<Cascade, RegressError> {
+pub fn load(path: impl AsRef<Path>) -> Result<Cascade, RegressError> {
+    let path = path.as_ref();
     let bytes = std::fs::read(path).map_err(io_err(path))?;
     from_bytes(&bytes)
 }

@@ -11,7 +11,8 @@ pub enum Stage<'a> {
         /// Placement name.
         placement: &'a str,
     },
-    /// Final fit of the two regressors of one placement; steps are channels.
+    /// Final fit of the regressors of one placement (S-x, S-z, and the speed when the cascade
+    /// has one); steps are channels.
     Regressors {
         /// Placement name.
         placement: &'a str,

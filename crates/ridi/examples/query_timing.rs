@@ -53,7 +53,7 @@ fn main() -> Result<(), Error> {
             _ => lists[which.ok_or("lists follow --train or --test")?].push(a.into()),
         }
     }
-    let model = model_file::load(model_path.as_ref())?;
+    let model = model_file::load(model_path)?;
     let bytes = std::fs::metadata(model_path)?.len();
     println!(
         "{model_path}: {:.1} MB, {:?}, stored samples {:?}",

@@ -26,6 +26,7 @@ use crate::track::{Regressed, TrackOptions};
 /// The frames pushed must carry the orientation the model was trained with
 /// ([`FeatureConfig::orientation`](ridi_features::FeatureConfig::orientation));
 /// [`LiveTracker`] sees to that.
+#[derive(Debug)]
 pub struct CascadeRegressor<'m> {
     model: &'m Cascade,
     extractor: FeatureExtractor,
@@ -56,6 +57,10 @@ impl VelocityRegressor for CascadeRegressor<'_> {
         // One more than the feature window: the feature of the regressed (last) frame covers
         // the frames before it, as in batch tracking.
         self.extractor.config().window + 1
+    }
+
+    fn up_axis(&self) -> Option<ridi_frames::UpAxis> {
+        Some(self.extractor.config().up_axis)
     }
 
     fn regress(
@@ -178,6 +183,7 @@ impl LiveSample {
 /// println!("walked to ({:.1}, {:.1}) m", end.x(), end.y());
 /// # Ok::<(), Box<dyn std::error::Error>>(())
 /// ```
+#[derive(Debug)]
 pub struct LiveTracker<'m> {
     tracker: Tracker<CascadeRegressor<'m>>,
     estimator: Option<Estimator>,
@@ -185,6 +191,7 @@ pub struct LiveTracker<'m> {
 }
 
 /// The orientation estimate of a stream, and the samples waiting for it.
+#[derive(Debug)]
 struct Estimator {
     filter: OrientationFilter,
     waiting: VecDeque<(f64, DeviceVec, DeviceVec)>,

@@ -43,7 +43,8 @@ impl PlacementMap {
 
     /// Reads `label,class` lines (`#` comments and blank lines skipped). A label given two
     /// different classes, and a file without any entry, are errors.
-    pub fn read(path: &Path) -> Result<Self> {
+    pub fn read(path: impl AsRef<Path>) -> Result<Self> {
+        let path = path.as_ref();
         let error = |message: String| PipelineError::File {
             path: path.to_path_buf(),
             message,

@@ -92,7 +92,8 @@ impl Track {
     /// Writes the trajectory CSV: `time,pos_x,pos_y,pos_z,vel_x,vel_y,vel_z,placement,
     /// bias_x,bias_y,bias_z`, one row per frame (`placement` is the latest regression's, empty
     /// before the first). Written atomically.
-    pub fn write_csv(&self, path: &Path) -> Result<()> {
+    pub fn write_csv(&self, path: impl AsRef<Path>) -> Result<()> {
+        let path = path.as_ref();
         let mut next = 0;
         let mut current: Option<&str> = None;
         write_atomically(path, |w| {

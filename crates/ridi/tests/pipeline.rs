@@ -438,6 +438,14 @@ fn a_model_tracks_in_the_orientation_it_was_trained_with() {
         regress_every: online.regress_every,
         ..TrackerConfig::default()
     };
+    // The regressor knows its model's S: a correction set up for the paper's (the tracker's
+    // default) is refused rather than fed velocities in another frame.
+    let regressor = CascadeRegressor::new(&model, online.placement_smoothing).unwrap();
+    let err = Tracker::new(TrackerConfig::default(), regressor).unwrap_err();
+    assert!(
+        err.to_string().contains("another stabilized frame"),
+        "{err}"
+    );
     let regressor = CascadeRegressor::new(&model, online.placement_smoothing).unwrap();
     let mut tracker = Tracker::new(config, regressor).unwrap();
     let e = &pre[0];
