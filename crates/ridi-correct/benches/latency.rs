@@ -9,8 +9,8 @@ mod common;
 use std::time::Instant;
 
 use ridi_correct::{
-    CorrectionConfig, CorrectionOutcome, Corrector, FrameWindow, RegressError, Regression, Sample,
-    Tracker, TrackerConfig, VelocityRegressor, solve_dense,
+    CorrectionConfig, CorrectionOutcome, Corrector, FrameWindow, Regression, RegressorError,
+    Sample, Tracker, TrackerConfig, VelocityRegressor, solve_dense,
 };
 use ridi_frames::WorldVec;
 
@@ -24,7 +24,7 @@ impl VelocityRegressor for Replay {
     fn window_len(&self) -> usize {
         200
     }
-    fn regress(&mut self, frames: &FrameWindow<'_>) -> Result<Option<Regression>, RegressError> {
+    fn regress(&mut self, frames: &FrameWindow<'_>) -> Result<Option<Regression>, RegressorError> {
         let f = frames.last_frame() as usize % self.velocity.len();
         Ok(Some(Regression {
             velocity: self.velocity[f],

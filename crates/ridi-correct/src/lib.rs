@@ -80,7 +80,7 @@ pub use input::{ImuSlices, VelocityTarget};
 pub use integrate::{Integrator, Pose, corrected_acceleration, integrate, world_acceleration};
 pub use knots::{BiasCurve, Knots};
 pub use placement::{PlacementFilter, PlacementSmoother, TrailingMajority};
-pub use regressor::{FrameWindow, RegressError, Regression, VelocityRegressor};
+pub use regressor::{FrameWindow, Regression, RegressorError, VelocityRegressor};
 /// The frame types the inputs are built from.
 pub use ridi_frames;
 pub use solve::{Correction, Corrector, Trajectory, correct};

@@ -49,7 +49,7 @@ pub struct Regression {
 }
 
 /// The error type a regressor may return.
-pub type RegressError = Box<dyn std::error::Error + Send + Sync>;
+pub type RegressorError = Box<dyn std::error::Error + Send + Sync>;
 
 /// A source of regressed velocities for the [`Tracker`](crate::Tracker): the SVR cascade in
 /// production, test doubles in tests.
@@ -72,7 +72,7 @@ pub trait VelocityRegressor {
     /// The velocity at the last frame of `frames`. `Ok(None)` means "no estimate here" (the
     /// frame is skipped silently); an error is reported in the tracker's update and the frame
     /// is skipped too.
-    fn regress(&mut self, frames: &FrameWindow<'_>) -> Result<Option<Regression>, RegressError>;
+    fn regress(&mut self, frames: &FrameWindow<'_>) -> Result<Option<Regression>, RegressorError>;
 }
 
 impl<R: VelocityRegressor + ?Sized> VelocityRegressor for Box<R> {
@@ -82,7 +82,7 @@ impl<R: VelocityRegressor + ?Sized> VelocityRegressor for Box<R> {
     fn up_axis(&self) -> Option<UpAxis> {
         (**self).up_axis()
     }
-    fn regress(&mut self, frames: &FrameWindow<'_>) -> Result<Option<Regression>, RegressError> {
+    fn regress(&mut self, frames: &FrameWindow<'_>) -> Result<Option<Regression>, RegressorError> {
         (**self).regress(frames)
     }
 }
@@ -94,7 +94,7 @@ impl<R: VelocityRegressor + ?Sized> VelocityRegressor for &mut R {
     fn up_axis(&self) -> Option<UpAxis> {
         (**self).up_axis()
     }
-    fn regress(&mut self, frames: &FrameWindow<'_>) -> Result<Option<Regression>, RegressError> {
+    fn regress(&mut self, frames: &FrameWindow<'_>) -> Result<Option<Regression>, RegressorError> {
         (**self).regress(frames)
     }
 }

@@ -6,7 +6,7 @@ mod common;
 use common::{Walk, max_position_error, walk};
 use ridi_correct::{
     CorrectionConfig, CorrectionOutcome, Corrector, FrameWindow, GapPolicy, ImuSlices,
-    InitialVelocity, PlacementFilter, RegressError, Regression, RegressionOutcome, Sample,
+    InitialVelocity, PlacementFilter, Regression, RegressionOutcome, RegressorError, Sample,
     TrackError, Tracker, TrackerConfig, VelocityRegressor, VelocityTarget, corrected_acceleration,
     integrate, world_acceleration,
 };
@@ -36,7 +36,7 @@ impl VelocityRegressor for Truth {
     fn window_len(&self) -> usize {
         self.window
     }
-    fn regress(&mut self, frames: &FrameWindow<'_>) -> Result<Option<Regression>, RegressError> {
+    fn regress(&mut self, frames: &FrameWindow<'_>) -> Result<Option<Regression>, RegressorError> {
         assert_eq!(frames.len(), self.window);
         let f = frames.last_frame();
         if self.fail_every.is_some_and(|k| f.is_multiple_of(k)) {
@@ -335,7 +335,7 @@ fn failing_regressions_are_reported_and_skipped() {
         fn window_len(&self) -> usize {
             10
         }
-        fn regress(&mut self, _: &FrameWindow<'_>) -> Result<Option<Regression>, RegressError> {
+        fn regress(&mut self, _: &FrameWindow<'_>) -> Result<Option<Regression>, RegressorError> {
             Ok(Some(Regression {
                 velocity: [f64::NAN, 0.0],
                 label: None,

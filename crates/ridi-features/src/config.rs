@@ -10,7 +10,7 @@ use crate::matrix::FeatureMatrix;
 /// One IMU channel of the feature window, three values (x, y, z in S) per frame.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
-pub enum Channel {
+pub enum FeatureChannel {
     /// Gyroscope, rad/s.
     Gyro,
     /// Linear acceleration (gravity removed, Android `TYPE_LINEAR_ACCELERATION`), m/s^2.
@@ -44,7 +44,7 @@ pub struct FeatureConfig {
     /// Training sample step in frames.
     pub step: usize,
     /// Channels, in the order they appear within each time row of the feature.
-    pub channels: Vec<Channel>,
+    pub channels: Vec<FeatureChannel>,
     /// Gaussian truncation, in sigmas (scipy's `truncate`).
     pub truncate: f64,
     /// Per-dimension z-scoring learned on the training set, applied to every feature computed
@@ -66,7 +66,7 @@ impl Default for FeatureConfig {
             feature_sigma: 2.0,
             target_sigma: 30.0,
             step: 10,
-            channels: vec![Channel::Gyro, Channel::LinearAcceleration],
+            channels: vec![FeatureChannel::Gyro, FeatureChannel::LinearAcceleration],
             truncate: 4.0,
             standardization: None,
             up_axis: UpAxis::PlusY,

@@ -4,7 +4,7 @@ use rayon::prelude::*;
 use ridi_frames::{DeviceVec, UpAxis};
 
 use crate::FeatureError;
-use crate::config::{Channel, FeatureConfig};
+use crate::config::{FeatureChannel, FeatureConfig};
 use crate::gaussian::{filter_strided_f32, half_kernel};
 use crate::matrix::FeatureMatrix;
 
@@ -59,10 +59,10 @@ impl<'a> ImuView<'a> {
         Ok(())
     }
 
-    fn channel(&self, c: Channel) -> &'a [DeviceVec] {
+    fn channel(&self, c: FeatureChannel) -> &'a [DeviceVec] {
         match c {
-            Channel::Gyro => self.gyro,
-            Channel::LinearAcceleration => self.linacce,
+            FeatureChannel::Gyro => self.gyro,
+            FeatureChannel::LinearAcceleration => self.linacce,
         }
     }
 }
@@ -81,7 +81,7 @@ impl StabilizedChannels {
     /// mismatched lengths, non-finite values or an empty channel list.
     pub fn new(
         imu: &ImuView<'_>,
-        channels: &[Channel],
+        channels: &[FeatureChannel],
         up_axis: UpAxis,
     ) -> Result<Self, FeatureError> {
         imu.check_lengths()?;
@@ -149,10 +149,10 @@ impl StabilizedChannels {
     }
 }
 
-fn channel_name(c: Channel) -> &'static str {
+fn channel_name(c: FeatureChannel) -> &'static str {
     match c {
-        Channel::Gyro => "gyro",
-        Channel::LinearAcceleration => "linacce",
+        FeatureChannel::Gyro => "gyro",
+        FeatureChannel::LinearAcceleration => "linacce",
     }
 }
 

@@ -90,7 +90,7 @@ mod matrix;
 mod targets;
 mod turn;
 
-pub use config::{Channel, FeatureConfig, Orientation, Standardization, StandardizationFit};
+pub use config::{FeatureChannel, FeatureConfig, Orientation, Standardization, StandardizationFit};
 pub use error::FeatureError;
 pub use features::{
     FeatureExtractor, ImuView, SampleSchedule, StabilizedChannels, compute_features,

@@ -6,8 +6,8 @@ use common::naive;
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use ridi_features::{
-    Channel, FeatureConfig, FeatureError, FeatureExtractor, FeatureMatrix, ImuView, SampleSchedule,
-    Standardization, StandardizationFit, compute_features,
+    FeatureChannel, FeatureConfig, FeatureError, FeatureExtractor, FeatureMatrix, ImuView,
+    SampleSchedule, Standardization, StandardizationFit, compute_features,
 };
 use ridi_frames::{DeviceVec, UpAxis};
 
@@ -145,13 +145,13 @@ fn layout_is_time_major_gyro_then_linacce() {
     }
     // Channel order follows the configuration.
     let swapped = FeatureConfig {
-        channels: vec![Channel::LinearAcceleration, Channel::Gyro],
+        channels: vec![FeatureChannel::LinearAcceleration, FeatureChannel::Gyro],
         ..FeatureConfig::default()
     };
     let y = compute_features(&imu, &swapped, &[200]).unwrap();
     assert!((y.row(0)[0] - 4.0).abs() < 2e-6 && (y.row(0)[3] - 1.0).abs() < 2e-6);
     let gyro_only = FeatureConfig {
-        channels: vec![Channel::Gyro],
+        channels: vec![FeatureChannel::Gyro],
         ..FeatureConfig::default()
     };
     assert_eq!(gyro_only.feature_dim(), 600);
@@ -313,7 +313,7 @@ fn bad_input_is_an_error_not_a_panic() {
         Err(FeatureError::DimensionMismatch { .. })
     ));
     let gyro_only = FeatureExtractor::new(FeatureConfig {
-        channels: vec![Channel::Gyro],
+        channels: vec![FeatureChannel::Gyro],
         ..config.clone()
     })
     .unwrap();
@@ -340,7 +340,7 @@ fn invalid_configurations_are_rejected() {
             ..base.clone()
         },
         FeatureConfig {
-            channels: vec![Channel::Gyro, Channel::Gyro],
+            channels: vec![FeatureChannel::Gyro, FeatureChannel::Gyro],
             ..base.clone()
         },
         FeatureConfig {
@@ -388,7 +388,10 @@ fn config_default_is_the_paper_and_round_trips_through_json() {
         (c.feature_sigma, c.target_sigma, c.truncate),
         (2.0, 30.0, 4.0)
     );
-    assert_eq!(c.channels, vec![Channel::Gyro, Channel::LinearAcceleration]);
+    assert_eq!(
+        c.channels,
+        vec![FeatureChannel::Gyro, FeatureChannel::LinearAcceleration]
+    );
     assert_eq!(c.standardization, None);
     let with_std = FeatureConfig {
         standardization: Some(Standardization {

@@ -51,7 +51,7 @@
 //! use ridi_regress::{Cascade, CascadeParams, MatrixRef, NoProgress, RegressorChoice, TrainingSet, model_file};
 //!
 //! // A tiny feature config: a 2-frame window of one channel gives 6 values per sample.
-//! let config = FeatureConfig { window: 2, channels: vec![ridi_features::Channel::Gyro], ..FeatureConfig::default() };
+//! let config = FeatureConfig { window: 2, channels: vec![ridi_features::FeatureChannel::Gyro], ..FeatureConfig::default() };
 //! // Two placements; the velocity depends on the features, the placement on their sign.
 //! let mut x = Vec::new();
 //! let (mut y, mut placement, mut group) = (Vec::new(), Vec::new(), Vec::new());

@@ -2,7 +2,7 @@
 
 mod common;
 
-use ridi_features::{Channel, FeatureConfig};
+use ridi_features::{FeatureChannel, FeatureConfig};
 use ridi_regress::{
     Cascade, CascadeParams, GridSpec, MatrixRef, NoProgress, ProgressEvent, RegressError,
     RegressorChoice, Stage, Storage, StoredAs, Svc, SvcParams, TrainingSet, model_file,
@@ -40,7 +40,7 @@ fn make(placements: usize, seqs: usize, per_seq: usize, seed: u64) -> Data {
 fn make_window(placements: usize, seqs: usize, per_seq: usize, seed: u64, window: usize) -> Data {
     let config = FeatureConfig {
         window,
-        channels: vec![Channel::Gyro, Channel::LinearAcceleration],
+        channels: vec![FeatureChannel::Gyro, FeatureChannel::LinearAcceleration],
         ..FeatureConfig::default()
     };
     let d = config.feature_dim();

@@ -66,7 +66,7 @@ impl VelocityRegressor for CascadeRegressor<'_> {
     fn regress(
         &mut self,
         frames: &FrameWindow<'_>,
-    ) -> std::result::Result<Option<Regression>, ridi_correct::RegressError> {
+    ) -> std::result::Result<Option<Regression>, ridi_correct::RegressorError> {
         let imu = ImuView::new(frames.gyro, frames.linacce, frames.gravity)?;
         let stab = self.extractor.stabilize(&imu)?;
         let len = frames.len();
