@@ -546,10 +546,7 @@ fn run(cli: Cli) -> Result<()> {
 /// Refuses an output path that cannot be written: its folder missing or not a folder, or the
 /// path itself a folder. Checked before long work (training, tracking) rather than after it.
 fn check_output(path: &Path) -> Result<()> {
-    let parent = match path.parent() {
-        Some(p) if !p.as_os_str().is_empty() => p,
-        _ => Path::new("."),
-    };
+    let parent = folder_of(path);
     if !parent.is_dir() {
         bail!(
             "cannot write {}: the folder {} does not exist",
@@ -590,14 +587,17 @@ fn check_not_input(out: &Path, inputs: &[PathBuf], others: &[&Path]) -> Result<(
     let Some(target) = resolved(out) else {
         return Ok(()); // its folder is missing: check_output says so
     };
-    if let Some(input) = inputs.iter().find(|i| resolved(i) == Some(target.clone())) {
+    if let Some(input) = inputs
+        .iter()
+        .find(|i| resolved(i).as_ref() == Some(&target))
+    {
         bail!(
             "cannot write {}: the command reads it ({}); choose another output",
             out.display(),
             input.display()
         );
     }
-    if others.iter().any(|o| resolved(o) == Some(target.clone())) {
+    if others.iter().any(|o| resolved(o).as_ref() == Some(&target)) {
         bail!("cannot write {}: it is given as two outputs", out.display());
     }
     Ok(())
@@ -608,11 +608,15 @@ fn resolved(path: &Path) -> Option<PathBuf> {
     if let Ok(p) = path.canonicalize() {
         return Some(p);
     }
-    let parent = match path.parent() {
+    Some(folder_of(path).canonicalize().ok()?.join(path.file_name()?))
+}
+
+/// The folder a file path is in (`.` for a bare file name).
+fn folder_of(path: &Path) -> &Path {
+    match path.parent() {
         Some(p) if !p.as_os_str().is_empty() => p,
         _ => Path::new("."),
-    };
-    Some(parent.canonicalize().ok()?.join(path.file_name()?))
+    }
 }
 
 /// `--placement-window` (checked by clap: finite, at least 0): 0 turns the majority vote off.
