@@ -428,8 +428,7 @@ fn run(cli: Cli) -> Result<()> {
             let model = train_with_progress(&seqs, &opts).map_err(|e| {
                 let folds = matches!(
                     e.downcast_ref::<PipelineError>(),
-                    Some(PipelineError::Regress(RegressError::NotEnoughData(m)))
-                        if m.contains("cross-validation")
+                    Some(PipelineError::Regress(RegressError::TooFewSequences { .. }))
                 );
                 if folds {
                     e.context(

@@ -17,6 +17,18 @@ pub enum RegressError {
     /// Not enough data to train what was asked (e.g. a placement class with too few samples).
     #[error("not enough data: {0}")]
     NotEnoughData(String),
+    /// Grid search cross-validates by sequence, and a placement has fewer than two.
+    #[error(
+        "{}cross-validation by sequence needs at least 2 sequences, found {found} (with one, \
+         train with fixed C and epsilon instead of a search)",
+        if placement.is_empty() { String::new() } else { format!("placement '{placement}': ") }
+    )]
+    TooFewSequences {
+        /// The placement searched (empty where it is not known).
+        placement: String,
+        /// Its distinct sequences.
+        found: usize,
+    },
     /// The training was cancelled by the progress callback.
     #[error("training cancelled")]
     Cancelled,

@@ -92,11 +92,10 @@ pub fn assign_folds(
     distinct.sort_unstable();
     distinct.dedup();
     if distinct.len() < 2 {
-        return Err(RegressError::NotEnoughData(format!(
-            "cross-validation by sequence needs at least 2 sequences, found {} (with one, train \
-             with fixed C and epsilon instead of a search)",
-            distinct.len()
-        )));
+        return Err(RegressError::TooFewSequences {
+            placement: String::new(),
+            found: distinct.len(),
+        });
     }
     let k = folds.min(distinct.len());
     let mut counts: Vec<usize> = distinct
@@ -184,7 +183,13 @@ pub(crate) fn search(
 ) -> Result<Vec<GridRow>, RegressError> {
     spec.validate()?;
     let smo = &solver.smo;
-    let (fold, k) = assign_folds(groups, spec.folds, spec.seed)?;
+    let (fold, k) = assign_folds(groups, spec.folds, spec.seed).map_err(|e| match e {
+        RegressError::TooFewSequences { found, .. } => RegressError::TooFewSequences {
+            placement: placement.to_string(),
+            found,
+        },
+        other => other,
+    })?;
     let mut cs = spec.c.clone();
     cs.sort_by(f64::total_cmp);
     cs.dedup();
@@ -373,7 +378,7 @@ mod tests {
         assert_eq!(k, 2);
         assert!(matches!(
             assign_folds(&[5, 5, 5], 3, 0),
-            Err(RegressError::NotEnoughData(_))
+            Err(RegressError::TooFewSequences { found: 1, .. })
         ));
     }
 }

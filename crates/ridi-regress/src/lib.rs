@@ -36,7 +36,7 @@
 //!   [`RegressError::NotEnoughData`] naming the placement.
 //! - Grid search needs at least 2 sequences in a placement. A placement with fewer sequences
 //!   than folds uses one fold per sequence. A placement with a single sequence fails with
-//!   `NotEnoughData`.
+//!   [`RegressError::TooFewSequences`].
 //! - With one placement the classifier is skipped, and every query gets placement 0.
 //!
 //! # Model files

@@ -326,8 +326,10 @@ fn small_or_degenerate_placements_give_clear_errors_or_documented_fallbacks() {
         }
     }
     match Cascade::train(&one_seq.set(), &small_grid(), &mut NoProgress) {
-        Err(RegressError::NotEnoughData(m)) => assert!(m.contains("placement0"), "{m}"),
-        other => panic!("expected NotEnoughData, got {other:?}"),
+        Err(e @ RegressError::TooFewSequences { found: 1, .. }) => {
+            assert!(e.to_string().starts_with("placement 'placement0': "), "{e}")
+        }
+        other => panic!("expected TooFewSequences, got {other:?}"),
     }
     // A single placement: no classifier, every query gets placement 0.
     let single = make(1, 3, 10, 4);
