@@ -66,7 +66,8 @@ enum Command {
     #[command(after_help = "Examples:\n  \
         ridi convert ../shared/data/raw/tyrex-attitude-smartphones --out converted\n  \
         ridi convert my_capture/ --from ridi-raw --out converted\n  \
-        ridi convert indoor-location-competition-20/data --from ilc --out converted\n\n\
+        ridi convert indoor-location-competition-20/data --from ilc --out converted\n  \
+        ridi convert phone_at_100hz/ --out converted --rate 200   (train, track and eval need 200 Hz)\n\n\
         Writes <out>/<name>/processed/data.csv per sequence and list files \
         (`path,placement` per line): for a Tyrex root, list_<subject>.txt per person and list_all.txt.")]
     Convert {
@@ -79,6 +80,10 @@ enum Command {
         /// Source format (detected when omitted).
         #[arg(long, value_enum)]
         from: Option<FromFormat>,
+        /// Resample every sequence to this rate, Hz (linear interpolation, slerp for
+        /// rotations); a gap longer than 5 frame intervals is refused: split it first.
+        #[arg(long, value_name = "HZ", value_parser = positive)]
+        rate: Option<f64>,
     },
 
     /// Train the placement classifier and velocity regressors on labelled recordings.
@@ -360,13 +365,18 @@ fn run(cli: Cli) -> Result<()> {
                 }
             }
         }
-        Command::Convert { source, out, from } => {
-            let summary = ridi::convert::convert(
-                &source,
-                &out,
-                from.map(Format::from),
-                &ReadOptions::default(),
-            )?;
+        Command::Convert {
+            source,
+            out,
+            from,
+            rate,
+        } => {
+            let opts = ridi::convert::ConvertOptions {
+                from: from.map(Format::from),
+                read: ReadOptions::default(),
+                rate_hz: rate,
+            };
+            let summary = ridi::convert::convert(&source, &out, &opts)?;
             for w in &summary.warnings {
                 eprintln!("warning: {w}");
             }

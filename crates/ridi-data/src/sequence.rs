@@ -530,6 +530,12 @@ pub enum SequenceError {
         /// The limit.
         max_gap_s: f64,
     },
+    /// A resampling rate that is not a finite number above 0 ([`Sequence::resampled`]).
+    #[error("cannot resample to {rate_hz} Hz: the rate must be a finite number above 0")]
+    InvalidRate {
+        /// The rate asked for.
+        rate_hz: f64,
+    },
     /// A value beyond the hard physical bound of its channel ([`Validation::limit`]): a
     /// corrupt value or a wrong unit.
     #[error("`{channel}.{}` at frame {index}: {}", AXES[*axis], beyond(*channel, *value, *limit))]
@@ -898,6 +904,51 @@ impl Sequence {
                 .map(|w| ((w[1].x() - w[0].x()).powi(2) + (w[1].y() - w[0].y()).powi(2)).sqrt())
                 .sum(),
         )
+    }
+
+    /// The sequence on a uniform timeline at `rate_hz` from its first frame to at most its
+    /// last: vectors (IMU and ground-truth positions) linearly interpolated, rotations by
+    /// slerp, step times kept. For a recording at another rate than a model's (RIDI models
+    /// count frames of a 200 Hz stream); `ridi convert --rate` applies it.
+    ///
+    /// # Errors
+    /// A `rate_hz` that is not finite and positive; a gap between two frames longer than
+    /// `max_gap_s` (interpolating would invent the frames of a gap: split the recording
+    /// there first); the default validation of the result.
+    pub fn resampled(&self, rate_hz: f64, max_gap_s: f64) -> Result<Sequence, SequenceError> {
+        use crate::resample::{interpolate_rot, interpolate_vec3, uniform_timeline};
+        if !(rate_hz.is_finite() && rate_hz > 0.0) {
+            return Err(SequenceError::InvalidRate { rate_hz });
+        }
+        let p = &self.parts;
+        let t = &p.time;
+        if let Some(i) = t.windows(2).position(|w| w[1] - w[0] > max_gap_s) {
+            return Err(SequenceError::Gap {
+                index: i + 1,
+                time: t[i + 1],
+                gap_s: t[i + 1] - t[i],
+                max_gap_s,
+            });
+        }
+        let time = uniform_timeline(t[0], t[t.len() - 1], rate_hz);
+        let vec3 = |v: &[DeviceVec]| interpolate_vec3(t, v, &time);
+        Sequence::new(SequenceParts {
+            name: p.name.clone(),
+            placement: p.placement.clone(),
+            gyro: vec3(&p.gyro),
+            acce: vec3(&p.acce),
+            linacce: vec3(&p.linacce),
+            gravity: vec3(&p.gravity),
+            magnet: p.magnet.as_deref().map(vec3),
+            orientation: interpolate_rot(t, &p.orientation, &time),
+            orientation_source: p.orientation_source,
+            ground_truth: p.ground_truth.as_ref().map(|gt| GroundTruth {
+                position: interpolate_vec3(t, &gt.position, &time),
+                orientation: interpolate_rot(t, &gt.orientation, &time),
+            }),
+            steps: p.steps.clone(),
+            time,
+        })
     }
 
     /// The frames in `range`, as a new sequence with the same name and labels.

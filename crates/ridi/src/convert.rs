@@ -36,6 +36,24 @@ pub struct ConvertSummary {
     pub warnings: Vec<String>,
 }
 
+/// How to convert.
+#[derive(Debug, Clone, Default)]
+pub struct ConvertOptions {
+    /// Read every source as this format instead of detecting it.
+    pub from: Option<Format>,
+    /// How to read (validation limits).
+    pub read: ReadOptions,
+    /// Resample every sequence to this rate, Hz ([`Sequence::resampled`]); `None` keeps each
+    /// sequence's timeline.
+    ///
+    /// [`Sequence::resampled`]: ridi_data::Sequence::resampled
+    pub rate_hz: Option<f64>,
+}
+
+/// Longest gap `--rate` interpolates across, in frame intervals of the source: longer ones
+/// would be filled with invented frames, so the recording has to be split there first.
+const RESAMPLE_MAX_GAP_FRAMES: f64 = 5.0;
+
 /// What converting one source produced: the sequences written and the warnings.
 type Written = (Vec<Converted>, Vec<String>);
 
@@ -247,9 +265,9 @@ fn tyrex_subject(name: &str) -> Option<&str> {
 pub fn convert(
     source: &Path,
     out: &Path,
-    from: Option<Format>,
-    opts: &ReadOptions,
+    opts: &ConvertOptions,
 ) -> Result<ConvertSummary, DataError> {
+    let from = opts.from;
     let dirs = sources(source, from)?;
     let listed = labels_from_lists(source);
     let labels = &listed.labels;
@@ -257,10 +275,21 @@ pub fn convert(
     let results: Vec<Result<Written, DataError>> = dirs
         .par_iter()
         .map(|dir| {
-            let loaded = read_any(dir, from, opts)?;
+            let loaded = read_any(dir, from, &opts.read)?;
             let mut written = Vec::new();
             let listed = dir.canonicalize().ok().and_then(|d| labels.get(&d));
             for seq in &loaded.sequences {
+                let resampled = match opts.rate_hz {
+                    Some(rate) => {
+                        let max_gap = RESAMPLE_MAX_GAP_FRAMES / seq.median_rate_hz();
+                        Some(
+                            seq.resampled(rate, max_gap)
+                                .map_err(|e| DataError::sequence(dir, e))?,
+                        )
+                    }
+                    None => None,
+                };
+                let seq = resampled.as_ref().unwrap_or(seq);
                 let rel = Path::new(seq.name()).join("processed").join("data.csv");
                 write_ridi_csv(seq, staging.file(&rel)?)?;
                 written.push(Converted {

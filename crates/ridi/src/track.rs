@@ -275,8 +275,8 @@ pub(crate) fn check_frames(seq: &Sequence, config: &FeatureConfig) -> Result<()>
             seq.name(),
             format!(
                 "has a rate of {rate:.1} Hz (median frame interval); models count windows and \
-                 knots in frames of a {RATE_HZ} Hz stream (within {:.0} %): resample it to \
-                 {RATE_HZ} Hz",
+                 knots in frames of a {RATE_HZ} Hz stream (within {:.0} %): resample it with \
+                 `ridi convert <recording> --out <folder> --rate {RATE_HZ}`",
                 RATE_TOLERANCE * 100.0
             ),
         ));

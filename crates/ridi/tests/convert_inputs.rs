@@ -3,8 +3,11 @@
 
 use std::path::{Path, PathBuf};
 
-use ridi::convert::convert;
-use ridi::data::{Format, ReadOptions, read_sequence, write_ridi_csv, write_ridi_plain};
+use ridi::convert::{ConvertOptions, convert};
+use ridi::data::{
+    Format, GroundTruth, ReadOptions, Sequence, SequenceError, SequenceParts, read_sequence,
+    write_ridi_csv, write_ridi_plain,
+};
 
 fn seq(name: &str) -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR"))
@@ -61,7 +64,9 @@ fn a_bad_source_leaves_no_conversion_behind() {
     let opts = ReadOptions::default();
     // A new output folder (and its parent) is not left behind.
     let out = dir.path().join("new/conv");
-    let e = convert(&src, &out, None, &opts).unwrap_err().to_string();
+    let e = convert(&src, &out, &ConvertOptions::default())
+        .unwrap_err()
+        .to_string();
     assert!(
         e.contains("b_seq/processed/data.csv:301: field `gyro_y`"),
         "{e}"
@@ -73,7 +78,7 @@ fn a_bad_source_leaves_no_conversion_behind() {
     std::fs::write(out.join("a_seq/processed/data.csv"), "old").unwrap();
     std::fs::write(out.join("notes.txt"), "mine").unwrap();
     let before = files_under(&out);
-    assert!(convert(&src, &out, None, &opts).is_err());
+    assert!(convert(&src, &out, &ConvertOptions::default()).is_err());
     assert_eq!(files_under(&out), before);
     assert_eq!(
         std::fs::read_to_string(out.join("a_seq/processed/data.csv")).unwrap(),
@@ -81,7 +86,7 @@ fn a_bad_source_leaves_no_conversion_behind() {
     );
     // Without the bad source, everything is written, replacing the old file.
     std::fs::remove_dir_all(src.join("b_seq")).unwrap();
-    let summary = convert(&src, &out, None, &opts).unwrap();
+    let summary = convert(&src, &out, &ConvertOptions::default()).unwrap();
     assert_eq!(summary.sequences.len(), 2);
     assert_eq!(summary.lists, [out.join("list_all.txt")]);
     let names: Vec<String> = files_under(&out)
@@ -114,9 +119,16 @@ fn a_source_of_another_format_than_given_says_what_it_is_and_what_was_expected()
     let out = dir.path().join("c");
     // The error of converting `source` as `from`, which must contain `want`.
     let fails = |source: &Path, from: Format, want: &str| {
-        let e = convert(source, &out, Some(from), &opts)
-            .unwrap_err()
-            .to_string();
+        let e = convert(
+            source,
+            &out,
+            &ConvertOptions {
+                from: Some(from),
+                ..ConvertOptions::default()
+            },
+        )
+        .unwrap_err()
+        .to_string();
         assert!(e.contains(want), "{e}");
         e
     };
@@ -169,7 +181,15 @@ fn a_source_of_another_format_than_given_says_what_it_is_and_what_was_expected()
     std::fs::create_dir_all(plain.parent().unwrap()).unwrap();
     write_ridi_plain(&s, &plain).unwrap();
     for source in [&csv, &plain] {
-        let summary = convert(source, &out, Some(Format::RidiCsv), &opts).unwrap();
+        let summary = convert(
+            source,
+            &out,
+            &ConvertOptions {
+                from: Some(Format::RidiCsv),
+                ..ConvertOptions::default()
+            },
+        )
+        .unwrap();
         assert_eq!(summary.sequences[0].frames, s.len());
     }
     let files = files_under(&out);
@@ -180,7 +200,6 @@ fn a_source_of_another_format_than_given_says_what_it_is_and_what_was_expected()
 #[test]
 fn list_labels_in_the_source_carry_over_and_a_folder_of_another_format_is_named() {
     let dir = tempfile::tempdir().unwrap();
-    let opts = ReadOptions::default();
     let src = sources_named(dir.path(), &["walk_a", "walk_b", "walk_c"]);
     // The RIDI layout keeps labels in list files beside the sequences; a licence is no list,
     // and a second list that disagrees keeps the first label with a warning.
@@ -189,7 +208,7 @@ fn list_labels_in_the_source_carry_over_and_a_folder_of_another_format_is_named(
     std::fs::write(src.join("list_b.txt"), "# other\nwalk_b,Swinging\n").unwrap();
 
     let out = dir.path().join("out");
-    let summary = convert(&src, &out, None, &opts).unwrap();
+    let summary = convert(&src, &out, &ConvertOptions::default()).unwrap();
     let labels: Vec<(&str, Option<&str>)> = summary
         .sequences
         .iter()
@@ -219,7 +238,9 @@ fn list_labels_in_the_source_carry_over_and_a_folder_of_another_format_is_named(
     // Converting into the source folder would replace the lists it read: refused, and the
     // folder stays as it was.
     let before = std::fs::read_to_string(src.join("list_a.txt")).unwrap();
-    let e = convert(&src, &src, None, &opts).unwrap_err().to_string();
+    let e = convert(&src, &src, &ConvertOptions::default())
+        .unwrap_err()
+        .to_string();
     assert!(
         e.contains("the conversion reads this file and would replace it"),
         "{e}"
@@ -238,13 +259,99 @@ fn list_labels_in_the_source_carry_over_and_a_folder_of_another_format_is_named(
 
     // Asked for another format, the folder says what it holds.
     for from in [Format::Tyrex, Format::Ilc, Format::RidiRaw] {
-        let e = convert(&src, &dir.path().join("x"), Some(from), &opts)
-            .unwrap_err()
-            .to_string();
+        let e = convert(
+            &src,
+            &dir.path().join("x"),
+            &ConvertOptions {
+                from: Some(from),
+                ..ConvertOptions::default()
+            },
+        )
+        .unwrap_err()
+        .to_string();
         assert!(
             e.contains("but 3 source(s) of another format")
                 && e.contains("is a RIDI processed csv"),
             "{e}"
         );
     }
+}
+
+#[test]
+fn rate_resamples_every_sequence_and_refuses_to_fill_gaps() {
+    let dir = tempfile::tempdir().unwrap();
+    let opts = ReadOptions::default();
+    let full = read_sequence(seq("Thibaud_Nexus5_NoDist_Texting"), &opts).unwrap();
+    // The same walk logged at 100 Hz: every other frame.
+    let keep: Vec<usize> = (0..full.len()).step_by(2).collect();
+    let at_100 = |keep: &[usize]| {
+        let p = full.parts();
+        let pick = |v: &[ridi::frames::DeviceVec]| keep.iter().map(|&i| v[i]).collect();
+        let gt = p.ground_truth.as_ref().unwrap();
+        Sequence::new(SequenceParts {
+            time: keep.iter().map(|&i| p.time[i]).collect(),
+            gyro: pick(&p.gyro),
+            acce: pick(&p.acce),
+            linacce: pick(&p.linacce),
+            gravity: pick(&p.gravity),
+            orientation: keep.iter().map(|&i| p.orientation[i]).collect(),
+            ground_truth: Some(GroundTruth {
+                position: keep.iter().map(|&i| gt.position[i]).collect(),
+                orientation: keep.iter().map(|&i| gt.orientation[i]).collect(),
+            }),
+            ..p.clone()
+        })
+        .unwrap()
+    };
+    let slow = at_100(&keep);
+    let src = dir.path().join("src/walk/processed");
+    std::fs::create_dir_all(&src).unwrap();
+    write_ridi_csv(&slow, src.join("data.csv")).unwrap();
+
+    let out = dir.path().join("out");
+    let to_200 = ConvertOptions {
+        rate_hz: Some(200.0),
+        ..ConvertOptions::default()
+    };
+    convert(&dir.path().join("src"), &out, &to_200).unwrap();
+    let back = read_sequence(out.join("walk"), &opts).unwrap();
+    assert!(
+        (back.median_rate_hz() - 200.0).abs() < 0.01,
+        "{}",
+        back.median_rate_hz()
+    );
+    assert!(
+        back.len() >= 2 * slow.len() - 2,
+        "{} from {}",
+        back.len(),
+        slow.len()
+    );
+    // Interpolation reproduces the 200 Hz original closely between the 100 Hz samples.
+    let n = back.len().min(full.len());
+    let worst = (0..n)
+        .map(|i| (back.acce()[i] - full.acce()[i]).norm())
+        .fold(0.0, f64::max);
+    assert!(worst < 3.0, "{worst}");
+    // At the 100 Hz samples themselves, the values are the recorded ones.
+    for i in (0..n).step_by(2) {
+        let d = (back.acce()[i] - full.acce()[i]).norm();
+        assert!(d < 1e-4, "frame {i}: {d}");
+    }
+    assert!((back.time()[0] - full.time()[0]).abs() < 1e-6);
+
+    // A 0.1 s gap (10 frame intervals at 100 Hz) would be filled with invented frames.
+    let gappy: Vec<usize> = keep
+        .iter()
+        .copied()
+        .filter(|i| !(1000..1020).contains(i))
+        .collect();
+    write_ridi_csv(&at_100(&gappy), src.join("data.csv")).unwrap();
+    let e = convert(&dir.path().join("src"), &dir.path().join("out2"), &to_200)
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("gap of 0.110 s") && e.contains("walk"), "{e}");
+    assert!(matches!(
+        slow.resampled(0.0, 1.0),
+        Err(SequenceError::InvalidRate { .. })
+    ));
 }

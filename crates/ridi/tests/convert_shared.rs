@@ -24,7 +24,7 @@ fn the_whole_tyrex_root_converts_with_one_list_per_person() {
         return;
     };
     let out = tempfile::tempdir().unwrap();
-    let summary = ridi::convert::convert(&root, out.path(), None, &ReadOptions::default()).unwrap();
+    let summary = ridi::convert::convert(&root, out.path(), &Default::default()).unwrap();
     // 24 runs, some split at long mocap or sensor gaps into parts, each named and listed.
     assert!(summary.sequences.len() >= 24, "{}", summary.sequences.len());
     assert!(!summary.warnings.is_empty(), "splits are reported");
@@ -52,7 +52,7 @@ fn indoor_location_competition_paths_convert_with_the_hand_placement() {
         return;
     };
     let out = tempfile::tempdir().unwrap();
-    let summary = ridi::convert::convert(&root, out.path(), None, &ReadOptions::default()).unwrap();
+    let summary = ridi::convert::convert(&root, out.path(), &Default::default()).unwrap();
     assert_eq!(summary.sequences.len(), 12);
     assert!(summary.warnings.is_empty(), "{:?}", summary.warnings);
     let all = read_list(out.path().join("list_all.txt")).unwrap();
