@@ -27,7 +27,10 @@ pub enum Orientation {
     #[default]
     Recorded,
     /// Estimated from gyro and accelerometer (`ridi_frames::estimate_orientation`, default
-    /// filter), with gravity and linear acceleration derived from it.
+    /// filter), with gravity and linear acceleration derived from it: for each frame's
+    /// estimate `q`, gravity `ridi_frames::gravity_in_device(q, ridi_frames::STANDARD_GRAVITY)`
+    /// and linear acceleration the accelerometer minus that gravity (what `ridi::oriented`
+    /// and `ridi::LiveTracker` do).
     Estimated,
 }
 
