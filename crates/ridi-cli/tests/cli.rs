@@ -100,6 +100,15 @@ fn inspect_prints_text_and_json() {
         stderr(&out)
     );
     assert!(!text.contains("-0.00"), "{text}");
+    // Less than a feature window: readable, but nothing to train, track or evaluate.
+    let short = dir.path().join("short.csv");
+    ridi::data::write_ridi_csv(&seq.slice(0..150), &short).unwrap();
+    let out = ridi(&["inspect", s(&short)]);
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        out.status.success() && text.contains("150 frames: no whole feature window (200 frames)"),
+        "{text}"
+    );
 }
 
 #[test]
