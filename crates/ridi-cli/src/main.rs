@@ -14,6 +14,7 @@ use ridi::eval::{AlignWindow, EvalConfig};
 use ridi::features::FeatureConfig;
 use ridi::frames::UpAxis;
 use ridi::regress::{Cascade, ProgressEvent, RegressError, Stage, Storage, StoredAs, model_file};
+use ridi::source::{ReadFiles, folder_of, resolved};
 use ridi::{
     EvalOptions, GridChoice, Method, Orientation, PipelineError, PlacementMap, Purpose,
     TrackOptions, TrainOptions, apply_orientation,
@@ -408,15 +409,14 @@ fn run(cli: Cli) -> Result<()> {
         } => {
             set_jobs(jobs)?;
             check_output(&out)?;
-            let mut inputs: Vec<PathBuf> = list.clone();
+            let mut read = list.clone();
             for l in &list {
                 // Unreadable lists are reported by load_lists below, with their line.
                 if let Ok(entries) = ridi::data::read_list(l) {
-                    inputs.extend(read_files(
-                        &entries.into_iter().map(|e| e.path).collect::<Vec<_>>(),
-                    ));
+                    read.extend(entries.into_iter().map(|e| e.path));
                 }
             }
+            let inputs = ReadFiles::of(&read);
             check_not_input(&out, &inputs, &[])?;
             let seqs = load_lists(&list, placement_map.as_deref(), Purpose::Training)?;
             let defaults = TrainOptions::default();
@@ -467,7 +467,7 @@ fn run(cli: Cli) -> Result<()> {
         } => {
             // Every output is checked before any work, so that a bad --plot cannot leave the
             // trajectory written and the command failed.
-            let inputs = read_files(&[sequence.clone(), model.clone()]);
+            let inputs = ReadFiles::of([&sequence, &model]);
             check_output(&out)?;
             check_not_input(&out, &inputs, &[])?;
             if let Some(plot) = &plot {
@@ -580,52 +580,21 @@ fn check_output_folder(dir: &Path) -> Result<()> {
     Ok(())
 }
 
-/// The files a command reads from `paths`: a sequence given as a folder stands for the files
-/// its reader takes ([`ridi::data::source_files`]); anything else for itself.
-fn read_files(paths: &[PathBuf]) -> Vec<PathBuf> {
-    paths
-        .iter()
-        .flat_map(|p| ridi::data::source_files(p).unwrap_or_else(|_| vec![p.clone()]))
-        .collect()
-}
-
-/// Refuses an output that would overwrite what the command reads (`inputs`, from
-/// [`read_files`]) or another of its outputs (`others`). Files beside a recording that its
-/// reader does not take, e.g. a trajectory, may be written.
-fn check_not_input(out: &Path, inputs: &[PathBuf], others: &[&Path]) -> Result<()> {
-    let Some(target) = resolved(out) else {
-        return Ok(()); // its folder is missing: check_output says so
-    };
-    if let Some(input) = inputs
-        .iter()
-        .find(|i| resolved(i).as_ref() == Some(&target))
-    {
+/// Refuses an output that would replace what the command reads (`inputs`) or another of its
+/// outputs (`others`).
+fn check_not_input(out: &Path, inputs: &ReadFiles, others: &[&Path]) -> Result<()> {
+    if let Some(input) = inputs.overwritten_by(out) {
         bail!(
             "cannot write {}: the command reads it ({}); choose another output",
             out.display(),
             input.display()
         );
     }
-    if others.iter().any(|o| resolved(o).as_ref() == Some(&target)) {
+    let target = resolved(out);
+    if target.is_some() && others.iter().any(|o| resolved(o) == target) {
         bail!("cannot write {}: it is given as two outputs", out.display());
     }
     Ok(())
-}
-
-/// `path` with its folder resolved (links, `..`), whether or not the file exists yet.
-fn resolved(path: &Path) -> Option<PathBuf> {
-    if let Ok(p) = path.canonicalize() {
-        return Some(p);
-    }
-    Some(folder_of(path).canonicalize().ok()?.join(path.file_name()?))
-}
-
-/// The folder a file path is in (`.` for a bare file name).
-fn folder_of(path: &Path) -> &Path {
-    match path.parent() {
-        Some(p) if !p.as_os_str().is_empty() => p,
-        _ => Path::new("."),
-    }
 }
 
 /// `--placement-window` (checked by clap: finite, at least 0): 0 turns the majority vote off.

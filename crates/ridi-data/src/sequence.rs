@@ -678,6 +678,29 @@ fn check_len(field: &'static str, expected: usize, found: usize) -> Result<(), S
     }
 }
 
+/// `time` strictly increasing, with no step longer than `max_gap_s`.
+fn check_steps(time: &[f64], max_gap_s: f64) -> Result<(), SequenceError> {
+    for (i, w) in time.windows(2).enumerate() {
+        let gap = w[1] - w[0];
+        if gap <= 0.0 {
+            return Err(SequenceError::TimeNotIncreasing {
+                index: i + 1,
+                previous: w[0],
+                next: w[1],
+            });
+        }
+        if gap > max_gap_s {
+            return Err(SequenceError::Gap {
+                index: i + 1,
+                time: w[1],
+                gap_s: gap,
+                max_gap_s,
+            });
+        }
+    }
+    Ok(())
+}
+
 fn check_vecs(field: &'static str, n: usize, v: &[DeviceVec]) -> Result<(), SequenceError> {
     check_len(field, n, v.len())?;
     match v.iter().position(|x| !x.is_finite()) {
@@ -707,24 +730,7 @@ impl Sequence {
                 index,
             });
         }
-        for (i, w) in parts.time.windows(2).enumerate() {
-            let gap = w[1] - w[0];
-            if gap <= 0.0 {
-                return Err(SequenceError::TimeNotIncreasing {
-                    index: i + 1,
-                    previous: w[0],
-                    next: w[1],
-                });
-            }
-            if gap > limits.max_gap_s {
-                return Err(SequenceError::Gap {
-                    index: i + 1,
-                    time: w[1],
-                    gap_s: gap,
-                    max_gap_s: limits.max_gap_s,
-                });
-            }
-        }
+        check_steps(&parts.time, limits.max_gap_s)?;
         check_vecs("gyro", n, &parts.gyro)?;
         check_vecs("acce", n, &parts.acce)?;
         check_vecs("linacce", n, &parts.linacce)?;
@@ -922,14 +928,7 @@ impl Sequence {
         }
         let p = &self.parts;
         let t = &p.time;
-        if let Some(i) = t.windows(2).position(|w| w[1] - w[0] > max_gap_s) {
-            return Err(SequenceError::Gap {
-                index: i + 1,
-                time: t[i + 1],
-                gap_s: t[i + 1] - t[i],
-                max_gap_s,
-            });
-        }
+        check_steps(t, max_gap_s)?;
         let time = uniform_timeline(t[0], t[t.len() - 1], rate_hz);
         let vec3 = |v: &[DeviceVec]| interpolate_vec3(t, v, &time);
         Sequence::new(SequenceParts {

@@ -9,7 +9,7 @@ use ridi_data::{
 };
 use ridi_data::{ilc, tyrex};
 
-use crate::source::{is_a, not_a, read_any, with_article};
+use crate::source::{ReadFiles, is_a, not_a, read_any, with_article};
 use crate::staging::Staging;
 
 /// One sequence written by [`convert`].
@@ -218,17 +218,10 @@ fn check_overwrites(
     sequences: &[Converted],
     written_lists: &[PathBuf],
 ) -> Result<(), DataError> {
-    let mut inputs: Vec<PathBuf> = lists.to_vec();
-    for s in sources {
-        inputs.extend(ridi_data::source_files(s).unwrap_or_else(|_| vec![s.clone()]));
-    }
-    let inputs: Vec<PathBuf> = inputs
-        .iter()
-        .filter_map(|p| p.canonicalize().ok())
-        .collect();
+    let inputs = ReadFiles::of(sources.iter().chain(lists));
     let outputs = sequences.iter().map(|c| &c.path).chain(written_lists);
     for out in outputs {
-        if out.canonicalize().is_ok_and(|o| inputs.contains(&o)) {
+        if inputs.overwritten_by(out).is_some() {
             return Err(DataError::format(
                 Location::file(out),
                 "the conversion reads this file and would replace it: choose an --out outside \

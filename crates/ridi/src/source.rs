@@ -1,6 +1,6 @@
 //! Reading sequences from any supported layout, including those that yield several sequences.
 
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 use ridi_data::tyrex::{self, TyrexOptions};
 use ridi_data::{DataError, Format, Location, ReadOptions, Sequence, detect, read_sequence};
@@ -89,5 +89,53 @@ pub fn read_any(
             sequences: vec![read_sequence(path, opts)?],
             warnings: Vec::new(),
         }),
+    }
+}
+
+/// The files a command reads, resolved once, to refuse an output that would replace one.
+#[derive(Debug, Clone, Default)]
+pub struct ReadFiles {
+    /// (as given, resolved)
+    files: Vec<(PathBuf, PathBuf)>,
+}
+
+impl ReadFiles {
+    /// `paths`, a sequence among them standing for the files its reader takes
+    /// ([`ridi_data::source_files`]: a folder's data files, a Tyrex run's `.mat`); any other
+    /// path (a model, a list) for itself.
+    pub fn of<'a>(paths: impl IntoIterator<Item = &'a PathBuf>) -> Self {
+        let files = paths
+            .into_iter()
+            .flat_map(|p| ridi_data::source_files(p).unwrap_or_else(|_| vec![p.clone()]))
+            .filter_map(|f| resolved(&f).map(|r| (f, r)))
+            .collect();
+        Self { files }
+    }
+
+    /// The input `out` would replace, if any. Files beside a recording that its reader does
+    /// not take (a trajectory, notes) are not inputs.
+    pub fn overwritten_by(&self, out: &Path) -> Option<&Path> {
+        let target = resolved(out)?;
+        self.files
+            .iter()
+            .find(|(_, r)| *r == target)
+            .map(|(given, _)| given.as_path())
+    }
+}
+
+/// `path` with its folder resolved (links, `..`), whether or not the file exists yet; `None`
+/// when its folder does not exist.
+pub fn resolved(path: &Path) -> Option<PathBuf> {
+    if let Ok(p) = path.canonicalize() {
+        return Some(p);
+    }
+    Some(folder_of(path).canonicalize().ok()?.join(path.file_name()?))
+}
+
+/// The folder a file path is in (`.` for a bare file name).
+pub fn folder_of(path: &Path) -> &Path {
+    match path.parent() {
+        Some(p) if !p.as_os_str().is_empty() => p,
+        _ => Path::new("."),
     }
 }
