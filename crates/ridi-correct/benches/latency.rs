@@ -28,7 +28,7 @@ impl VelocityRegressor for Replay {
         let f = frames.last_frame() as usize % self.velocity.len();
         Ok(Some(Regression {
             velocity: self.velocity[f],
-            label: None,
+            placement: None,
         }))
     }
 }

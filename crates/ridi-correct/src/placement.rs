@@ -33,10 +33,10 @@ impl PlacementFilter {
     /// `max_changes` changes between consecutive known labels within
     /// `[i - radius, i + radius]` (clipped to the slice). Unknown labels (`None`) are skipped,
     /// so they neither count as nor hide a change.
-    pub fn flags(&self, labels: &[Option<u32>]) -> Vec<bool> {
+    pub fn flags(&self, labels: &[Option<usize>]) -> Vec<bool> {
         // changes[i] = number of changes between consecutive known labels up to index i.
         let mut changes = Vec::with_capacity(labels.len());
-        let mut prev: Option<u32> = None;
+        let mut prev: Option<usize> = None;
         let mut count = 0usize;
         for l in labels {
             if let Some(l) = *l {

@@ -45,7 +45,7 @@ pub struct Regression {
     pub velocity: [f64; 2],
     /// Placement class id (e.g. leg, bag, hand, body), if the regressor classifies; used by
     /// the placement-change filter.
-    pub label: Option<u32>,
+    pub placement: Option<usize>,
 }
 
 /// The error type a regressor may return.

@@ -288,7 +288,7 @@ pub struct Segment {
 struct StoredTarget {
     frame: u64,
     velocity: [f64; 2],
-    label: Option<u32>,
+    placement: Option<usize>,
 }
 
 /// A window's inputs, owned so that a background thread can solve them.
@@ -654,7 +654,7 @@ impl<R: VelocityRegressor> Tracker<R> {
                 .iter()
                 .filter(|t| t.frame >= first_frame && t.frame < first_frame + (b - a) as u64)
                 .collect();
-            let labels: Vec<Option<u32>> = stored.iter().map(|t| t.label).collect();
+            let labels: Vec<Option<usize>> = stored.iter().map(|t| t.placement).collect();
             let zero = self.filter_flags(&labels);
             let targets: Vec<VelocityTarget> = stored
                 .iter()
@@ -690,7 +690,7 @@ impl<R: VelocityRegressor> Tracker<R> {
         Ok(out)
     }
 
-    fn filter_flags(&self, labels: &[Option<u32>]) -> Vec<bool> {
+    fn filter_flags(&self, labels: &[Option<usize>]) -> Vec<bool> {
         match &self.config.placement_filter {
             Some(f) => f.flags(labels),
             None => vec![false; labels.len()],
@@ -705,7 +705,7 @@ impl<R: VelocityRegressor> Tracker<R> {
                 let t = StoredTarget {
                     frame,
                     velocity: r.velocity,
-                    label: r.label,
+                    placement: r.placement,
                 };
                 self.targets.push_back(t);
                 if let Some(h) = &mut self.history {
@@ -742,7 +742,7 @@ impl<R: VelocityRegressor> Tracker<R> {
         };
         let mut job = self.spare.take().unwrap_or_default();
         job.targets.clear();
-        let labels: Vec<Option<u32>> = self.targets.iter().map(|t| t.label).collect();
+        let labels: Vec<Option<usize>> = self.targets.iter().map(|t| t.placement).collect();
         let zero = self.filter_flags(&labels);
         for (t, z) in self.targets.iter().zip(zero) {
             if t.frame >= first && t.frame <= frame {

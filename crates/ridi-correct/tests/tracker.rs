@@ -42,14 +42,14 @@ impl VelocityRegressor for Truth {
         if self.fail_every.is_some_and(|k| f.is_multiple_of(k)) {
             return Err("model not loaded".into());
         }
-        let label = match self.flip_between {
-            Some((a, b)) if f >= a && f <= b => Some(((f / 50) % 2) as u32),
+        let placement = match self.flip_between {
+            Some((a, b)) if f >= a && f <= b => Some(((f / 50) % 2) as usize),
             _ => Some(0),
         };
-        Ok(self
-            .velocity
-            .get(f as usize)
-            .map(|&velocity| Regression { velocity, label }))
+        Ok(self.velocity.get(f as usize).map(|&velocity| Regression {
+            velocity,
+            placement,
+        }))
     }
 }
 
@@ -338,7 +338,7 @@ fn failing_regressions_are_reported_and_skipped() {
         fn regress(&mut self, _: &FrameWindow<'_>) -> Result<Option<Regression>, RegressorError> {
             Ok(Some(Regression {
                 velocity: [f64::NAN, 0.0],
-                label: None,
+                placement: None,
             }))
         }
     }

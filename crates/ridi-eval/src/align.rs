@@ -436,7 +436,7 @@ mod tests {
                 &[[0.0; 2]; 2],
                 AlignWindow::All
             ),
-            Err(EvalError::TimeNotMonotonic { index: 1 })
+            Err(EvalError::TimeDecreasing { index: 1 })
         ));
         assert!(matches!(
             fit_alignment(&[0.0], &[[0.0; 2]; 2], &[[0.0; 2]; 2], AlignWindow::All),

@@ -32,7 +32,7 @@ pub enum EvalError {
     },
     /// Timestamps go backwards.
     #[error("times decrease at index {index}")]
-    TimeNotMonotonic {
+    TimeDecreasing {
         /// First index whose time is smaller than the previous one.
         index: usize,
     },
@@ -113,7 +113,7 @@ pub(crate) fn check_times(times: &[f64]) -> Result<()> {
     check_non_empty("times", times.len())?;
     check_finite("times", times)?;
     match times.windows(2).position(|w| w[1] < w[0]) {
-        Some(i) => Err(EvalError::TimeNotMonotonic { index: i + 1 }),
+        Some(i) => Err(EvalError::TimeDecreasing { index: i + 1 }),
         None => Ok(()),
     }
 }

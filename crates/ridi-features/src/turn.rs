@@ -15,21 +15,21 @@ use crate::matrix::FeatureMatrix;
 /// `x' = c x + s z`, `z' = -s x + c z` (right-handed about +y).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct YawTurn {
-    cos: f32,
-    sin: f32,
+    cos: f64,
+    sin: f64,
 }
 
 impl YawTurn {
     /// The turn by `angle` radians about S-up.
     pub fn new(angle: f64) -> Self {
         Self {
-            cos: angle.cos() as f32,
-            sin: angle.sin() as f32,
+            cos: angle.cos(),
+            sin: angle.sin(),
         }
     }
 
     /// Turns a horizontal vector `[S-x, S-z]` (a velocity target).
-    pub fn horizontal(&self, v: [f32; 2]) -> [f32; 2] {
+    pub fn horizontal(&self, v: [f64; 2]) -> [f64; 2] {
         [
             self.cos * v[0] + self.sin * v[1],
             -self.sin * v[0] + self.cos * v[1],
@@ -45,8 +45,9 @@ impl YawTurn {
                 found: row.len(),
             });
         }
+        let (c, s) = (self.cos as f32, self.sin as f32);
         for v in row.chunks_exact_mut(3) {
-            [v[0], v[2]] = self.horizontal([v[0], v[2]]);
+            [v[0], v[2]] = [c * v[0] + s * v[2], -s * v[0] + c * v[2]];
         }
         Ok(())
     }
@@ -58,7 +59,7 @@ pub struct TurnedRows {
     /// The input rows, then copy 0 of every row, copy 1, ...
     pub features: FeatureMatrix,
     /// Their targets, turned with them.
-    pub targets: Vec<[f32; 2]>,
+    pub targets: Vec<[f64; 2]>,
     /// For each row, the input row it comes from (to repeat labels and groups).
     pub source: Vec<usize>,
 }
@@ -69,7 +70,7 @@ pub struct TurnedRows {
 /// angles. Deterministic. Fails when `targets` and `features` differ in length.
 pub fn turned_copies(
     features: &FeatureMatrix,
-    targets: &[[f32; 2]],
+    targets: &[[f64; 2]],
     copies: usize,
 ) -> Result<TurnedRows, FeatureError> {
     if targets.len() != features.rows() {
@@ -122,7 +123,7 @@ mod tests {
 
     /// A flat phone with heading `yaw` (about world up) walking along world +y at 1 m/s, its
     /// gyro and linear acceleration given in the world and measured in the device frame.
-    fn walk(yaw: f64) -> (FeatureMatrix, Vec<[f32; 2]>) {
+    fn walk(yaw: f64) -> (FeatureMatrix, Vec<[f64; 2]>) {
         let n = 1000;
         let time: Vec<f64> = (0..n).map(|i| i as f64 / 200.0).collect();
         let q = WorldFromDevice::from_axis_angle(&Vector3::z_axis(), yaw);
@@ -149,12 +150,7 @@ mod tests {
             gravity: &gravity,
         };
         let y = compute_targets(&gt, &config, &frames).unwrap();
-        let y = y
-            .values
-            .iter()
-            .map(|v| [v[0] as f32, v[1] as f32])
-            .collect();
-        (x, y)
+        (x, y.values)
     }
 
     #[test]
@@ -204,7 +200,7 @@ mod tests {
         for r in 0..turned.rows() {
             let i = source[r];
             // Speed and the vertical channels are kept.
-            let speed = |v: [f32; 2]| (v[0] * v[0] + v[1] * v[1]).sqrt();
+            let speed = |v: [f64; 2]| v[0].hypot(v[1]);
             assert!((speed(ty[r]) - speed(y[i])).abs() < 1e-5);
             for k in (1..1200).step_by(3) {
                 assert_eq!(turned.row(r)[k], x.row(i)[k]);

@@ -23,7 +23,7 @@ fn benches(c: &mut Criterion) {
         b.iter(|| kernel::gram(x, &norms, gamma))
     });
 
-    let y: Vec<f32> = data.y.iter().map(|v| v[1]).collect();
+    let y: Vec<f64> = data.y.iter().map(|v| v[1]).collect();
     g.bench_function("svr_fit_2000_c10_eps0.01", |b| {
         b.iter(|| Svr::fit(x, &y, &SvrParams::new(10.0, 0.01, gamma)).unwrap())
     });

@@ -6,7 +6,7 @@
 
 pub struct Synth {
     pub x: Vec<f32>,
-    pub y: Vec<[f32; 2]>,
+    pub y: Vec<[f64; 2]>,
     pub placement: Vec<usize>,
     pub group: Vec<u64>,
     pub dim: usize,
@@ -71,7 +71,7 @@ pub fn generate(n: usize, placements: usize, per_seq: usize, seed: u64) -> Synth
                     s.x.push(v as f32);
                 }
             }
-            s.y.push([(speed * turn.sin()) as f32, (-speed * turn.cos()) as f32]);
+            s.y.push([speed * turn.sin(), -speed * turn.cos()]);
             s.placement.push(p);
             s.group.push(seq);
         }

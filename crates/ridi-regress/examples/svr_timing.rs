@@ -65,7 +65,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let threads = rayon::current_num_threads();
     match task.as_str() {
         "svr" => {
-            let y: Vec<f32> = data.y.iter().map(|v| v[1]).collect();
+            let y: Vec<f64> = data.y.iter().map(|v| v[1]).collect();
             let p = SvrParams {
                 c,
                 epsilon: eps,
@@ -79,7 +79,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             let mse = pred
                 .iter()
                 .zip(&y)
-                .map(|(a, b)| ((a - b) as f64).powi(2))
+                .map(|(a, b)| (a - b).powi(2))
                 .sum::<f64>()
                 / n as f64;
             println!(
@@ -217,7 +217,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             std::fs::create_dir_all(&dir)?;
             let bytes = |v: &[f32]| v.iter().flat_map(|f| f.to_le_bytes()).collect::<Vec<u8>>();
             std::fs::write(dir.join("x.f32"), bytes(&data.x))?;
-            let y: Vec<f32> = data.y.iter().flat_map(|v| *v).collect();
+            let y: Vec<f32> = data.y.iter().flat_map(|v| v.map(|c| c as f32)).collect();
             std::fs::write(dir.join("y.f32"), bytes(&y))?;
             let lab: Vec<u8> = data
                 .placement

@@ -188,7 +188,7 @@ pub struct TrainingSet<'a> {
     /// Feature matrix (`n × dim`).
     pub features: MatrixRef<'a>,
     /// Velocity targets in S (two horizontal components).
-    pub targets: &'a [[f32; 2]],
+    pub targets: &'a [[f64; 2]],
     /// Placement of each sample, an index into `placement_names`.
     pub placements: &'a [usize],
     /// Placement names; every name needs samples.
@@ -208,7 +208,7 @@ pub struct Prediction {
     /// ([`CascadeParams::speed`]) the regressed components `v` scaled by
     /// `max(s, 0) / max(|v|, 0.1 m/s)`, `s` the regressed speed: the floor keeps a direction
     /// that is barely known from being blown up.
-    pub velocity: [f32; 2],
+    pub velocity: [f64; 2],
 }
 
 /// Below this regressed velocity (m/s) the speed channel scales by `s / SPEED_FLOOR` at most.
@@ -265,16 +265,15 @@ impl ClassModel {
     }
 
     /// The velocity from the kernel-weighted sums of the channels (before their offsets).
-    fn velocity(&self, sums: &[f64]) -> [f32; 2] {
+    fn velocity(&self, sums: &[f64]) -> [f64; 2] {
         let v = [sums[0] - self.reg_rho[0], sums[1] - self.reg_rho[1]];
-        let v = match &self.speed {
+        match &self.speed {
             None => v,
             Some(sp) => {
                 let gain = (sums[2] - sp.rho).max(0.0) / v[0].hypot(v[1]).max(SPEED_FLOOR);
                 [v[0] * gain, v[1] * gain]
             }
-        };
-        [v[0] as f32, v[1] as f32]
+        }
     }
 }
 
@@ -288,7 +287,7 @@ pub struct RoundingEffect {
     /// Share of the queries given the same placement by both.
     pub placement_agreement: f64,
     /// Largest absolute velocity difference per channel (queries with the same placement).
-    pub max_velocity_diff: [f32; 2],
+    pub max_velocity_diff: [f64; 2],
     /// Mean absolute velocity difference per channel (queries with the same placement).
     pub mean_velocity_diff: [f64; 2],
 }
@@ -499,7 +498,7 @@ impl Cascade {
             );
             let channels = 2 + usize::from(params.speed);
             let target = |i: usize, ch: usize| {
-                let [x, z] = data.targets[i].map(f64::from);
+                let [x, z] = data.targets[i];
                 if ch < 2 { [x, z][ch] } else { x.hypot(z) }
             };
             let targets: Vec<Vec<f64>> = (0..channels)
@@ -744,7 +743,7 @@ impl Cascade {
         &self,
         x: MatrixRef<'_>,
         placement: usize,
-    ) -> Result<Vec<[f32; 2]>, RegressError> {
+    ) -> Result<Vec<[f64; 2]>, RegressError> {
         self.check_dim(x)?;
         if placement >= self.classes.len() {
             return Err(RegressError::Shape(format!(
@@ -820,7 +819,7 @@ impl Cascade {
         let stored = self.predict_blocks(Rows::Stored, queries, None);
         let reference = self.predict_blocks(Rows::Exact(&exact), queries, None);
         let mut same = 0usize;
-        let mut max = [0.0f32; 2];
+        let mut max = [0.0f64; 2];
         let mut sum = [0.0f64; 2];
         for (a, b) in stored.iter().zip(&reference) {
             if a.placement != b.placement {
@@ -830,7 +829,7 @@ impl Cascade {
             for ch in 0..2 {
                 let d = (a.velocity[ch] - b.velocity[ch]).abs();
                 max[ch] = max[ch].max(d);
-                sum[ch] += d as f64;
+                sum[ch] += d;
             }
         }
         let n = stored.len();

@@ -15,7 +15,9 @@
 //! blocked GEMM (faer) with precomputed squared norms, `K_ij = exp(-γ(|x_i|² + |x_j|² -
 //! 2 x_i·x_j))`, either as a full matrix computed once in parallel (when it fits in
 //! [`SolverConfig::kernel_memory`]) or as a bounded LRU row cache that computes missing rows in
-//! batches. Gradients and dual variables are `f64`.
+//! batches. Gradients and dual variables are `f64`, and so are targets and predictions: the
+//! `[f64; 2]` velocities of ridi-features' targets and ridi-correct's regressions, with
+//! placements as `usize` indices into [`Cascade::placements`].
 //!
 //! # Reuse
 //!
@@ -60,7 +62,7 @@
 //!     let p = i % 2;
 //!     let s = if p == 0 { 1.0 } else { -1.0 };
 //!     x.extend([s + t, s - t, t, 0.5 * t, s, -t]);
-//!     y.push([t, 1.0 - t]);
+//!     y.push([f64::from(t), f64::from(1.0 - t)]);
 //!     placement.push(p);
 //!     group.push((i / 10) as u64);
 //! }

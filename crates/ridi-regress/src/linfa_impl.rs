@@ -44,7 +44,11 @@ where
 
     fn fit(&self, dataset: &DatasetBase<ArrayBase<D, Ix2>, T>) -> Result<Svr, RegressError> {
         let x = records(dataset.records());
-        let y: Vec<f32> = dataset.as_single_targets().iter().copied().collect();
+        let y: Vec<f64> = dataset
+            .as_single_targets()
+            .iter()
+            .map(|&v| f64::from(v))
+            .collect();
         Svr::fit(
             MatrixRef::new(&x, dataset.records().ncols().max(1))?,
             &y,
@@ -78,7 +82,7 @@ impl<D: Data<Elem = f32>> PredictInplace<ArrayBase<D, Ix2>, Array1<f32>> for Svr
         let data = records(x);
         let pred = MatrixRef::new(&data, x.ncols().max(1)).and_then(|m| self.predict(m));
         match pred {
-            Ok(p) if p.len() == y.len() => y.iter_mut().zip(p).for_each(|(o, v)| *o = v),
+            Ok(p) if p.len() == y.len() => y.iter_mut().zip(p).for_each(|(o, v)| *o = v as f32),
             _ => y.fill(f32::NAN),
         }
     }

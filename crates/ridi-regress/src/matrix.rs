@@ -78,6 +78,16 @@ impl<'a> MatrixRef<'a> {
     }
 }
 
+/// Borrows a feature matrix of ridi-features (the features [`crate::TrainingSet`] and
+/// [`crate::Cascade::predict`] take), with the checks of [`MatrixRef::new`].
+impl<'a> TryFrom<&'a ridi_features::FeatureMatrix> for MatrixRef<'a> {
+    type Error = RegressError;
+
+    fn try_from(m: &'a ridi_features::FeatureMatrix) -> Result<Self, RegressError> {
+        MatrixRef::new(m.as_slice(), m.cols())
+    }
+}
+
 /// Owned row-major `f32` matrix.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Matrix {
@@ -124,5 +134,24 @@ impl Matrix {
     /// All values, row-major.
     pub fn as_slice(&self) -> &[f32] {
         &self.data
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use ridi_features::FeatureMatrix;
+
+    #[test]
+    fn borrows_a_feature_matrix_with_the_same_checks() {
+        let m = FeatureMatrix::from_vec(2, 3, vec![1.0, 2.0, 3.0, 4.0, 5.0, 6.0]).unwrap();
+        let r = MatrixRef::try_from(&m).unwrap();
+        assert_eq!((r.rows(), r.dim()), (2, 3));
+        assert_eq!(r.row(1), &[4.0, 5.0, 6.0]);
+        let bad = FeatureMatrix::from_vec(1, 2, vec![1.0, f32::NAN]).unwrap();
+        assert!(matches!(
+            MatrixRef::try_from(&bad),
+            Err(RegressError::NonFinite(_))
+        ));
     }
 }

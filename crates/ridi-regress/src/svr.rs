@@ -175,7 +175,7 @@ pub(crate) fn check_xy(x: MatrixRef<'_>, n_targets: usize) -> Result<(), Regress
 
 impl Svr {
     /// Trains on rows of `x` with targets `y`.
-    pub fn fit(x: MatrixRef<'_>, y: &[f32], params: &SvrParams) -> Result<Self, RegressError> {
+    pub fn fit(x: MatrixRef<'_>, y: &[f64], params: &SvrParams) -> Result<Self, RegressError> {
         params.validate()?;
         check_xy(x, y.len())?;
         if let Some(i) = y.iter().position(|v| !v.is_finite()) {
@@ -188,11 +188,10 @@ impl Svr {
             params.solver.regressor_kernel,
         );
         let idx: Vec<usize> = (0..x.rows()).collect();
-        let yd: Vec<f64> = y.iter().map(|&v| v as f64).collect();
         let dual = solve_svr(
             rows.as_ref(),
             &idx,
-            &yd,
+            y,
             params.c,
             params.epsilon,
             None,
@@ -219,12 +218,12 @@ impl Svr {
     }
 
     /// Predictions for every row of `x`.
-    pub fn predict(&self, x: MatrixRef<'_>) -> Result<Vec<f32>, RegressError> {
+    pub fn predict(&self, x: MatrixRef<'_>) -> Result<Vec<f64>, RegressError> {
         Ok(self
             .exp
             .eval(x)?
             .into_iter()
-            .map(|s| (s - self.rho) as f32)
+            .map(|s| s - self.rho)
             .collect())
     }
 

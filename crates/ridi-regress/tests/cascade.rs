@@ -10,7 +10,7 @@ use ridi_regress::{
 
 struct Data {
     x: Vec<f32>,
-    y: Vec<[f32; 2]>,
+    y: Vec<[f64; 2]>,
     placement: Vec<usize>,
     group: Vec<u64>,
     names: Vec<String>,
@@ -67,8 +67,7 @@ fn make_window(placements: usize, seqs: usize, per_seq: usize, seed: u64, window
                     );
                 }
                 let gain = 1.0 + p as f64 * 0.3;
-                data.y
-                    .push([(gain * a) as f32, (0.5 * b * b - 0.3 * gain) as f32]);
+                data.y.push([gain * a, 0.5 * b * b - 0.3 * gain]);
                 data.placement.push(p);
                 data.group.push((p * 100 + s) as u64);
             }
@@ -146,7 +145,7 @@ fn cascade_classifies_regresses_and_batches_consistently() {
     let mse: f64 = batch
         .iter()
         .zip(&test.y)
-        .map(|(p, t)| ((p.velocity[0] - t[0]).powi(2) + (p.velocity[1] - t[1]).powi(2)) as f64)
+        .map(|(p, t)| (p.velocity[0] - t[0]).powi(2) + (p.velocity[1] - t[1]).powi(2))
         .sum::<f64>()
         / 120.0;
     assert!(mse < 0.01, "velocity MSE {mse}");
@@ -198,8 +197,8 @@ fn speed_regressor_scales_velocities_to_the_regressed_speed() {
     let xt = MatrixRef::new(&test.x, 24).unwrap();
     let scaled = model.predict(xt).unwrap();
     let unscaled = plain.predict(xt).unwrap();
-    let speed = |v: [f32; 2]| v[0].hypot(v[1]);
-    let (mut err_scaled, mut moved) = (0.0f32, 0.0f32);
+    let speed = |v: [f64; 2]| v[0].hypot(v[1]);
+    let (mut err_scaled, mut moved) = (0.0f64, 0.0f64);
     for (i, (s, u)) in scaled.iter().zip(&unscaled).enumerate() {
         assert_eq!(s.placement, u.placement);
         // Same direction as the plain model's velocity, only its size changes.
@@ -373,7 +372,7 @@ fn half_precision_samples_stay_close_to_the_exact_model() {
     // are of order 1 m/s: the stored model moves velocities by well under 1 cm/s.
     for ch in 0..2 {
         assert!(r.max_velocity_diff[ch] < 5e-3, "{r:?}");
-        assert!(r.mean_velocity_diff[ch] <= r.max_velocity_diff[ch] as f64);
+        assert!(r.mean_velocity_diff[ch] <= r.max_velocity_diff[ch]);
     }
     assert!(
         r.max_velocity_diff.iter().any(|&d| d > 0.0),

@@ -63,14 +63,11 @@ fn two_point_regressor_matches_closed_form() {
     for (c, eps) in [(100.0, 0.1), (0.5, 0.1), (10.0, 0.0)] {
         let mut p = SvrParams::new(c, eps, gamma);
         p.solver = tight();
-        let m = Svr::fit(MatrixRef::new(&x, 2).unwrap(), &[t as f32, -t as f32], &p).unwrap();
+        let m = Svr::fit(MatrixRef::new(&x, 2).unwrap(), &[t, -t], &p).unwrap();
         let beta = ((t - eps) / (1.0 - k)).min(c);
         let f = m.predict(MatrixRef::new(&x, 2).unwrap()).unwrap();
-        assert!(
-            (f[0] as f64 - beta * (1.0 - k)).abs() < 1e-5,
-            "C={c}: {f:?}"
-        );
-        assert!((f[1] as f64 + beta * (1.0 - k)).abs() < 1e-5);
+        assert!((f[0] - beta * (1.0 - k)).abs() < 1e-5, "C={c}: {f:?}");
+        assert!((f[1] + beta * (1.0 - k)).abs() < 1e-5);
         assert!(m.rho().abs() < 1e-6);
         let mut coef = m.dual_coef().to_vec();
         coef.sort_by(f64::total_cmp);
@@ -104,7 +101,7 @@ fn regressor_satisfies_kkt_conditions() {
             .get(&xm.row(i).iter().map(|v| v.to_bits()).collect::<Vec<_>>())
             .copied()
             .unwrap_or(0.0);
-        let r = (y[i] - f[i]) as f64;
+        let r = y[i] - f[i];
         assert!(a.abs() <= c + 1e-12);
         if a == 0.0 {
             assert!(
@@ -178,7 +175,7 @@ fn regressor_matches_linfa_svm() {
         p.solver = tight();
         let ours = Svr::fit(xm, &y, &p).unwrap();
         let records = Array2::from_shape_fn((80, 8), |(i, j)| x[i * 8 + j] as f64);
-        let targets = Array1::from_iter(y.iter().map(|&v| v as f64));
+        let targets = Array1::from_iter(y.iter().copied());
         let oracle = Svm::<f64, f64>::params()
             .c_svr(c, Some(eps))
             .eps(1e-9)
@@ -195,7 +192,7 @@ fn regressor_matches_linfa_svm() {
         let theirs = oracle.predict(&test);
         let mine = ours.predict(MatrixRef::new(&xt, 8).unwrap()).unwrap();
         for (a, b) in mine.iter().zip(theirs.iter()) {
-            assert!((*a as f64 - b).abs() < 2e-4, "C={c} eps={eps}: {a} vs {b}");
+            assert!((a - b).abs() < 2e-4, "C={c} eps={eps}: {a} vs {b}");
         }
     }
 }
@@ -283,7 +280,7 @@ fn invalid_inputs_are_errors_not_panics() {
     assert!(Svr::fit(xm, &[1.0], &SvrParams::new(1.0, 0.1, 0.5)).is_err());
     assert!(Svr::fit(xm, &[1.0, 2.0], &SvrParams::new(-1.0, 0.1, 0.5)).is_err());
     assert!(Svr::fit(xm, &[1.0, 2.0], &SvrParams::new(1.0, -0.1, 0.5)).is_err());
-    assert!(Svr::fit(xm, &[1.0, f32::INFINITY], &SvrParams::new(1.0, 0.1, 0.5)).is_err());
+    assert!(Svr::fit(xm, &[1.0, f64::INFINITY], &SvrParams::new(1.0, 0.1, 0.5)).is_err());
     assert!(Svc::fit(xm, &[1, 1], &SvcParams::new(1.0, 0.5)).is_err());
     let m = Svr::fit(xm, &[1.0, 2.0], &SvrParams::new(1.0, 0.1, 0.5)).unwrap();
     assert!(

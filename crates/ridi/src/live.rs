@@ -80,7 +80,7 @@ impl VelocityRegressor for CascadeRegressor<'_> {
                 p.placement = label;
             }
         }
-        let velocity = [p.velocity[0] as f64, p.velocity[1] as f64];
+        let velocity = p.velocity;
         self.made.push(Regressed {
             frame: frames.last_frame() as usize,
             placement: p.placement,
@@ -88,7 +88,7 @@ impl VelocityRegressor for CascadeRegressor<'_> {
         });
         Ok(Some(Regression {
             velocity,
-            label: Some(p.placement as u32),
+            placement: Some(p.placement),
         }))
     }
 }

@@ -144,14 +144,14 @@ pub fn regress(seq: &Sequence, model: &Cascade, opts: &TrackOptions) -> Result<V
         return Ok(Vec::new());
     }
     let features = fx.features(&fx.stabilize(&imu_view(seq)?)?, &frames)?;
-    let predictions = model.predict(MatrixRef::new(features.as_slice(), features.cols())?)?;
+    let predictions = model.predict(MatrixRef::try_from(&features)?)?;
     let mut out: Vec<Regressed> = frames
         .iter()
         .zip(predictions)
         .map(|(&frame, p)| Regressed {
             frame,
             placement: p.placement,
-            velocity: [p.velocity[0] as f64, p.velocity[1] as f64],
+            velocity: p.velocity,
         })
         .collect();
     let Some(smoother) = opts.placement_smoothing else {
@@ -175,7 +175,7 @@ pub fn regress(seq: &Sequence, model: &Cascade, opts: &TrackOptions) -> Result<V
             model.predict_with_placement(MatrixRef::new(&rows, features.cols())?, p)?;
         for (&i, v) in moved.iter().zip(velocities) {
             out[i].placement = p;
-            out[i].velocity = [v[0] as f64, v[1] as f64];
+            out[i].velocity = v;
         }
     }
     Ok(out)

@@ -100,7 +100,7 @@ pub struct TrainingData {
     /// Features (`n x dim`), not standardized.
     pub features: FeatureMatrix,
     /// Targets `[S-x, S-z]`, m/s.
-    pub targets: Vec<[f32; 2]>,
+    pub targets: Vec<[f64; 2]>,
     /// Placement index of each sample into `placement_names`.
     pub placements: Vec<usize>,
     /// Placement names, sorted.
@@ -172,7 +172,7 @@ pub fn training_data(seqs: &[Sequence], config: &FeatureConfig) -> Result<Traini
     let names: Vec<String> = names.into_iter().map(str::to_string).collect();
     let schedule = SampleSchedule::training(&config)?;
     let fx = FeatureExtractor::new(config.clone())?;
-    let per_seq: Vec<(FeatureMatrix, Vec<[f32; 2]>)> = seqs
+    let per_seq: Vec<(FeatureMatrix, Vec<[f64; 2]>)> = seqs
         .par_iter()
         .map(|s| {
             check_frames(s, &config)?;
@@ -181,12 +181,7 @@ pub fn training_data(seqs: &[Sequence], config: &FeatureConfig) -> Result<Traini
             let frames = schedule.frames(s.len());
             let features = fx.features(&fx.stabilize(&imu_view(s)?)?, &frames)?;
             let targets = compute_targets(&ground_truth_view(s)?, &config, &frames)?;
-            let t = targets
-                .values
-                .iter()
-                .map(|v| [v[0] as f32, v[1] as f32])
-                .collect();
-            Ok((features, t))
+            Ok((features, targets.values))
         })
         .collect::<Result<_>>()?;
     let mut data = TrainingData {
@@ -238,7 +233,7 @@ pub fn train(
         config.standardization = Some(s);
     }
     let set = TrainingSet {
-        features: MatrixRef::new(data.features.as_slice(), data.features.cols())?,
+        features: MatrixRef::try_from(&data.features)?,
         targets: &data.targets,
         placements: &data.placements,
         placement_names: &data.placement_names,

@@ -19,7 +19,7 @@ impl Rng {
 }
 
 /// `n × d` features with smooth structure and a nonlinear target.
-pub fn regression(n: usize, d: usize, seed: u64) -> (Vec<f32>, Vec<f32>) {
+pub fn regression(n: usize, d: usize, seed: u64) -> (Vec<f32>, Vec<f64>) {
     let mut rng = Rng(seed);
     let mut x = Vec::with_capacity(n * d);
     let mut y = Vec::with_capacity(n);
@@ -30,7 +30,7 @@ pub fn regression(n: usize, d: usize, seed: u64) -> (Vec<f32>, Vec<f32>) {
             let t = j as f64 / d as f64;
             x.push((a * (3.0 * t).sin() + b * (5.0 * t + a).cos() + 0.1 * rng.uniform()) as f32);
         }
-        y.push(((2.0 * a).sin() + 0.5 * b * b + 0.05 * rng.uniform()) as f32);
+        y.push((2.0 * a).sin() + 0.5 * b * b + 0.05 * rng.uniform());
     }
     (x, y)
 }
