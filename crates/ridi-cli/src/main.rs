@@ -773,6 +773,9 @@ fn evaluate_and_write(
     for dir in dirs {
         std::fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))?;
     }
+    // Read before report.json is replaced: whose plots an earlier evaluation wrote.
+    let mut plotted = earlier_sequences(out);
+    plotted.extend(seqs.iter().map(|s| s.name().to_string()));
     let spinner = ProgressBar::new_spinner();
     spinner.set_message(format!("evaluating {} sequences", seqs.len()));
     spinner.enable_steady_tick(std::time::Duration::from_millis(200));
@@ -786,7 +789,7 @@ fn evaluate_and_write(
         }
     }
     written.extend(report.write(out)?);
-    let stale = remove_stale_plots(&plot_dir, &written)?;
+    let stale = remove_stale_plots(&plot_dir, &plotted, &written)?;
     print_summary(&report);
     outln!(
         "wrote {} files into {} (report.md, report.json{}){}",
@@ -802,27 +805,41 @@ fn evaluate_and_write(
     Ok(report)
 }
 
+/// The sequences of the `report.json` an earlier evaluation left in `out` (none when there is
+/// none, or it cannot be read: it only decides which old plots may go).
+fn earlier_sequences(out: &Path) -> Vec<String> {
+    let Ok(text) = std::fs::read_to_string(out.join("report.json")) else {
+        return Vec::new();
+    };
+    let Ok(json) = serde_json::from_str::<serde_json::Value>(&text) else {
+        return Vec::new();
+    };
+    json["sequences"]
+        .as_array()
+        .into_iter()
+        .flatten()
+        .filter_map(|s| s["name"].as_str().map(str::to_string))
+        .collect()
+}
+
 /// Removes the plots an earlier evaluation left in `dir` that this one did not write (other
 /// sequences, the other format, or `--plots none`), so that the folder matches the report.
-/// Only files named like `ridi eval`'s plots are touched; `dir` goes if that empties it.
-fn remove_stale_plots(dir: &Path, written: &[PathBuf]) -> Result<usize> {
-    let Ok(entries) = std::fs::read_dir(dir) else {
-        return Ok(0);
-    };
+/// Only the plot files of `sequences` (those of the earlier report and of this evaluation)
+/// are touched, so other files in `dir` stay; `dir` goes if that empties it.
+fn remove_stale_plots(dir: &Path, sequences: &[String], written: &[PathBuf]) -> Result<usize> {
     let mut removed = 0;
-    for entry in entries {
-        let path = entry
-            .with_context(|| format!("cannot list {}", dir.display()))?
-            .path();
-        let name = path.file_name().unwrap_or_default().to_string_lossy();
-        let ours = [".trajectory.", ".velocity."]
-            .iter()
-            .any(|k| name.contains(k))
-            && (name.ends_with(".png") || name.ends_with(".svg"));
-        if ours && path.is_file() && !written.contains(&path) {
-            std::fs::remove_file(&path)
-                .with_context(|| format!("cannot remove {}", path.display()))?;
-            removed += 1;
+    // A name that is not a plain file name (an edited report.json) must not reach outside.
+    let plain = |name: &&String| Path::new(name.as_str()).file_name() == Some(name.as_ref());
+    for name in sequences.iter().filter(plain) {
+        for kind in ["trajectory", "velocity"] {
+            for ext in ["png", "svg"] {
+                let path = dir.join(format!("{name}.{kind}.{ext}"));
+                if path.is_file() && !written.contains(&path) {
+                    std::fs::remove_file(&path)
+                        .with_context(|| format!("cannot remove {}", path.display()))?;
+                    removed += 1;
+                }
+            }
         }
     }
     // Only succeeds when nothing else is in the folder.

@@ -386,6 +386,9 @@ fn convert_train_track_and_eval() {
     };
     let methods = ["--methods", "ridi,ridi,still", "--placement-map", "tyrex4"];
     let before = std::fs::read_dir(report.join("plots")).unwrap().count();
+    // A file of the user's named like a plot, but of no evaluated sequence, stays.
+    let mine = report.join("plots/mine.trajectory.png");
+    std::fs::write(&mine, "not a plot of ridi's").unwrap();
     let out = eval_one(&report, &[&methods[..], &["--plots", "svg"]].concat());
     assert!(out.status.success(), "{}", stderr(&out));
     let printed = String::from_utf8_lossy(&out.stdout);
@@ -396,7 +399,9 @@ fn convert_train_track_and_eval() {
         )),
         "{printed}"
     );
-    assert_eq!(std::fs::read_dir(report.join("plots")).unwrap().count(), 2);
+    assert_eq!(std::fs::read_dir(report.join("plots")).unwrap().count(), 3);
+    assert_eq!(std::fs::read(&mine).unwrap(), b"not a plot of ridi's");
+    std::fs::remove_file(&mine).unwrap();
     let json_one: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(report.join("report.json")).unwrap())
             .unwrap();
