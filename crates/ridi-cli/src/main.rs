@@ -132,6 +132,11 @@ enum Command {
         /// paper's 10 without copies, and the paper's number of rows with them].
         #[arg(long, value_name = "FRAMES", value_parser = |s: &str| count(s, 1, MAX_FRAMES_APART))]
         step: Option<usize>,
+        /// Frames per feature window (the paper's 200, 1 s at 200 Hz). The model records it;
+        /// recordings must then be longer than one window to track. 100 gave a lower RTE 5 s
+        /// and shorter paths on the Tyrex protocol (docs/benchmarks.md).
+        #[arg(long, default_value_t = 200, value_name = "FRAMES", value_parser = |s: &str| count(s, MIN_WINDOW, MAX_WINDOW))]
+        window: usize,
         /// No speed regressor (the paper): by default each placement also regresses the speed
         /// and each regressed velocity is scaled to it, since turned training windows make the
         /// velocity's direction less certain than its size.
@@ -404,6 +409,7 @@ fn run(cli: Cli) -> Result<()> {
             storage,
             turned_copies,
             step,
+            window,
             no_speed,
             up_axis,
         } => {
@@ -425,6 +431,7 @@ fn run(cli: Cli) -> Result<()> {
                 turned_copies,
                 features: FeatureConfig {
                     step: step.unwrap_or(ridi::train::default_step(turned_copies)),
+                    window,
                     up_axis: up_axis.into(),
                     orientation: orientation.into(),
                     ..defaults.features.clone()
@@ -656,6 +663,12 @@ fn train_with_progress(seqs: &[Sequence], opts: &TrainOptions) -> Result<Cascade
 
 fn print_training(model: &Cascade) {
     outln!("placements: {}", model.placements().join(", "));
+    let config = model.feature_config();
+    outln!(
+        "feature window: {} frames, a training window every {} frames",
+        config.window,
+        config.step
+    );
     let up = match model.feature_config().up_axis {
         UpAxis::PlusY => "device +y",
         UpAxis::PlusOrMinusY => "device +y, or -y while upside down",
@@ -855,6 +868,12 @@ const MAX_TURNED_COPIES: usize = 32;
 /// Largest `--step` and `--regress-every`: one minute at 200 Hz. Windows further apart leave
 /// too few training rows, or too few regressions for the correction, to mean anything.
 const MAX_FRAMES_APART: usize = 12_000;
+
+/// Smallest `--window`: 0.1 s at 200 Hz, about the feature smoothing's kernel (17 taps at sigma 2).
+const MIN_WINDOW: usize = 20;
+
+/// Largest `--window`: 10 s at 200 Hz (12,000 values per feature; the paper's is 1 s).
+const MAX_WINDOW: usize = 2_000;
 
 /// A whole number in `min..=max`, for clap.
 fn count(text: &str, min: usize, max: usize) -> std::result::Result<usize, String> {

@@ -168,6 +168,7 @@ fn bad_flags_and_outputs_fail_before_any_work() {
     for (flag, value, says) in [
         ("--turned-copies", "100000", "from 0 to 32"),
         ("--step", "0", "from 1 to 12000"),
+        ("--window", "10", "from 20 to 2000"),
         ("--classifier-c", "0", "above 0"),
         ("--classifier-c", "NaN", "above 0"),
         ("--jobs", "0", "from 1 to 4096"),

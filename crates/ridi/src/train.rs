@@ -53,7 +53,8 @@ impl GridChoice {
 /// instead of 10 (so the rows, and the training time, stay the paper's), a speed regressor
 /// per placement, and S built on device -y while the phone is upside down
 /// ([`UpAxis::PlusOrMinusY`]). Set `turned_copies: 0`, `features.step: 10`,
-/// `features.up_axis: UpAxis::PlusY` and `cascade.speed: false` for the paper exactly.
+/// `features.up_axis: UpAxis::PlusY` and `cascade.speed: false` for the paper's cascade on
+/// standardized features, and `standardize: false` too for the original's raw features.
 #[derive(Debug, Clone, PartialEq)]
 pub struct TrainOptions {
     /// Feature configuration (its `standardization` is filled in when `standardize` is set).

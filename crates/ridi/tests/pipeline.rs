@@ -29,6 +29,26 @@ fn quick_model(seqs: &[Sequence]) -> ridi::regress::Cascade {
     ridi::train(seqs, &opts, &mut NoProgress).unwrap()
 }
 
+/// The batch and the online track of `seq`, without placement smoothing (batch votes over a
+/// centred window, streaming over the window before).
+fn batch_and_online(seq: &Sequence, model: &ridi::regress::Cascade) -> (ridi::Track, ridi::Track) {
+    let unsmoothed = TrackOptions {
+        placement_smoothing: None,
+        ..TrackOptions::default()
+    };
+    let batch = ridi::track(seq, model, &unsmoothed).unwrap();
+    let online = ridi::track(
+        seq,
+        model,
+        &TrackOptions {
+            online: true,
+            ..unsmoothed
+        },
+    )
+    .unwrap();
+    (batch, online)
+}
+
 #[test]
 fn train_track_and_evaluate_on_the_sample() {
     let train = load("list_train.txt");
@@ -252,21 +272,7 @@ fn online_tracking_stays_close_to_batch_tracking() {
     let train = load("list_Guillaume.txt");
     let model = quick_model(&train);
     let seq = &load("list_Jakob.txt")[7]; // Texting
-    // Batch votes over a centred window, streaming over the window before: compare unsmoothed.
-    let unsmoothed = TrackOptions {
-        placement_smoothing: None,
-        ..TrackOptions::default()
-    };
-    let batch = ridi::track(seq, &model, &unsmoothed).unwrap();
-    let online = ridi::track(
-        seq,
-        &model,
-        &TrackOptions {
-            online: true,
-            ..unsmoothed
-        },
-    )
-    .unwrap();
+    let (batch, online) = batch_and_online(seq, &model);
     assert_eq!(batch.time.len(), seq.len());
     assert_eq!(online.time.len(), seq.len());
     // Both regress at the same frames with the same features (batched GEMM and single-query
@@ -688,4 +694,33 @@ fn another_rate_or_less_than_a_window_is_refused_by_name() {
             "{err}"
         );
     }
+}
+
+/// A model trained with another feature window than the paper's regresses from that window
+/// on, batch and online alike, and a recording is judged by its window.
+#[test]
+fn a_shorter_feature_window_is_the_models_own() {
+    let mut opts = TrainOptions::default();
+    opts.cascade.regressors = GridChoice::None.regressors();
+    opts.features.window = 100;
+    let model = ridi::train(&load("list_Guillaume.txt"), &opts, &mut NoProgress).unwrap();
+    assert_eq!(model.feature_config().window, 100);
+    assert_eq!(model.dim(), 600);
+    let seq = &load("list_Jakob.txt")[7];
+    let (batch, online) = batch_and_online(seq, &model);
+    // The first regression has the 100 frames before it, then one every 50 frames.
+    assert_eq!(batch.regressions[0].frame, 100);
+    assert_eq!(batch.regressions[1].frame, 150);
+    assert_eq!(batch.regressions.len(), online.regressions.len());
+    for (a, b) in batch.regressions.iter().zip(&online.regressions) {
+        assert_eq!((a.frame, a.placement), (b.frame, b.placement));
+        assert!((a.velocity[1] - b.velocity[1]).abs() < 1e-3, "{a:?} {b:?}");
+    }
+    // 150 frames: too short for the paper's window, enough for this one.
+    let opts = TrackOptions::default();
+    assert!(ridi::track(&seq.slice(0..150), &model, &opts).is_ok());
+    let err = ridi::track(&seq.slice(0..100), &model, &opts)
+        .unwrap_err()
+        .to_string();
+    assert!(err.contains("feature window of 100 frames"), "{err}");
 }
