@@ -13,7 +13,7 @@ use ridi::data::{Format, ReadOptions, Sequence};
 use ridi::eval::{AlignWindow, EvalConfig};
 use ridi::features::FeatureConfig;
 use ridi::frames::UpAxis;
-use ridi::regress::{Cascade, ProgressEvent, RegressError, Stage, Storage, StoredAs, model_file};
+use ridi::regress::{Cascade, ProgressEvent, RegressError, Stage, Storage, model_file};
 use ridi::source::{ReadFiles, folder_of, resolved};
 use ridi::{
     EvalOptions, GridChoice, Method, Orientation, PipelineError, PlacementMap, Purpose,
@@ -51,13 +51,16 @@ struct Cli {
 
 #[derive(Subcommand)]
 enum Command {
-    /// Describe a recording: format, duration, rate, gravity, ground truth, warnings.
+    /// Describe a recording (format, duration, rate, gravity, ground truth, warnings) or a
+    /// model file (placements, feature window, frame, regressors, cross-validation).
     #[command(after_help = "Examples:\n  \
         ridi inspect datasets/sample/Jakob_Nexus5_NoDist_Texting\n  \
+        ridi inspect model.ridi\n  \
         ridi inspect path/to/ridi/dan_body1/processed/data.csv --json\n  \
         ridi inspect ../shared/data/raw/tyrex-attitude-smartphones/datasets/android/Guillaume_Nexus5_NoDist_AR")]
     Inspect {
-        /// A RIDI data.csv, data_plain.txt, RIDI raw folder, or Tyrex sequence folder.
+        /// A RIDI data.csv, data_plain.txt, RIDI raw folder, Tyrex sequence folder, or a model
+        /// file of `ridi train`.
         sequence: PathBuf,
         /// Print JSON instead of text.
         #[arg(long)]
@@ -356,6 +359,16 @@ impl From<FromFormat> for Format {
 fn run(cli: Cli) -> Result<()> {
     match cli.command {
         Command::Inspect { sequence, json } => {
+            if is_model_file(&sequence) {
+                let model = load_model(&sequence)?;
+                let report = ridi::inspect::inspect_model(&model);
+                if json {
+                    outln!("{}", serde_json::to_string_pretty(&report)?);
+                } else {
+                    out!("{report}");
+                }
+                return Ok(());
+            }
             let opts = ReadOptions::default();
             let loaded = ridi::read_any(&sequence, None, &opts)?;
             for seq in &loaded.sequences {
@@ -662,68 +675,15 @@ fn train_with_progress(seqs: &[Sequence], opts: &TrainOptions) -> Result<Cascade
 }
 
 fn print_training(model: &Cascade) {
-    outln!("placements: {}", model.placements().join(", "));
-    let config = model.feature_config();
-    outln!(
-        "feature window: {} frames, a training window every {} frames",
-        config.window,
-        config.step
-    );
-    let up = match model.feature_config().up_axis {
-        UpAxis::PlusY => "device +y",
-        UpAxis::PlusOrMinusY => "device +y, or -y while upside down",
-    };
-    outln!("stabilized frame S built on: {up}");
-    let orientation = match model.feature_config().orientation {
-        Orientation::Recorded => "as recorded",
-        Orientation::Estimated => "estimated from gyro + accelerometer",
-    };
-    outln!("orientation: {orientation} (track and eval use the same)");
-    match model.stored_as() {
-        StoredAs::Half => outln!("samples stored: {} values in half precision", model.dim()),
-        StoredAs::Projected { components, energy } => outln!(
-            "samples stored: {components} principal coordinates of {} ({:.3} % of the variance)",
-            model.dim(),
-            100.0 * energy
-        ),
-    }
-    for (p, name) in model.placements().iter().enumerate() {
-        if let Some([x, z]) = model.regressor_params(p) {
-            let speed = model
-                .speed_params(p)
-                .map_or(String::new(), |s| format!("  speed: C={} eps={}", s.0, s.1));
-            outln!(
-                "  {name:<12} {:>6} samples  S-x: C={} eps={}  S-z: C={} eps={}{speed}",
-                model.stored_samples(p),
-                x.0,
-                x.1,
-                z.0,
-                z.1
-            );
-        }
-    }
-    let rows = model.grid_results();
-    if !rows.is_empty() {
-        outln!("cross-validation (MSE, (m/s)^2, mean over folds):");
-        outln!(
-            "  {:<12} {:>7} {:>8} {:>8} {:>10}",
-            "placement",
-            "channel",
-            "C",
-            "epsilon",
-            "MSE"
-        );
-        for r in rows {
-            outln!(
-                "  {:<12} {:>7} {:>8} {:>8} {:>10.5}",
-                r.placement,
-                ["S-x", "S-z", "speed"][usize::from(r.channel.min(2))],
-                r.c,
-                r.epsilon,
-                r.mse
-            );
-        }
-    }
+    out!("{}", ridi::inspect::inspect_model(model));
+}
+
+/// `true` for a file that starts like a model file (recordings never do).
+fn is_model_file(path: &Path) -> bool {
+    use std::io::Read;
+    let mut head = [0u8; model_file::MAGIC.len()];
+    std::fs::File::open(path).is_ok_and(|mut f| f.read_exact(&mut head).is_ok())
+        && head == model_file::MAGIC
 }
 
 fn plot_track(seq: &Sequence, track: &ridi::Track, path: &Path) -> Result<()> {

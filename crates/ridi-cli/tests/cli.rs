@@ -304,6 +304,39 @@ fn convert_train_track_and_eval() {
     assert_eq!(paper_model.feature_config().up_axis, UpAxis::PlusY);
     assert_eq!(default_model.feature_config().up_axis, UpAxis::PlusOrMinusY);
 
+    // `ridi inspect` describes a model file as `ridi train` did, or as JSON.
+    let out = ridi(&["inspect", s(&paper)]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let described = String::from_utf8_lossy(&out.stdout);
+    assert!(printed.starts_with(described.as_ref()), "{described}");
+    assert!(
+        printed.contains(
+            "feature window: 200 frames (sigma 2), a training window every 10 frames, standardized"
+        ),
+        "{printed}"
+    );
+    let out = ridi(&["inspect", s(&model), "--json"]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let json: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(json["window"], 200);
+    assert_eq!(json["step"], 20);
+    assert_eq!(json["up_axis"], "plus_or_minus_y");
+    assert_eq!(json["placements"][0]["name"], "hand");
+    assert_eq!(
+        json["placements"][0]["speed"],
+        serde_json::json!([10.0, 0.01])
+    );
+    // A model file cut short is an error naming it.
+    let cut = dir.path().join("cut.ridi");
+    std::fs::write(&cut, &std::fs::read(&model).unwrap()[..100]).unwrap();
+    let out = ridi(&["inspect", s(&cut)]);
+    assert!(!out.status.success());
+    assert!(
+        stderr(&out).contains("cannot load model") && stderr(&out).contains("cut.ridi"),
+        "{}",
+        stderr(&out)
+    );
+
     let csv = dir.path().join("t.csv");
     let png = dir.path().join("t.png");
     let test_seq = sample().join("Jakob_Nexus5_NoDist_Texting");

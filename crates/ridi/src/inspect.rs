@@ -1,9 +1,13 @@
-//! What `ridi inspect` reports about a sequence.
+//! What `ridi inspect` reports about a sequence or a model.
 
 use ridi_data::{Format, Sequence};
+use ridi_features::FeatureChannel;
 use ridi_frames::UpAxis;
+use ridi_regress::grid::GridRow;
+use ridi_regress::{Cascade, StoredAs, model_file};
 use serde::Serialize;
 
+use crate::orientation::Orientation;
 use crate::track::{RATE_HZ, RATE_TOLERANCE};
 
 /// Summary statistics of a scalar series.
@@ -239,6 +243,162 @@ impl std::fmt::Display for Inspection {
         }
         for w in &self.warnings {
             writeln!(f, "warning:      {w}")?;
+        }
+        Ok(())
+    }
+}
+
+/// What `ridi inspect` reports about a model file (and `ridi train` about the model it
+/// trained), as JSON with `--json`.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct ModelInspection {
+    /// Model file format version ([`ridi_regress::model_file::FORMAT_VERSION`]).
+    pub format_version: u32,
+    /// Frames per feature window.
+    pub window: usize,
+    /// Frames between training windows.
+    pub step: usize,
+    /// Gaussian sigma within each window, frames.
+    pub feature_sigma: f64,
+    /// Gaussian sigma of the velocity targets, frames.
+    pub target_sigma: f64,
+    /// Feature channels, in row order.
+    pub channels: Vec<FeatureChannel>,
+    /// Values per feature (`window x 3 x channels`).
+    pub dim: usize,
+    /// Whether features are z-scored with the training set's statistics.
+    pub standardized: bool,
+    /// The device axis S is built on.
+    pub up_axis: UpAxis,
+    /// The orientation features are computed with (track and eval use the same).
+    pub orientation: Orientation,
+    /// Principal coordinates stored per sample (`None`: every value in half precision).
+    pub projected_components: Option<usize>,
+    /// Share of the training variance the stored coordinates hold (1 for half precision).
+    pub stored_variance: f64,
+    /// One entry per placement.
+    pub placements: Vec<PlacementModel>,
+    /// Cross-validation results of the grid search (empty without a search).
+    pub grid: Vec<GridRow>,
+}
+
+/// The regressors of one placement ([`ModelInspection::placements`]).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct PlacementModel {
+    /// Placement name.
+    pub name: String,
+    /// Training samples the model keeps for it.
+    pub samples: usize,
+    /// `(C, epsilon)` of the S-x and S-z regressors.
+    pub velocity: [(f64, f64); 2],
+    /// `(C, epsilon)` of the speed regressor, if the model has one.
+    pub speed: Option<(f64, f64)>,
+}
+
+/// Describes a trained model.
+pub fn inspect_model(model: &Cascade) -> ModelInspection {
+    let config = model.feature_config();
+    let (projected_components, stored_variance) = match model.stored_as() {
+        StoredAs::Half => (None, 1.0),
+        StoredAs::Projected { components, energy } => (Some(components), energy),
+    };
+    let placements = model
+        .placements()
+        .iter()
+        .enumerate()
+        .map(|(p, name)| PlacementModel {
+            name: name.clone(),
+            samples: model.stored_samples(p),
+            velocity: model.regressor_params(p).unwrap_or_default(),
+            speed: model.speed_params(p),
+        })
+        .collect();
+    ModelInspection {
+        format_version: model_file::FORMAT_VERSION,
+        window: config.window,
+        step: config.step,
+        feature_sigma: config.feature_sigma,
+        target_sigma: config.target_sigma,
+        channels: config.channels.clone(),
+        dim: model.dim(),
+        standardized: config.standardization.is_some(),
+        up_axis: config.up_axis,
+        orientation: config.orientation,
+        projected_components,
+        stored_variance,
+        placements,
+        grid: model.grid_results().to_vec(),
+    }
+}
+
+impl std::fmt::Display for ModelInspection {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let names: Vec<&str> = self.placements.iter().map(|p| p.name.as_str()).collect();
+        writeln!(f, "placements: {}", names.join(", "))?;
+        writeln!(
+            f,
+            "feature window: {} frames (sigma {}), a training window every {} frames, {}",
+            self.window,
+            self.feature_sigma,
+            self.step,
+            if self.standardized {
+                "standardized"
+            } else {
+                "raw (not standardized)"
+            }
+        )?;
+        let up = match self.up_axis {
+            UpAxis::PlusY => "device +y",
+            UpAxis::PlusOrMinusY => "device +y, or -y while upside down",
+        };
+        writeln!(f, "stabilized frame S built on: {up}")?;
+        let orientation = match self.orientation {
+            Orientation::Recorded => "as recorded",
+            Orientation::Estimated => "estimated from gyro + accelerometer",
+        };
+        writeln!(
+            f,
+            "orientation: {orientation} (track and eval use the same)"
+        )?;
+        match self.projected_components {
+            None => writeln!(f, "samples stored: {} values in half precision", self.dim)?,
+            Some(components) => writeln!(
+                f,
+                "samples stored: {components} principal coordinates of {} ({:.3} % of the \
+                 variance)",
+                self.dim,
+                100.0 * self.stored_variance
+            )?,
+        }
+        for p in &self.placements {
+            let [x, z] = p.velocity;
+            let speed = p
+                .speed
+                .map_or(String::new(), |s| format!("  speed: C={} eps={}", s.0, s.1));
+            writeln!(
+                f,
+                "  {:<12} {:>6} samples  S-x: C={} eps={}  S-z: C={} eps={}{speed}",
+                p.name, p.samples, x.0, x.1, z.0, z.1
+            )?;
+        }
+        if !self.grid.is_empty() {
+            writeln!(f, "cross-validation (MSE, (m/s)^2, mean over folds):")?;
+            writeln!(
+                f,
+                "  {:<12} {:>7} {:>8} {:>8} {:>10}",
+                "placement", "channel", "C", "epsilon", "MSE"
+            )?;
+            for r in &self.grid {
+                writeln!(
+                    f,
+                    "  {:<12} {:>7} {:>8} {:>8} {:>10.5}",
+                    r.placement,
+                    ["S-x", "S-z", "speed"][usize::from(r.channel.min(2))],
+                    r.c,
+                    r.epsilon,
+                    r.mse
+                )?;
+            }
         }
         Ok(())
     }
