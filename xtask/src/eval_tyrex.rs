@@ -339,9 +339,13 @@ fn person(seq: &Sequence) -> &str {
     seq.name().split('_').next().unwrap_or_default()
 }
 
-/// RTE 5 s of the correction driven by ground-truth velocities: the floor the orientation sets.
-fn oracle_rte(seq: &Sequence, opts: &EvalOptions) -> Result<f64> {
-    let config = ridi::features::FeatureConfig::default();
+/// RTE 5 s of the correction driven by ground-truth velocities: the floor the orientation sets,
+/// at the frames a model with feature window `window` regresses.
+fn oracle_rte(seq: &Sequence, window: usize, opts: &EvalOptions) -> Result<f64> {
+    let config = ridi::features::FeatureConfig {
+        window,
+        ..Default::default()
+    };
     let frames = SampleSchedule::every(&config, opts.track.regress_every)?.frames(seq.len());
     let targets = compute_targets(&ground_truth_view(seq)?, &config, &frames)?;
     let regs: Vec<Regressed> = frames
@@ -430,7 +434,7 @@ fn run_variant(seqs: &[Sequence], models: &[Cascade], train_s: f64, v: &Variant)
             per_sequence.push(SeqRow::new(r, t, s, correction)?);
         }
         for s in &test {
-            oracle.push(oracle_rte(s, &eval_opts)?);
+            oracle.push(oracle_rte(s, model.feature_config().window, &eval_opts)?);
         }
     }
     eprintln!("  {}: evaluated", v.name);
@@ -818,7 +822,7 @@ mod tests {
         };
         let correction = opts.track.correction;
         let rte = |t: &Traces, which| swapped_rte(&seq, t, correction, which).unwrap();
-        let oracle = oracle_rte(&seq, &opts).unwrap();
+        let oracle = oracle_rte(&seq, config.window, &opts).unwrap();
         // The true direction restores the ground truth exactly; the true speed changes nothing
         // while only the direction is wrong, and mends the shortening.
         let only_turned = traces(turned.clone());

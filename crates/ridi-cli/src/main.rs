@@ -135,11 +135,11 @@ enum Command {
         /// paper's 10 without copies, and the paper's number of rows with them].
         #[arg(long, value_name = "FRAMES", value_parser = |s: &str| count(s, 1, MAX_FRAMES_APART))]
         step: Option<usize>,
-        /// Frames per feature window (the paper's 200, 1 s at 200 Hz). The model records it;
-        /// recordings must then be longer than one window to track. 100 gave a lower RTE 5 s
-        /// and shorter paths on the Tyrex protocol (docs/benchmarks.md).
-        #[arg(long, default_value_t = 200, value_name = "FRAMES", value_parser = |s: &str| count(s, MIN_WINDOW, MAX_WINDOW))]
-        window: usize,
+        /// Frames per feature window [default: the paper's 200, 1 s at 200 Hz]. The model
+        /// records it; recordings must then be longer than one window to track. 100 gave a
+        /// lower RTE 5 s and shorter paths on the Tyrex protocol (docs/benchmarks.md).
+        #[arg(long, value_name = "FRAMES", value_parser = |s: &str| count(s, MIN_WINDOW, MAX_WINDOW))]
+        window: Option<usize>,
         /// No speed regressor (the paper): by default each placement also regresses the speed
         /// and each regressed velocity is scaled to it, since turned training windows make the
         /// velocity's direction less certain than its size.
@@ -444,7 +444,7 @@ fn run(cli: Cli) -> Result<()> {
                 turned_copies,
                 features: FeatureConfig {
                     step: step.unwrap_or(ridi::train::default_step(turned_copies)),
-                    window,
+                    window: window.unwrap_or(defaults.features.window),
                     up_axis: up_axis.into(),
                     orientation: orientation.into(),
                     ..defaults.features.clone()
@@ -678,12 +678,18 @@ fn print_training(model: &Cascade) {
     out!("{}", ridi::inspect::inspect_model(model));
 }
 
-/// `true` for a file that starts like a model file (recordings never do).
+/// `true` for a file that starts like a model file, or is a model file's first bytes cut
+/// short (recordings never are): loading it then says what is wrong with it.
 fn is_model_file(path: &Path) -> bool {
     use std::io::Read;
-    let mut head = [0u8; model_file::MAGIC.len()];
-    std::fs::File::open(path).is_ok_and(|mut f| f.read_exact(&mut head).is_ok())
-        && head == model_file::MAGIC
+    let Ok(file) = std::fs::File::open(path) else {
+        return false;
+    };
+    let mut head = Vec::new();
+    let magic = &model_file::MAGIC;
+    file.take(magic.len() as u64).read_to_end(&mut head).is_ok()
+        && !head.is_empty()
+        && magic.starts_with(&head)
 }
 
 fn plot_track(seq: &Sequence, track: &ridi::Track, path: &Path) -> Result<()> {
@@ -832,8 +838,10 @@ const MAX_FRAMES_APART: usize = 12_000;
 /// Smallest `--window`: 0.1 s at 200 Hz, about the feature smoothing's kernel (17 taps at sigma 2).
 const MIN_WINDOW: usize = 20;
 
-/// Largest `--window`: 10 s at 200 Hz (12,000 values per feature; the paper's is 1 s).
-const MAX_WINDOW: usize = 2_000;
+/// Largest `--window`: 3 s at 200 Hz. Features grow with the window (3,600 values here, 1,200
+/// for the paper's 1 s), and so do their memory and the projected storage's covariance and
+/// eigendecomposition (quadratic and cubic in it); 400 frames were measured, and were worse.
+const MAX_WINDOW: usize = 600;
 
 /// A whole number in `min..=max`, for clap.
 fn count(text: &str, min: usize, max: usize) -> std::result::Result<usize, String> {
@@ -1020,6 +1028,39 @@ mod tests {
         fn source(&self) -> Option<&(dyn std::error::Error + 'static)> {
             Some(&self.0)
         }
+    }
+
+    /// Only the plots of the named sequences go, and only inside the folder, whatever an
+    /// edited or corrupt report.json names.
+    #[test]
+    fn stale_plots_are_those_of_named_sequences_inside_the_folder() {
+        let dir = tempfile::tempdir().unwrap();
+        let plots = dir.path().join("plots");
+        std::fs::create_dir_all(&plots).unwrap();
+        let file = |p: &Path| {
+            std::fs::write(p, "x").unwrap();
+            p.to_path_buf()
+        };
+        let outside = file(&dir.path().join("x.trajectory.png"));
+        let old = file(&plots.join("a.velocity.svg"));
+        let kept = file(&plots.join("a.trajectory.png"));
+        let mine = file(&plots.join("b.trajectory.png"));
+        std::fs::write(
+            dir.path().join("report.json"),
+            r#"{"sequences":[{"name":"a"},{"name":"../x"},{"name":""},{"x":1}]}"#,
+        )
+        .unwrap();
+        let names = earlier_sequences(dir.path());
+        assert_eq!(names, ["a", "../x", ""]);
+        assert_eq!(
+            remove_stale_plots(&plots, &names, std::slice::from_ref(&kept)).unwrap(),
+            1
+        );
+        assert!(!old.exists() && kept.exists() && mine.exists() && outside.exists());
+        // A report.json that is not JSON, or none, names nothing.
+        std::fs::write(dir.path().join("report.json"), "{ cut").unwrap();
+        assert!(earlier_sequences(dir.path()).is_empty());
+        assert!(earlier_sequences(&plots).is_empty());
     }
 
     #[test]

@@ -100,13 +100,15 @@ fn inspect_prints_text_and_json() {
         stderr(&out)
     );
     assert!(!text.contains("-0.00"), "{text}");
-    // Less than a feature window: readable, but nothing to train, track or evaluate.
+    // Less than a feature window: readable, but nothing to train, track or evaluate with
+    // the default window.
     let short = dir.path().join("short.csv");
     ridi::data::write_ridi_csv(&seq.slice(0..150), &short).unwrap();
     let out = ridi(&["inspect", s(&short)]);
     let text = String::from_utf8_lossy(&out.stdout);
     assert!(
-        out.status.success() && text.contains("150 frames: no whole feature window (200 frames)"),
+        out.status.success()
+            && text.contains("150 frames: no whole feature window of the default 200 frames"),
         "{text}"
     );
 }
@@ -168,7 +170,7 @@ fn bad_flags_and_outputs_fail_before_any_work() {
     for (flag, value, says) in [
         ("--turned-copies", "100000", "from 0 to 32"),
         ("--step", "0", "from 1 to 12000"),
-        ("--window", "10", "from 20 to 2000"),
+        ("--window", "10", "from 20 to 600"),
         ("--classifier-c", "0", "above 0"),
         ("--classifier-c", "NaN", "above 0"),
         ("--jobs", "0", "from 1 to 4096"),
@@ -326,15 +328,39 @@ fn convert_train_track_and_eval() {
         json["placements"][0]["speed"],
         serde_json::json!([10.0, 0.01])
     );
-    // A model file cut short is an error naming it.
+    // A model file cut short, even within its magic number, is an error naming it.
     let cut = dir.path().join("cut.ridi");
-    std::fs::write(&cut, &std::fs::read(&model).unwrap()[..100]).unwrap();
-    let out = ridi(&["inspect", s(&cut)]);
-    assert!(!out.status.success());
-    assert!(
-        stderr(&out).contains("cannot load model") && stderr(&out).contains("cut.ridi"),
-        "{}",
-        stderr(&out)
+    for len in [100, 5] {
+        std::fs::write(&cut, &std::fs::read(&model).unwrap()[..len]).unwrap();
+        let out = ridi(&["inspect", s(&cut)]);
+        assert!(!out.status.success());
+        assert!(
+            stderr(&out).contains("cannot load model") && stderr(&out).contains("cut.ridi"),
+            "{}",
+            stderr(&out)
+        );
+    }
+    // Another feature window is the model's, and shown.
+    let short = dir.path().join("short.ridi");
+    let out = ridi(&[
+        "train",
+        "--list",
+        s(&list),
+        "--out",
+        s(&short),
+        "--grid",
+        "none",
+        "--placement-map",
+        "tyrex4",
+        "--window",
+        "100",
+    ]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let out = ridi(&["inspect", s(&short), "--json"]);
+    let json: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(
+        (json["window"].clone(), json["dim"].clone()),
+        (100.into(), 600.into())
     );
 
     let csv = dir.path().join("t.csv");

@@ -43,8 +43,9 @@ impl FrameWindow<'_> {
 pub struct Regression {
     /// Horizontal velocity in the stabilized frame S, `[S-x, S-z]`, m/s.
     pub velocity: [f64; 2],
-    /// Placement class id (e.g. leg, bag, hand, body), if the regressor classifies; used by
-    /// the placement-change filter.
+    /// The placement it was regressed for, as an index into the regressor's placement names
+    /// (e.g. leg, bag, hand, body), if the regressor classifies; used by the placement-change
+    /// filter.
     pub placement: Option<usize>,
 }
 

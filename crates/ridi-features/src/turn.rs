@@ -201,7 +201,7 @@ mod tests {
             let i = source[r];
             // Speed and the vertical channels are kept.
             let speed = |v: [f64; 2]| v[0].hypot(v[1]);
-            assert!((speed(ty[r]) - speed(y[i])).abs() < 1e-5);
+            assert!((speed(ty[r]) - speed(y[i])).abs() < 1e-12);
             for k in (1..1200).step_by(3) {
                 assert_eq!(turned.row(r)[k], x.row(i)[k]);
             }

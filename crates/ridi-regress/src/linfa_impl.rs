@@ -1,5 +1,7 @@
 //! linfa vocabulary: [`Fit`] on linfa datasets for [`SvrParams`] and [`SvcParams`], and
-//! [`PredictInplace`] for the fitted [`Svr`] and [`Svc`].
+//! [`PredictInplace`] for the fitted [`Svr`] and [`Svc`]. Datasets are `f32` throughout, records
+//! and regression targets alike (linfa's usual single float type); the adapter converts the
+//! targets to the `f64` of [`Svr::fit`] and its predictions back.
 //!
 //! ```
 //! use linfa::prelude::*;

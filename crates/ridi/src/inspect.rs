@@ -117,8 +117,8 @@ pub fn inspect(seq: &Sequence, format: Format) -> Inspection {
     }
     if (2..=window).contains(&seq.len()) {
         warnings.push(format!(
-            "{} frames: no whole feature window ({window} frames) before any of them, nothing \
-             to train, track or evaluate",
+            "{} frames: no whole feature window of the default {window} frames before any of \
+             them, nothing to train, track or evaluate with such a model",
             seq.len()
         ));
     }

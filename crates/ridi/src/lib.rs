@@ -13,7 +13,7 @@
 //!
 //! Pipeline modules: [`source`] reads any supported layout, [`convert`] writes the RIDI
 //! layout with list files (all or nothing, through [`staging`]), [`lists`] reads list files
-//! for training and evaluation with the labels they need, [`inspect`] summarizes a recording,
+//! for training and evaluation with the labels they need, [`inspect`] summarizes a recording or a model,
 //! [`orientation`] swaps in an orientation estimated from gyro and accelerometer, [`live`]
 //! tracks a stream sample by sample.
 
