@@ -326,8 +326,9 @@ fn convert_train_track_and_eval() {
     assert_eq!(json["placements"][0]["name"], "hand");
     assert_eq!(
         json["placements"][0]["speed"],
-        serde_json::json!([10.0, 0.01])
+        serde_json::json!({"c": 10.0, "epsilon": 0.01})
     );
+    assert_eq!(json["placements"][3]["s_z"]["c"], 10.0);
     // A model file cut short, even within its magic number, is an error naming it.
     let cut = dir.path().join("cut.ridi");
     for len in [100, 5] {

@@ -278,7 +278,8 @@ pub struct ModelInspection {
     pub stored_variance: f64,
     /// One entry per placement.
     pub placements: Vec<PlacementModel>,
-    /// Cross-validation results of the grid search (empty without a search).
+    /// Cross-validation results of the grid search (empty without a search); `channel` is 0
+    /// for S-x, 1 for S-z and 2 for the speed.
     pub grid: Vec<GridRow>,
 }
 
@@ -289,10 +290,33 @@ pub struct PlacementModel {
     pub name: String,
     /// Training samples the model keeps for it.
     pub samples: usize,
-    /// `(C, epsilon)` of the S-x and S-z regressors.
-    pub velocity: [(f64, f64); 2],
-    /// `(C, epsilon)` of the speed regressor, if the model has one.
-    pub speed: Option<(f64, f64)>,
+    /// The S-x regressor.
+    pub s_x: Regressor,
+    /// The S-z regressor.
+    pub s_z: Regressor,
+    /// The speed regressor, if the model has one.
+    pub speed: Option<Regressor>,
+}
+
+/// Hyper-parameters of one epsilon-SVR ([`PlacementModel`]).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct Regressor {
+    /// `C`.
+    pub c: f64,
+    /// Epsilon, m/s.
+    pub epsilon: f64,
+}
+
+impl From<(f64, f64)> for Regressor {
+    fn from((c, epsilon): (f64, f64)) -> Self {
+        Regressor { c, epsilon }
+    }
+}
+
+impl std::fmt::Display for Regressor {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "C={} eps={}", self.c, self.epsilon)
+    }
 }
 
 /// Describes a trained model.
@@ -306,11 +330,15 @@ pub fn inspect_model(model: &Cascade) -> ModelInspection {
         .placements()
         .iter()
         .enumerate()
-        .map(|(p, name)| PlacementModel {
-            name: name.clone(),
-            samples: model.stored_samples(p),
-            velocity: model.regressor_params(p).unwrap_or_default(),
-            speed: model.speed_params(p),
+        .map(|(p, name)| {
+            let [x, z] = model.regressor_params(p).unwrap_or_default();
+            PlacementModel {
+                name: name.clone(),
+                samples: model.stored_samples(p),
+                s_x: x.into(),
+                s_z: z.into(),
+                speed: model.speed_params(p).map(Regressor::from),
+            }
         })
         .collect();
     ModelInspection {
@@ -371,14 +399,11 @@ impl std::fmt::Display for ModelInspection {
             )?,
         }
         for p in &self.placements {
-            let [x, z] = p.velocity;
-            let speed = p
-                .speed
-                .map_or(String::new(), |s| format!("  speed: C={} eps={}", s.0, s.1));
+            let speed = p.speed.map_or(String::new(), |s| format!("  speed: {s}"));
             writeln!(
                 f,
-                "  {:<12} {:>6} samples  S-x: C={} eps={}  S-z: C={} eps={}{speed}",
-                p.name, p.samples, x.0, x.1, z.0, z.1
+                "  {:<12} {:>6} samples  S-x: {}  S-z: {}{speed}",
+                p.name, p.samples, p.s_x, p.s_z
             )?;
         }
         if !self.grid.is_empty() {
