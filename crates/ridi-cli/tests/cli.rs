@@ -261,39 +261,33 @@ fn convert_train_track_and_eval() {
 
     let model = dir.path().join("m.ridi");
     let list = sample().join("list_Guillaume.txt");
-    let out = ridi(&[
-        "train",
-        "--list",
-        s(&list),
-        "--out",
-        s(&model),
-        "--grid",
-        "none",
-        "--placement-map",
-        "tyrex4",
-    ]);
+    // Guillaume's runs in 4 groups, without grid search, and `extra`.
+    let train = |out: &Path, extra: &[&str]| {
+        let mut args = vec![
+            "train",
+            "--list",
+            s(&list),
+            "--out",
+            s(out),
+            "--grid",
+            "none",
+            "--placement-map",
+            "tyrex4",
+        ];
+        args.extend_from_slice(extra);
+        ridi(&args)
+    };
+    let out = train(&model, &[]);
     assert!(out.status.success(), "{}", stderr(&out));
     let printed = String::from_utf8_lossy(&out.stdout);
     assert!(printed.contains("placements: hand, pocket, running, swing"));
     // Default training has a speed regressor per placement; the paper's has none.
     assert!(printed.contains("speed: C=10 eps=0.01"), "{printed}");
     let paper = dir.path().join("paper.ridi");
-    let out = ridi(&[
-        "train",
-        "--list",
-        s(&list),
-        "--out",
-        s(&paper),
-        "--grid",
-        "none",
-        "--placement-map",
-        "tyrex4",
-        "--turned-copies",
-        "0",
-        "--no-speed",
-        "--up-axis",
-        "plus-y",
-    ]);
+    let out = train(
+        &paper,
+        &["--turned-copies", "0", "--no-speed", "--up-axis", "plus-y"],
+    );
     assert!(out.status.success(), "{}", stderr(&out));
     let printed = String::from_utf8_lossy(&out.stdout);
     assert!(!printed.contains("speed:"), "{printed}");
@@ -343,19 +337,7 @@ fn convert_train_track_and_eval() {
     }
     // Another feature window is the model's, and shown.
     let short = dir.path().join("short.ridi");
-    let out = ridi(&[
-        "train",
-        "--list",
-        s(&list),
-        "--out",
-        s(&short),
-        "--grid",
-        "none",
-        "--placement-map",
-        "tyrex4",
-        "--window",
-        "100",
-    ]);
+    let out = train(&short, &["--window", "100"]);
     assert!(out.status.success(), "{}", stderr(&out));
     let out = ridi(&["inspect", s(&short), "--json"]);
     let json: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
