@@ -9,12 +9,13 @@ use clap::{Parser, Subcommand, ValueEnum};
 use indicatif::{ProgressBar, ProgressStyle};
 
 use ridi::correct::PlacementSmoother;
-use ridi::data::{Format, ReadOptions, Sequence};
+use ridi::data::{Format, ListEntry, ReadOptions, Sequence};
 use ridi::eval::{AlignWindow, EvalConfig};
 use ridi::features::FeatureConfig;
 use ridi::frames::UpAxis;
 use ridi::regress::{Cascade, ProgressEvent, RegressError, Stage, Storage, model_file};
 use ridi::source::{ReadFiles, folder_of, resolved};
+use ridi::staging::Staging;
 use ridi::{
     EvalOptions, GridChoice, Method, Orientation, PipelineError, PlacementMap, Purpose,
     TrackOptions, TrainOptions, apply_orientation,
@@ -59,10 +60,11 @@ enum Command {
         ridi inspect path/to/ridi/dan_body1/processed/data.csv --json\n  \
         ridi inspect ../shared/data/raw/tyrex-attitude-smartphones/datasets/android/Guillaume_Nexus5_NoDist_AR")]
     Inspect {
-        /// A RIDI data.csv, data_plain.txt, RIDI raw folder, Tyrex sequence folder, or a model
-        /// file of `ridi train`.
+        /// A RIDI data.csv, data_plain.txt, RIDI raw folder, Tyrex sequence folder, Indoor
+        /// Location Competition path file, or a model file of `ridi train`.
         sequence: PathBuf,
-        /// Print JSON instead of text.
+        /// Print JSON instead of text: one object, or an array of the parts of a recording
+        /// split at its gaps (each with the reader's warnings).
         #[arg(long)]
         json: bool,
     },
@@ -86,7 +88,7 @@ enum Command {
         from: Option<FromFormat>,
         /// Resample every sequence to this rate, Hz (linear interpolation, slerp for
         /// rotations); a gap longer than 5 frame intervals is refused: split it first.
-        #[arg(long, value_name = "HZ", value_parser = positive)]
+        #[arg(long, value_name = "HZ", value_parser = rate_hz)]
         rate: Option<f64>,
     },
 
@@ -162,7 +164,8 @@ enum Command {
         The CSV has time,pos_x,pos_y,pos_z,vel_x,vel_y,vel_z,placement,bias_x,bias_y,bias_z \
         (world frame of the device orientation, metres from the start).")]
     Track {
-        /// A RIDI data.csv, data_plain.txt, raw folder, or Tyrex run.
+        /// A RIDI data.csv, data_plain.txt, raw folder, Tyrex run, or Indoor Location
+        /// Competition path file.
         sequence: PathBuf,
         /// Model file from `ridi train`.
         #[arg(long)]
@@ -180,7 +183,7 @@ enum Command {
         #[arg(long, default_value_t = 50, value_parser = |s: &str| count(s, 1, MAX_FRAMES_APART))]
         regress_every: usize,
         /// Weight of the bias prior (paper: 0.1).
-        #[arg(long, default_value_t = 0.1, value_parser = non_negative)]
+        #[arg(long, default_value_t = 0.1, value_parser = positive)]
         lambda: f64,
         /// Estimate the initial velocity instead of assuming the walk starts at rest.
         #[arg(long)]
@@ -371,16 +374,34 @@ fn run(cli: Cli) -> Result<()> {
             }
             let opts = ReadOptions::default();
             let loaded = ridi::read_any(&sequence, None, &opts)?;
+            let mut reports = Vec::new();
             for seq in &loaded.sequences {
                 let mut report = ridi::inspect::inspect(seq, loaded.format);
-                // The reader's warnings (gaps, splits, dropped parts) belong to every part read.
-                report
-                    .warnings
-                    .splice(0..0, loaded.warnings.iter().cloned());
                 if json {
-                    outln!("{}", serde_json::to_string_pretty(&report)?);
-                } else {
+                    // The reader's warnings (gaps, splits, dropped parts) belong to every part.
+                    report
+                        .warnings
+                        .splice(0..0, loaded.warnings.iter().cloned());
+                }
+                reports.push(report);
+            }
+            if json {
+                // One object, or an array of the parts of a recording split at its gaps.
+                let text = match &reports[..] {
+                    [one] => serde_json::to_string_pretty(one)?,
+                    parts => serde_json::to_string_pretty(parts)?,
+                };
+                outln!("{text}");
+            } else {
+                for (i, report) in reports.iter().enumerate() {
+                    if i > 0 {
+                        outln!();
+                    }
                     out!("{report}");
+                }
+                // Once for the recording, not once per part.
+                for w in &loaded.warnings {
+                    outln!("warning:      {w}");
                 }
             }
         }
@@ -395,6 +416,7 @@ fn run(cli: Cli) -> Result<()> {
                 read: ReadOptions::default(),
                 rate_hz: rate,
             };
+            check_output_folder(&out)?;
             let summary = ridi::convert::convert(&source, &out, &opts)?;
             for w in &summary.warnings {
                 eprintln!("warning: {w}");
@@ -428,16 +450,13 @@ fn run(cli: Cli) -> Result<()> {
         } => {
             set_jobs(jobs)?;
             check_output(&out)?;
+            let entries = read_entries(&list)?;
             let mut read = list.clone();
-            for l in &list {
-                // Unreadable lists are reported by load_lists below, with their line.
-                if let Ok(entries) = ridi::data::read_list(l) {
-                    read.extend(entries.into_iter().map(|e| e.path));
-                }
-            }
+            read.extend(entries.iter().map(|e| e.path.clone()));
             let inputs = ReadFiles::of(&read);
             check_not_input(&out, &inputs, &[])?;
-            let seqs = load_lists(&list, placement_map.as_deref(), Purpose::Training)?;
+            let listed = load_listed(entries, placement_map.as_deref(), Purpose::Training)?;
+            let seqs = &listed.seqs;
             let defaults = TrainOptions::default();
             let mut opts = TrainOptions {
                 standardize: !no_standardize,
@@ -455,7 +474,8 @@ fn run(cli: Cli) -> Result<()> {
             opts.cascade.regressors = GridChoice::from(grid).regressors();
             opts.cascade.storage = storage.into();
             opts.cascade.speed = !no_speed;
-            let model = train_with_progress(&seqs, &opts).map_err(|e| {
+            let model = train_with_progress(seqs, &opts).map_err(|e| {
+                let e = listed.locate(e);
                 let folds = matches!(
                     e.downcast_ref::<PipelineError>(),
                     Some(PipelineError::Regress(RegressError::TooFewSequences { .. }))
@@ -521,16 +541,21 @@ fn run(cli: Cli) -> Result<()> {
             }
             let track = ridi::track(seq, &model, &opts)
                 .with_context(|| format!("cannot track {}", sequence.display()))?;
+            // The plot first: if it fails, the command has written nothing. (Both folders were
+            // found writable above, so the trajectory's write after it hardly can.)
+            if let Some(plot) = &plot {
+                plot_track(seq, &track, plot)?;
+            }
             track.write_csv(&out)?;
+            let n = track.regressions.len();
             outln!(
-                "{}: {} frames, {} regressions -> {}",
+                "{}: {} frames, {n} regression{} -> {}",
                 seq.name(),
                 track.time.len(),
-                track.regressions.len(),
+                if n == 1 { "" } else { "s" },
                 out.display()
             );
             if let Some(plot) = plot {
-                plot_track(seq, &track, &plot)?;
                 outln!("plot: {}", plot.display());
             }
         }
@@ -555,12 +580,27 @@ fn run(cli: Cli) -> Result<()> {
                 }
             }
             let model = load_model(&model)?;
-            let seqs = load_lists(&list, placement_map.as_deref(), Purpose::Evaluation)?;
+            let listed = load_listed(
+                read_entries(&list)?,
+                placement_map.as_deref(),
+                Purpose::Evaluation,
+            )?;
             let track = TrackOptions {
                 placement_smoothing: placement_smoothing(placement_window),
                 ..TrackOptions::default()
             };
-            evaluate_and_write(&seqs, &model, chosen, track, align, &out, plots)?;
+            let staging = stage(&out)?;
+            evaluate_and_write(
+                &listed.seqs,
+                &model,
+                chosen,
+                track,
+                align,
+                staging,
+                &out,
+                plots,
+            )
+            .map_err(|e| listed.locate(e))?;
         }
         Command::Demo {
             out,
@@ -572,8 +612,9 @@ fn run(cli: Cli) -> Result<()> {
     Ok(())
 }
 
-/// Refuses an output path that cannot be written: its folder missing or not a folder, or the
-/// path itself a folder. Checked before long work (training, tracking) rather than after it.
+/// Refuses an output path that cannot be written: its folder missing, not a folder or not
+/// writable, or the path itself a folder. Checked before long work (training, tracking)
+/// rather than after it.
 fn check_output(path: &Path) -> Result<()> {
     let parent = folder_of(path);
     if !parent.is_dir() {
@@ -586,7 +627,23 @@ fn check_output(path: &Path) -> Result<()> {
     if path.is_dir() {
         bail!("cannot write {}: it is a folder", path.display());
     }
+    // Outputs are written through a temporary file beside them: try to make one now.
+    if let Err(e) = tempfile::NamedTempFile::new_in(parent) {
+        // The kind alone: the error's own text names the temporary file, not the output.
+        bail!(
+            "cannot write {}: cannot create files in {} ({})",
+            path.display(),
+            parent.display(),
+            std::io::Error::from(e.kind())
+        );
+    }
     Ok(())
+}
+
+/// Starts writing the output folder `dir` all or nothing ([`Staging`]): creates it if needed
+/// and a hidden staging folder in it, so that an unwritable folder fails before any work.
+fn stage(dir: &Path) -> Result<Staging> {
+    Staging::new(dir).with_context(|| format!("cannot write into {}", dir.display()))
 }
 
 /// Refuses an output folder that exists as something else (a file), before any work.
@@ -632,14 +689,40 @@ fn set_jobs(jobs: Option<usize>) -> Result<()> {
     Ok(())
 }
 
-fn load_lists(lists: &[PathBuf], map: Option<&str>, purpose: Purpose) -> Result<Vec<Sequence>> {
+/// The entries of the list files `lists`, in order.
+fn read_entries(lists: &[PathBuf]) -> Result<Vec<ListEntry>> {
+    let mut entries = Vec::new();
+    for l in lists {
+        entries.extend(ridi::data::read_list(l)?);
+    }
+    Ok(entries)
+}
+
+/// The listed sequences, each with the list entry it was read from.
+struct Listed {
+    seqs: Vec<Sequence>,
+    entries: Vec<ListEntry>,
+}
+
+impl Listed {
+    /// Adds the list file and line to an error about one listed sequence (found after loading,
+    /// as too short a recording), which names the sequence only.
+    fn locate(&self, e: anyhow::Error) -> anyhow::Error {
+        let Some(PipelineError::Sequence { sequence, .. }) = e.downcast_ref::<PipelineError>()
+        else {
+            return e;
+        };
+        match self.seqs.iter().position(|s| s.name() == sequence) {
+            Some(i) => e.context(self.entries[i].location().to_string()),
+            None => e,
+        }
+    }
+}
+
+fn load_listed(entries: Vec<ListEntry>, map: Option<&str>, purpose: Purpose) -> Result<Listed> {
     let map = map.map(PlacementMap::from_arg).transpose()?;
-    Ok(ridi::load_lists(
-        lists,
-        map.as_ref(),
-        purpose,
-        &ReadOptions::default(),
-    )?)
+    let seqs = ridi::lists::load_listed(&entries, map.as_ref(), purpose, &ReadOptions::default())?;
+    Ok(Listed { seqs, entries })
 }
 
 fn load_model(path: &Path) -> Result<Cascade> {
@@ -678,10 +761,18 @@ fn print_training(model: &Cascade) {
     out!("{}", ridi::inspect::inspect_model(model));
 }
 
-/// `true` for a file that starts like a model file, or is a model file's first bytes cut
-/// short (recordings never are): loading it then says what is wrong with it.
+/// `true` for a `.ridi` file, or a file that starts like a model file or is a model file's
+/// first bytes cut short (recordings never are): loading it then says what is wrong with it.
 fn is_model_file(path: &Path) -> bool {
     use std::io::Read;
+    // A `.ridi` file is meant as a model: if it is none, say so, not which data it is not.
+    if path
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("ridi"))
+        && path.is_file()
+    {
+        return true;
+    }
     let Ok(file) = std::fs::File::open(path) else {
         return false;
     };
@@ -720,12 +811,16 @@ fn plot_track(seq: &Sequence, track: &ridi::Track, path: &Path) -> Result<()> {
     Ok(())
 }
 
+/// Evaluates `seqs` and stages the reports and plots in `staging` (the output folder `out`),
+/// then moves them into place together: a failure on the way leaves `out` as it was.
+#[allow(clippy::too_many_arguments)]
 fn evaluate_and_write(
     seqs: &[Sequence],
     model: &Cascade,
     methods: Vec<Method>,
     track: TrackOptions,
     align: AlignWindow,
+    staging: Staging,
     out: &Path,
     plots: Plots,
 ) -> Result<ridi::Report> {
@@ -742,15 +837,9 @@ fn evaluate_and_write(
         Plots::Svg => Some("svg"),
         Plots::None => None,
     };
-    // Folders first: a folder that cannot be made fails the command before the evaluation.
     let plot_dir = out.join("plots");
-    let dirs: &[&Path] = if ext.is_some() {
-        &[out, &plot_dir]
-    } else {
-        &[out]
-    };
-    for dir in dirs {
-        std::fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))?;
+    if ext.is_some() {
+        check_output_folder(&plot_dir)?;
     }
     // Read before report.json is replaced: whose plots an earlier evaluation wrote.
     let mut plotted = earlier_sequences(out);
@@ -760,19 +849,22 @@ fn evaluate_and_write(
     spinner.enable_steady_tick(std::time::Duration::from_millis(200));
     let (report, traces) = ridi::evaluate(seqs, model, &opts)?;
     spinner.finish_and_clear();
-    // The plots before the reports: report.json is there only when everything was written.
     let mut written = Vec::new();
     if let Some(ext) = ext {
+        let staged = staging.dir(Path::new("plots"))?;
         for t in &traces {
-            written.extend(t.plot(&plot_dir, ext)?);
+            for file in t.plot(&staged, ext)? {
+                written.extend(file.file_name().map(|name| plot_dir.join(name)));
+            }
         }
     }
-    written.extend(report.write(out)?);
+    let reports = report.write(&staging.dir(Path::new(""))?)?.len();
+    staging.commit()?;
     let stale = remove_stale_plots(&plot_dir, &plotted, &written)?;
     print_summary(&report);
     outln!(
         "wrote {} files into {} (report.md, report.json{}){}",
-        written.len(),
+        written.len() + reports,
         out.display(),
         if ext.is_some() { ", plots/" } else { "" },
         if stale > 0 {
@@ -862,6 +954,17 @@ fn positive(text: &str) -> std::result::Result<f64, String> {
 }
 
 /// A finite number of at least 0, for clap.
+/// `--rate`: 1 Hz to 10 kHz, the frame intervals (1 s to 0.1 ms) the readers accept
+/// (`ridi_data::Validation::time_step_range`); phone sensors deliver 5-500 Hz.
+fn rate_hz(text: &str) -> std::result::Result<f64, String> {
+    match text.parse::<f64>() {
+        Ok(x) if (1.0..=10_000.0).contains(&x) => Ok(x),
+        _ => Err(format!(
+            "`{text}` is not a rate of 1 to 10000 Hz (frames 1 s to 0.1 ms apart)"
+        )),
+    }
+}
+
 fn non_negative(text: &str) -> std::result::Result<f64, String> {
     match text.parse::<f64>() {
         Ok(x) if x.is_finite() && x >= 0.0 => Ok(x),
@@ -952,34 +1055,41 @@ fn demo(out: &Path, data: Option<PathBuf>, grid: Grid, plots: Plots) -> Result<(
         );
     }
     check_output_folder(out)?;
+    // Before training: an output folder that cannot be written fails in a second, not after it.
+    let staging = stage(out)?;
     let map = Some("tyrex4");
-    let train = load_lists(&[train_list], map, Purpose::Training)?;
-    let test = load_lists(&[data.join("list_test.txt")], map, Purpose::Evaluation)?;
+    let train = load_listed(read_entries(&[train_list])?, map, Purpose::Training)?;
+    let test = load_listed(
+        read_entries(&[data.join("list_test.txt")])?,
+        map,
+        Purpose::Evaluation,
+    )?;
     outln!(
         "demo: training on {} sequences ({:.0} s), testing on {} held-out sequences",
-        train.len(),
-        train.iter().map(|s| s.duration()).sum::<f64>(),
-        test.len()
+        train.seqs.len(),
+        train.seqs.iter().map(|s| s.duration()).sum::<f64>(),
+        test.seqs.len()
     );
     let mut opts = TrainOptions::default();
     opts.cascade.regressors = GridChoice::from(grid).regressors();
     let started = std::time::Instant::now();
-    let model = train_with_progress(&train, &opts)?;
+    let model = train_with_progress(&train.seqs, &opts).map_err(|e| train.locate(e))?;
     outln!("trained in {:.1} s", started.elapsed().as_secs_f64());
     print_training(&model);
-    std::fs::create_dir_all(out).with_context(|| format!("cannot create {}", out.display()))?;
-    let model_path = out.join("model.ridi");
+    let model_path = staging.file(Path::new("model.ridi"))?;
     model_file::save(&model, &model_path)
-        .with_context(|| format!("cannot write {}", model_path.display()))?;
+        .with_context(|| format!("cannot write {}", out.join("model.ridi").display()))?;
     evaluate_and_write(
-        &test,
+        &test.seqs,
         &model,
         Method::ALL.to_vec(),
         TrackOptions::default(),
         AlignWindow::default(),
+        staging,
         out,
         plots,
-    )?;
+    )
+    .map_err(|e| test.locate(e))?;
     Ok(())
 }
 

@@ -56,18 +56,7 @@ fn inspect_prints_text_and_json() {
     // The reader's own warnings are in the report too (here: a Tyrex run of an unknown
     // motion, 20 s of a phone lying still), in text and JSON alike.
     let dir = tempfile::tempdir().unwrap();
-    let run = dir.path().join("Ann_Nexus5_NoDist_Dancing");
-    std::fs::create_dir_all(&run).unwrap();
-    for (file, values) in [
-        ("accelerometer.txt", "0.0 0.0 9.80665"),
-        ("gyroscope-calibrated.txt", "0.0 0.0 0.0"),
-        ("rotation-vector.txt", "0.0 0.0 0.0 1.0 0.17"),
-    ] {
-        let rows: String = (0..4000)
-            .map(|k| format!("{:.9} {values}\n", 0.003 + k as f64 * 0.005))
-            .collect();
-        std::fs::write(run.join(file), rows).unwrap();
-    }
+    let run = still_tyrex_run(dir.path(), "Ann_Nexus5_NoDist_Dancing", 4000, None);
     let out = ridi(&["inspect", s(&run), "--json"]);
     assert!(out.status.success(), "{}", stderr(&out));
     let json: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
@@ -80,6 +69,24 @@ fn inspect_prints_text_and_json() {
     let text = String::from_utf8_lossy(&out.stdout);
     assert_eq!(
         text.matches("does not end in a known motion").count(),
+        1,
+        "{text}"
+    );
+
+    // A run split at a sensor gap: JSON gives an array of the parts, text the reader's
+    // warnings once.
+    let split = still_tyrex_run(dir.path(), "Ann_Nexus5_NoDist_Texting", 6000, Some(3000));
+    let out = ridi(&["inspect", s(&split), "--json"]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let json: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let parts = json.as_array().expect("an array of parts");
+    assert_eq!(parts.len(), 2, "{json}");
+    assert!(parts[1]["warnings"].to_string().contains("split"), "{json}");
+    let out = ridi(&["inspect", s(&split)]);
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert_eq!(text.matches("name:").count(), 2, "{text}");
+    assert_eq!(
+        text.matches("accelerometer.txt:3001: gap").count(),
         1,
         "{text}"
     );
@@ -113,6 +120,31 @@ fn inspect_prints_text_and_json() {
     );
 }
 
+/// A Tyrex run `name` in `dir` of a phone lying still for `frames` frames at 200 Hz, with a
+/// 3-s gap in every stream before frame `gap_at` if given.
+fn still_tyrex_run(dir: &Path, name: &str, frames: usize, gap_at: Option<usize>) -> PathBuf {
+    let run = dir.join(name);
+    std::fs::create_dir_all(&run).unwrap();
+    for (file, values) in [
+        ("accelerometer.txt", "0.0 0.0 9.80665"),
+        ("gyroscope-calibrated.txt", "0.0 0.0 0.0"),
+        ("rotation-vector.txt", "0.0 0.0 0.0 1.0 0.17"),
+    ] {
+        let rows: String = (0..frames)
+            .map(|k| {
+                let gap = if gap_at.is_some_and(|g| k >= g) {
+                    3.0
+                } else {
+                    0.0
+                };
+                format!("{:.9} {values}\n", 0.003 + k as f64 * 0.005 + gap)
+            })
+            .collect();
+        std::fs::write(run.join(file), rows).unwrap();
+    }
+    run
+}
+
 #[test]
 fn errors_are_one_line_with_a_non_zero_exit() {
     let dir = tempfile::tempdir().unwrap();
@@ -139,6 +171,24 @@ fn errors_are_one_line_with_a_non_zero_exit() {
     let err = stderr(&out);
     assert!(!out.status.success() && err.contains("m.ridi"), "{err}");
     assert!(!csv.exists(), "no output on failure");
+    // Inspected, a `.ridi` file is judged as a model, whatever its bytes.
+    for bytes in [&b"not a model"[..], b""] {
+        std::fs::write(&model, bytes).unwrap();
+        let err = stderr(&ridi(&["inspect", s(&model)]));
+        assert!(err.starts_with("error: cannot load model"), "{err}");
+    }
+    // Something that exists but is neither file nor folder is not called missing.
+    if cfg!(unix) {
+        let err = stderr(&ridi(&["inspect", "/dev/null"]));
+        assert!(err.contains("neither a regular file nor a folder"), "{err}");
+    }
+    // Converting into a file, not a folder.
+    let out = ridi(&["convert", s(&seq), "--out", s(&bad)]);
+    let err = stderr(&out);
+    assert!(
+        !out.status.success() && err.contains("it is a file, not a folder"),
+        "{err}"
+    );
 }
 
 #[test]
@@ -226,8 +276,9 @@ fn bad_flags_and_outputs_fail_before_any_work() {
     };
     for (flag, value, says) in [
         ("--regress-every", "0", "from 1 to 12000"),
-        ("--lambda", "NaN", "at least 0"),
-        ("--lambda", "inf", "at least 0"),
+        ("--lambda", "NaN", "above 0"),
+        ("--lambda", "inf", "above 0"),
+        ("--lambda", "0", "above 0"),
     ] {
         let out = track(&[flag, value]);
         let err = stderr(&out);
@@ -349,17 +400,12 @@ fn convert_train_track_and_eval() {
     let csv = dir.path().join("t.csv");
     let png = dir.path().join("t.png");
     let test_seq = sample().join("Jakob_Nexus5_NoDist_Texting");
-    let out = ridi(&[
-        "track",
-        s(&test_seq),
-        "--model",
-        s(&model),
-        "--out",
-        s(&csv),
-        "--online",
-        "--plot",
-        s(&png),
-    ]);
+    let track_to = |input: &Path, out: &Path, extra: &[&str]| {
+        let mut args = vec!["track", s(input), "--model", s(&model), "--out", s(out)];
+        args.extend_from_slice(extra);
+        ridi(&args)
+    };
+    let out = track_to(&test_seq, &csv, &["--online", "--plot", s(&png)]);
     assert!(out.status.success(), "{}", stderr(&out));
     assert_eq!(std::fs::read_to_string(&csv).unwrap().lines().count(), 4801);
     assert!(std::fs::read(&png).unwrap().starts_with(b"\x89PNG"));
@@ -460,6 +506,101 @@ fn convert_train_track_and_eval() {
         stderr(&out)
     );
 
+    // An evaluation is written all or nothing: one output it cannot replace (report.md made
+    // a folder) leaves the earlier report.json, and no plots/ or staging folder behind.
+    let json_before = std::fs::read(report.join("report.json")).unwrap();
+    std::fs::remove_file(report.join("report.md")).unwrap();
+    std::fs::create_dir(report.join("report.md")).unwrap();
+    let out = eval_one(&report, &[&methods[..], &["--plots", "svg"]].concat());
+    assert!(!out.status.success());
+    assert_eq!(
+        std::fs::read(report.join("report.json")).unwrap(),
+        json_before
+    );
+    let mut left: Vec<String> = std::fs::read_dir(&report)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    left.sort();
+    assert_eq!(left, ["report.json", "report.md"]);
+    std::fs::remove_dir(report.join("report.md")).unwrap();
+    // A file where the plots go is named before the evaluation.
+    std::fs::write(report.join("plots"), "mine").unwrap();
+    let out = eval_one(&report, &[&methods[..], &["--plots", "png"]].concat());
+    let err = stderr(&out);
+    assert!(
+        !out.status.success() && err.contains("plots: it is a file, not a folder"),
+        "{err}"
+    );
+    std::fs::remove_file(report.join("plots")).unwrap();
+
+    // A recording listed twice, also through another path, and two recordings of one name
+    // are refused at their list line; so is, after loading, a recording too short to track.
+    let twice = dir.path().join("twice.txt");
+    let same = dir.path().join("same.txt");
+    let short_list = dir.path().join("short.txt");
+    for name in ["a", "b"] {
+        let run = dir.path().join(name).join("run/processed");
+        std::fs::create_dir_all(&run).unwrap();
+        std::fs::copy(
+            test_seq.join("processed/data.csv.gz"),
+            run.join("data.csv.gz"),
+        )
+        .unwrap();
+    }
+    std::fs::write(
+        &twice,
+        format!(
+            "{}\n{}\n",
+            s(&test_seq),
+            s(&test_seq.join("processed/data.csv.gz"))
+        ),
+    )
+    .unwrap();
+    std::fs::write(&same, "a/run\nb/run\n").unwrap();
+    let seq = ridi::data::read_sequence(&test_seq, &Default::default()).unwrap();
+    let short_run = dir.path().join("short/processed");
+    std::fs::create_dir_all(&short_run).unwrap();
+    ridi::data::write_ridi_csv(&seq.slice(0..150), short_run.join("data.csv")).unwrap();
+    std::fs::write(&short_list, format!("{}\nshort\n", s(&test_seq))).unwrap();
+    let new_report = dir.path().join("new-report");
+    for (list, says) in [
+        (&twice, "twice.txt:2: field `path`"),
+        (
+            &same,
+            "same.txt:2: field `path`: a sequence named `run` is already listed at",
+        ),
+        (&short_list, "short.txt:2: sequence `short`: has 150 frames"),
+    ] {
+        let out = ridi(&[
+            "eval",
+            "--list",
+            s(list),
+            "--model",
+            s(&model),
+            "--out",
+            s(&new_report),
+        ]);
+        let err = stderr(&out);
+        assert!(!out.status.success() && err.contains(says), "{err}");
+        assert!(!new_report.exists(), "{err}");
+    }
+
+    // An output folder that cannot be written fails before the work (procfs refuses new
+    // files even to root, who may write anywhere else).
+    if cfg!(target_os = "linux") {
+        let tracked = std::fs::read(&csv).unwrap();
+        let unwritable = Path::new("/proc/ridi-test.png");
+        let out = track_to(&test_seq, &csv, &["--plot", s(unwritable)]);
+        let err = stderr(&out);
+        assert!(
+            !out.status.success() && err.contains("cannot create files in /proc"),
+            "{err}"
+        );
+        assert!(!err.contains(".tmp"), "{err}");
+        assert_eq!(std::fs::read(&csv).unwrap(), tracked);
+    }
+
     // No output may overwrite an input: the recording, the model, a list, or a file a
     // sequence folder is read from; the inputs stay as they were.
     let recording = dir.path().join("v.csv.gz");
@@ -469,11 +610,6 @@ fn convert_train_track_and_eval() {
     std::fs::copy(&recording, folder.join("processed/data.csv.gz")).unwrap();
     let model_bytes = std::fs::read(&model).unwrap();
     let recording_bytes = std::fs::read(&recording).unwrap();
-    let track_to = |input: &Path, out: &Path, extra: &[&str]| {
-        let mut args = vec!["track", s(input), "--model", s(&model), "--out", s(out)];
-        args.extend_from_slice(extra);
-        ridi(&args)
-    };
     for (input, output) in [
         (&recording, &recording),
         (&recording, &model),
@@ -569,29 +705,17 @@ fn convert_train_track_and_eval() {
     // The placement majority window: off with 0, refused when negative. The orientation is
     // the model's: track no longer takes --orientation.
     let plain = dir.path().join("plain.csv");
-    let track_plain = |extra: &[&str]| {
-        let mut args = vec![
-            "track",
-            s(&test_seq),
-            "--model",
-            s(&model),
-            "--out",
-            s(&plain),
-        ];
-        args.extend_from_slice(extra);
-        ridi(&args)
-    };
-    let out = track_plain(&["--placement-window", "0"]);
+    let out = track_to(&test_seq, &plain, &["--placement-window", "0"]);
     assert!(out.status.success(), "{}", stderr(&out));
     let unsmoothed = std::fs::read_to_string(&plain).unwrap();
     assert_eq!(unsmoothed.lines().count(), 4801);
     assert_ne!(unsmoothed, std::fs::read_to_string(&csv).unwrap());
-    let out = track_plain(&["--orientation", "estimated"]);
+    let out = track_to(&test_seq, &plain, &["--orientation", "estimated"]);
     assert!(!out.status.success());
     assert!(stderr(&out).contains("--orientation"), "{}", stderr(&out));
     // A bad value is a usage error like any other flag's (exit code 2), for each command.
     for bad in ["-1", "nan", "inf"] {
-        let out = track_plain(&[&format!("--placement-window={bad}")]);
+        let out = track_to(&test_seq, &plain, &[&format!("--placement-window={bad}")]);
         assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
         assert!(
             stderr(&out).contains(&format!("invalid value '{bad}' for '--placement-window")),
@@ -707,6 +831,15 @@ fn convert_writes_all_or_nothing() {
         "{err}"
     );
     assert!(!conv.exists());
+    // A rate no phone records at is the flag's error, not the recording's.
+    for rate in ["0.5", "100000", "1e300"] {
+        let out = ridi(&["convert", s(&texting), "--out", s(&conv), "--rate", rate]);
+        let err = stderr(&out);
+        assert!(
+            out.status.code() == Some(2) && err.contains("--rate") && err.contains("1 to 10000 Hz"),
+            "{err}"
+        );
+    }
 
     // The source of another format than --from says what it is and what was expected.
     let csv = dir

@@ -90,7 +90,11 @@ fn locate(path: &Path) -> Result<(Format, PathBuf)> {
     if !path.is_dir() {
         return Err(DataError::format(
             Location::file(path),
-            "no such file or folder",
+            if path.exists() {
+                "neither a regular file nor a folder (a device, socket or pipe)"
+            } else {
+                "no such file or folder"
+            },
         ));
     }
     let has = |p: &str| path.join(p).is_file();

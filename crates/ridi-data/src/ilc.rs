@@ -524,16 +524,12 @@ fn parse_records(content: &str, path: &Path) -> Result<([Stream; 5], Header)> {
         }
         last = Some((line, Some(kind.name)));
     }
-    let complete = content.trim_end_matches([' ', '\t', '\r']).ends_with('\n');
-    if let Some((line, Some(ty))) = last
-        && !complete
-    {
-        return Err(DataError::format(
-            Location::line(path, line).with_field(ty),
-            "the file ends inside this record, without a line break: cut off while being \
-             written? (complete path files end with a `#\tendTime` line)",
-        ));
-    }
+    let last_record = last.and_then(|(line, ty)| Some(Location::line(path, line).with_field(ty?)));
+    text::check_line_break(
+        content,
+        last_record,
+        " (complete path files end with a `#\tendTime` line)",
+    )?;
     Ok((streams, header))
 }
 

@@ -89,5 +89,5 @@ pub use sequence::{
     SequenceError, SequenceParts, Validation,
 };
 pub use write::{
-    Precision, write_atomically, write_ridi_csv, write_ridi_csv_with, write_ridi_plain,
+    Precision, RoundTrip, write_atomically, write_ridi_csv, write_ridi_csv_with, write_ridi_plain,
 };

@@ -7,7 +7,7 @@
 
 use std::path::{Path, PathBuf};
 
-use crate::detect::read_sequence;
+use crate::detect::{read_sequence, source_files};
 use crate::error::{DataError, Location, Result};
 use crate::options::ReadOptions;
 use crate::sequence::Sequence;
@@ -100,7 +100,12 @@ pub fn load_list(path: impl AsRef<Path>, opts: &ReadOptions) -> Result<Vec<Seque
 /// Reads the sequences of `entries` (from [`read_list`], of one or several list files), in
 /// order, as [`load_list`] does: every path is checked to exist before any is read, and the
 /// placement is the entry's when it gives one.
+///
+/// A recording listed twice is refused, also through two paths (a folder and its
+/// `processed/data.csv`, a symbolic link): it would count twice in every mean, and sit on both
+/// sides of a cross-validation split.
 pub fn load_entries(entries: &[ListEntry], opts: &ReadOptions) -> Result<Vec<Sequence>> {
+    let mut seen: Vec<(Vec<PathBuf>, &ListEntry)> = Vec::new();
     for e in entries {
         if !e.path.exists() {
             return Err(DataError::format(
@@ -108,6 +113,27 @@ pub fn load_entries(entries: &[ListEntry], opts: &ReadOptions) -> Result<Vec<Seq
                 format!("sequence `{}` does not exist", e.path.display()),
             ));
         }
+        // What the read takes data from, resolved; an unknown format is reported by the read.
+        let Ok(files) = source_files(&e.path) else {
+            continue;
+        };
+        let files: Vec<PathBuf> = files
+            .iter()
+            .map(|f| f.canonicalize().unwrap_or_else(|_| f.clone()))
+            .collect();
+        if let Some((_, first)) = seen.iter().find(|(f, _)| *f == files) {
+            return Err(DataError::format(
+                e.location().with_field("path"),
+                format!(
+                    "sequence `{}` is the recording already listed at {}:{}; a recording listed \
+                     twice would count twice",
+                    e.path.display(),
+                    first.list.display(),
+                    first.line
+                ),
+            ));
+        }
+        seen.push((files, e));
     }
     entries
         .iter()

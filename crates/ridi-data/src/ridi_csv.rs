@@ -4,7 +4,8 @@
 //! columns of later versions and any column order are all accepted. Required: `time`, `gyro_*`,
 //! `acce_*`, `linacce_*`, `grav_*`, `rv_*`. Optional: `magnet_*` (all zeros also means "not
 //! recorded"), and `pos_*` with `ori_*` together (NaN on every row also means "no ground
-//! truth"). Time is in nanoseconds and becomes absolute seconds.
+//! truth"). Time is in nanoseconds and becomes absolute seconds. A last row without a line break
+//! after it is refused: the file was cut off while being written, maybe inside a value.
 
 use std::path::Path;
 
@@ -129,6 +130,8 @@ fn parse_table(text: &str, path: &Path) -> Result<Table> {
             "only a header line, no data rows",
         ));
     }
+    let last_row = row_lines.last().map(|&l| Location::line(path, l));
+    text::check_line_break(text, last_row, "")?;
     Ok(Table {
         rows,
         lines: row_lines,

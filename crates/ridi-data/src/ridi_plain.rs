@@ -2,6 +2,7 @@
 //! then `N` rows of the 27 processed [`COLUMNS`], tab-separated, without an index column. Any
 //! run of spaces or tabs is accepted as a separator.
 //! Magnet and ground truth follow the `data.csv` conventions (all zeros and all NaN mean absent).
+//! A last row without a line break after it is refused, as a file cut off while being written.
 
 use std::path::Path;
 
@@ -101,6 +102,8 @@ fn parse_table(text: &str, path: &Path) -> Result<Table> {
             ),
         ));
     }
+    let last_row = row_lines.last().map(|&l| Location::line(path, l));
+    text::check_line_break(text, last_row, "")?;
     Ok(Table {
         rows,
         lines: row_lines,

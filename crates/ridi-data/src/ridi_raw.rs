@@ -6,7 +6,8 @@
 //! starts with a `#` header line (any `#` line is skipped), then space-separated rows
 //! `t_ns values...`: `x y z` for the IMU files, `x y z w` for the game rotation vector in
 //! `orientation.txt`, `tx ty tz qx qy qz qw` for the Tango pose, `count` for `step.txt`. Extra
-//! trailing values are ignored; fewer are an error.
+//! trailing values are ignored; fewer are an error, and so is a last record without a line break
+//! after it (a file cut off while being written, whose last value may be cut short).
 //!
 //! Like the original processing, the pose timeline is the master clock: [`ReadOptions::pose_trim`]
 //! records are dropped at each end, then every sensor is linearly interpolated onto the pose
@@ -183,10 +184,15 @@ fn parse_records(
         lines: Vec::new(),
     };
     let mut row = Vec::with_capacity(width);
-    for (line, content) in text::lines(text::as_text(bytes, path)?) {
+    // The line of the last record, unless a `#` line follows it.
+    let mut last_record = None;
+    let text = text::as_text(bytes, path)?;
+    for (line, content) in text::lines(text) {
         if content.trim_start().starts_with('#') {
+            last_record = None;
             continue;
         }
+        last_record = Some(line);
         let mut cells = content.split_ascii_whitespace();
         let t = text::number(
             cells.next().unwrap_or(""),
@@ -220,6 +226,7 @@ fn parse_records(
         rec.values.extend_from_slice(&row);
         rec.lines.push(line);
     }
+    text::check_line_break(text, last_record.map(|l| Location::line(path, l)), "")?;
     // Duplicates are gone, so equal times cannot occur here; decreasing ones and gaps can.
     text::check_time(
         &rec.time,

@@ -186,6 +186,7 @@ fn median(v: &mut [f64]) -> f64 {
 /// | largest position component | 222 m | 10^6 m |
 /// | median interval between timestamps | 5-20 ms | 0.1 ms..1 s |
 /// | median ground-truth speed per Tyrex run | 0.17..2.33 m/s | 20 m/s |
+/// | largest ground-truth speed between consecutive frames (also over 2-20 frames) | 5.7 m/s | 100 m/s |
 ///
 /// Not caught: a gyro in deg/s on a phone that hardly turns (median |gyro| under 0.17 rad/s
 /// and the orientation turning at under [`GYRO_SCALE_MIN_RATE`] RMS), and a linear
@@ -242,6 +243,13 @@ pub struct Validation {
     /// at 1-2 m/s and run at 3-5; positions in millimetres or centimetres read as metres move
     /// 100-1000 times faster, which the bound on single positions cannot see.
     pub max_median_speed: f64,
+    /// Largest accepted speed of the ground truth between two consecutive frames, m/s: 100
+    /// (0.5 m in a 5 ms step). The fastest real motion is 5.7 m/s (a phone in a running
+    /// hand; no faster over 2-20 frames, so mocap jitter adds nothing), and the readers
+    /// interpolate across the mocap losses they bridge, which moves no faster; one corrupt
+    /// position jumps metres to kilometres within a step, which the median and the bound on
+    /// single positions cannot see.
+    pub max_speed: f64,
 }
 
 impl Default for Validation {
@@ -260,6 +268,7 @@ impl Default for Validation {
             gyro_scale_range: (0.25, 4.0),
             time_step_range: (1e-4, 1.0),
             max_median_speed: 20.0,
+            max_speed: 100.0,
         }
     }
 }
@@ -339,26 +348,41 @@ impl Validation {
         }
     }
 
-    /// Checks the median speed of `position` over `time` (seconds, increasing) against
-    /// [`Self::max_median_speed`]; fewer than two frames pass.
+    /// Checks the speed of `position` over `time` (seconds, increasing): the median against
+    /// [`Self::max_median_speed`] first (so that positions in another unit are reported as
+    /// such), then each step between consecutive frames against [`Self::max_speed`]; fewer
+    /// than two frames pass.
     pub fn check_speed(&self, time: &[f64], position: &[WorldVec]) -> Result<(), SequenceError> {
-        let mut speeds: Vec<f64> = time
-            .windows(2)
-            .zip(position.windows(2))
-            .map(|(t, p)| (p[1] - p[0]).norm() / (t[1] - t[0]))
-            .collect();
+        let step_speed =
+            |i: usize| (position[i] - position[i - 1]).norm() / (time[i] - time[i - 1]);
+        let n = time.len().min(position.len());
+        let mut speeds: Vec<f64> = (1..n).map(step_speed).collect();
         if speeds.is_empty() {
             return Ok(());
         }
         let median = median(&mut speeds);
         if median > self.max_median_speed {
-            Err(SequenceError::GroundTruthSpeed {
+            return Err(SequenceError::GroundTruthSpeed {
                 median,
                 max: self.max_median_speed,
-            })
-        } else {
-            Ok(())
+            });
         }
+        // A NaN speed (equal times) must not pass either.
+        let too_fast = |v: f64| v.is_nan() || v > self.max_speed;
+        let Some(index) = (1..n).find(|&i| too_fast(step_speed(i))) else {
+            return Ok(());
+        };
+        let step = (position[index] - position[index - 1]).to_array();
+        let axis = (0..3)
+            .max_by(|&a, &b| step[a].abs().total_cmp(&step[b].abs()))
+            .unwrap_or(0);
+        Err(SequenceError::GroundTruthJump {
+            index,
+            axis,
+            distance: norm(step),
+            dt: time[index] - time[index - 1],
+            max: self.max_speed,
+        })
     }
 
     /// Checks mean |acce| against mean |gravity| (both m/s^2) with
@@ -465,6 +489,19 @@ pub(crate) fn beyond(channel: Channel, value: f64, limit: f64) -> String {
         short(value),
         channel.beyond(),
         short(limit)
+    )
+}
+
+/// What is wrong with a ground-truth step too fast for a pedestrian, e.g. `jumps 1000 m in
+/// 0.005 s (200000 m/s): faster than any pedestrian (speed <= 100 m/s), a corrupt position?`.
+pub(crate) fn jump(distance: f64, dt: f64, max: f64) -> String {
+    format!(
+        "jumps {} m in {} s ({} m/s): faster than any pedestrian (speed <= {} m/s), a corrupt \
+         position?",
+        short(distance),
+        short(dt),
+        short(distance / dt),
+        short(max)
     )
 }
 
@@ -625,6 +662,25 @@ pub enum SequenceError {
         /// Median speed found, m/s.
         median: f64,
         /// The limit ([`Validation::max_median_speed`]).
+        max: f64,
+    },
+    /// Two consecutive ground-truth positions too far apart for the time between them
+    /// ([`Validation::max_speed`]): a corrupt position.
+    #[error(
+        "`ground_truth.position.{}` at frame {index}: {}",
+        AXES[*axis],
+        jump(*distance, *dt, *max)
+    )]
+    GroundTruthJump {
+        /// 0-based index of the later frame.
+        index: usize,
+        /// The axis that moves most: 0 (x), 1 (y) or 2 (z).
+        axis: usize,
+        /// Distance between the two positions, metres.
+        distance: f64,
+        /// Time between them, seconds.
+        dt: f64,
+        /// The limit, m/s.
         max: f64,
     },
     /// The median interval between timestamps is outside [`Validation::time_step_range`].
@@ -1109,5 +1165,50 @@ mod tests {
             .unwrap_err()
             .to_string();
         assert!(e.contains("in another unit"), "{e}");
+    }
+
+    #[test]
+    fn a_single_ground_truth_spike_is_caught_on_its_frame() {
+        let v = Validation::default();
+        // Walking at 1.4 m/s at 200 Hz, with a 0.8 s gap (no frames) in the middle.
+        let time: Vec<f64> = (0..50)
+            .map(|i| i as f64 * 0.005 + if i >= 25 { 0.8 } else { 0.0 })
+            .collect();
+        let walk: Vec<WorldVec> = time
+            .iter()
+            .map(|t| WorldVec::new(1.4 * t, 0.1, 1.2))
+            .collect();
+        v.check_speed(&time, &walk).unwrap();
+        // The fastest real motion, 5.7 m/s, passes.
+        let fast: Vec<WorldVec> = time
+            .iter()
+            .map(|t| WorldVec::new(0.0, 5.7 * t, 0.0))
+            .collect();
+        v.check_speed(&time, &fast).unwrap();
+
+        let mut spiked = walk.clone();
+        spiked[30] = WorldVec::new(999_999.0, 0.1, 1.2);
+        let e = v.check_speed(&time, &spiked).unwrap_err();
+        assert!(
+            matches!(e, SequenceError::GroundTruthJump { index: 30, axis: 0, dt, .. } if (dt - 0.005).abs() < 1e-12),
+            "{e:?}"
+        );
+        assert_eq!(
+            e.to_string(),
+            "`ground_truth.position.x` at frame 30: jumps 999997.677 m in 0.005 s (2e8 m/s): \
+             faster than any pedestrian (speed <= 100 m/s), a corrupt position?"
+        );
+        // The limit is the caller's to move.
+        let lax = Validation {
+            max_speed: f64::INFINITY,
+            ..Validation::default()
+        };
+        lax.check_speed(&time, &spiked).unwrap();
+        // Positions in millimetres are named by their median first, not as a jump.
+        let mm: Vec<WorldVec> = walk.iter().map(|p| *p * 1000.0).collect();
+        assert!(matches!(
+            v.check_speed(&time, &mm),
+            Err(SequenceError::GroundTruthSpeed { .. })
+        ));
     }
 }

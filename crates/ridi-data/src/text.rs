@@ -4,7 +4,7 @@
 use std::path::Path;
 
 use crate::error::{DataError, Location, Result};
-use crate::sequence::{AXES, Channel, SequenceError, Validation, beyond};
+use crate::sequence::{AXES, Channel, SequenceError, Validation, beyond, jump};
 
 /// Reads a whole file; the readers parse from memory because one pass over a byte slice is much
 /// faster than buffered line reading with a `String` per line.
@@ -54,6 +54,30 @@ pub(crate) fn lines(text: &str) -> impl Iterator<Item = (usize, &str)> {
         .enumerate()
         .map(|(i, l)| (i + 1, l.strip_suffix('\r').unwrap_or(l)))
         .filter(|(_, l)| !l.trim().is_empty())
+}
+
+/// Refuses a file whose last record, at `last_record` (`None`: the file ends in a header or
+/// comment line, or has no record), has no line break after it (trailing spaces, tabs and `\r`
+/// aside). Such a file was cut off while being written, and a value cut short still parses
+/// (`1.1827383` read as `1.`). `hint` ends the message (empty, or a space and a parenthesis).
+/// Data files only: small hand-written files (lists, settings) often lack the final break.
+pub(crate) fn check_line_break(
+    content: &str,
+    last_record: Option<Location>,
+    hint: &str,
+) -> Result<()> {
+    match last_record {
+        Some(at) if !content.trim_end_matches([' ', '\t', '\r']).ends_with('\n') => {
+            Err(DataError::format(
+                at,
+                format!(
+                    "the file ends inside this record, without a line break: cut off while \
+                     being written?{hint}"
+                ),
+            ))
+        }
+        _ => Ok(()),
+    }
 }
 
 /// Cells of a line separated by the ASCII byte `sep`, like `str::split` but with a plain byte
@@ -127,11 +151,18 @@ pub(crate) fn number(cell: &str, path: &Path, line: usize, field: &str, nan: Nan
 /// Parses a non-negative integer cell (row and column counts).
 pub(crate) fn count(cell: &str, path: &Path, line: usize, field: &str) -> Result<usize> {
     let s = cell.trim();
-    s.parse::<usize>().map_err(|_| {
-        DataError::format(
-            Location::line(path, line).with_field(field),
-            format!("`{}` is not a non-negative integer", snippet(s)),
-        )
+    s.parse::<usize>().map_err(|e| {
+        let message = match e.kind() {
+            std::num::IntErrorKind::PosOverflow => {
+                format!(
+                    "`{}` is too large: a count is at most {}",
+                    snippet(s),
+                    usize::MAX
+                )
+            }
+            _ => format!("`{}` is not a non-negative integer", snippet(s)),
+        };
+        DataError::format(Location::line(path, line).with_field(field), message)
     })
 }
 
@@ -231,6 +262,17 @@ pub(crate) fn sequence_error(
             fields.field(channel, Some(axis)),
             beyond(channel, value, limit),
         ),
+        &SequenceError::GroundTruthJump {
+            index,
+            axis,
+            distance,
+            dt,
+            max,
+        } => (
+            index,
+            fields.field(Channel::Position, Some(axis)),
+            jump(distance, dt, max),
+        ),
         SequenceError::GyroUnits { .. } | SequenceError::GyroScale { .. } => {
             return whole(Channel::Gyro, e.to_string());
         }
@@ -245,10 +287,16 @@ pub(crate) fn sequence_error(
     };
     match lines.and_then(|l| l.get(index)) {
         Some(&line) => DataError::format(Location::line(path, line).with_field(field), message),
-        None if matches!(e, SequenceError::Implausible { .. }) => DataError::format(
-            Location::file(path).with_field(field),
-            format!("frame {index}: {message}"),
-        ),
+        None if matches!(
+            e,
+            SequenceError::Implausible { .. } | SequenceError::GroundTruthJump { .. }
+        ) =>
+        {
+            DataError::format(
+                Location::file(path).with_field(field),
+                format!("frame {index}: {message}"),
+            )
+        }
         None => DataError::sequence(path, e),
     }
 }
@@ -305,6 +353,45 @@ mod tests {
                 .to_string()
                 .contains("empty")
         );
+    }
+
+    #[test]
+    fn counts_too_large_are_named_as_such() {
+        assert_eq!(count(" 27 ", p(), 1, "columns").unwrap(), 27);
+        let e = count("99999999999999999999999", p(), 1, "rows").unwrap_err();
+        assert_eq!(
+            e.to_string(),
+            format!(
+                "f.csv:1: field `rows`: `99999999999999999999999` is too large: a count is at \
+                 most {}",
+                usize::MAX
+            )
+        );
+        for bad in ["-1", "2.5", "x", ""] {
+            let e = count(bad, p(), 2, "rows").unwrap_err().to_string();
+            assert!(e.ends_with("is not a non-negative integer"), "{bad}: {e}");
+        }
+    }
+
+    #[test]
+    fn a_last_record_without_a_line_break_is_refused() {
+        let at = || Some(Location::line(p(), 3).with_field("x"));
+        for complete in ["a\nb\n", "a\r\nb\r\n", "a\nb\n  \t", "a\nb\n\n"] {
+            check_line_break(complete, at(), "").unwrap();
+        }
+        for cut in ["a\nb", "a\nb \t", "a\r\nb\r"] {
+            let e = check_line_break(cut, at(), " (hint)")
+                .unwrap_err()
+                .to_string();
+            assert_eq!(
+                e,
+                "f.csv:3: field `x`: the file ends inside this record, without a line break: \
+                 cut off while being written? (hint)",
+                "{cut:?}"
+            );
+        }
+        // No record at the end (a header, a comment, nothing): nothing to check.
+        check_line_break("# header", None, "").unwrap();
     }
 
     #[test]

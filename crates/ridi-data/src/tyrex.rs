@@ -43,10 +43,12 @@
 //! is reported in [`TyrexRead::warnings`].
 //!
 //! # Errors
-//! Every error names the file, and the line and field when one is to blame. The accelerometer,
-//! gyroscope and rotation vector files are checked against the [`Validation`] limits before
-//! resampling: their median time step (seconds: milliseconds step by 5 s), and every
-//! accelerometer and gyroscope value against its physical bound (the gyro's median magnitude
+//! Every error names the file, and the line and field when one is to blame. A phone file whose
+//! last line has no line break after it was cut off while being written and is refused
+//! (`timeAlignment.txt` and `record.properties` are not: some shared runs lack it). The
+//! accelerometer, gyroscope and rotation vector files are checked against the [`Validation`]
+//! limits before resampling: their median time step (seconds: milliseconds step by 5 s), and
+//! every accelerometer and gyroscope value against its physical bound (the gyro's median magnitude
 //! too); the accelerometer's scale against gravity is checked on each sequence and reported on
 //! `accelerometer.txt`.
 //!
@@ -478,6 +480,7 @@ fn read_stream<T>(
             "no samples: the file is empty",
         ));
     }
+    text::check_line_break(content, lines.last().map(|&l| Location::line(path, l)), "")?;
     // Gaps are not errors here: they split the recording (see `intervals`).
     text::check_time(&time, &lines, path, names[0], f64::INFINITY)?;
     Ok(Stream {

@@ -1,8 +1,8 @@
 //! Writers of the RIDI processed layout: `data.csv` as pandas writes it and `data_plain.txt` as
 //! the C++ tools read it.
 //!
-//! Every value is written with Rust's shortest round-trip float formatting and time as integer
-//! nanoseconds, so reading a written file gives the same sequence back bit for bit, except that
+//! Every value is written as [`RoundTrip`] formats it (the shortest text that reads back as the
+//! same float) and time as integer nanoseconds, so reading a written file gives the same sequence back bit for bit, except that
 //! time is rounded to whole nanoseconds, and that what the layout cannot hold is lost: the
 //! name (taken from the path when read), placement, steps and the orientation source (read back
 //! as the game rotation vector).
@@ -17,7 +17,7 @@
 //! Files are written atomically: to a temporary file in the target folder, then renamed, so a
 //! crash never leaves a half-written file under the final name.
 
-use std::fmt::Write as _;
+use std::fmt::{self, Write as _};
 use std::io::Write;
 use std::path::Path;
 
@@ -94,12 +94,44 @@ pub enum Precision {
     F32,
 }
 
+/// A float as ridi-rs writes numbers to files: the shortest text that reads back as the same
+/// value. Magnitudes from 1e-4 to 1e16 (and zero, NaN, infinities) are written as `Display`
+/// writes them (`0.25`, `-3`, `NaN`); others in exponent notation, as `{:?}` does (`1.28e-300`,
+/// `2e20`), since `Display` never uses an exponent and writes 1e-300 with 300 digits. Every
+/// float parser (Rust, C, pandas) reads both forms.
+///
+/// ```
+/// use ridi_data::RoundTrip;
+/// assert_eq!(RoundTrip(-0.125).to_string(), "-0.125");
+/// assert_eq!(RoundTrip(1.28e-300).to_string(), "1.28e-300");
+/// assert_eq!(RoundTrip(0.1f32).to_string(), "0.1");
+/// ```
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct RoundTrip<T>(pub T);
+
+/// For `f64` and `f32`, each comparing in its own type (`1e-4f32` is not `1e-4`).
+macro_rules! round_trip_display {
+    ($($t:ty),*) => {$(
+        impl fmt::Display for RoundTrip<$t> {
+            fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+                let a = self.0.abs();
+                if a == 0.0 || !a.is_finite() || (1e-4..1e16).contains(&a) {
+                    fmt::Display::fmt(&self.0, f)
+                } else {
+                    fmt::LowerExp::fmt(&self.0, f)
+                }
+            }
+        }
+    )*};
+}
+round_trip_display!(f64, f32);
+
 /// Appends `v` to `line` at `precision`.
 fn push_value(line: &mut String, v: f64, precision: Precision) {
     // Formatting into a String cannot fail.
     let _ = match precision {
-        Precision::F64 => write!(line, "{v}"),
-        Precision::F32 => write!(line, "{}", v as f32),
+        Precision::F64 => write!(line, "{}", RoundTrip(v)),
+        Precision::F32 => write!(line, "{}", RoundTrip(v as f32)),
     };
 }
 
@@ -170,4 +202,36 @@ pub fn write_ridi_plain(seq: &Sequence, path: impl AsRef<Path>) -> Result<()> {
         }
         Ok(())
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn floats_round_trip_in_short_text_at_any_magnitude() {
+        // Ordinary values are written as `Display` writes them.
+        for v in [
+            0.0, -0.0, 1.0, -3.5, 0.1, 9.80665, 1e-4, 123456.789, 9.999e15,
+        ] {
+            assert_eq!(RoundTrip(v).to_string(), v.to_string(), "{v}");
+        }
+        assert_eq!(RoundTrip(f64::NAN).to_string(), "NaN");
+        for (v, text) in [
+            (1.28e-300, "1.28e-300"),
+            (-9.99e-5, "-9.99e-5"),
+            (f64::MIN_POSITIVE / 4.0, "5.562684646268003e-309"),
+            (1e16, "1e16"),
+            (-f64::MAX, "-1.7976931348623157e308"),
+        ] {
+            assert_eq!(RoundTrip(v).to_string(), text);
+            assert_eq!(text.parse::<f64>().unwrap().to_bits(), v.to_bits());
+        }
+        assert_eq!(RoundTrip(1e-30f32).to_string(), "1e-30");
+        assert_eq!(RoundTrip(1e-4f32).to_string(), "0.0001");
+        assert_eq!(RoundTrip(0.1f32).to_string(), "0.1");
+        // The longest text any f64 gets, against 300-odd digits with `Display`.
+        assert!(f64::MIN_POSITIVE.to_string().len() > 300);
+        assert!(RoundTrip(-f64::MIN_POSITIVE).to_string().len() <= 24);
+    }
 }

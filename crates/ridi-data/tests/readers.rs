@@ -398,7 +398,7 @@ fn raw_bad_files_name_file_line_and_field() {
         edit_file(f, "gravity.txt", |s| {
             let mut l: Vec<&str> = s.lines().collect();
             l.swap(10, 11);
-            l.join("\n")
+            l.join("\n") + "\n"
         })
     });
     assert_err(r, &["gravity.txt:12: field `t`: timestamp goes back"]);
@@ -645,6 +645,36 @@ fn lists_load_every_format_and_set_placements() {
     assert_err(
         load_list(&list, &opts()),
         &["nothing", "not a known dataset folder"],
+    );
+}
+
+#[test]
+fn lists_refuse_a_recording_listed_twice_also_through_another_path() {
+    let d = dataset();
+    let root = d.path();
+    let list = root.join("list.txt");
+    std::fs::write(&list, "csv_seq,handheld\nraw_seq\ncsv_seq,body\n").unwrap();
+    assert_err(
+        load_list(&list, &opts()),
+        &[
+            "list.txt:3: field `path`",
+            "csv_seq",
+            "already listed at",
+            "list.txt:1",
+        ],
+    );
+    // The folder and the file it is read from are one recording.
+    let other = root.join("other.txt");
+    std::fs::write(&other, "csv_seq/processed/data.csv\n").unwrap();
+    let entries: Vec<_> = [&list, &other]
+        .iter()
+        .flat_map(|l| ridi_data::read_list(l).unwrap())
+        .filter(|e| e.line != 3)
+        .collect();
+    let e = ridi_data::load_entries(&entries, &opts()).unwrap_err();
+    assert!(
+        e.to_string().contains("other.txt:1: field `path`") && e.to_string().contains("list.txt:1"),
+        "{e}"
     );
 }
 

@@ -118,18 +118,13 @@ impl Fixture {
 }
 
 /// Replaces line `n` (1-based) of `text`.
+/// `text` with line `n` replaced, every line ending in a line break as in the fixture files.
 fn replace_line(text: &str, n: usize, new: &str) -> String {
     text.lines()
         .enumerate()
-        .map(|(i, l)| {
-            if i + 1 == n {
-                new.to_owned()
-            } else {
-                l.to_owned()
-            }
-        })
-        .collect::<Vec<_>>()
-        .join("\n")
+        .map(|(i, l)| if i + 1 == n { new } else { l })
+        .map(|l| format!("{l}\n"))
+        .collect()
 }
 
 #[test]
@@ -418,6 +413,26 @@ fn text_errors_name_file_line_and_field() {
         matches!(&e, DataError::Io { path, .. } if path.ends_with("gyroscope-calibrated.txt")),
         "{e}"
     );
+}
+
+#[test]
+fn phone_files_cut_before_their_last_line_break_are_refused() {
+    let fx = Fixture::standard();
+    let text = std::fs::read_to_string(fx.dir.join("accelerometer.txt")).unwrap();
+    let last = text.lines().count();
+    // `... 9.80665` cut to `... 9.806`: still a number, so only the missing break tells.
+    fx.write("accelerometer.txt", &text[..text.len() - 3]);
+    assert_err(
+        &fx,
+        &[&format!(
+            "accelerometer.txt:{last}: the file ends inside this record, without a line break"
+        )],
+    );
+
+    // The one-number `timeAlignment.txt` is exempt: a real one lacks its final break.
+    let fx = Fixture::standard();
+    fx.write("timeAlignment.txt", &format!("  {TIME_DIFF:e}"));
+    tyrex::read(&fx.dir, &TyrexOptions::default()).unwrap();
 }
 
 /// `f` applied to the columns `cols` of every row of a phone file.

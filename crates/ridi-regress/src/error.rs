@@ -47,8 +47,8 @@ pub enum RegressError {
         /// Version this build writes and reads.
         supported: u32,
     },
-    /// The file ends before the length its header announces.
-    #[error("model file truncated: expected {expected} bytes, found {found}")]
+    /// The file ends before the length its header announces (or that length is corrupt).
+    #[error("model file truncated (or its header corrupt): {found} of {expected} bytes")]
     Truncated {
         /// Bytes announced by the header (header included).
         expected: u64,

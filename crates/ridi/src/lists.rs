@@ -36,7 +36,10 @@ impl Purpose {
 ///   written in the lists are checked before any sequence is read);
 /// - for training, a sequence without a placement label (neither in the list nor from its
 ///   source, as a Tyrex run's motion);
-/// - a sequence without ground truth.
+/// - a sequence without ground truth;
+/// - a recording listed twice ([`ridi_data::load_entries`]);
+/// - for evaluation, two sequences of the same name (from different folders): the report's
+///   rows and plot files are named after the sequence.
 pub fn load_lists(
     lists: &[impl AsRef<Path>],
     map: Option<&PlacementMap>,
@@ -47,16 +50,45 @@ pub fn load_lists(
     for list in lists {
         entries.extend(read_list(list)?);
     }
+    load_listed(&entries, map, purpose, opts)
+}
+
+/// [`load_lists`] for list entries already read ([`read_list`]): the sequence of each entry,
+/// in order, so that a caller can name an entry's list file and line in later errors.
+pub fn load_listed(
+    entries: &[ListEntry],
+    map: Option<&PlacementMap>,
+    purpose: Purpose,
+    opts: &ReadOptions,
+) -> Result<Vec<Sequence>> {
     if let Some(map) = map {
-        for e in &entries {
+        for e in entries {
             if let Some(label) = &e.placement {
                 map.class_at(label, e.location())?;
             }
         }
     }
-    let mut seqs = load_entries(&entries, opts)?;
-    for (seq, entry) in seqs.iter_mut().zip(&entries) {
+    let mut seqs = load_entries(entries, opts)?;
+    for (seq, entry) in seqs.iter_mut().zip(entries) {
         check(seq, entry, map, purpose)?;
+    }
+    if purpose == Purpose::Evaluation {
+        for (i, (seq, entry)) in seqs.iter().zip(entries).enumerate() {
+            if let Some(j) = seqs[..i].iter().position(|s| s.name() == seq.name()) {
+                return Err(DataError::format(
+                    entry.location().with_field("path"),
+                    format!(
+                        "a sequence named `{}` is already listed at {}:{} (another recording): \
+                         an evaluation names its report rows and plots after the sequence; \
+                         rename one folder",
+                        seq.name(),
+                        entries[j].list.display(),
+                        entries[j].line
+                    ),
+                )
+                .into());
+            }
+        }
     }
     Ok(seqs)
 }

@@ -73,6 +73,14 @@ impl Staging {
         Ok(path)
     }
 
+    /// The staged folder `rel` (relative to the output folder, `""` for the output folder
+    /// itself), created: where to write output files whose names another function chooses.
+    pub fn dir(&self, rel: &Path) -> Result<PathBuf, DataError> {
+        let dir = self.temp.path().join("new").join(rel);
+        std::fs::create_dir_all(&dir).map_err(|e| DataError::io(&dir, e))?;
+        Ok(dir)
+    }
+
     /// Moves every staged file into the output folder, replacing files of the same name. If a
     /// move fails, those done are undone (replaced files come back) and the error returned.
     pub fn commit(mut self) -> Result<(), DataError> {

@@ -3,7 +3,7 @@
 use std::path::Path;
 
 use ridi_correct::{CorrectionConfig, PlacementSmoother, VelocityTarget, correct};
-use ridi_data::{Sequence, write_atomically};
+use ridi_data::{RoundTrip, Sequence, write_atomically};
 use ridi_features::{FeatureConfig, FeatureExtractor, Orientation, SampleSchedule};
 use ridi_frames::{DeviceVec, WorldVec};
 use ridi_regress::{Cascade, MatrixRef};
@@ -110,20 +110,21 @@ impl Track {
                     next += 1;
                 }
                 let (p, v, b) = (self.position[i], self.velocity[i], self.bias[i]);
+                let r = RoundTrip;
                 writeln!(
                     w,
                     "{},{},{},{},{},{},{},{},{},{},{}",
-                    self.time[i],
-                    p.x(),
-                    p.y(),
-                    p.z(),
-                    v.x(),
-                    v.y(),
-                    v.z(),
+                    r(self.time[i]),
+                    r(p.x()),
+                    r(p.y()),
+                    r(p.z()),
+                    r(v.x()),
+                    r(v.y()),
+                    r(v.z()),
                     current.unwrap_or(""),
-                    b.x(),
-                    b.y(),
-                    b.z()
+                    r(b.x()),
+                    r(b.y()),
+                    r(b.z())
                 )?;
             }
             Ok(())

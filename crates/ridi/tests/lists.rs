@@ -207,10 +207,22 @@ fn missing_labels_ground_truth_and_sequences_name_the_list_file() {
     let good = list(
         dir.path(),
         "good.txt",
-        &[line("Guillaume_Nexus5_NoDist_Texting", "Texting")],
+        &[line("Thibaud_Nexus5_NoDist_Texting", "Texting")],
     );
     let e = err(load(&[good.as_path(), &l], None, Purpose::Training));
     assert!(e.starts_with(&format!("{}:3: ", l.display())), "{e}");
+    // One recording in two lists: refused at the second, naming the first.
+    let again = list(
+        dir.path(),
+        "again.txt",
+        &[line("Thibaud_Nexus5_NoDist_Texting", "Texting")],
+    );
+    let e = err(load(&[good.as_path(), &again], None, Purpose::Training));
+    assert!(
+        e.starts_with(&format!("{}:1: field `path`: ", again.display()))
+            && e.contains(&format!("already listed at {}:1", good.display())),
+        "{e}"
+    );
 }
 
 #[test]

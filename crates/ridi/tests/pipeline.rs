@@ -295,6 +295,15 @@ fn online_tracking_stays_close_to_batch_tracking() {
     let text = std::fs::read_to_string(&csv).unwrap();
     assert!(text.starts_with("time,pos_x,pos_y,pos_z,vel_x,vel_y,vel_z,placement,bias_x"));
     assert_eq!(text.lines().count(), seq.len() + 1);
+    // Tiny biases come out in exponent notation, not as hundreds of digits, and read back.
+    let mut tiny = batch.clone();
+    tiny.bias[0] = ridi::frames::DeviceVec::new(1.28e-300, -5e-20, 0.0);
+    tiny.write_csv(&csv).unwrap();
+    let text = std::fs::read_to_string(&csv).unwrap();
+    let first = text.lines().nth(1).unwrap();
+    assert!(first.ends_with(",1.28e-300,-5e-20,0"), "{first}");
+    let longest = text.split([',', '\n']).map(str::len).max().unwrap();
+    assert!(longest < 30, "a field of {longest} characters");
 }
 
 #[test]

@@ -1,0 +1,177 @@
+//! Input that still parses but is wrong (a file cut inside its last value, one corrupt
+//! ground-truth position, a count too large for an integer) and values of extreme magnitude in
+//! written files.
+
+mod common;
+
+use std::io::Write as _;
+use std::path::Path;
+
+use common::*;
+use ridi_data::ridi_frames::DeviceVec;
+use ridi_data::{ReadOptions, Sequence, ridi_csv, ridi_plain, write_ridi_csv, write_ridi_plain};
+
+/// `text` without its final line break and the last `n` characters of its last value, and the
+/// number of its last line.
+fn cut_last_value(text: &str, n: usize) -> (String, usize) {
+    let body = text.trim_end_matches('\n');
+    let cut = &body[..body.len() - n];
+    assert!(cut.ends_with(|c: char| c.is_ascii_digit()), "{cut:?}");
+    (cut.to_owned(), cut.lines().count())
+}
+
+#[test]
+fn processed_files_cut_before_their_last_line_break_are_refused() {
+    let opts = ReadOptions::default();
+    let path = Path::new("walk/data.csv");
+    let (cut, last) = cut_last_value(&String::from_utf8(valid_csv(20)).unwrap(), 3);
+    // With its line break the cut file would read: the cut value still parses.
+    ridi_csv::parse(format!("{cut}\n").as_bytes(), path, &opts).unwrap();
+    assert_err(
+        ridi_csv::parse(cut.as_bytes(), path, &opts),
+        &[&format!(
+            "walk/data.csv:{last}: the file ends inside this record, without a line break: cut \
+             off while being written?"
+        )],
+    );
+
+    // The same through gzip.
+    let dir = tempfile::tempdir().unwrap();
+    let gz = dir.path().join("data.csv.gz");
+    let mut enc = flate2::write::GzEncoder::new(Vec::new(), flate2::Compression::fast());
+    enc.write_all(cut.as_bytes()).unwrap();
+    std::fs::write(&gz, enc.finish().unwrap()).unwrap();
+    assert_err(
+        ridi_csv::read(&gz, &opts),
+        &[&format!(
+            "data.csv.gz:{last}: the file ends inside this record"
+        )],
+    );
+
+    let path = Path::new("data_plain.txt");
+    let (cut, last) = cut_last_value(&String::from_utf8(valid_plain(10)).unwrap(), 3);
+    ridi_plain::parse(format!("{cut}\n").as_bytes(), path, &opts).unwrap();
+    assert_err(
+        ridi_plain::parse(cut.as_bytes(), path, &opts),
+        &[&format!(
+            "data_plain.txt:{last}: the file ends inside this record"
+        )],
+    );
+
+    // Empty and header-only files keep their own errors.
+    assert_err(ridi_csv::parse(b"", path, &opts), &["file is empty"]);
+    let csv = String::from_utf8(valid_csv(5)).unwrap();
+    let header = csv.lines().next().unwrap();
+    assert_err(
+        ridi_csv::parse(header.as_bytes(), path, &opts),
+        &["only a header line, no data rows"],
+    );
+    assert_err(
+        ridi_plain::parse(b"5 27", path, &opts),
+        &["file ends after 0 of the 5 rows"],
+    );
+}
+
+#[test]
+fn raw_files_cut_before_their_last_line_break_are_refused() {
+    let mut last = 0;
+    let (_d, r) = raw_with(|f| {
+        edit_file(f, "acce.txt", |s| {
+            let (cut, line) = cut_last_value(s, 3);
+            last = line;
+            cut
+        })
+    });
+    assert_err(
+        r,
+        &[&format!(
+            "acce.txt:{last}: the file ends inside this record, without a line break"
+        )],
+    );
+    // A file that ends in its `#` header (no records) is still an optional file without rows.
+    let (_d, r) = raw_with(|f| edit_file(f, "magnet.txt", |_| "# t_ns x y z".to_owned()));
+    assert!(r.unwrap().magnet().is_none());
+}
+
+#[test]
+fn a_single_corrupt_ground_truth_position_is_named_on_its_line() {
+    let text = String::from_utf8(valid_csv(20)).unwrap();
+    // Column 17 is `pos_x` (after the pandas index and `time`); line 9 is frame 7.
+    let spiked = with_cell(&text, 9, 17, "999999");
+    assert_err(
+        ridi_csv::parse(
+            spiked.as_bytes(),
+            Path::new("walk/data.csv"),
+            &ReadOptions::default(),
+        ),
+        &[
+            "walk/data.csv:9: field `pos_x`: jumps 99999",
+            "faster than any pedestrian (speed <= 100 m/s), a corrupt position?",
+        ],
+    );
+
+    // In a raw folder, on the line of `pose.txt` it was read from.
+    let (_d, r) = raw_with(|f| {
+        edit_file(f, "pose.txt", |s| {
+            edit_cells(s, ' ', |line, cells| {
+                if line == 20 {
+                    cells[1] = "999999".to_owned();
+                }
+            })
+        })
+    });
+    assert_err(r, &["pose.txt:20: field `tx`: jumps 99999"]);
+}
+
+#[test]
+fn a_row_count_too_large_for_an_integer_is_named_as_such() {
+    let text = String::from_utf8(valid_plain(10)).unwrap();
+    let (_, rows) = text.split_once('\n').unwrap();
+    let huge = format!("99999999999999999999999 27\n{rows}");
+    assert_err(
+        ridi_plain::parse(
+            huge.as_bytes(),
+            Path::new("data_plain.txt"),
+            &ReadOptions::default(),
+        ),
+        &["data_plain.txt:1: field `rows`: `99999999999999999999999` is too large"],
+    );
+}
+
+#[test]
+fn tiny_and_huge_values_are_written_short_and_read_back_exactly() {
+    let mut parts = sample_sequence("walk", 30, true, true).into_parts();
+    parts.gyro[3] = DeviceVec::new(1.28e-300, -4.9e-324, 0.25);
+    parts.magnet.as_mut().unwrap()[4] = DeviceVec::new(-2.5e-20, 1e-4, 9.9e-5);
+    let seq = Sequence::new(parts).unwrap();
+    let dir = tempfile::tempdir().unwrap();
+    let csv = dir.path().join("walk/data.csv");
+    let plain = dir.path().join("walk/data_plain.txt");
+    std::fs::create_dir_all(csv.parent().unwrap()).unwrap();
+    write_ridi_csv(&seq, &csv).unwrap();
+    write_ridi_plain(&seq, &plain).unwrap();
+    for path in [&csv, &plain] {
+        let text = std::fs::read_to_string(path).unwrap();
+        for value in [
+            "1.28e-300",
+            "-5e-324",
+            "-2.5e-20",
+            "0.0001",
+            "9.9e-5",
+            "0.25",
+        ] {
+            assert!(text.contains(value), "{value} not in {}", path.display());
+        }
+        // 27 values of at most 24 characters each.
+        assert!(
+            text.lines().all(|l| l.len() < 27 * 25),
+            "{}",
+            path.display()
+        );
+    }
+    assert_eq!(ridi_csv::read(&csv, &ReadOptions::default()).unwrap(), seq);
+    assert_eq!(
+        ridi_plain::read(&plain, &ReadOptions::default()).unwrap(),
+        seq
+    );
+}
