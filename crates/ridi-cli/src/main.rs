@@ -450,7 +450,7 @@ fn run(cli: Cli) -> Result<()> {
         } => {
             set_jobs(jobs)?;
             check_output(&out)?;
-            let entries = read_entries(&list)?;
+            let entries = ridi::lists::read_lists(&list)?;
             let mut read = list.clone();
             read.extend(entries.iter().map(|e| e.path.clone()));
             let inputs = ReadFiles::of(&read);
@@ -571,7 +571,7 @@ fn run(cli: Cli) -> Result<()> {
             align,
         } => {
             set_jobs(jobs)?;
-            check_output_folder(&out)?;
+            check_eval_output(&out, plots)?;
             let mut chosen: Vec<Method> = Vec::new();
             for m in &methods {
                 let m = m.parse::<Method>().map_err(anyhow::Error::msg)?;
@@ -581,7 +581,7 @@ fn run(cli: Cli) -> Result<()> {
             }
             let model = load_model(&model)?;
             let listed = load_listed(
-                read_entries(&list)?,
+                ridi::lists::read_lists(&list)?,
                 placement_map.as_deref(),
                 Purpose::Evaluation,
             )?;
@@ -589,14 +589,13 @@ fn run(cli: Cli) -> Result<()> {
                 placement_smoothing: placement_smoothing(placement_window),
                 ..TrackOptions::default()
             };
-            let staging = stage(&out)?;
             evaluate_and_write(
                 &listed.seqs,
                 &model,
+                None,
                 chosen,
                 track,
                 align,
-                staging,
                 &out,
                 plots,
             )
@@ -640,18 +639,52 @@ fn check_output(path: &Path) -> Result<()> {
     Ok(())
 }
 
-/// Starts writing the output folder `dir` all or nothing ([`Staging`]): creates it if needed
-/// and a hidden staging folder in it, so that an unwritable folder fails before any work.
-fn stage(dir: &Path) -> Result<Staging> {
-    Staging::new(dir).with_context(|| format!("cannot write into {}", dir.display()))
+/// Refuses, before any work, an evaluation's output folder (and its `plots/` if plots are
+/// written) that exists as a file or cannot be written.
+fn check_eval_output(out: &Path, plots: Plots) -> Result<()> {
+    check_output_folder(out)?;
+    if plots != Plots::None {
+        check_output_folder(&out.join("plots"))?;
+    }
+    Ok(())
 }
 
-/// Refuses an output folder that exists as something else (a file), before any work.
+/// Refuses, before any work, an output folder that exists as something else (a file) or
+/// could not be written (nor created).
 fn check_output_folder(dir: &Path) -> Result<()> {
     if dir.exists() && !dir.is_dir() {
         bail!(
             "cannot write into {}: it is a file, not a folder",
             dir.display()
+        );
+    }
+    // The folder, or the nearest existing one it would be created in, must take new entries.
+    let Some(existing) = dir
+        .ancestors()
+        .map(|d| {
+            if d.as_os_str().is_empty() {
+                Path::new(".")
+            } else {
+                d
+            }
+        })
+        .find(|d| d.exists())
+    else {
+        return Ok(());
+    };
+    if !existing.is_dir() {
+        bail!(
+            "cannot write into {}: {} is a file, not a folder",
+            dir.display(),
+            existing.display()
+        );
+    }
+    if let Err(e) = tempfile::tempdir_in(existing) {
+        bail!(
+            "cannot write into {}: cannot create folders in {} ({})",
+            dir.display(),
+            existing.display(),
+            std::io::Error::from(e.kind())
         );
     }
     Ok(())
@@ -689,15 +722,6 @@ fn set_jobs(jobs: Option<usize>) -> Result<()> {
     Ok(())
 }
 
-/// The entries of the list files `lists`, in order.
-fn read_entries(lists: &[PathBuf]) -> Result<Vec<ListEntry>> {
-    let mut entries = Vec::new();
-    for l in lists {
-        entries.extend(ridi::data::read_list(l)?);
-    }
-    Ok(entries)
-}
-
 /// The listed sequences, each with the list entry it was read from.
 struct Listed {
     seqs: Vec<Sequence>,
@@ -712,9 +736,15 @@ impl Listed {
         else {
             return e;
         };
-        match self.seqs.iter().position(|s| s.name() == sequence) {
-            Some(i) => e.context(self.entries[i].location().to_string()),
-            None => e,
+        // Only where the name is the one sequence's (training allows recordings of one name).
+        let mut named = self
+            .seqs
+            .iter()
+            .enumerate()
+            .filter(|(_, s)| s.name() == sequence);
+        match (named.next(), named.next()) {
+            (Some((i, _)), None) => e.context(self.entries[i].location().to_string()),
+            _ => e,
         }
     }
 }
@@ -811,16 +841,18 @@ fn plot_track(seq: &Sequence, track: &ridi::Track, path: &Path) -> Result<()> {
     Ok(())
 }
 
-/// Evaluates `seqs` and stages the reports and plots in `staging` (the output folder `out`),
-/// then moves them into place together: a failure on the way leaves `out` as it was.
+/// Evaluates `seqs`, then writes the reports, the plots and, if `model_name` is given, the
+/// model under that name into `out` all or nothing ([`Staging`]): a failure on the way leaves
+/// `out` as it was. (The staging folder exists only while the files are written, so a killed
+/// evaluation leaves nothing behind.)
 #[allow(clippy::too_many_arguments)]
 fn evaluate_and_write(
     seqs: &[Sequence],
     model: &Cascade,
+    model_name: Option<&str>,
     methods: Vec<Method>,
     track: TrackOptions,
     align: AlignWindow,
-    staging: Staging,
     out: &Path,
     plots: Plots,
 ) -> Result<ridi::Report> {
@@ -838,9 +870,6 @@ fn evaluate_and_write(
         Plots::None => None,
     };
     let plot_dir = out.join("plots");
-    if ext.is_some() {
-        check_output_folder(&plot_dir)?;
-    }
     // Read before report.json is replaced: whose plots an earlier evaluation wrote.
     let mut plotted = earlier_sequences(out);
     plotted.extend(seqs.iter().map(|s| s.name().to_string()));
@@ -849,6 +878,13 @@ fn evaluate_and_write(
     spinner.enable_steady_tick(std::time::Duration::from_millis(200));
     let (report, traces) = ridi::evaluate(seqs, model, &opts)?;
     spinner.finish_and_clear();
+    let staging =
+        Staging::new(out).with_context(|| format!("cannot write into {}", out.display()))?;
+    if let Some(name) = model_name {
+        let path = staging.file(Path::new(name))?;
+        model_file::save(model, &path)
+            .with_context(|| format!("cannot write {}", out.join(name).display()))?;
+    }
     let mut written = Vec::new();
     if let Some(ext) = ext {
         let staged = staging.dir(Path::new("plots"))?;
@@ -860,7 +896,11 @@ fn evaluate_and_write(
     }
     let reports = report.write(&staging.dir(Path::new(""))?)?.len();
     staging.commit()?;
-    let stale = remove_stale_plots(&plot_dir, &plotted, &written)?;
+    // The new report is in place: an old plot that cannot go is worth a warning, not a failure.
+    let stale = remove_stale_plots(&plot_dir, &plotted, &written).unwrap_or_else(|e| {
+        eprintln!("warning: {}", one_line(&e));
+        0
+    });
     print_summary(&report);
     outln!(
         "wrote {} files into {} (report.md, report.json{}){}",
@@ -953,7 +993,6 @@ fn positive(text: &str) -> std::result::Result<f64, String> {
     }
 }
 
-/// A finite number of at least 0, for clap.
 /// `--rate`: 1 Hz to 10 kHz, the frame intervals (1 s to 0.1 ms) the readers accept
 /// (`ridi_data::Validation::time_step_range`); phone sensors deliver 5-500 Hz.
 fn rate_hz(text: &str) -> std::result::Result<f64, String> {
@@ -965,6 +1004,7 @@ fn rate_hz(text: &str) -> std::result::Result<f64, String> {
     }
 }
 
+/// A finite number of at least 0, for clap.
 fn non_negative(text: &str) -> std::result::Result<f64, String> {
     match text.parse::<f64>() {
         Ok(x) if x.is_finite() && x >= 0.0 => Ok(x),
@@ -1054,13 +1094,16 @@ fn demo(out: &Path, data: Option<PathBuf>, grid: Grid, plots: Plots) -> Result<(
             data.display()
         );
     }
-    check_output_folder(out)?;
     // Before training: an output folder that cannot be written fails in a second, not after it.
-    let staging = stage(out)?;
+    check_eval_output(out, plots)?;
     let map = Some("tyrex4");
-    let train = load_listed(read_entries(&[train_list])?, map, Purpose::Training)?;
+    let train = load_listed(
+        ridi::lists::read_lists(&[train_list])?,
+        map,
+        Purpose::Training,
+    )?;
     let test = load_listed(
-        read_entries(&[data.join("list_test.txt")])?,
+        ridi::lists::read_lists(&[data.join("list_test.txt")])?,
         map,
         Purpose::Evaluation,
     )?;
@@ -1076,16 +1119,13 @@ fn demo(out: &Path, data: Option<PathBuf>, grid: Grid, plots: Plots) -> Result<(
     let model = train_with_progress(&train.seqs, &opts).map_err(|e| train.locate(e))?;
     outln!("trained in {:.1} s", started.elapsed().as_secs_f64());
     print_training(&model);
-    let model_path = staging.file(Path::new("model.ridi"))?;
-    model_file::save(&model, &model_path)
-        .with_context(|| format!("cannot write {}", out.join("model.ridi").display()))?;
     evaluate_and_write(
         &test.seqs,
         &model,
+        Some("model.ridi"),
         Method::ALL.to_vec(),
         TrackOptions::default(),
         AlignWindow::default(),
-        staging,
         out,
         plots,
     )

@@ -883,3 +883,85 @@ fn empty_lists_are_errors() {
     );
     assert!(!model.exists());
 }
+
+#[test]
+fn demo_writes_model_reports_and_plots_all_or_nothing() {
+    let dir = tempfile::tempdir().unwrap();
+    let data = dir.path().join("data");
+    std::fs::create_dir_all(&data).unwrap();
+    let line = |name: &str, label: &str| format!("{},{label}\n", s(&sample().join(name)));
+    std::fs::write(
+        data.join("list_train.txt"),
+        line("Guillaume_Nexus5_NoDist_Texting", "Texting")
+            + &line("Guillaume_Nexus5_NoDist_Swinging", "Swinging"),
+    )
+    .unwrap();
+    let test = line("Jakob_Nexus5_NoDist_Texting", "Texting");
+    std::fs::write(data.join("list_test.txt"), &test).unwrap();
+    let out = dir.path().join("demo");
+    let demo = || {
+        ridi(&[
+            "demo",
+            "--data",
+            s(&data),
+            "--out",
+            s(&out),
+            "--plots",
+            "svg",
+        ])
+    };
+    let run = demo();
+    assert!(run.status.success(), "{}", stderr(&run));
+    let report = std::fs::read(out.join("report.json")).unwrap();
+    let model = std::fs::read(out.join("model.ridi")).unwrap();
+    ridi::regress::model_file::from_bytes(&model).unwrap();
+    assert!(
+        out.join("plots/Jakob_Nexus5_NoDist_Texting.trajectory.svg")
+            .is_file()
+    );
+
+    // A held-out recording too short to track fails the demo at its list line, after
+    // training, and the earlier demo's files stay as they were (none added, no staging left).
+    let seq = ridi::data::read_sequence(
+        sample().join("Jakob_Nexus5_NoDist_Swinging"),
+        &Default::default(),
+    )
+    .unwrap();
+    std::fs::create_dir_all(data.join("short/processed")).unwrap();
+    ridi::data::write_ridi_csv(&seq.slice(0..150), data.join("short/processed/data.csv")).unwrap();
+    std::fs::write(data.join("list_test.txt"), test + "short,Swinging\n").unwrap();
+    let before: Vec<_> = std::fs::read_dir(&out)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .collect();
+    let run = demo();
+    let err = stderr(&run);
+    assert!(
+        !run.status.success() && err.contains("list_test.txt:2: sequence `short`: has 150 frames"),
+        "{err}"
+    );
+    let after: Vec<_> = std::fs::read_dir(&out)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .collect();
+    assert_eq!(before, after);
+    assert_eq!(std::fs::read(out.join("report.json")).unwrap(), report);
+    assert_eq!(std::fs::read(out.join("model.ridi")).unwrap(), model);
+    // Into a folder that cannot be made, it fails before training.
+    let run = ridi(&[
+        "demo",
+        "--data",
+        s(&data),
+        "--out",
+        s(&out.join("report.json/x")),
+    ]);
+    let err = stderr(&run);
+    assert!(
+        !run.status.success() && err.contains("cannot write into"),
+        "{err}"
+    );
+    assert!(
+        !String::from_utf8_lossy(&run.stdout).contains("trained"),
+        "trained first"
+    );
+}

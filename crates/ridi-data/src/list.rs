@@ -117,10 +117,11 @@ pub fn load_entries(entries: &[ListEntry], opts: &ReadOptions) -> Result<Vec<Seq
         let Ok(files) = source_files(&e.path) else {
             continue;
         };
-        let files: Vec<PathBuf> = files
+        let mut files: Vec<PathBuf> = files
             .iter()
             .map(|f| f.canonicalize().unwrap_or_else(|_| f.clone()))
             .collect();
+        files.sort();
         if let Some((_, first)) = seen.iter().find(|(f, _)| *f == files) {
             return Err(DataError::format(
                 e.location().with_field("path"),

@@ -245,7 +245,9 @@ pub struct Validation {
     pub max_median_speed: f64,
     /// Largest accepted speed of the ground truth between two consecutive frames, m/s: 100
     /// (0.5 m in a 5 ms step). The fastest real motion is 5.7 m/s (a phone in a running
-    /// hand; no faster over 2-20 frames, so mocap jitter adds nothing), and the readers
+    /// hand; no faster over 2-20 frames, so mocap jitter adds nothing; measured on Tyrex
+    /// motion capture and competition waypoints, not on RIDI's Tango poses, whose
+    /// relocalization jumps, if any exceed 0.5 m in a frame, would be refused), and the readers
     /// interpolate across the mocap losses they bridge, which moves no faster; one corrupt
     /// position jumps metres to kilometres within a step, which the median and the bound on
     /// single positions cannot see.

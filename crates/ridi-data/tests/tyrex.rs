@@ -117,8 +117,7 @@ impl Fixture {
     }
 }
 
-/// Replaces line `n` (1-based) of `text`.
-/// `text` with line `n` replaced, every line ending in a line break as in the fixture files.
+/// `text` with line `n` (1-based) replaced, every line ending in a line break as in the fixture files.
 fn replace_line(text: &str, n: usize, new: &str) -> String {
     text.lines()
         .enumerate()

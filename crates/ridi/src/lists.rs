@@ -46,11 +46,16 @@ pub fn load_lists(
     purpose: Purpose,
     opts: &ReadOptions,
 ) -> Result<Vec<Sequence>> {
+    load_listed(&read_lists(lists)?, map, purpose, opts)
+}
+
+/// The entries of the list files `lists`, in order (syntax checked, sequences not read).
+pub fn read_lists(lists: &[impl AsRef<Path>]) -> Result<Vec<ListEntry>> {
     let mut entries = Vec::new();
     for list in lists {
         entries.extend(read_list(list)?);
     }
-    load_listed(&entries, map, purpose, opts)
+    Ok(entries)
 }
 
 /// [`load_lists`] for list entries already read ([`read_list`]): the sequence of each entry,
@@ -80,7 +85,7 @@ pub fn load_listed(
                     format!(
                         "a sequence named `{}` is already listed at {}:{} (another recording): \
                          an evaluation names its report rows and plots after the sequence; \
-                         rename one folder",
+                         rename one",
                         seq.name(),
                         entries[j].list.display(),
                         entries[j].line
