@@ -626,17 +626,23 @@ fn check_output(path: &Path) -> Result<()> {
     if path.is_dir() {
         bail!("cannot write {}: it is a folder", path.display());
     }
-    // Outputs are written through a temporary file beside them: try to make one now.
-    if let Err(e) = tempfile::NamedTempFile::new_in(parent) {
-        // The kind alone: the error's own text names the temporary file, not the output.
-        bail!(
-            "cannot write {}: cannot create files in {} ({})",
+    // Outputs are written through a temporary file beside them.
+    probe(parent).map_err(|e| {
+        anyhow::anyhow!(
+            "cannot write {}: cannot create files in {} ({e})",
             path.display(),
-            parent.display(),
-            std::io::Error::from(e.kind())
-        );
-    }
-    Ok(())
+            parent.display()
+        )
+    })
+}
+
+/// Whether new entries can be made in the folder `dir`: makes and removes an empty temporary
+/// folder there. The error is its kind alone, since the error's own text names the temporary
+/// entry, not the output.
+fn probe(dir: &Path) -> std::io::Result<()> {
+    tempfile::tempdir_in(dir)
+        .map(drop)
+        .map_err(|e| e.kind().into())
 }
 
 /// Refuses, before any work, an evaluation's output folder (and its `plots/` if plots are
@@ -679,15 +685,13 @@ fn check_output_folder(dir: &Path) -> Result<()> {
             existing.display()
         );
     }
-    if let Err(e) = tempfile::tempdir_in(existing) {
-        bail!(
-            "cannot write into {}: cannot create folders in {} ({})",
+    probe(existing).map_err(|e| {
+        anyhow::anyhow!(
+            "cannot write into {}: cannot create folders in {} ({e})",
             dir.display(),
-            existing.display(),
-            std::io::Error::from(e.kind())
-        );
-    }
-    Ok(())
+            existing.display()
+        )
+    })
 }
 
 /// Refuses an output that would replace what the command reads (`inputs`) or another of its
