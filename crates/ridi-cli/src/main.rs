@@ -541,12 +541,23 @@ fn run(cli: Cli) -> Result<()> {
             }
             let track = ridi::track(seq, &model, &opts)
                 .with_context(|| format!("cannot track {}", sequence.display()))?;
-            // The plot first: if it fails, the command has written nothing. (Both folders were
-            // found writable above, so the trajectory's write after it hardly can.)
+            // Both outputs are written in full before either replaces a file: the trajectory
+            // under a temporary name beside it, then the plot (itself written through a
+            // temporary file), then the trajectory renamed into place. A failed write leaves
+            // both as they were.
+            let staged = tempfile::Builder::new()
+                .prefix(".ridi-track-")
+                .suffix(".csv")
+                .tempfile_in(folder_of(&out))
+                .with_context(|| format!("cannot write {}", out.display()))?
+                .into_temp_path();
+            track.write_csv(&staged)?;
             if let Some(plot) = &plot {
                 plot_track(seq, &track, plot)?;
             }
-            track.write_csv(&out)?;
+            staged
+                .persist(&out)
+                .with_context(|| format!("cannot write {}", out.display()))?;
             let n = track.regressions.len();
             outln!(
                 "{}: {} frames, {n} regression{} -> {}",
@@ -1101,16 +1112,12 @@ fn demo(out: &Path, data: Option<PathBuf>, grid: Grid, plots: Plots) -> Result<(
     // Before training: an output folder that cannot be written fails in a second, not after it.
     check_eval_output(out, plots)?;
     let map = Some("tyrex4");
-    let train = load_listed(
-        ridi::lists::read_lists(&[train_list])?,
-        map,
-        Purpose::Training,
-    )?;
-    let test = load_listed(
-        ridi::lists::read_lists(&[data.join("list_test.txt")])?,
-        map,
-        Purpose::Evaluation,
-    )?;
+    let train_entries = ridi::lists::read_lists(&[train_list])?;
+    let test_entries = ridi::lists::read_lists(&[data.join("list_test.txt")])?;
+    // Held out means held out: no recording on both lists.
+    ridi::data::check_entries(&[train_entries.as_slice(), &test_entries].concat())?;
+    let train = load_listed(train_entries, map, Purpose::Training)?;
+    let test = load_listed(test_entries, map, Purpose::Evaluation)?;
     outln!(
         "demo: training on {} sequences ({:.0} s), testing on {} held-out sequences",
         train.seqs.len(),

@@ -409,6 +409,13 @@ fn convert_train_track_and_eval() {
     assert!(out.status.success(), "{}", stderr(&out));
     assert_eq!(std::fs::read_to_string(&csv).unwrap().lines().count(), 4801);
     assert!(std::fs::read(&png).unwrap().starts_with(b"\x89PNG"));
+    // The trajectory's temporary name is gone once it is in place.
+    let hidden: Vec<_> = std::fs::read_dir(dir.path())
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .filter(|n| n.starts_with('.'))
+        .collect();
+    assert!(hidden.is_empty(), "{hidden:?}");
 
     let report = dir.path().join("report");
     let test_list = sample().join("list_Jakob.txt");
@@ -958,6 +965,25 @@ fn demo_writes_model_reports_and_plots_all_or_nothing() {
     let err = stderr(&run);
     assert!(
         !run.status.success() && err.contains("cannot write into"),
+        "{err}"
+    );
+    assert!(
+        !String::from_utf8_lossy(&run.stdout).contains("trained"),
+        "trained first"
+    );
+    // A held-out recording that is also a training one is refused before training.
+    std::fs::write(
+        data.join("list_test.txt"),
+        line("Guillaume_Nexus5_NoDist_Swinging", "Swinging"),
+    )
+    .unwrap();
+    let run = demo();
+    let err = stderr(&run);
+    assert!(
+        !run.status.success()
+            && err.contains("list_test.txt:1: field `path`")
+            && err.contains("already listed at")
+            && err.contains("list_train.txt:2"),
         "{err}"
     );
     assert!(

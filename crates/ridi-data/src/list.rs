@@ -105,6 +105,23 @@ pub fn load_list(path: impl AsRef<Path>, opts: &ReadOptions) -> Result<Vec<Seque
 /// `processed/data.csv`, a symbolic link): it would count twice in every mean, and sit on both
 /// sides of a cross-validation split.
 pub fn load_entries(entries: &[ListEntry], opts: &ReadOptions) -> Result<Vec<Sequence>> {
+    check_entries(entries)?;
+    entries
+        .iter()
+        .map(|e| {
+            let mut seq = read_sequence(&e.path, opts)?;
+            if e.placement.is_some() {
+                seq.set_placement(e.placement.clone());
+            }
+            Ok(seq)
+        })
+        .collect()
+}
+
+/// The checks [`load_entries`] makes before reading anything: every listed path exists and no
+/// recording is listed twice. Useful on its own over entries that are loaded apart, such as a
+/// training and a test list (a recording in both would be tested on after training on it).
+pub fn check_entries(entries: &[ListEntry]) -> Result<()> {
     let mut seen: Vec<(Vec<PathBuf>, &ListEntry)> = Vec::new();
     for e in entries {
         if !e.path.exists() {
@@ -127,7 +144,7 @@ pub fn load_entries(entries: &[ListEntry], opts: &ReadOptions) -> Result<Vec<Seq
                 e.location().with_field("path"),
                 format!(
                     "sequence `{}` is the recording already listed at {}:{}; a recording listed \
-                     twice would count twice",
+                     twice would count twice, or be tested on after training on it",
                     e.path.display(),
                     first.list.display(),
                     first.line
@@ -136,14 +153,5 @@ pub fn load_entries(entries: &[ListEntry], opts: &ReadOptions) -> Result<Vec<Seq
         }
         seen.push((files, e));
     }
-    entries
-        .iter()
-        .map(|e| {
-            let mut seq = read_sequence(&e.path, opts)?;
-            if e.placement.is_some() {
-                seq.set_placement(e.placement.clone());
-            }
-            Ok(seq)
-        })
-        .collect()
+    Ok(())
 }

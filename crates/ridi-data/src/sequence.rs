@@ -371,10 +371,14 @@ impl Validation {
         }
         // A NaN speed (equal times) must not pass either.
         let too_fast = |v: f64| v.is_nan() || v > self.max_speed;
-        let Some(index) = (1..n).find(|&i| too_fast(step_speed(i))) else {
+        let Some(later) = (1..n).find(|&i| too_fast(step_speed(i))) else {
             return Ok(());
         };
-        let step = (position[index] - position[index - 1]).to_array();
+        // A step has two ends; name the frame that disagrees with its other neighbour too (a
+        // one-frame spike), or frame 0 when everything after it agrees.
+        let back_too = later + 1 < n && too_fast(step_speed(later + 1));
+        let index = if later == 1 && !back_too { 0 } else { later };
+        let step = (position[later] - position[later - 1]).to_array();
         let axis = (0..3)
             .max_by(|&a, &b| step[a].abs().total_cmp(&step[b].abs()))
             .unwrap_or(0);
@@ -382,7 +386,7 @@ impl Validation {
             index,
             axis,
             distance: norm(step),
-            dt: time[index] - time[index - 1],
+            dt: time[later] - time[later - 1],
             max: self.max_speed,
         })
     }
@@ -497,6 +501,14 @@ pub(crate) fn beyond(channel: Channel, value: f64, limit: f64) -> String {
 /// What is wrong with a ground-truth step too fast for a pedestrian, e.g. `jumps 1000 m in
 /// 0.005 s (200000 m/s): faster than any pedestrian (speed <= 100 m/s), a corrupt position?`.
 pub(crate) fn jump(distance: f64, dt: f64, max: f64) -> String {
+    if dt.partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater) {
+        // Only reachable by calling `check_speed` directly: `Sequence::new` refuses such times.
+        return format!(
+            "jumps {} m between frames {} s apart: time must increase",
+            short(distance),
+            short(dt)
+        );
+    }
     format!(
         "jumps {} m in {} s ({} m/s): faster than any pedestrian (speed <= {} m/s), a corrupt \
          position?",
@@ -550,7 +562,8 @@ pub enum SequenceError {
     /// Time does not strictly increase.
     #[error("time does not increase at frame {index}: {previous} s then {next} s")]
     TimeNotIncreasing {
-        /// 0-based index of the later frame.
+        /// 0-based index of the suspect frame: the middle of a one-frame spike, frame 0 when
+        /// only the first step is too fast, otherwise the later frame of the first such step.
         index: usize,
         /// Time of the earlier frame.
         previous: f64,
@@ -674,7 +687,8 @@ pub enum SequenceError {
         jump(*distance, *dt, *max)
     )]
     GroundTruthJump {
-        /// 0-based index of the later frame.
+        /// 0-based index of the suspect frame: the middle of a one-frame spike, frame 0 when
+        /// only the first step is too fast, otherwise the later frame of the first such step.
         index: usize,
         /// The axis that moves most: 0 (x), 1 (y) or 2 (z).
         axis: usize,
@@ -1199,6 +1213,40 @@ mod tests {
             e.to_string(),
             "`ground_truth.position.x` at frame 30: jumps 999997.677 m in 0.005 s (2e8 m/s): \
              faster than any pedestrian (speed <= 100 m/s), a corrupt position?"
+        );
+        // A spike on the first frame is reported there, not on frame 1.
+        let mut first = walk.clone();
+        first[0] = WorldVec::new(999_999.0, 0.1, 1.2);
+        let e = v.check_speed(&time, &first).unwrap_err();
+        assert!(
+            matches!(e, SequenceError::GroundTruthJump { index: 0, .. }),
+            "{e:?}"
+        );
+        // A lasting shift from frame 30 on is reported at frame 30.
+        let shifted: Vec<WorldVec> = walk
+            .iter()
+            .enumerate()
+            .map(|(i, p)| {
+                if i >= 30 {
+                    *p + WorldVec::new(1e4, 0.0, 0.0)
+                } else {
+                    *p
+                }
+            })
+            .collect();
+        let e = v.check_speed(&time, &shifted).unwrap_err();
+        assert!(
+            matches!(e, SequenceError::GroundTruthJump { index: 30, .. }),
+            "{e:?}"
+        );
+        // Equal times (which `Sequence::new` refuses before) give no "NaN m/s".
+        let mut still_time = time.clone();
+        still_time[10] = still_time[9];
+        let e = v.check_speed(&still_time, &walk).unwrap_err();
+        assert_eq!(
+            e.to_string(),
+            "`ground_truth.position.x` at frame 10: jumps 0.007 m between frames 0 s apart: time \
+             must increase"
         );
         // The limit is the caller's to move.
         let lax = Validation {
