@@ -293,7 +293,7 @@ fn swapped_rte(
             Regressed {
                 frame: seq.time().partition_point(|&x| x < t),
                 placement: 0,
-                velocity: [direction[0] * scale, direction[1] * scale],
+                velocity: ridi::frames::StabHorizontal::from_array(direction) * scale,
             }
         })
         .collect();
@@ -799,7 +799,10 @@ mod tests {
             .frames(seq.len());
         let truth = compute_targets(&ground_truth_view(&seq).unwrap(), &config, &frames)
             .unwrap()
-            .values;
+            .values
+            .iter()
+            .map(|v| v.to_array())
+            .collect::<Vec<_>>();
         // Regressions turned by 30 degrees one way, then the other, every 5 s (a constant turn
         // would vanish in the alignment; the speed right), and then also 20 % short.
         let turned: Vec<[f64; 2]> = truth

@@ -17,7 +17,7 @@ use ridi_frames::WorldVec;
 /// Replays a lap's exact velocities (frame modulo lap length): a regression costs nothing,
 /// so the measurements isolate integration and correction.
 struct Replay {
-    velocity: Vec<[f64; 2]>,
+    velocity: Vec<ridi_frames::StabHorizontal>,
 }
 
 impl VelocityRegressor for Replay {

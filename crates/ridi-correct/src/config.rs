@@ -40,8 +40,11 @@ pub struct CorrectionConfig {
     /// integration across missing data. Default 0.1 s (20 samples at 200 Hz).
     pub max_dt: f64,
     /// The definition of S the target velocities are expressed in: the one of the regressor
-    /// that produced them (a model's feature configuration records it). Default: the paper's,
-    /// [`UpAxis::PlusY`].
+    /// that produced them. Default: the paper's, [`UpAxis::PlusY`]; models trained by `ridi`
+    /// default to [`UpAxis::PlusOrMinusY`], so with a `ridi_regress::Cascade` set
+    /// `up_axis: model.feature_config().up_axis` (the [`Tracker`](crate::Tracker) refuses a
+    /// mismatch with its regressor; a batch correction cannot see where its targets came
+    /// from, and a wrong S turns every target of an upside-down phone by a half turn).
     pub up_axis: UpAxis,
 }
 

@@ -11,7 +11,7 @@ use ridi_frames::{DeviceVec, WorldVec};
 use crate::config::{CorrectionConfig, InitialVelocity};
 use crate::error::CorrectError;
 use crate::input::{ImuSlices, VelocityTarget, validate_targets};
-use crate::integrate::{corrected_acceleration, integrate_unchecked};
+use crate::integrate::{corrected_acceleration_unchecked, integrate_unchecked};
 use crate::knots::{BiasCurve, Knots};
 use crate::solve::Correction;
 
@@ -26,7 +26,7 @@ pub fn objective(
     config.validate()?;
     imu.validate(config.max_dt)?;
     validate_targets(targets, imu.len())?;
-    let acc = corrected_acceleration(imu, &correction.bias);
+    let acc = corrected_acceleration_unchecked(imu, &correction.bias);
     let poses = integrate_unchecked(imu.time, &acc, correction.initial_velocity, WorldVec::ZERO);
     let mut e = 0.0;
     for t in targets {

@@ -25,7 +25,15 @@ pub enum CorrectError {
     NonFinite {
         /// Which input.
         what: &'static str,
-        /// Frame (or target) index.
+        /// Frame index.
+        frame: usize,
+    },
+    /// A velocity target with a NaN or infinite component.
+    #[error("velocity target {index} (frame {frame}) is not finite")]
+    NonFiniteTarget {
+        /// Target index.
+        index: usize,
+        /// The frame it is for.
         frame: usize,
     },
     /// `time[frame] <= time[frame - 1]`.
@@ -66,6 +74,9 @@ pub enum CorrectError {
     /// A configuration value is out of its domain.
     #[error("invalid configuration: {0}")]
     InvalidConfig(&'static str),
+    /// Stored knots that [`Knots::new`](crate::Knots::new) cannot have made.
+    #[error("invalid knots: {0}")]
+    InvalidKnots(&'static str),
     /// At a target frame, the horizontal S rows and the world vertical are (nearly) linearly
     /// dependent: gravity and orientation disagree by about 90 degrees.
     #[error("inconsistent gravity and orientation at target frame {frame}")]

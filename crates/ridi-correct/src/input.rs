@@ -1,6 +1,6 @@
 //! Inputs of a correction: per-frame IMU slices and regressed velocity targets.
 
-use ridi_frames::{DeviceVec, WorldFromDevice};
+use ridi_frames::{DeviceVec, StabHorizontal, WorldFromDevice};
 use serde::{Deserialize, Serialize};
 
 use crate::error::CorrectError;
@@ -136,7 +136,7 @@ pub struct VelocityTarget {
     /// Frame index (into the slices of the correction).
     pub frame: usize,
     /// `[S-x, S-z]` velocity, m/s (forward is -z).
-    pub velocity: [f64; 2],
+    pub velocity: StabHorizontal,
 }
 
 /// Checks that targets are finite, strictly increasing and inside `0..len`.
@@ -152,10 +152,10 @@ pub(crate) fn validate_targets(targets: &[VelocityTarget], len: usize) -> Result
         if i > 0 && t.frame <= targets[i - 1].frame {
             return Err(CorrectError::TargetsNotIncreasing { index: i });
         }
-        if !t.velocity.iter().all(|v| v.is_finite()) {
-            return Err(CorrectError::NonFinite {
-                what: "target velocity",
-                frame: i,
+        if !t.velocity.is_finite() {
+            return Err(CorrectError::NonFiniteTarget {
+                index: i,
+                frame: t.frame,
             });
         }
     }

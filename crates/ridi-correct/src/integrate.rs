@@ -126,16 +126,37 @@ pub(crate) fn integrate_unchecked(
 }
 
 /// World-frame accelerations `R_WI(f) a_I(f)` (no bias correction).
-pub fn world_acceleration(imu: &ImuSlices<'_>) -> Vec<WorldVec> {
-    imu.orientation
+///
+/// # Errors
+/// What [`ImuSlices::validate`] refuses (any time step is accepted).
+pub fn world_acceleration(imu: &ImuSlices<'_>) -> Result<Vec<WorldVec>, CorrectError> {
+    imu.validate(f64::INFINITY)?;
+    Ok(imu
+        .orientation
         .iter()
         .zip(imu.linacce)
         .map(|(q, a)| *q * *a)
-        .collect()
+        .collect())
 }
 
-/// Corrected world-frame accelerations `R_WI(f) (a_I(f) + x(f))`, `x` the bias curve.
-pub fn corrected_acceleration(imu: &ImuSlices<'_>, bias: &BiasCurve) -> Vec<WorldVec> {
+/// Corrected world-frame accelerations `R_WI(f) (a_I(f) + x(f))`, `x` the bias curve (frames
+/// past its last knot take the last knot's value).
+///
+/// # Errors
+/// What [`ImuSlices::validate`] refuses (any time step is accepted).
+pub fn corrected_acceleration(
+    imu: &ImuSlices<'_>,
+    bias: &BiasCurve,
+) -> Result<Vec<WorldVec>, CorrectError> {
+    imu.validate(f64::INFINITY)?;
+    Ok(corrected_acceleration_unchecked(imu, bias))
+}
+
+/// [`corrected_acceleration`] of slices already validated.
+pub(crate) fn corrected_acceleration_unchecked(
+    imu: &ImuSlices<'_>,
+    bias: &BiasCurve,
+) -> Vec<WorldVec> {
     (0..imu.len())
         .map(|f| imu.orientation[f] * (imu.linacce[f] + bias.at(f, imu.time[f])))
         .collect()
@@ -180,5 +201,35 @@ mod tests {
             integrate(&[], &[], WorldVec::ZERO, WorldVec::ZERO),
             Err(CorrectError::Empty)
         );
+    }
+
+    #[test]
+    fn world_accelerations_refuse_slices_of_other_lengths() {
+        use crate::knots::Knots;
+        use ridi_frames::{DeviceVec, WorldFromDevice};
+        let time: Vec<f64> = (0..20).map(|i| f64::from(i) * 0.005).collect();
+        let linacce = vec![DeviceVec::new(0.1, 0.0, 0.0); 20];
+        let orientation = vec![WorldFromDevice::identity(); 20];
+        let gravity = vec![DeviceVec::new(0.0, 0.0, 9.81); 20];
+        let mut imu = ImuSlices {
+            time: &time,
+            linacce: &linacce,
+            orientation: &orientation,
+            gravity: &gravity,
+        };
+        let bias = BiasCurve::zero(Knots::new(&time, 5));
+        assert_eq!(
+            world_acceleration(&imu).unwrap()[3],
+            WorldVec::new(0.1, 0.0, 0.0)
+        );
+        assert_eq!(corrected_acceleration(&imu, &bias).unwrap().len(), 20);
+        imu.orientation = &orientation[..10];
+        let short = Err(CorrectError::LengthMismatch {
+            what: "orientation",
+            expected: 20,
+            got: 10,
+        });
+        assert_eq!(world_acceleration(&imu), short);
+        assert_eq!(corrected_acceleration(&imu, &bias), short);
     }
 }

@@ -3,6 +3,8 @@
 use ridi_frames::DeviceVec;
 use serde::{Deserialize, Serialize};
 
+use crate::error::CorrectError;
+
 /// Knot placement over a sequence of `len` frames: frames `0, s, 2s, ...` (`s` the spacing)
 /// plus a final knot at the last frame when it is not already one, so that every frame,
 /// including the tail, lies between two knots (the original left the tail uncorrected).
@@ -10,10 +12,50 @@ use serde::{Deserialize, Serialize};
 /// Between two knots the bias is interpolated linearly in *time*, so irregular sampling does
 /// not distort it.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(try_from = "KnotParts")]
 pub struct Knots {
     spacing: usize,
     frames: Vec<usize>,
     times: Vec<f64>,
+}
+
+/// [`Knots`] as stored, checked on the way in: [`Knots::locate`] indexes by them.
+#[derive(Deserialize)]
+struct KnotParts {
+    spacing: usize,
+    frames: Vec<usize>,
+    times: Vec<f64>,
+}
+
+impl TryFrom<KnotParts> for Knots {
+    type Error = CorrectError;
+    fn try_from(p: KnotParts) -> Result<Self, CorrectError> {
+        let bad = CorrectError::InvalidKnots;
+        if p.spacing == 0 {
+            return Err(bad("spacing 0"));
+        }
+        if p.frames.len() != p.times.len() {
+            return Err(bad("as many times as frames are needed"));
+        }
+        let n = p.frames.len();
+        // Frames 0, s, 2s, ... and possibly a final knot after the last multiple of s.
+        let regular = |i: usize| p.frames[i] == i * p.spacing;
+        let last_ok = n < 2 || regular(n - 1) || p.frames[n - 1] < (n - 1) * p.spacing;
+        if !(0..n.saturating_sub(1)).all(regular)
+            || !last_ok
+            || p.frames.windows(2).any(|w| w[1] <= w[0])
+        {
+            return Err(bad("frames are not every `spacing` frames from 0"));
+        }
+        if p.times.iter().any(|t| !t.is_finite()) || p.times.windows(2).any(|w| w[1] <= w[0]) {
+            return Err(bad("times must be finite and increasing"));
+        }
+        Ok(Self {
+            spacing: p.spacing,
+            frames: p.frames,
+            times: p.times,
+        })
+    }
 }
 
 impl Knots {
@@ -89,14 +131,55 @@ impl Knots {
 
 /// A piecewise-linear device-frame acceleration bias: one value per knot.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(try_from = "BiasParts")]
 pub struct BiasCurve {
-    /// Where the values sit.
-    pub knots: Knots,
-    /// Bias at each knot, device frame, m/s².
-    pub values: Vec<DeviceVec>,
+    pub(crate) knots: Knots,
+    pub(crate) values: Vec<DeviceVec>,
+}
+
+/// [`BiasCurve`] as stored, checked on the way in ([`BiasCurve::new`]).
+#[derive(Deserialize)]
+struct BiasParts {
+    knots: Knots,
+    values: Vec<DeviceVec>,
+}
+
+impl TryFrom<BiasParts> for BiasCurve {
+    type Error = CorrectError;
+    fn try_from(p: BiasParts) -> Result<Self, CorrectError> {
+        Self::new(p.knots, p.values)
+    }
 }
 
 impl BiasCurve {
+    /// The curve with `values[k]` at knot `k`: one finite value per knot.
+    pub fn new(knots: Knots, values: Vec<DeviceVec>) -> Result<Self, CorrectError> {
+        if values.len() != knots.len() {
+            return Err(CorrectError::LengthMismatch {
+                what: "bias values (one per knot)",
+                expected: knots.len(),
+                got: values.len(),
+            });
+        }
+        if let Some(k) = values.iter().position(|v| !v.is_finite()) {
+            return Err(CorrectError::NonFinite {
+                what: "bias",
+                frame: knots.frames()[k],
+            });
+        }
+        Ok(Self { knots, values })
+    }
+
+    /// Where the values sit.
+    pub fn knots(&self) -> &Knots {
+        &self.knots
+    }
+
+    /// Bias at each knot, device frame, m/s².
+    pub fn values(&self) -> &[DeviceVec] {
+        &self.values
+    }
+
     /// The zero bias over `knots`.
     pub fn zero(knots: Knots) -> Self {
         let values = vec![DeviceVec::ZERO; knots.len()];
@@ -148,12 +231,54 @@ mod tests {
     fn curve_is_linear_between_knots() {
         let time: Vec<f64> = (0..11).map(|i| i as f64).collect();
         let knots = Knots::new(&time, 10);
-        let curve = BiasCurve {
-            knots,
-            values: vec![DeviceVec::new(0.0, 1.0, 2.0), DeviceVec::new(1.0, 1.0, 0.0)],
-        };
+        let curve = BiasCurve::new(
+            knots.clone(),
+            vec![DeviceVec::new(0.0, 1.0, 2.0), DeviceVec::new(1.0, 1.0, 0.0)],
+        )
+        .unwrap();
         let mid = curve.at(5, 5.0);
         assert!((mid - DeviceVec::new(0.5, 1.0, 1.0)).norm() < 1e-12);
         assert_eq!(curve.last(), DeviceVec::new(1.0, 1.0, 0.0));
+        // One value per knot, finite.
+        assert_eq!(
+            BiasCurve::new(knots.clone(), vec![DeviceVec::ZERO]),
+            Err(CorrectError::LengthMismatch {
+                what: "bias values (one per knot)",
+                expected: 2,
+                got: 1
+            })
+        );
+        let nan = vec![DeviceVec::ZERO, DeviceVec::new(f64::NAN, 0.0, 0.0)];
+        assert_eq!(
+            BiasCurve::new(knots, nan),
+            Err(CorrectError::NonFinite {
+                what: "bias",
+                frame: 10
+            })
+        );
+    }
+
+    #[test]
+    fn stored_knots_and_curves_are_checked_on_the_way_in() {
+        let time: Vec<f64> = (0..12).map(|i| i as f64 * 0.5).collect();
+        let curve = BiasCurve::zero(Knots::new(&time, 5));
+        let json = serde_json::to_string(&curve).unwrap();
+        assert_eq!(serde_json::from_str::<BiasCurve>(&json).unwrap(), curve);
+        for (from, to) in [
+            ("\"spacing\":5", "\"spacing\":0"),
+            ("[0,5,10,11]", "[0,5,11,10]"),
+            ("[0,5,10,11]", "[0,4,10,11]"),
+            ("[0,5,10,11]", "[0,5,10,17]"),
+            ("[0.0,2.5,5.0,5.5]", "[0.0,2.5,5.5,5.0]"),
+            ("[0.0,0.0,0.0],[0.0,0.0,0.0]]", "[0.0,0.0,0.0]]"),
+        ] {
+            assert!(json.contains(from), "{json}");
+            let bad = json.replacen(from, to, 1);
+            let e = serde_json::from_str::<BiasCurve>(&bad).unwrap_err();
+            assert!(
+                e.to_string().contains("invalid knots") || e.to_string().contains("bias values"),
+                "{bad}: {e}"
+            );
+        }
     }
 }

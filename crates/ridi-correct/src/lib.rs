@@ -35,7 +35,7 @@
 //!
 //! ```
 //! use ridi_correct::{CorrectionConfig, Corrector, ImuSlices, VelocityTarget};
-//! use ridi_frames::{DeviceVec, WorldFromDevice};
+//! use ridi_frames::{DeviceVec, StabHorizontal, WorldFromDevice};
 //!
 //! // Two seconds at 200 Hz of a phone lying flat, its accelerometer biased by 0.05 m/s² along
 //! // device x, while the walker stands still (regressed velocity zero every 10 frames).
@@ -46,7 +46,7 @@
 //! let gravity = vec![DeviceVec::new(0.0, 0.0, 9.81); n];
 //! let imu = ImuSlices { time: &time, linacce: &linacce, orientation: &orientation, gravity: &gravity };
 //! let targets: Vec<VelocityTarget> =
-//!     (10..n).step_by(10).map(|frame| VelocityTarget { frame, velocity: [0.0, 0.0] }).collect();
+//!     (10..n).step_by(10).map(|frame| VelocityTarget { frame, velocity: StabHorizontal::ZERO }).collect();
 //!
 //! let config = CorrectionConfig { lambda: 1e-6, ..CorrectionConfig::default() };
 //! let trajectory = Corrector::new(config)?.correct(&imu, &targets)?;

@@ -1,6 +1,6 @@
 //! The interface between the tracker and a velocity regressor.
 
-use ridi_frames::{DeviceVec, UpAxis, WorldFromDevice};
+use ridi_frames::{DeviceVec, StabHorizontal, UpAxis, WorldFromDevice};
 
 /// A view of the most recent frames of the stream, oldest first, one entry per frame in
 /// each slice. The last frame is the one to regress.
@@ -42,7 +42,7 @@ impl FrameWindow<'_> {
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Regression {
     /// Horizontal velocity in the stabilized frame S, `[S-x, S-z]`, m/s.
-    pub velocity: [f64; 2],
+    pub velocity: StabHorizontal,
     /// The placement it was regressed for, as an index into the regressor's placement names
     /// (e.g. leg, bag, hand, body), if the regressor classifies; used by the placement-change
     /// filter.

@@ -15,7 +15,7 @@ use serde::{Deserialize, Serialize};
 use crate::config::{CorrectionConfig, InitialVelocity};
 use crate::error::CorrectError;
 use crate::input::{ImuSlices, VelocityTarget, validate_targets};
-use crate::integrate::{Pose, corrected_acceleration, integrate_unchecked};
+use crate::integrate::{Pose, corrected_acceleration_unchecked, integrate_unchecked};
 use crate::knots::{BiasCurve, Knots};
 
 /// Result of a correction solve.
@@ -239,7 +239,7 @@ impl Corrector {
         targets: &[VelocityTarget],
     ) -> Result<Trajectory, CorrectError> {
         let correction = self.solve(imu, targets)?;
-        let acc = corrected_acceleration(imu, &correction.bias);
+        let acc = corrected_acceleration_unchecked(imu, &correction.bias);
         let poses =
             integrate_unchecked(imu.time, &acc, correction.initial_velocity, WorldVec::ZERO);
         Ok(Trajectory { poses, correction })

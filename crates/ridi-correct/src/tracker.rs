@@ -51,7 +51,7 @@ use std::collections::VecDeque;
 use std::sync::mpsc::{Receiver, SyncSender, sync_channel};
 use std::thread::JoinHandle;
 
-use ridi_frames::{DeviceVec, WorldFromDevice, WorldVec};
+use ridi_frames::{DeviceVec, StabHorizontal, WorldFromDevice, WorldVec};
 use serde::{Deserialize, Serialize};
 use thiserror::Error;
 
@@ -287,7 +287,7 @@ pub struct Segment {
 #[derive(Debug, Clone, Copy)]
 struct StoredTarget {
     frame: u64,
-    velocity: [f64; 2],
+    velocity: StabHorizontal,
     placement: Option<usize>,
 }
 
@@ -661,7 +661,7 @@ impl<R: VelocityRegressor> Tracker<R> {
                 .zip(&zero)
                 .map(|(t, &z)| VelocityTarget {
                     frame: (t.frame - first_frame) as usize,
-                    velocity: if z { [0.0, 0.0] } else { t.velocity },
+                    velocity: if z { StabHorizontal::ZERO } else { t.velocity },
                 })
                 .collect();
             let mut trajectory = if targets.is_empty()
@@ -701,7 +701,7 @@ impl<R: VelocityRegressor> Tracker<R> {
         let n = self.regressor.window_len().max(1);
         let view = self.ring.last(n);
         match self.regressor.regress(&view) {
-            Ok(Some(r)) if r.velocity.iter().all(|v| v.is_finite()) => {
+            Ok(Some(r)) if r.velocity.is_finite() => {
                 let t = StoredTarget {
                     frame,
                     velocity: r.velocity,
@@ -751,7 +751,7 @@ impl<R: VelocityRegressor> Tracker<R> {
                 }
                 job.targets.push(VelocityTarget {
                     frame: (t.frame - first) as usize,
-                    velocity: if z { [0.0, 0.0] } else { t.velocity },
+                    velocity: if z { StabHorizontal::ZERO } else { t.velocity },
                 });
             }
         }

@@ -10,12 +10,12 @@ use ridi_correct::{
     TrackError, Tracker, TrackerConfig, VelocityRegressor, VelocityTarget, corrected_acceleration,
     integrate, world_acceleration,
 };
-use ridi_frames::{DeviceVec, WorldVec};
+use ridi_frames::{DeviceVec, StabHorizontal, WorldVec};
 
 /// Returns the exact S velocity of the walk at the regressed frame; can be told to fail or
 /// to flip placement labels.
 struct Truth {
-    velocity: Vec<[f64; 2]>,
+    velocity: Vec<StabHorizontal>,
     window: usize,
     fail_every: Option<u64>,
     flip_between: Option<(u64, u64)>,
@@ -137,7 +137,7 @@ fn each_window_starts_from_raw_data_and_the_earlier_output() {
             .unwrap()
             .solve_from(&imu, &targets, initial)
             .unwrap();
-        let acc = corrected_acceleration(&imu, &c.bias);
+        let acc = corrected_acceleration(&imu, &c.bias).unwrap();
         let poses = integrate(imu.time, &acc, c.initial_velocity, start_pose.position).unwrap();
         for (i, p) in poses.iter().enumerate() {
             let got = tracker.pose((start + i) as u64).unwrap();
@@ -163,7 +163,7 @@ fn sliding_windows_remove_the_drift() {
     let e = max_position_error(&live, &w.poses_true);
     let raw = integrate(
         &w.time,
-        &world_acceleration(&w.imu()),
+        &world_acceleration(&w.imu()).unwrap(),
         WorldVec::ZERO,
         WorldVec::ZERO,
     )
@@ -337,7 +337,7 @@ fn failing_regressions_are_reported_and_skipped() {
         }
         fn regress(&mut self, _: &FrameWindow<'_>) -> Result<Option<Regression>, RegressorError> {
             Ok(Some(Regression {
-                velocity: [f64::NAN, 0.0],
+                velocity: StabHorizontal::new(f64::NAN, 0.0),
                 placement: None,
             }))
         }

@@ -171,10 +171,25 @@ pub fn detect(path: impl AsRef<Path>) -> Result<Format> {
     locate(path.as_ref()).map(|(f, _)| f)
 }
 
-/// Reads a sequence of any detected format (see [`detect`]). A Tyrex run split into several
-/// parts is refused here: use [`tyrex::read`](crate::tyrex::read), which returns every part.
-/// An Indoor Location Competition path file is read with [`ilc::IlcOptions`] built from `opts`
-/// (placement `hand`).
+/// Reads a sequence of any detected format (see [`detect`]), **dropping the reader's
+/// warnings** (see below). A Tyrex run split into several parts is refused here: use
+/// [`tyrex::read`](crate::tyrex::read), which returns every part. An Indoor Location
+/// Competition path file is read with [`ilc::IlcOptions`] built from `opts` (placement `hand`).
+///
+/// # Warnings are dropped
+///
+/// This returns the sequence only: **the reader's warnings are lost**. Of the readers here the
+/// Tyrex one warns, in [`TyrexRead::warnings`](crate::tyrex::TyrexRead::warnings): splits at
+/// mocap or sensor gaps, parts shorter than
+/// [`TyrexOptions::min_part_s`](crate::tyrex::TyrexOptions::min_part_s) that were dropped, a
+/// clipped accelerometer, an unknown motion (so no placement). A run read here can come back as
+/// one clean-looking sequence while its reader warned a dozen times
+/// (`Guillaume_Nexus5_NoDist_AR`: 12 warnings, 4 dropped parts). To get them, call
+/// [`tyrex::read`](crate::tyrex::read) with `TyrexOptions::from(opts)` (the options this
+/// function uses, see [`TyrexOptions`](crate::tyrex::TyrexOptions)), or, from the `ridi`
+/// facade crate, `ridi::read_any`, which returns the sequences of any format together with
+/// their warnings. [`load_list`](crate::load_list) and [`load_entries`](crate::load_entries)
+/// read every listed path through this function, so they drop the warnings too.
 pub fn read_sequence(path: impl AsRef<Path>, opts: &ReadOptions) -> Result<Sequence> {
     let (format, file) = locate(path.as_ref())?;
     match format {

@@ -21,7 +21,8 @@
 //! | dataset list file (`path,placement` per line) | [`read_list`], [`load_list`], [`load_entries`] | |
 //!
 //! [`detect`] tells the format of a file or folder and [`read_sequence`] reads any of them
-//! (a Tyrex run only when it is not split into parts). [`ReadOptions`] holds the validation limits and the
+//! (a Tyrex run only when it is not split into parts; it drops the reader's warnings, which
+//! [`tyrex::read`] returns). [`ReadOptions`] holds the validation limits and the
 //! raw synchronization settings.
 //!
 //! Conventions at the file edges: time is nanoseconds in files and seconds (absolute, `f64`)

@@ -27,7 +27,10 @@
 //! QTM struct's `RigidBodies.Positions` (1x3xN, mm) divided by 1000, and
 //! `RigidBodies.Rotations` (1x9xN, a column-major 3x3 with `p_room = R p_phone`). The rigid body
 //! was defined to coincide with the Android device frame, so `R` is the world-from-device
-//! rotation directly. Frames where the mocap lost the body are `NaN` in the file.
+//! rotation directly. Frames where the mocap lost the body are `NaN` in the file. A finite `R`
+//! must be a rotation matrix ([`Rot::from_matrix`](ridi_frames::Rot::from_matrix): determinant
+//! positive, `|RᵀR − I|` within 1e-3; the Tyrex exports are within 1e-7), otherwise reading
+//! fails naming the file, the field and the frame.
 //!
 //! # Time
 //! Mocap frame `i` (0-based, first exported frame) is at mocap time `i / FrameRate`, and
@@ -72,7 +75,7 @@
 use std::path::{Path, PathBuf};
 
 use ridi_frames::nalgebra::Matrix3;
-use ridi_frames::{DeviceVec, STANDARD_GRAVITY, WorldFromDevice, WorldVec};
+use ridi_frames::{DeviceVec, QuatError, STANDARD_GRAVITY, WorldFromDevice, WorldVec};
 
 use crate::android;
 use crate::error::{DataError, Location, Result};
@@ -264,7 +267,11 @@ pub fn mat_path(dir: &Path) -> Option<PathBuf> {
 /// The take is the top-level struct with a `RigidBodies` field (the one named after the file
 /// if several: QTM names the variable after the take, which does not always match the file).
 /// The first rigid body is used. A frame is valid when its position and rotation are finite;
-/// a finite rotation that is not a proper rotation matrix is an error.
+/// a finite rotation that is not a proper rotation matrix (a reflection, or further than
+/// [`Rot::ORTHONORMALITY_TOLERANCE`](ridi_frames::Rot::ORTHONORMALITY_TOLERANCE) from
+/// orthonormal: the Tyrex exports are within 1e-7) is an error naming the file, the field
+/// `<take>.RigidBodies.Rotations` and the frame (from 1). Valid rotations are taken as the
+/// nearest rotation ([`Rot::from_matrix`](ridi_frames::Rot::from_matrix)).
 pub fn read_ground_truth(path: impl AsRef<Path>) -> Result<MocapTrack> {
     let path = path.as_ref();
     let mat = MatFile::read(path)?;
@@ -319,21 +326,20 @@ pub fn read_ground_truth(path: impl AsRef<Path>) -> Result<MocapTrack> {
             pose.push(None);
             continue;
         }
-        let m = Matrix3::from_column_slice(&r);
-        let err = (m.transpose() * m - Matrix3::identity()).abs().max();
-        if err > 1e-3 || m.determinant() <= 0.0 {
-            return Err(DataError::format(
-                Location::file(path).with_field(field("RigidBodies.Rotations")),
-                format!(
-                    "frame {} is not a rotation matrix (|R'R - I| = {err:.2e}, det = {:.3})",
-                    i + 1,
-                    m.determinant()
-                ),
-            ));
-        }
+        let orientation =
+            WorldFromDevice::from_matrix(&Matrix3::from_column_slice(&r)).map_err(|e| {
+                DataError::format(
+                    Location::file(path).with_field(field("RigidBodies.Rotations")),
+                    // Frames are numbered from 1, as MATLAB and QTM do.
+                    match e {
+                        QuatError::NotRotation { .. } => format!("frame {} is {e}", i + 1),
+                        _ => format!("frame {}: {e}", i + 1),
+                    },
+                )
+            })?;
         pose.push(Some(MocapPose {
             position: WorldVec::new(p[0] / 1000.0, p[1] / 1000.0, p[2] / 1000.0),
-            orientation: WorldFromDevice::from_matrix(&m),
+            orientation,
         }));
     }
     Ok(MocapTrack {

@@ -582,6 +582,75 @@ fn mat_errors_name_the_file_and_field() {
     assert_err(&fx, &["every frame is NaN"]);
 }
 
+/// Mocap rotations go through `Rot::from_matrix`: a scaled matrix or a reflection is an error
+/// naming the file, the field and the frame; the rounding of a real export is accepted and
+/// gives the nearest rotation.
+#[test]
+fn mocap_matrices_that_are_not_rotations_name_file_field_and_frame() {
+    let (p, r) = frames(600, &[]);
+
+    // 2 I: the unchecked conversion made it a "unit" quaternion with w = 1.32.
+    let mut bad = r.clone();
+    bad[99] = [2.0, 0.0, 0.0, 0.0, 2.0, 0.0, 0.0, 0.0, 2.0];
+    let fx = with_mat(qtm_like("Take_1", 60.0, &p, &bad));
+    assert_err(
+        &fx,
+        &[
+            &mat_file_name(&fx),
+            "field `Take_1.RigidBodies.Rotations`: frame 100 is not a rotation matrix",
+            "|R'R - I| = 3.00e0",
+            "at most 1e-3",
+            "det = 8.000",
+        ],
+    );
+    let e = tyrex::read_ground_truth(&fx.mat).unwrap_err();
+    assert!(matches!(e, DataError::Format { .. }), "{e:?}");
+
+    // diag(-1, 1, 1): orthonormal, but a reflection.
+    let mut bad = r.clone();
+    bad[0] = [-1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0];
+    let fx = with_mat(qtm_like("Take_1", 60.0, &p, &bad));
+    assert_err(
+        &fx,
+        &[
+            "field `Take_1.RigidBodies.Rotations`: frame 1 is not a rotation matrix",
+            "|R'R - I| = 0.00e0",
+            "det = -1.000",
+        ],
+    );
+
+    // Perturbed by 1e-6 (the Tyrex exports are within 1e-7 of orthonormal): accepted, unit,
+    // and within a few microradians of the true rotation. The standard fixture's 30 s of mocap,
+    // so that the whole run can be read too.
+    let (p, r) = frames(60 * 30, &[]);
+    let mut noisy = r.clone();
+    for (k, m) in noisy.iter_mut().enumerate() {
+        for (j, v) in m.iter_mut().enumerate() {
+            *v += 1e-6 * if (k + j) % 3 == 0 { 1.0 } else { -0.5 };
+        }
+    }
+    let fx = with_mat(qtm_like("Take_1", 60.0, &p, &noisy));
+    let track = tyrex::read_ground_truth(&fx.mat).unwrap();
+    assert_eq!(track.valid_count(), 60 * 30);
+    for (i, pose) in track.pose.iter().enumerate() {
+        let q = pose.unwrap().orientation;
+        assert!((q.quaternion().norm() - 1.0).abs() < 1e-14);
+        let truth = yaw(OMEGA * i as f64 / 60.0);
+        assert!(
+            q.angle_to(&truth) < 1e-5,
+            "frame {i}: {}",
+            q.angle_to(&truth)
+        );
+    }
+    assert_eq!(
+        tyrex::read(&fx.dir, &TyrexOptions::default())
+            .unwrap()
+            .sequences
+            .len(),
+        1
+    );
+}
+
 #[test]
 fn truncated_or_mangled_mat_is_an_error_naming_it() {
     let fx = Fixture::standard();

@@ -295,3 +295,70 @@ fn read_sequence_reads_a_single_part_tyrex_run_and_refuses_a_split_one() {
         "{err}"
     );
 }
+
+/// The measurement behind `Rot::ORTHONORMALITY_TOLERANCE`: every tracked Qualisys rotation of
+/// the 24 runs is orthonormal to single precision (largest |R'R - I| entry 9.8e-8), far inside
+/// the tolerance, and each converts to a unit quaternion.
+#[test]
+fn real_mocap_rotations_are_orthonormal_far_inside_the_tolerance() {
+    use ridi_data::ridi_frames::nalgebra::Matrix3;
+    let Some(root) = root() else { return };
+    let mut worst = (0.0f64, String::new(), 0);
+    let mut tracked = 0;
+    for dir in tyrex::list_sequences(&root).unwrap() {
+        let path = tyrex::mat_path(&dir).unwrap();
+        let m = MatFile::read(&path).unwrap();
+        let variable = tyrex::read_ground_truth(&path).unwrap().variable;
+        let rot = m
+            .lookup(&format!("{variable}.RigidBodies.Rotations"))
+            .and_then(|v| v.as_numeric())
+            .unwrap();
+        // [bodies, 9, frames], column-major: body 0 of frame i is at 9 * bodies * i + c.
+        let bodies = if rot.dims.len() == 3 { rot.dims[0] } else { 1 };
+        let frames = *rot.dims.last().unwrap();
+        for i in 0..frames {
+            let r: Vec<f64> = (0..9).map(|c| rot.real[bodies * (c + 9 * i)]).collect();
+            if !r.iter().all(|v| v.is_finite()) {
+                continue;
+            }
+            tracked += 1;
+            let r = Matrix3::from_column_slice(&r);
+            let err = (r.transpose() * r - Matrix3::identity()).abs().max();
+            if err > worst.0 {
+                worst = (err, variable.clone(), i + 1);
+            }
+            let q = WorldFromDevice::from_matrix(&r).unwrap();
+            assert!((q.quaternion().norm() - 1.0).abs() < 1e-15);
+        }
+    }
+    eprintln!(
+        "{tracked} tracked mocap rotations: largest |R'R - I| {:.2e} ({} frame {})",
+        worst.0, worst.1, worst.2
+    );
+    assert!(tracked > 150_000, "{tracked}");
+    assert!(worst.0 < 2e-7, "{worst:?}");
+    assert!(worst.0 * 1000.0 < WorldFromDevice::ORTHONORMALITY_TOLERANCE);
+}
+
+/// `read_sequence` returns the sequence and drops the reader's warnings (documented there):
+/// `tyrex::read` is the way to see them.
+#[test]
+fn read_sequence_drops_the_tyrex_warnings_that_tyrex_read_returns() {
+    let Some(root) = root() else { return };
+    let dir = root.join("datasets/android/Guillaume_Nexus5_NoDist_AR");
+    let opts = ridi_data::ReadOptions::default();
+    let seq = ridi_data::read_sequence(&dir, &opts).unwrap();
+    let read = tyrex::read(&dir, &TyrexOptions::from(&opts)).unwrap();
+    assert_eq!(read.sequences, [seq]);
+    let dropped = read
+        .warnings
+        .iter()
+        .filter(|w| w.ends_with(": dropped"))
+        .count();
+    assert_eq!(
+        (read.warnings.len(), dropped),
+        (12, 4),
+        "{:#?}",
+        read.warnings
+    );
+}

@@ -54,6 +54,23 @@ pub enum EvalError {
         /// What is wrong with it.
         reason: String,
     },
+    /// The timeline's mean sampling rate ([`crate::estimate_rate_hz`]) is more than
+    /// [`crate::RATE_TOLERANCE`] away from [`crate::EvalConfig::rate_hz`], the rate the RTE
+    /// windows are counted at: every RTE would be over windows of the wrong duration (100 Hz
+    /// data with the default 200 Hz gives windows twice as long, and about twice the RTE).
+    #[error(
+        "the timeline is sampled at {timeline_hz:.1} Hz but EvalConfig::rate_hz is {config_hz} Hz \
+         (more than {pct:.0} % apart): the RTE windows would last {ratio:.2} times their nominal \
+         seconds; set `rate_hz` to `estimate_rate_hz(times)`",
+        pct = crate::RATE_TOLERANCE * 100.0,
+        ratio = .config_hz / .timeline_hz
+    )]
+    RateMismatch {
+        /// Mean rate of the timeline, Hz: `(N − 1) / (t_{N−1} − t₀)`.
+        timeline_hz: f64,
+        /// `EvalConfig::rate_hz`, Hz.
+        config_hz: f64,
+    },
     /// A class label is not one of the declared classes.
     #[error("label {label} is not a declared class ({classes} classes)")]
     UnknownLabel {

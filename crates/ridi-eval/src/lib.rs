@@ -7,7 +7,10 @@
 //!   stretch, RIDI's 10 s by default.
 //! - [`metrics`]: MPE (m and % of path length), ATE and RTE in Euclidean and RoNIN
 //!   per-coordinate forms, short-window RTE, path length ratio, velocity MSE, placement accuracy
-//!   and confusion matrix.
+//!   and confusion matrix. RTE windows are set in seconds ([`EvalConfig`]) and counted in
+//!   frames at [`EvalConfig::rate_hz`], 200 Hz by default: [`evaluate_trajectory`] refuses a
+//!   timeline whose mean rate is more than 10 % from it ([`EvalError::RateMismatch`]); set
+//!   `rate_hz` to [`estimate_rate_hz`]`(times)` for data at another rate.
 //! - [`report`]: serde report structs (`report.json`), per-method means, markdown tables
 //!   (`report.md`).
 //! - [`pdr`]: the step-counting baseline: step detection and step-and-heading integration.
@@ -66,9 +69,10 @@ pub use align::{
 };
 pub use error::{EvalError, Result};
 pub use metrics::{
-    ConfusionMatrix, EvalConfig, TrajectoryEval, accuracy, ate, ate_ronin, estimate_rate_hz,
-    evaluate_trajectory, mean_position_error, mean_position_error_percent, path_length,
-    path_length_ratio, rte, rte_ronin, seconds_to_frames, trajectory_metrics, velocity_mse,
+    ConfusionMatrix, EvalConfig, RATE_TOLERANCE, TrajectoryEval, accuracy, ate, ate_ronin,
+    check_rate, estimate_rate_hz, evaluate_trajectory, mean_position_error,
+    mean_position_error_percent, path_length, path_length_ratio, rte, rte_ronin, seconds_to_frames,
+    trajectory_metrics, velocity_mse,
 };
 pub use pdr::{StepDetectorConfig, detect_steps, detect_steps_in_magnitude, pdr_trajectory};
 pub use report::{

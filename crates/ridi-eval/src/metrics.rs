@@ -187,6 +187,28 @@ pub fn estimate_rate_hz(times: &[f64]) -> Result<f64> {
     Ok((times.len() - 1) as f64 / span)
 }
 
+/// Checks that `times` is sampled at `config.rate_hz`, the rate [`EvalConfig`]'s RTE windows
+/// are counted at: its mean rate ([`estimate_rate_hz`]) must be within [`RATE_TOLERANCE`]
+/// (10 %) of `config.rate_hz`. Returns that mean rate.
+///
+/// [`evaluate_trajectory`] calls it; call it before [`trajectory_metrics`] when the timeline
+/// is at hand.
+///
+/// # Errors
+/// A non-positive or non-finite `config.rate_hz`, an invalid timeline (as
+/// [`estimate_rate_hz`]), or [`EvalError::RateMismatch`], which names both rates.
+pub fn check_rate(times: &[f64], config: &EvalConfig) -> Result<f64> {
+    check_positive("rate_hz", config.rate_hz)?;
+    let timeline_hz = estimate_rate_hz(times)?;
+    if (timeline_hz - config.rate_hz).abs() > RATE_TOLERANCE * config.rate_hz {
+        return Err(EvalError::RateMismatch {
+            timeline_hz,
+            config_hz: config.rate_hz,
+        });
+    }
+    Ok(timeline_hz)
+}
+
 /// Velocity mean squared error per channel, (m/s)²:
 /// `MSE_c = (1/N) Σᵢ (predᵢ,c − targetᵢ,c)²` for the two horizontal channels `c ∈ {0, 1}`.
 ///
@@ -314,18 +336,32 @@ impl ConfusionMatrix {
     }
 }
 
+/// How far the mean rate of a timeline ([`estimate_rate_hz`]) may be from
+/// [`EvalConfig::rate_hz`], as a fraction of `rate_hz`, in the functions that take both
+/// ([`evaluate_trajectory`], [`check_rate`]): 10 %, as phones' nominal rates vary by a few
+/// percent (the pipeline accepts 180-220 Hz recordings for the same reason).
+pub const RATE_TOLERANCE: f64 = 0.1;
+
 /// Settings of a per-sequence trajectory evaluation.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct EvalConfig {
     /// Initial stretch the rigid alignment is fitted on (RIDI: 10 s).
     pub align: AlignWindow,
-    /// RTE window, seconds (RoNIN: 60 s).
+    /// RTE window, seconds (RoNIN: 60 s), counted as frames at [`EvalConfig::rate_hz`].
     pub rte_window_s: f64,
-    /// Short RTE window, seconds, for local drift (5 s).
+    /// Short RTE window, seconds, for local drift (5 s), counted as frames at
+    /// [`EvalConfig::rate_hz`].
     pub short_rte_window_s: f64,
-    /// Rate used to turn the RTE windows into frame counts. RoNIN uses a nominal 200 Hz (12000
-    /// frames per minute) whatever the true rate; pass [`estimate_rate_hz`] of the timeline for
-    /// windows in true seconds.
+    /// Rate used to turn the RTE windows into frame counts ([`seconds_to_frames`]): 200 Hz by
+    /// default, RoNIN's nominal rate (12000 frames per minute).
+    ///
+    /// It must match the data. [`evaluate_trajectory`] refuses a timeline whose mean rate
+    /// ([`estimate_rate_hz`]) is more than [`RATE_TOLERANCE`] (10 %) away
+    /// ([`EvalError::RateMismatch`]): with the default, 100 Hz data would otherwise get RTE
+    /// over windows twice as long (2 min and 10 s), silently. For data at another rate set it
+    /// to `estimate_rate_hz(times)?`. [`trajectory_metrics`], which has no timeline, trusts it:
+    /// call it on an [`align_trajectory`] result to count windows in frames whatever the rate
+    /// (RoNIN's fixed 12000 frames on data that is not at 200 Hz).
     pub rate_hz: f64,
 }
 
@@ -344,6 +380,13 @@ impl Default for EvalConfig {
 /// already aligned (the alignment setting of `config` is not used).
 ///
 /// See [`TrajectoryMetrics`] for each field's formula.
+///
+/// Without a timeline this cannot check the rate: the RTE windows are
+/// `seconds_to_frames(config.rte_window_s, config.rate_hz)` and
+/// `seconds_to_frames(config.short_rte_window_s, config.rate_hz)` frames, i.e. they last the
+/// configured seconds only if the frames really are at `config.rate_hz`. Set `rate_hz` to the
+/// data's rate ([`estimate_rate_hz`]), check it with [`check_rate`], or use
+/// [`evaluate_trajectory`], which refuses a mismatch.
 ///
 /// # Errors
 /// Fewer than 2 frames, mismatched lengths, non-finite coordinates, invalid windows or rate.
@@ -382,14 +425,38 @@ pub struct TrajectoryEval {
 
 /// Aligns `est` onto `gt` over `config.align`, then computes [`trajectory_metrics`].
 ///
+/// `times` must be sampled at `config.rate_hz`, the rate the RTE windows are counted at: a
+/// mean rate ([`estimate_rate_hz`]) more than [`RATE_TOLERANCE`] (10 %) away is refused
+/// ([`check_rate`]). For data at another rate than the default 200 Hz, set
+/// `rate_hz: estimate_rate_hz(times)?`.
+///
 /// # Errors
-/// As [`crate::align::align_trajectory`] and [`trajectory_metrics`].
+/// [`EvalError::RateMismatch`] for a timeline at another rate than `config.rate_hz`, a
+/// non-positive `config.rate_hz`, a timeline of fewer than 2 frames or zero duration, and as
+/// [`crate::align::align_trajectory`] and [`trajectory_metrics`].
+///
+/// ```
+/// use ridi_eval::{EvalConfig, EvalError, estimate_rate_hz, evaluate_trajectory};
+///
+/// // 30 s at 100 Hz: the default config counts its windows at 200 Hz, and is refused.
+/// let times: Vec<f64> = (0..3000).map(|i| f64::from(i) / 100.0).collect();
+/// let gt: Vec<[f64; 2]> = times.iter().map(|&t| [t, 0.0]).collect();
+/// let est: Vec<[f64; 2]> = times.iter().map(|&t| [t, 0.01 * t]).collect();
+/// let err = evaluate_trajectory(&times, &est, &gt, &EvalConfig::default()).unwrap_err();
+/// assert!(matches!(err, EvalError::RateMismatch { .. }));
+///
+/// let config = EvalConfig { rate_hz: estimate_rate_hz(&times)?, ..EvalConfig::default() };
+/// let out = evaluate_trajectory(&times, &est, &gt, &config)?;
+/// assert!(out.metrics.rte_5s_m > 0.0);
+/// # Ok::<(), EvalError>(())
+/// ```
 pub fn evaluate_trajectory(
     times: &[f64],
     est: &[[f64; 2]],
     gt: &[[f64; 2]],
     config: &EvalConfig,
 ) -> Result<TrajectoryEval> {
+    check_rate(times, config)?;
     let (alignment, aligned) = align_trajectory(times, est, gt, config.align)?;
     let metrics = trajectory_metrics(&aligned, gt, config)?;
     Ok(TrajectoryEval {
@@ -568,6 +635,138 @@ mod tests {
         assert!(ConfusionMatrix::from_indices(&[], &[], &["a"]).is_err());
         assert!(ConfusionMatrix::from_indices(&[0], &[0], &[]).is_err());
         assert!(accuracy::<usize>(&[], &[]).is_err());
+    }
+
+    /// `n` frames at `rate` Hz; ground truth walks along x at 1 m/s and the estimate walks
+    /// `drift` m/s faster, so the displacement error over any `d` seconds is `drift · d`.
+    fn drifting_walk(n: usize, rate: f64, drift: f64) -> (Vec<f64>, Vec<[f64; 2]>, Vec<[f64; 2]>) {
+        let times: Vec<f64> = (0..n).map(|i| i as f64 / rate).collect();
+        let gt = times.iter().map(|&t| [t, 0.0]).collect();
+        let est = times.iter().map(|&t| [(1.0 + drift) * t, 0.0]).collect();
+        (times, est, gt)
+    }
+
+    #[test]
+    fn evaluate_refuses_a_timeline_at_another_rate_than_the_config() {
+        // 100 Hz data, default config (200 Hz): refused, naming both rates and the fix.
+        let (times, est, gt) = drifting_walk(4000, 100.0, 0.1);
+        let err = evaluate_trajectory(&times, &est, &gt, &EvalConfig::default()).unwrap_err();
+        match err {
+            EvalError::RateMismatch {
+                timeline_hz,
+                config_hz,
+            } => {
+                assert!(approx(timeline_hz, 100.0), "{timeline_hz}");
+                assert_eq!(config_hz, 200.0);
+            }
+            other => panic!("{other:?}"),
+        }
+        let text = err.to_string();
+        for part in [
+            "sampled at 100.0 Hz",
+            "EvalConfig::rate_hz is 200 Hz",
+            "more than 10 % apart",
+            "2.00 times their nominal",
+            "set `rate_hz` to `estimate_rate_hz(times)`",
+        ] {
+            assert!(text.contains(part), "`{part}` not in: {text}");
+        }
+
+        // The fix the message gives: 5 s windows are 500 frames, drift 0.1 m/s → 0.5 m.
+        let config = EvalConfig {
+            rate_hz: estimate_rate_hz(&times).unwrap(),
+            ..EvalConfig::default()
+        };
+        let out = evaluate_trajectory(&times, &est, &gt, &config).unwrap();
+        assert!(
+            (out.metrics.rte_5s_m - 0.5).abs() < 1e-9,
+            "{}",
+            out.metrics.rte_5s_m
+        );
+        // What the default config silently gave before: 1000-frame windows, 10 s at 100 Hz.
+        let aligned = out.aligned;
+        let wrong = trajectory_metrics(&aligned, &gt, &EvalConfig::default()).unwrap();
+        assert!((wrong.rte_5s_m - 1.0).abs() < 1e-9, "{}", wrong.rte_5s_m);
+
+        // Twice the configured rate is refused too (windows half as long).
+        let (times, est, gt) = drifting_walk(4000, 400.0, 0.1);
+        let err = evaluate_trajectory(&times, &est, &gt, &EvalConfig::default()).unwrap_err();
+        assert!(err.to_string().contains("0.50 times"), "{err}");
+    }
+
+    #[test]
+    fn rates_within_ten_percent_of_the_config_are_accepted() {
+        let config = EvalConfig::default();
+        for rate in [181.0, 195.0, 200.0, 205.3, 219.0] {
+            let (times, est, gt) = drifting_walk(3000, rate, 0.0);
+            assert!(approx(check_rate(&times, &config).unwrap(), rate), "{rate}");
+            let out = evaluate_trajectory(&times, &est, &gt, &config).unwrap();
+            assert!(out.metrics.rte_m < 1e-9, "{rate}");
+        }
+        for rate in [100.0, 179.0, 221.0, 400.0] {
+            let (times, est, gt) = drifting_walk(3000, rate, 0.0);
+            assert!(
+                matches!(
+                    check_rate(&times, &config),
+                    Err(EvalError::RateMismatch { .. })
+                ),
+                "{rate}"
+            );
+            assert!(
+                matches!(
+                    evaluate_trajectory(&times, &est, &gt, &config),
+                    Err(EvalError::RateMismatch { .. })
+                ),
+                "{rate}"
+            );
+        }
+        // The tolerance is relative to the configured rate.
+        let (times, est, gt) = drifting_walk(3000, 92.0, 0.0);
+        let at_100 = EvalConfig {
+            rate_hz: 100.0,
+            ..config
+        };
+        assert!(evaluate_trajectory(&times, &est, &gt, &at_100).is_ok());
+        assert_eq!(RATE_TOLERANCE, 0.1);
+    }
+
+    #[test]
+    fn rate_check_reports_bad_configs_and_timelines_as_such() {
+        let (times, est, gt) = drifting_walk(100, 200.0, 0.0);
+        for bad in [0.0, -200.0, f64::NAN, f64::INFINITY] {
+            let config = EvalConfig {
+                rate_hz: bad,
+                ..EvalConfig::default()
+            };
+            assert!(
+                matches!(
+                    evaluate_trajectory(&times, &est, &gt, &config),
+                    Err(EvalError::InvalidParameter {
+                        name: "rate_hz",
+                        ..
+                    })
+                ),
+                "{bad}"
+            );
+        }
+        let config = EvalConfig::default();
+        assert!(matches!(
+            evaluate_trajectory(&[], &[], &[], &config),
+            Err(EvalError::Empty { what: "times" })
+        ));
+        assert!(matches!(
+            check_rate(&[0.0], &config),
+            Err(EvalError::TooShort { .. })
+        ));
+        assert!(matches!(
+            check_rate(&[0.0, 1.0, 0.5], &config),
+            Err(EvalError::TimeDecreasing { index: 2 })
+        ));
+        // Mismatched lengths are still reported as such, after the rate check.
+        assert!(matches!(
+            evaluate_trajectory(&times, &est[..50], &gt, &config),
+            Err(EvalError::LengthMismatch { .. })
+        ));
     }
 
     #[test]

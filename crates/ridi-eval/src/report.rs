@@ -25,6 +25,10 @@ use crate::metrics::{ConfusionMatrix, EvalConfig};
 /// | `rte_ronin_m` | `rte_m / √2`: RoNIN's per-coordinate RTE |
 /// | `rte_5s_m` | Euclidean RTE over a 5 s window by default |
 /// | `path_length_ratio` | `L(est) / L(gt)`; `null` if the ground truth does not move |
+///
+/// The RTE windows are counted in frames at [`EvalConfig::rate_hz`] (60 s = 12000 frames at the
+/// default 200 Hz), so they last their nominal seconds only on data at that rate, which
+/// [`crate::evaluate_trajectory`] checks.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct TrajectoryMetrics {
     /// Mean positional error, metres.

@@ -26,11 +26,11 @@ pub enum Orientation {
     /// As recorded (RIDI: Tango or game rotation vector; Tyrex: Android rotation vector).
     #[default]
     Recorded,
-    /// Estimated from gyro and accelerometer (`ridi_frames::estimate_orientation`, default
-    /// filter), with gravity and linear acceleration derived from it: for each frame's
-    /// estimate `q`, gravity `ridi_frames::gravity_in_device(q, ridi_frames::STANDARD_GRAVITY)`
-    /// and linear acceleration the accelerometer minus that gravity (what `ridi::oriented`
-    /// and `ridi::LiveTracker` do).
+    /// Estimated from gyro and accelerometer
+    /// ([`ridi_frames::estimate_orientation`] with the default filter), gravity and linear
+    /// acceleration derived from each frame's estimate by [`ridi_frames::gravity_and_linacce`]
+    /// (what `ridi::oriented` and `ridi::LiveTracker` do). The extractor does not do it: give
+    /// it those streams.
     Estimated,
 }
 

@@ -1,7 +1,7 @@
 //! Velocity targets in the stabilized frame.
 
 use rayon::prelude::*;
-use ridi_frames::{DeviceVec, StabVec, UpAxis, WorldFromDevice, WorldVec};
+use ridi_frames::{DeviceVec, StabHorizontal, StabVec, UpAxis, WorldFromDevice, WorldVec};
 
 use crate::FeatureError;
 use crate::config::FeatureConfig;
@@ -87,7 +87,7 @@ pub struct Targets {
     /// Smoothed velocity in S at each sample frame, `[S-x, S-z]` in m/s (`f64`: targets are
     /// few, and regression and evaluation want them exact). S-x points right, S-z back:
     /// walking forward gives a negative S-z, as in the original RIDI.
-    pub values: Vec<[f64; 2]>,
+    pub values: Vec<StabHorizontal>,
     /// Smoothed velocity in S at every frame, all three components (S-y is vertical), for
     /// evaluation and plots.
     pub velocity: Vec<StabVec>,
@@ -178,10 +178,7 @@ pub fn compute_targets(
         });
     }
     let velocity = stabilized_velocity(gt, config.up_axis, config.target_sigma, config.truncate)?;
-    let values = frames
-        .iter()
-        .map(|&f| [velocity[f].x(), velocity[f].z()])
-        .collect();
+    let values = frames.iter().map(|&f| velocity[f].horizontal()).collect();
     Ok(Targets {
         frames: frames.to_vec(),
         values,

@@ -8,6 +8,8 @@
 //! (a back-pocket phone turned 100 degrees, a swinging hand turned around); turned copies teach
 //! it that the velocity turns with the signal.
 
+use ridi_frames::StabHorizontal;
+
 use crate::FeatureError;
 use crate::matrix::FeatureMatrix;
 
@@ -28,12 +30,10 @@ impl YawTurn {
         }
     }
 
-    /// Turns a horizontal vector `[S-x, S-z]` (a velocity target).
-    pub fn horizontal(&self, v: [f64; 2]) -> [f64; 2] {
-        [
-            self.cos * v[0] + self.sin * v[1],
-            -self.sin * v[0] + self.cos * v[1],
-        ]
+    /// Turns a horizontal vector in S (a velocity target).
+    pub fn horizontal(&self, v: StabHorizontal) -> StabHorizontal {
+        let [x, z] = v.to_array();
+        StabHorizontal::new(self.cos * x + self.sin * z, -self.sin * x + self.cos * z)
     }
 
     /// Turns every 3-vector `x y z` of a feature row in place (any number of channels: all
@@ -59,7 +59,7 @@ pub struct TurnedRows {
     /// The input rows, then copy 0 of every row, copy 1, ...
     pub features: FeatureMatrix,
     /// Their targets, turned with them.
-    pub targets: Vec<[f64; 2]>,
+    pub targets: Vec<StabHorizontal>,
     /// For each row, the input row it comes from (to repeat labels and groups).
     pub source: Vec<usize>,
 }
@@ -68,9 +68,13 @@ pub struct TurnedRows {
 /// `2 pi frac(i phi + j / copies)` (phi the golden ratio), so each row's copies are evenly
 /// spaced around the circle and neighbouring rows, which overlap in time, start at well spread
 /// angles. Deterministic. Fails when `targets` and `features` differ in length.
+///
+/// The rows must not be standardized yet: a per-column standardization scales S-x and S-z
+/// differently, so turning a standardized row is not standardizing a turned one. Turn first,
+/// then fit the standardization on all rows (as `ridi`'s training does).
 pub fn turned_copies(
     features: &FeatureMatrix,
-    targets: &[[f64; 2]],
+    targets: &[StabHorizontal],
     copies: usize,
 ) -> Result<TurnedRows, FeatureError> {
     if targets.len() != features.rows() {
@@ -123,7 +127,7 @@ mod tests {
 
     /// A flat phone with heading `yaw` (about world up) walking along world +y at 1 m/s, its
     /// gyro and linear acceleration given in the world and measured in the device frame.
-    fn walk(yaw: f64) -> (FeatureMatrix, Vec<[f64; 2]>) {
+    fn walk(yaw: f64) -> (FeatureMatrix, Vec<StabHorizontal>) {
         let n = 1000;
         let time: Vec<f64> = (0..n).map(|i| i as f64 / 200.0).collect();
         let q = WorldFromDevice::from_axis_angle(&Vector3::z_axis(), yaw);
@@ -183,7 +187,7 @@ mod tests {
                 assert!((a - b).abs() < 1e-5, "{a} {b}");
             }
             let v = t.horizontal(y[i]);
-            assert!((v[0] - y_turned[i][0]).abs() < 1e-5 && (v[1] - y_turned[i][1]).abs() < 1e-5);
+            assert!((v - y_turned[i]).norm() < 1e-5, "{v:?} {:?}", y_turned[i]);
         }
     }
 
@@ -200,15 +204,13 @@ mod tests {
         for r in 0..turned.rows() {
             let i = source[r];
             // Speed and the vertical channels are kept.
-            let speed = |v: [f64; 2]| v[0].hypot(v[1]);
-            assert!((speed(ty[r]) - speed(y[i])).abs() < 1e-12);
+            assert!((ty[r].norm() - y[i].norm()).abs() < 1e-12);
             for k in (1..1200).step_by(3) {
                 assert_eq!(turned.row(r)[k], x.row(i)[k]);
             }
         }
         // The two copies of one row are half a turn apart.
-        let (a, b) = (ty[3], ty[6]);
-        assert!((a[0] + b[0]).abs() < 1e-5 && (a[1] + b[1]).abs() < 1e-5);
+        assert!((ty[3] + ty[6]).norm() < 1e-5);
         assert!(turned_copies(&x, &y[..2], 1).is_err());
     }
 }

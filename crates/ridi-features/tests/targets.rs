@@ -8,7 +8,9 @@ use ridi_features::{
     stabilized_velocity,
 };
 use ridi_frames::nalgebra::Vector3;
-use ridi_frames::{DeviceVec, Rot, UpAxis, World, WorldFromDevice, WorldVec, gravity_in_device};
+use ridi_frames::{
+    DeviceVec, Rot, StabHorizontal, UpAxis, World, WorldFromDevice, WorldVec, gravity_in_device,
+};
 
 struct Walk {
     time: Vec<f64>,
@@ -103,7 +105,7 @@ fn plus_or_minus_y_gives_a_top_down_phone_the_upright_targets() {
             "{x:?} vs {y:?}"
         );
     }
-    assert!((a.values[0][0].hypot(a.values[0][1]) - v.norm()).abs() < 1e-9);
+    assert!((a.values[0].norm() - v.norm()).abs() < 1e-9);
 }
 
 #[test]
@@ -115,7 +117,7 @@ fn forward_walk_is_negative_s_z() {
     let walk = constant_walk(300, forward_w * 1.4, q);
     let t = compute_targets(&walk.view(), &FeatureConfig::default(), &[250]).unwrap();
     assert!(
-        t.values[0][0].abs() < 1e-9 && (t.values[0][1] + 1.4).abs() < 1e-9,
+        (t.values[0] - StabHorizontal::new(0.0, -1.4)).norm() < 1e-9,
         "{:?}",
         t.values
     );
@@ -213,7 +215,7 @@ fn edge_cases_and_errors() {
     assert!(t.values.is_empty() && t.velocity.is_empty());
     let one = constant_walk(1, WorldVec::new(1.0, 0.0, 0.0), q);
     let t = compute_targets(&one.view(), &config, &[0]).unwrap();
-    assert_eq!(t.values, vec![[0.0, 0.0]]);
+    assert_eq!(t.values, vec![StabHorizontal::ZERO]);
     let walk = constant_walk(50, WorldVec::new(1.0, 0.0, 0.0), q);
     assert_eq!(
         compute_targets(&walk.view(), &config, &[50]).unwrap_err(),

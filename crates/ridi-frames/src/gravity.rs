@@ -131,3 +131,32 @@ pub fn stab_from_world(orientation: WorldFromDevice, gravity: DeviceVec) -> Stab
 pub fn gravity_in_device(orientation: WorldFromDevice, magnitude: f64) -> DeviceVec {
     orientation.inverse() * (UP_W * magnitude)
 }
+
+/// Gravity (pointing up, [`STANDARD_GRAVITY`] long) and linear acceleration (accelerometer
+/// minus that gravity) of one sample, from an orientation estimated without the OS's gravity
+/// sensor ([`estimate_orientation`](crate::estimate_orientation)): what stands in for the
+/// gravity and linear acceleration streams, so that the three stay consistent.
+pub fn gravity_and_linacce(
+    orientation: WorldFromDevice,
+    acce: DeviceVec,
+) -> (DeviceVec, DeviceVec) {
+    let gravity = gravity_in_device(orientation, STANDARD_GRAVITY);
+    (gravity, acce - gravity)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use nalgebra::Vector3;
+
+    #[test]
+    fn estimated_gravity_and_linear_acceleration_add_up_to_the_accelerometer() {
+        // Tilted 0.4 rad about world x, pushed 1 m/s² along world z (up).
+        let q = WorldFromDevice::from_axis_angle(&Vector3::x_axis(), 0.4);
+        let acce = q.inverse() * crate::WorldVec::new(0.0, 0.0, STANDARD_GRAVITY + 1.0);
+        let (g, lin) = gravity_and_linacce(q, acce);
+        assert!((q * g - crate::WorldVec::new(0.0, 0.0, STANDARD_GRAVITY)).norm() < 1e-12);
+        assert!((q * lin - crate::WorldVec::new(0.0, 0.0, 1.0)).norm() < 1e-12);
+        assert!((g + lin - acce).norm() < 1e-12);
+    }
+}

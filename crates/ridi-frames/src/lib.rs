@@ -10,7 +10,9 @@
 //!   (right) and S-z (back; forward is -z).
 //!
 //! [`Vec3<F>`] is a vector in frame `F`; [`Rot<To, From>`] a rotation that maps `Vec3<From>` to
-//! `Vec3<To>`. Rotations are Hamilton unit quaternions with `v_To = q v_From q*`; the device
+//! `Vec3<To>`. [`Horizontal<F>`] is the part of a vector perpendicular to `F`'s up axis:
+//! [`StabHorizontal`] (`[S-x, S-z]`, what RIDI regresses) and [`WorldHorizontal`]
+//! (`[W-x, W-y]`). Rotations are Hamilton unit quaternions with `v_To = q v_From q*`; the device
 //! orientation is [`WorldFromDevice`]. Quaternion component order is never implicit: use
 //! [`Rot::from_wxyz`] or [`Rot::from_xyzw`] at file edges.
 //!
@@ -75,6 +77,7 @@
 pub mod estimate;
 mod frame;
 mod gravity;
+mod horizontal;
 mod rotation;
 mod vector;
 
@@ -85,8 +88,10 @@ pub use estimate::{
 };
 pub use frame::{Device, Frame, Stabilized, World};
 pub use gravity::{
-    STANDARD_GRAVITY, UP_S, UP_W, UpAxis, align_gravity, gravity_in_device, stab_from_world,
+    STANDARD_GRAVITY, UP_S, UP_W, UpAxis, align_gravity, gravity_and_linacce, gravity_in_device,
+    stab_from_world,
 };
+pub use horizontal::{Horizontal, StabHorizontal, WorldHorizontal};
 pub use rotation::{QuatError, Rot, StabFromDevice, StabFromWorld, WorldFromDevice};
 pub use vector::{DeviceVec, StabVec, Vec3, WorldVec};
 

@@ -31,28 +31,50 @@ pub type StabFromDevice = Rot<Stabilized, Device>;
 /// World to stabilized frame: `align(g) * q*`.
 pub type StabFromWorld = Rot<Stabilized, World>;
 
-/// Why a quaternion was rejected.
+/// Why a quaternion or a rotation matrix was rejected.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum QuatError {
-    /// A component is NaN or infinite.
+    /// A component of the quaternion, or an entry of the matrix ([`Rot::from_matrix`]), is NaN
+    /// or infinite.
     NotFinite,
     /// The norm is too far from 1 to be a rotation (see [`Rot::NORM_TOLERANCE`]).
     NotUnit {
         /// The norm found.
         norm: f64,
     },
+    /// A matrix given to [`Rot::from_matrix`] is not a rotation matrix: too far from
+    /// orthonormal (see [`Rot::ORTHONORMALITY_TOLERANCE`]), or of a determinant that is not
+    /// positive (a reflection, or a singular matrix).
+    NotRotation {
+        /// Largest entry of `|MᵀM − I|`, 0 for an orthonormal matrix.
+        orthonormality_error: f64,
+        /// Determinant of `M`: +1 for a rotation, −1 for a reflection.
+        determinant: f64,
+    },
 }
 
 impl fmt::Display for QuatError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {
-            QuatError::NotFinite => write!(f, "quaternion has a non-finite component"),
+            QuatError::NotFinite => write!(f, "a component is NaN or infinite"),
             QuatError::NotUnit { norm } => {
                 write!(f, "quaternion norm {norm} is not close to 1")
             }
+            QuatError::NotRotation {
+                orthonormality_error,
+                determinant,
+            } => write!(
+                f,
+                "not a rotation matrix (|R'R - I| = {orthonormality_error:.2e}, at most {:.0e} \
+                 allowed; det = {determinant:.3}, must be positive)",
+                ORTHONORMALITY_TOLERANCE
+            ),
         }
     }
 }
+
+/// See [`Rot::ORTHONORMALITY_TOLERANCE`].
+const ORTHONORMALITY_TOLERANCE: f64 = 1e-3;
 
 impl std::error::Error for QuatError {}
 
@@ -74,11 +96,66 @@ impl<To: Frame, From: Frame> Rot<To, From> {
         }
     }
 
-    /// Wraps a rotation matrix mapping `From` to `To` (columns: the `From` axes in `To`).
-    pub fn from_matrix(m: &Matrix3<f64>) -> Self {
-        Self::from_unit_quaternion(UnitQuaternion::from_rotation_matrix(
-            &Rotation3::from_matrix_unchecked(*m),
-        ))
+    /// Largest accepted entry of `|MᵀM − I|` in [`Rot::from_matrix`].
+    ///
+    /// Chosen from the only matrices read from files so far, the Qualisys motion-capture
+    /// rotations of the Tyrex benchmark (`RigidBodies.Rotations`, single-precision values):
+    /// over the 24 `Nexus5_NoDist` runs (about 171 000 tracked frames) the largest error is
+    /// 9.8e-8 (median 4.5e-8), so 1e-3 leaves four orders of magnitude for other exporters
+    /// while still refusing a wrong column, a scaled matrix or a mangled entry.
+    pub const ORTHONORMALITY_TOLERANCE: f64 = ORTHONORMALITY_TOLERANCE;
+
+    /// The rotation of a rotation matrix mapping `From` to `To` (columns: the `From` axes in
+    /// `To`).
+    ///
+    /// A matrix read from a file is orthonormal only to its precision: within
+    /// [`Rot::ORTHONORMALITY_TOLERANCE`] (largest entry of `|MᵀM − I|`) it is accepted and the
+    /// result is the *nearest* rotation (the orthonormal polar factor `U Vᵀ` of the SVD
+    /// `M = U Σ Vᵀ`, nearest in the Frobenius norm), as a normalized unit quaternion.
+    ///
+    /// # Errors
+    /// [`QuatError::NotFinite`] when an entry is NaN or infinite; [`QuatError::NotRotation`]
+    /// (with the orthonormality error and the determinant) when `M` is further than the
+    /// tolerance from orthonormal, e.g. a scaled rotation, or when its determinant is not
+    /// positive: a reflection such as `diag(−1, 1, 1)` is orthonormal but not a rotation.
+    ///
+    /// ```
+    /// use ridi_frames::nalgebra::Matrix3;
+    /// use ridi_frames::{QuatError, WorldFromDevice};
+    ///
+    /// // A quarter turn about z, as a 7-digit text file would give it.
+    /// let m = Matrix3::new(0.0, -1.0, 0.0, 1.0, 1e-7, 0.0, 0.0, 0.0, 1.0);
+    /// let q = WorldFromDevice::from_matrix(&m)?;
+    /// assert!((q.quaternion().norm() - 1.0).abs() < 1e-15);
+    ///
+    /// let reflection = Matrix3::from_diagonal(&[-1.0, 1.0, 1.0].into());
+    /// assert!(matches!(
+    ///     WorldFromDevice::from_matrix(&reflection),
+    ///     Err(QuatError::NotRotation { .. })
+    /// ));
+    /// # Ok::<(), QuatError>(())
+    /// ```
+    pub fn from_matrix(m: &Matrix3<f64>) -> Result<Self, QuatError> {
+        if !m.iter().all(|v| v.is_finite()) {
+            return Err(QuatError::NotFinite);
+        }
+        let orthonormality_error = (m.transpose() * m - Matrix3::identity()).abs().max();
+        let determinant = m.determinant();
+        // Written so that a NaN (from an overflow in a huge matrix) is refused too.
+        if !(determinant > 0.0 && orthonormality_error <= ORTHONORMALITY_TOLERANCE) {
+            return Err(QuatError::NotRotation {
+                orthonormality_error,
+                determinant,
+            });
+        }
+        // det M > 0 and M non-singular, so det(U Vᵀ) = +1: a proper rotation.
+        let svd = m.svd(true, true);
+        let (Some(u), Some(v_t)) = (svd.u, svd.v_t) else {
+            unreachable!("nalgebra computes U and Vᵀ when asked to")
+        };
+        let nearest = Rotation3::from_matrix_unchecked(u * v_t);
+        let q = UnitQuaternion::from_rotation_matrix(&nearest).into_inner();
+        Ok(Self::from_unit_quaternion(UnitQuaternion::new_normalize(q)))
     }
 
     /// Rotation by `angle` radians about `axis` (given in either frame: it is the same).
@@ -220,5 +297,97 @@ impl<'de, To: Frame, From: Frame> Deserialize<'de> for Rot<To, From> {
     fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
         let c = <[f64; 4]>::deserialize(d)?;
         Self::from_wxyz(c).map_err(serde::de::Error::custom)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn not_rotation(m: Matrix3<f64>) -> (f64, f64) {
+        match WorldFromDevice::from_matrix(&m) {
+            Err(QuatError::NotRotation {
+                orthonormality_error,
+                determinant,
+            }) => (orthonormality_error, determinant),
+            other => panic!("{m} gave {other:?}"),
+        }
+    }
+
+    #[test]
+    fn from_matrix_refuses_a_reflection() {
+        // Orthonormal, so only the determinant tells it from a rotation.
+        let (err, det) = not_rotation(Matrix3::from_diagonal(&Vector3::new(-1.0, 1.0, 1.0)));
+        assert_eq!((err, det), (0.0, -1.0));
+        // A rotation followed by a reflection, too.
+        let q = WorldFromDevice::from_scaled_axis(Vector3::new(0.3, -1.2, 2.0));
+        let (err, det) = not_rotation(-q.matrix());
+        assert!(err < 1e-12 && (det + 1.0).abs() < 1e-12, "{err} {det}");
+        let text = WorldFromDevice::from_matrix(&-q.matrix())
+            .unwrap_err()
+            .to_string();
+        assert!(
+            text.contains("not a rotation matrix") && text.contains("det = -1.000"),
+            "{text}"
+        );
+    }
+
+    #[test]
+    fn from_matrix_refuses_scaled_and_singular_matrices() {
+        // 2 I: MᵀM − I = 3 I (the unchecked conversion gave w = 1.32 here).
+        let (err, det) = not_rotation(Matrix3::identity() * 2.0);
+        assert_eq!((err, det), (3.0, 8.0));
+        // Just outside the tolerance on the diagonal: (1 + d)² − 1 ≈ 2d.
+        let d = 0.6 * Rot::<World, Device>::ORTHONORMALITY_TOLERANCE;
+        let (err, _) = not_rotation(Matrix3::identity() * (1.0 + d));
+        assert!(err > Rot::<World, Device>::ORTHONORMALITY_TOLERANCE);
+        let (_, det) = not_rotation(Matrix3::zeros());
+        assert_eq!(det, 0.0);
+        // Overflow in MᵀM must not slip through as NaN.
+        not_rotation(Matrix3::identity() * 1e200);
+        let text = WorldFromDevice::from_matrix(&(Matrix3::identity() * 2.0))
+            .unwrap_err()
+            .to_string();
+        assert!(
+            text.contains("|R'R - I| = 3.00e0") && text.contains("at most 1e-3"),
+            "{text}"
+        );
+    }
+
+    #[test]
+    fn from_matrix_refuses_non_finite_entries() {
+        for bad in [f64::NAN, f64::INFINITY, f64::NEG_INFINITY] {
+            let mut m = Matrix3::identity();
+            m[(1, 2)] = bad;
+            assert_eq!(
+                WorldFromDevice::from_matrix(&m),
+                Err(QuatError::NotFinite),
+                "{bad}"
+            );
+        }
+    }
+
+    #[test]
+    fn from_matrix_accepts_a_slightly_perturbed_rotation_as_a_unit_quaternion() {
+        let q = WorldFromDevice::from_scaled_axis(Vector3::new(-0.4, 0.9, 2.5));
+        let mut m = q.matrix();
+        let noise = [1.0, -0.5, 0.25, 0.8, -1.0, 0.3, -0.7, 0.6, 0.9];
+        for (v, n) in m.iter_mut().zip(noise) {
+            *v += 1e-6 * n;
+        }
+        let r = WorldFromDevice::from_matrix(&m).unwrap();
+        assert!((r.quaternion().norm() - 1.0).abs() < 1e-15);
+        assert!(r.angle_to(&q) < 3e-6, "{}", r.angle_to(&q));
+        // The nearest rotation: no farther from M than the rotation it was perturbed from.
+        assert!((r.matrix() - m).norm() <= (q.matrix() - m).norm() + 1e-15);
+        let back = r.matrix();
+        assert!((back.transpose() * back - Matrix3::identity()).abs().max() < 1e-15);
+        // An exact rotation comes back unchanged.
+        let exact = WorldFromDevice::from_matrix(&q.matrix()).unwrap();
+        assert!(exact.angle_to(&q) < 1e-12);
+        assert_eq!(
+            WorldFromDevice::from_matrix(&Matrix3::identity()).unwrap(),
+            WorldFromDevice::identity()
+        );
     }
 }

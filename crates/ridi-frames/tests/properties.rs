@@ -3,8 +3,8 @@
 use proptest::prelude::*;
 use ridi_frames::nalgebra::{Matrix3, Vector3};
 use ridi_frames::{
-    Device, DeviceVec, Rot, StabFromDevice, StabFromWorld, Stabilized, UP_S, UP_W, UpAxis, World,
-    WorldFromDevice, align_gravity, gravity_in_device, stab_from_world,
+    Device, DeviceVec, QuatError, Rot, StabFromDevice, StabFromWorld, Stabilized, UP_S, UP_W,
+    UpAxis, World, WorldFromDevice, align_gravity, gravity_in_device, stab_from_world,
 };
 
 fn vec3(range: f64) -> impl Strategy<Value = Vector3<f64>> {
@@ -107,8 +107,52 @@ proptest! {
         // xyzw and wxyz are permutations of one another, not the same array.
         let [w, x, y, z] = q.to_wxyz();
         prop_assert_eq!(q.to_xyzw(), [x, y, z, w]);
-        let m = WorldFromDevice::from_matrix(&q.matrix());
+        let m = WorldFromDevice::from_matrix(&q.matrix()).unwrap();
         prop_assert!(m.angle_to(&q) < 1e-12);
+    }
+
+    #[test]
+    fn nearly_orthonormal_matrices_give_the_nearest_rotation(
+        q in rotation(),
+        noise in prop::array::uniform9(-1.0..1.0f64),
+        size in 1e-9..1e-4f64,
+    ) {
+        // Within the tolerance: each entry of MᵀM − I is at most 2·√3·size + 3·size², < 1e-3.
+        let mut m = q.matrix();
+        for (v, n) in m.iter_mut().zip(noise) {
+            *v += size * n;
+        }
+        let r = WorldFromDevice::from_matrix(&m).unwrap();
+        prop_assert!((r.quaternion().norm() - 1.0).abs() < 1e-14);
+        assert_orthonormal(&r.matrix())?;
+        // Nearest rotation in the Frobenius norm: at least as near as the unperturbed one.
+        prop_assert!((r.matrix() - m).norm() <= (q.matrix() - m).norm() + 1e-14);
+        prop_assert!(r.angle_to(&q) < 6.0 * size, "{} vs {size}", r.angle_to(&q));
+    }
+
+    #[test]
+    fn reflections_and_scaled_rotations_are_refused(q in rotation(), scale in 0.0..3.0f64) {
+        let reflected = WorldFromDevice::from_matrix(&-q.matrix());
+        let refused = matches!(
+            reflected,
+            Err(QuatError::NotRotation { determinant, .. }) if determinant < -0.99
+        );
+        prop_assert!(refused, "{reflected:?}");
+        let m = Matrix3::from_diagonal(&Vector3::new(-1.0, 1.0, 1.0)) * q.matrix();
+        prop_assert!(WorldFromDevice::from_matrix(&m).is_err());
+        // s R: |MᵀM − I| = |s² − 1| on the diagonal.
+        let err = (scale * scale - 1.0).abs();
+        let result = WorldFromDevice::from_matrix(&(q.matrix() * scale));
+        if err > 1.01 * WorldFromDevice::ORTHONORMALITY_TOLERANCE {
+            let refused = matches!(
+                result,
+                Err(QuatError::NotRotation { orthonormality_error, .. })
+                    if (orthonormality_error - err).abs() < 1e-9
+            );
+            prop_assert!(refused, "{scale}: {result:?}");
+        } else if err < 0.99 * WorldFromDevice::ORTHONORMALITY_TOLERANCE {
+            prop_assert!(result.unwrap().angle_to(&q) < 1e-9);
+        }
     }
 
     #[test]

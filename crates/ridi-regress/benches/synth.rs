@@ -4,9 +4,11 @@
 //! a nonlinear function of the latent walking speed and heading, sequences are groups.
 #![allow(dead_code)]
 
+use ridi_features::ridi_frames::StabHorizontal;
+
 pub struct Synth {
     pub x: Vec<f32>,
-    pub y: Vec<[f64; 2]>,
+    pub y: Vec<StabHorizontal>,
     pub placement: Vec<usize>,
     pub group: Vec<u64>,
     pub dim: usize,
@@ -71,7 +73,7 @@ pub fn generate(n: usize, placements: usize, per_seq: usize, seed: u64) -> Synth
                     s.x.push(v as f32);
                 }
             }
-            s.y.push([speed * turn.sin(), -speed * turn.cos()]);
+            s.y.push(StabHorizontal::new(speed * turn.sin(), -speed * turn.cos()));
             s.placement.push(p);
             s.group.push(seq);
         }

@@ -217,7 +217,11 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             std::fs::create_dir_all(&dir)?;
             let bytes = |v: &[f32]| v.iter().flat_map(|f| f.to_le_bytes()).collect::<Vec<u8>>();
             std::fs::write(dir.join("x.f32"), bytes(&data.x))?;
-            let y: Vec<f32> = data.y.iter().flat_map(|v| v.map(|c| c as f32)).collect();
+            let y: Vec<f32> = data
+                .y
+                .iter()
+                .flat_map(|v| v.to_array().map(|c| c as f32))
+                .collect();
             std::fs::write(dir.join("y.f32"), bytes(&y))?;
             let lab: Vec<u8> = data
                 .placement

@@ -18,6 +18,7 @@ use std::hash::{DefaultHasher, Hash, Hasher};
 
 use rayon::prelude::*;
 use ridi_features::FeatureConfig;
+use ridi_features::ridi_frames::StabHorizontal;
 use serde::{Deserialize, Serialize};
 
 use crate::config::{self, SolverConfig};
@@ -188,7 +189,7 @@ pub struct TrainingSet<'a> {
     /// Feature matrix (`n × dim`).
     pub features: MatrixRef<'a>,
     /// Velocity targets in S (two horizontal components).
-    pub targets: &'a [[f64; 2]],
+    pub targets: &'a [StabHorizontal],
     /// Placement of each sample, an index into `placement_names`.
     pub placements: &'a [usize],
     /// Placement names; every name needs samples.
@@ -208,7 +209,7 @@ pub struct Prediction {
     /// ([`CascadeParams::speed`]) the regressed components `v` scaled by
     /// `max(s, 0) / max(|v|, 0.1 m/s)`, `s` the regressed speed: the floor keeps a direction
     /// that is barely known from being blown up.
-    pub velocity: [f64; 2],
+    pub velocity: StabHorizontal,
 }
 
 /// Below this regressed velocity (m/s) the speed channel scales by `s / SPEED_FLOOR` at most.
@@ -265,14 +266,11 @@ impl ClassModel {
     }
 
     /// The velocity from the kernel-weighted sums of the channels (before their offsets).
-    fn velocity(&self, sums: &[f64]) -> [f64; 2] {
-        let v = [sums[0] - self.reg_rho[0], sums[1] - self.reg_rho[1]];
+    fn velocity(&self, sums: &[f64]) -> StabHorizontal {
+        let v = StabHorizontal::new(sums[0] - self.reg_rho[0], sums[1] - self.reg_rho[1]);
         match &self.speed {
             None => v,
-            Some(sp) => {
-                let gain = (sums[2] - sp.rho).max(0.0) / v[0].hypot(v[1]).max(SPEED_FLOOR);
-                [v[0] * gain, v[1] * gain]
-            }
+            Some(sp) => v * ((sums[2] - sp.rho).max(0.0) / v.norm().max(SPEED_FLOOR)),
         }
     }
 }
@@ -399,11 +397,7 @@ fn check_training_set(
             data.features.dim()
         )));
     }
-    if let Some(i) = data
-        .targets
-        .iter()
-        .position(|t| !t.iter().all(|v| v.is_finite()))
-    {
+    if let Some(i) = data.targets.iter().position(|t| !t.is_finite()) {
         return Err(RegressError::NonFinite(format!("target of sample {i}")));
     }
     let k = data.placement_names.len();
@@ -498,8 +492,8 @@ impl Cascade {
             );
             let channels = 2 + usize::from(params.speed);
             let target = |i: usize, ch: usize| {
-                let [x, z] = data.targets[i];
-                if ch < 2 { [x, z][ch] } else { x.hypot(z) }
+                let t = data.targets[i];
+                if ch < 2 { t[ch] } else { t.norm() }
             };
             let targets: Vec<Vec<f64>> = (0..channels)
                 .map(|ch| idx.iter().map(|&i| target(i, ch)).collect())
@@ -627,14 +621,15 @@ impl Cascade {
 
     /// Classifies and regresses one query (the online path).
     pub fn predict_one(&self, q: &[f32]) -> Result<Prediction, RegressError> {
-        let m = MatrixRef::new(q, self.dim.max(1))?;
-        if m.rows() != 1 || q.len() != self.dim {
+        if q.len() != self.dim {
             return Err(RegressError::Shape(format!(
                 "query has {} values, model expects {}",
                 q.len(),
                 self.dim
             )));
         }
+        // Non-finite values are refused here.
+        MatrixRef::new(q, self.dim.max(1))?;
         Ok(SCRATCH.with(|s| {
             let s = &mut *s.borrow_mut();
             let Some(p) = &self.projection else {
@@ -724,7 +719,7 @@ impl Cascade {
         let mut out = vec![
             Prediction {
                 placement: placement.unwrap_or(0),
-                velocity: [0.0; 2]
+                velocity: StabHorizontal::ZERO
             };
             x.rows()
         ];
@@ -743,7 +738,7 @@ impl Cascade {
         &self,
         x: MatrixRef<'_>,
         placement: usize,
-    ) -> Result<Vec<[f64; 2]>, RegressError> {
+    ) -> Result<Vec<StabHorizontal>, RegressError> {
         self.check_dim(x)?;
         if placement >= self.classes.len() {
             return Err(RegressError::Shape(format!(

@@ -16,7 +16,8 @@
 //! 2 x_i·x_j))`, either as a full matrix computed once in parallel (when it fits in
 //! [`SolverConfig::kernel_memory`]) or as a bounded LRU row cache that computes missing rows in
 //! batches. Gradients and dual variables are `f64`, and so are targets and predictions: the
-//! `[f64; 2]` velocities of ridi-features' targets and ridi-correct's regressions, with
+//! velocities in S ([`StabHorizontal`](ridi_features::ridi_frames::StabHorizontal)) of
+//! ridi-features' targets and ridi-correct's regressions, with
 //! placements as `usize` indices into [`Cascade::placements`].
 //!
 //! # Reuse
@@ -44,12 +45,16 @@
 //! # Model files
 //!
 //! [`model_file`]: magic number, format version, CRC32, bincode 2 payload including the
-//! [`ridi_features::FeatureConfig`]; atomic writes, deterministic bytes.
+//! [`ridi_features::FeatureConfig`]; atomic writes, deterministic bytes. That configuration is
+//! how a model is used: its features must be computed with it, and its velocities are in the S
+//! its `up_axis` defines (give the same `up_axis` to a correction of them, ridi-correct's
+//! `CorrectionConfig::up_axis`).
 //!
 //! # Example
 //!
 //! ```
 //! use ridi_features::FeatureConfig;
+//! use ridi_features::ridi_frames::StabHorizontal;
 //! use ridi_regress::{Cascade, CascadeParams, MatrixRef, NoProgress, RegressorChoice, TrainingSet, model_file};
 //!
 //! // A tiny feature config: a 2-frame window of one channel gives 6 values per sample.
@@ -62,7 +67,7 @@
 //!     let p = i % 2;
 //!     let s = if p == 0 { 1.0 } else { -1.0 };
 //!     x.extend([s + t, s - t, t, 0.5 * t, s, -t]);
-//!     y.push([f64::from(t), f64::from(1.0 - t)]);
+//!     y.push(StabHorizontal::new(f64::from(t), f64::from(1.0 - t)));
 //!     placement.push(p);
 //!     group.push((i / 10) as u64);
 //! }

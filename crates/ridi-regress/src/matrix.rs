@@ -43,6 +43,9 @@ impl<'a> MatrixRef<'a> {
     }
 
     /// Rows `r0..r1` (no re-validation: the parent was validated).
+    ///
+    /// # Panics
+    /// If `r0 > r1` or `r1 > self.rows()`, as slicing would.
     pub fn rows_range(&self, r0: usize, r1: usize) -> MatrixRef<'a> {
         MatrixRef {
             data: &self.data[r0 * self.dim..r1 * self.dim],

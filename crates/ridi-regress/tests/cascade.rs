@@ -2,6 +2,7 @@
 
 mod common;
 
+use ridi_features::ridi_frames::StabHorizontal;
 use ridi_features::{FeatureChannel, FeatureConfig};
 use ridi_regress::{
     Cascade, CascadeParams, GridSpec, MatrixRef, NoProgress, ProgressEvent, RegressError,
@@ -10,7 +11,7 @@ use ridi_regress::{
 
 struct Data {
     x: Vec<f32>,
-    y: Vec<[f64; 2]>,
+    y: Vec<StabHorizontal>,
     placement: Vec<usize>,
     group: Vec<u64>,
     names: Vec<String>,
@@ -67,7 +68,8 @@ fn make_window(placements: usize, seqs: usize, per_seq: usize, seed: u64, window
                     );
                 }
                 let gain = 1.0 + p as f64 * 0.3;
-                data.y.push([gain * a, 0.5 * b * b - 0.3 * gain]);
+                data.y
+                    .push(StabHorizontal::new(gain * a, 0.5 * b * b - 0.3 * gain));
                 data.placement.push(p);
                 data.group.push((p * 100 + s) as u64);
             }
@@ -160,11 +162,18 @@ fn cascade_classifies_regresses_and_batches_consistently() {
         let forced = model
             .predict_with_placement(xt.rows_range(i, i + 1), one.placement)
             .unwrap();
-        for (f, o) in forced[0].iter().zip(&one.velocity) {
-            assert!((f - o).abs() < 1e-4);
-        }
+        assert!((forced[0] - one.velocity).norm() < 1e-4);
     }
-    assert!(model.predict_one(&test.x[..23]).is_err());
+    assert_eq!(
+        model.predict_one(&test.x[..23]).unwrap_err().to_string(),
+        RegressError::Shape("query has 23 values, model expects 24".into()).to_string()
+    );
+    let mut nan = test.x[..24].to_vec();
+    nan[5] = f32::NAN;
+    assert!(matches!(
+        model.predict_one(&nan),
+        Err(RegressError::NonFinite(_))
+    ));
 }
 
 /// The speed regressor: a third grid channel, velocities scaled to the regressed speed, the
@@ -197,19 +206,18 @@ fn speed_regressor_scales_velocities_to_the_regressed_speed() {
     let xt = MatrixRef::new(&test.x, 24).unwrap();
     let scaled = model.predict(xt).unwrap();
     let unscaled = plain.predict(xt).unwrap();
-    let speed = |v: [f64; 2]| v[0].hypot(v[1]);
     let (mut err_scaled, mut moved) = (0.0f64, 0.0f64);
     for (i, (s, u)) in scaled.iter().zip(&unscaled).enumerate() {
         assert_eq!(s.placement, u.placement);
         // Same direction as the plain model's velocity, only its size changes.
         let cross = s.velocity[0] * u.velocity[1] - s.velocity[1] * u.velocity[0];
         assert!(
-            cross.abs() < 1e-3 * speed(u.velocity).max(1.0),
+            cross.abs() < 1e-3 * u.velocity.norm().max(1.0),
             "{s:?} {u:?}"
         );
         assert!(s.velocity[0] * u.velocity[0] + s.velocity[1] * u.velocity[1] >= 0.0);
-        err_scaled = err_scaled.max((speed(s.velocity) - speed(test.y[i])).abs());
-        moved = moved.max((speed(s.velocity) - speed(u.velocity)).abs());
+        err_scaled = err_scaled.max((s.velocity.norm() - test.y[i].norm()).abs());
+        moved = moved.max((s.velocity.norm() - u.velocity.norm()).abs());
         let one = model.predict_one(xt.row(i)).unwrap();
         for ch in 0..2 {
             assert!((one.velocity[ch] - s.velocity[ch]).abs() < 1e-4);

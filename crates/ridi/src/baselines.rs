@@ -19,7 +19,7 @@ use std::str::FromStr;
 use ridi_correct::{CorrectionConfig, integrate, world_acceleration};
 use ridi_data::Sequence;
 use ridi_eval::{StepDetectorConfig, detect_steps, pdr_trajectory};
-use ridi_frames::{StabVec, UpAxis, WorldVec};
+use ridi_frames::{StabHorizontal, StabVec, UpAxis, WorldVec};
 use serde::{Deserialize, Serialize};
 
 use crate::error::{PipelineError, Result};
@@ -146,7 +146,7 @@ pub fn trajectory(
             regressions
                 .iter()
                 .map(|r| Regressed {
-                    velocity: [0.0, -r.velocity[0].hypot(r.velocity[1])],
+                    velocity: StabHorizontal::new(0.0, -r.velocity.norm()),
                     ..*r
                 })
                 .collect(),
@@ -158,11 +158,11 @@ pub fn trajectory(
                 regressions
                     .iter()
                     .map(|r| {
-                        let n = r.velocity[0].hypot(r.velocity[1]);
+                        let n = r.velocity.norm();
                         let v = if n > 1e-9 {
-                            [speed * r.velocity[0] / n, speed * r.velocity[1] / n]
+                            r.velocity * (speed / n)
                         } else {
-                            [0.0, 0.0]
+                            StabHorizontal::ZERO
                         };
                         Regressed { velocity: v, ..*r }
                     })
@@ -171,7 +171,7 @@ pub fn trajectory(
             )
         }
         Method::Raw => {
-            let acc = world_acceleration(&imu_slices(seq));
+            let acc = world_acceleration(&imu_slices(seq))?;
             let poses = integrate(seq.time(), &acc, WorldVec::ZERO, WorldVec::ZERO)?;
             Ok(poses
                 .iter()

@@ -128,6 +128,21 @@ fn evaluate_one(seq: &Sequence, model: &Cascade, opts: &EvalOptions) -> Result<E
         .ok_or_else(|| PipelineError::sequence(seq.name(), "has no ground truth to evaluate"))?;
     let gt2 = gt.horizontal();
     check_trackable(seq, model, opts.track.correction.max_dt)?;
+    // Before the work: the RTE windows are counted in frames at `rate_hz`, which a recording
+    // with many dropped frames (each gap short enough to track across) does not have.
+    if let Err(e) = ridi_eval::check_rate(seq.time(), &opts.metrics) {
+        let message = match e {
+            ridi_eval::EvalError::RateMismatch {
+                timeline_hz,
+                config_hz,
+            } => format!(
+                "averages {timeline_hz:.1} Hz (dropped frames?), but the RTE windows are counted \
+                 at {config_hz} Hz: resample it with `ridi convert --rate {config_hz}`"
+            ),
+            e => e.to_string(),
+        };
+        return Err(PipelineError::sequence(seq.name(), message));
+    }
     let regressions: Vec<Regressed> = if opts.methods.iter().any(|m| m.needs_model()) {
         regress(seq, model, &opts.track)?
     } else {
@@ -135,11 +150,12 @@ fn evaluate_one(seq: &Sequence, model: &Cascade, opts: &EvalOptions) -> Result<E
     };
     let frames: Vec<usize> = regressions.iter().map(|r| r.frame).collect();
     let targets = compute_targets(&ground_truth_view(seq)?, model.feature_config(), &frames)?;
-    let predicted: Vec<[f64; 2]> = regressions.iter().map(|r| r.velocity).collect();
+    let predicted: Vec<[f64; 2]> = regressions.iter().map(|r| r.velocity.to_array()).collect();
+    let truth: Vec<[f64; 2]> = targets.values.iter().map(|v| v.to_array()).collect();
     let vel_mse = if predicted.is_empty() {
         [f64::NAN; 2]
     } else {
-        velocity_mse(&predicted, &targets.values)?
+        velocity_mse(&predicted, &truth)?
     };
     let names: Vec<String> = regressions
         .iter()
@@ -192,7 +208,7 @@ fn evaluate_one(seq: &Sequence, model: &Cascade, opts: &EvalOptions) -> Result<E
             methods: traced,
             regression_time: frames.iter().map(|&f| seq.time()[f]).collect(),
             regressed: predicted,
-            true_velocity: targets.values,
+            true_velocity: truth,
             placements: names,
         },
     })

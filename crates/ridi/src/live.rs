@@ -18,7 +18,6 @@ use ridi_frames::{DeviceVec, FilterConfig, OrientationFilter, WorldFromDevice};
 use ridi_regress::{Cascade, MatrixRef};
 
 use crate::error::{PipelineError, Result};
-use crate::orientation::estimated_gravity_and_linacce;
 use crate::track::{Regressed, TrackOptions};
 
 /// The cascade as the streaming tracker's regressor: features of the latest window, one query.
@@ -331,7 +330,7 @@ impl<'m> LiveTracker<'m> {
         // One orientation per sample given, in order: the oldest waiting samples are known.
         let known = est.orientations.len().min(est.waiting.len());
         for (q, (time, gyro, acce)) in est.orientations.drain(..).zip(est.waiting.drain(..known)) {
-            let (gravity, linacce) = estimated_gravity_and_linacce(q, acce);
+            let (gravity, linacce) = ridi_frames::gravity_and_linacce(q, acce);
             out.push(self.tracker.push(&Sample {
                 time,
                 gyro,

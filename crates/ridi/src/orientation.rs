@@ -10,10 +10,7 @@
 use std::borrow::Cow;
 
 use ridi_data::{OrientationSource, Sequence};
-use ridi_frames::{
-    DeviceVec, FilterConfig, STANDARD_GRAVITY, WorldFromDevice, estimate_orientation,
-    gravity_in_device,
-};
+use ridi_frames::{FilterConfig, estimate_orientation, gravity_and_linacce};
 
 use crate::error::{PipelineError, Result};
 
@@ -32,21 +29,11 @@ pub fn with_estimated_orientation(seq: &Sequence, filter: &FilterConfig) -> Resu
     (p.gravity, p.linacce) = q
         .iter()
         .zip(&p.acce)
-        .map(|(&q, &a)| estimated_gravity_and_linacce(q, a))
+        .map(|(&q, &a)| gravity_and_linacce(q, a))
         .unzip();
     p.orientation = q;
     p.orientation_source = Some(OrientationSource::Estimated);
     Sequence::new(p).map_err(|e| PipelineError::sequence(seq.name(), e.to_string()))
-}
-
-/// Gravity (standard magnitude, the estimate's up direction) and linear acceleration
-/// (accelerometer minus that gravity) of one sample with an estimated orientation `q`.
-pub(crate) fn estimated_gravity_and_linacce(
-    q: WorldFromDevice,
-    acce: DeviceVec,
-) -> (DeviceVec, DeviceVec) {
-    let gravity = gravity_in_device(q, STANDARD_GRAVITY);
-    (gravity, acce - gravity)
 }
 
 /// `seq` with the orientation `choice` asks for: `seq` itself when it has it already (a recorded
@@ -93,6 +80,7 @@ pub fn apply_orientation(choice: Orientation, seqs: &mut [Sequence]) -> Result<(
 mod tests {
     use super::*;
     use ridi_data::{ReadOptions, load_list};
+    use ridi_frames::{STANDARD_GRAVITY, gravity_in_device};
 
     #[test]
     fn estimate_replaces_orientation_gravity_and_linear_acceleration_consistently() {

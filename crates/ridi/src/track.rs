@@ -5,7 +5,7 @@ use std::path::Path;
 use ridi_correct::{CorrectionConfig, PlacementSmoother, VelocityTarget, correct};
 use ridi_data::{RoundTrip, Sequence, write_atomically};
 use ridi_features::{FeatureConfig, FeatureExtractor, Orientation, SampleSchedule};
-use ridi_frames::{DeviceVec, WorldVec};
+use ridi_frames::{DeviceVec, StabHorizontal, WorldVec};
 use ridi_regress::{Cascade, MatrixRef};
 use serde::{Deserialize, Serialize};
 
@@ -63,7 +63,7 @@ pub struct Regressed {
     /// Placement index into the model's placement names.
     pub placement: usize,
     /// Velocity `[S-x, S-z]`, m/s.
-    pub velocity: [f64; 2],
+    pub velocity: StabHorizontal,
 }
 
 /// A tracked sequence: one pose per frame, plus what produced it.

@@ -8,7 +8,7 @@ use ridi_features::{
     FeatureConfig, FeatureExtractor, FeatureMatrix, GroundTruthView, ImuView, SampleSchedule,
     Standardization, compute_targets,
 };
-use ridi_frames::UpAxis;
+use ridi_frames::{StabHorizontal, UpAxis};
 use ridi_regress::{
     Cascade, CascadeParams, GridSpec, MatrixRef, Progress, RegressorChoice, TrainingSet,
 };
@@ -101,7 +101,7 @@ pub struct TrainingData {
     /// Features (`n x dim`), not standardized.
     pub features: FeatureMatrix,
     /// Targets `[S-x, S-z]`, m/s.
-    pub targets: Vec<[f64; 2]>,
+    pub targets: Vec<StabHorizontal>,
     /// Placement index of each sample into `placement_names`.
     pub placements: Vec<usize>,
     /// Placement names, sorted.
@@ -173,7 +173,7 @@ pub fn training_data(seqs: &[Sequence], config: &FeatureConfig) -> Result<Traini
     let names: Vec<String> = names.into_iter().map(str::to_string).collect();
     let schedule = SampleSchedule::training(&config)?;
     let fx = FeatureExtractor::new(config.clone())?;
-    let per_seq: Vec<(FeatureMatrix, Vec<[f64; 2]>)> = seqs
+    let per_seq: Vec<(FeatureMatrix, Vec<StabHorizontal>)> = seqs
         .par_iter()
         .map(|s| {
             check_frames(s, &config)?;

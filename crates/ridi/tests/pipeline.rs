@@ -152,27 +152,7 @@ fn train_track_and_evaluate_on_the_sample() {
 
     // A gap the readers accept (0.2 s) but double integration does not: named where it is,
     // for batch and streaming tracks and for evaluation.
-    let mut parts = test[0].clone().into_parts();
-    fn cut<T>(v: &mut Vec<T>) {
-        v.drain(1000..1040);
-    }
-    cut(&mut parts.time);
-    cut(&mut parts.gyro);
-    cut(&mut parts.acce);
-    cut(&mut parts.linacce);
-    cut(&mut parts.gravity);
-    cut(&mut parts.orientation);
-    if let Some(m) = parts.magnet.as_mut() {
-        cut(m);
-    }
-    if let Some(gt) = parts.ground_truth.as_mut() {
-        cut(&mut gt.position);
-        cut(&mut gt.orientation);
-    }
-    if let Some(steps) = parts.steps.as_mut() {
-        cut(steps);
-    }
-    let gappy = Sequence::new(parts).unwrap();
+    let gappy = without_frames(&test[0], |i| (1000..1040).contains(&i));
     for online in [false, true] {
         let opts = TrackOptions {
             online,
@@ -189,6 +169,18 @@ fn train_track_and_evaluate_on_the_sample() {
         .unwrap_err()
         .to_string();
     assert!(err.contains("a gap of 0.205 s"), "{err}");
+    // Every ninth frame dropped: each gap is short enough to track across, but the RTE
+    // windows, counted in frames at 200 Hz, would not last 5 s and 1 min.
+    let holey = without_frames(&test[0], |i| i % 9 == 4);
+    let err = ridi::evaluate(&[holey], &model, &EvalOptions::default())
+        .unwrap_err()
+        .to_string();
+    assert!(
+        err.contains(test[0].name())
+            && err.contains("averages 177.8 Hz (dropped frames?)")
+            && err.contains("ridi convert --rate 200"),
+        "{err}"
+    );
 
     // Plots of one sequence.
     let files = traces[0].plot(dir.path(), "svg").unwrap();
@@ -732,4 +724,33 @@ fn a_shorter_feature_window_is_the_models_own() {
         .unwrap_err()
         .to_string();
     assert!(err.contains("feature window of 100 frames"), "{err}");
+}
+
+/// `seq` without the frames `drop` picks, in every per-frame stream.
+fn without_frames(seq: &Sequence, drop: impl Fn(usize) -> bool) -> Sequence {
+    fn keep<T>(v: &mut Vec<T>, drop: &dyn Fn(usize) -> bool) {
+        let mut i = 0;
+        v.retain(|_| {
+            i += 1;
+            !drop(i - 1)
+        });
+    }
+    let mut parts = seq.clone().into_parts();
+    keep(&mut parts.time, &drop);
+    keep(&mut parts.gyro, &drop);
+    keep(&mut parts.acce, &drop);
+    keep(&mut parts.linacce, &drop);
+    keep(&mut parts.gravity, &drop);
+    keep(&mut parts.orientation, &drop);
+    if let Some(m) = parts.magnet.as_mut() {
+        keep(m, &drop);
+    }
+    if let Some(gt) = parts.ground_truth.as_mut() {
+        keep(&mut gt.position, &drop);
+        keep(&mut gt.orientation, &drop);
+    }
+    if let Some(steps) = parts.steps.as_mut() {
+        keep(steps, &drop);
+    }
+    Sequence::new(parts).unwrap()
 }

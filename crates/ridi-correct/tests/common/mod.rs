@@ -70,10 +70,7 @@ pub fn walk(n: usize, spacing: usize, v0: WorldVec, jitter: bool) -> Walk {
             )
         })
         .collect();
-    let curve = ridi_correct::BiasCurve {
-        knots: knots.clone(),
-        values: bias_knots.clone(),
-    };
+    let curve = ridi_correct::BiasCurve::new(knots.clone(), bias_knots.clone()).unwrap();
     let bias: Vec<DeviceVec> = (0..n).map(|f| curve.at(f, time[f])).collect();
     let linacce: Vec<DeviceVec> = (0..n)
         .map(|f| orientation[f].inverse() * acc_true[f] - bias[f])
@@ -118,7 +115,7 @@ impl Walk {
             * self.poses_true[frame].velocity;
         VelocityTarget {
             frame,
-            velocity: [vs.x(), vs.z()],
+            velocity: vs.horizontal(),
         }
     }
 
