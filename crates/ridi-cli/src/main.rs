@@ -544,14 +544,16 @@ fn run(cli: Cli) -> Result<()> {
             // Both outputs are written in full before either replaces a file: the trajectory
             // under a temporary name beside it, then the plot (itself written through a
             // temporary file), then the trajectory renamed into place. A failed write leaves
-            // both as they were.
+            // both as they were; only a failed rename, after the plot's, would not.
             let staged = tempfile::Builder::new()
                 .prefix(".ridi-track-")
                 .suffix(".csv")
                 .tempfile_in(folder_of(&out))
                 .with_context(|| format!("cannot write {}", out.display()))?
                 .into_temp_path();
-            track.write_csv(&staged)?;
+            track
+                .write_csv(&staged)
+                .with_context(|| format!("cannot write {}", out.display()))?;
             if let Some(plot) = &plot {
                 plot_track(seq, &track, plot)?;
             }
@@ -1126,6 +1128,11 @@ fn demo(out: &Path, data: Option<PathBuf>, grid: Grid, plots: Plots) -> Result<(
     );
     let mut opts = TrainOptions::default();
     opts.cascade.regressors = GridChoice::from(grid).regressors();
+    // A held-out run that cannot be evaluated fails before the training, not after it.
+    for seq in &test.seqs {
+        ridi::evaluate::check_evaluable(seq, &opts.features, &EvalOptions::default())
+            .map_err(|e| test.locate(e.into()))?;
+    }
     let started = std::time::Instant::now();
     let model = train_with_progress(&train.seqs, &opts).map_err(|e| train.locate(e))?;
     outln!("trained in {:.1} s", started.elapsed().as_secs_f64());

@@ -927,7 +927,7 @@ fn demo_writes_model_reports_and_plots_all_or_nothing() {
             .is_file()
     );
 
-    // A held-out recording too short to track fails the demo at its list line, after
+    // A held-out recording too short to track fails the demo at its list line, before
     // training, and the earlier demo's files stay as they were (none added, no staging left).
     let seq = ridi::data::read_sequence(
         sample().join("Jakob_Nexus5_NoDist_Swinging"),
@@ -946,6 +946,10 @@ fn demo_writes_model_reports_and_plots_all_or_nothing() {
     assert!(
         !run.status.success() && err.contains("list_test.txt:2: sequence `short`: has 150 frames"),
         "{err}"
+    );
+    assert!(
+        !String::from_utf8_lossy(&run.stdout).contains("trained"),
+        "trained first"
     );
     let after: Vec<_> = std::fs::read_dir(&out)
         .unwrap()

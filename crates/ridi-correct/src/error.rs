@@ -74,6 +74,14 @@ pub enum CorrectError {
     /// A configuration value is out of its domain.
     #[error("invalid configuration: {0}")]
     InvalidConfig(&'static str),
+    /// A bias curve with another number of values than knots.
+    #[error("a bias curve needs one value per knot: {knots} knots, {values} values")]
+    BiasLength {
+        /// Number of knots.
+        knots: usize,
+        /// Number of values.
+        values: usize,
+    },
     /// Stored knots that [`Knots::new`](crate::Knots::new) cannot have made.
     #[error("invalid knots: {0}")]
     InvalidKnots(&'static str),

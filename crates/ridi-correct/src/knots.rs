@@ -39,8 +39,11 @@ impl TryFrom<KnotParts> for Knots {
         }
         let n = p.frames.len();
         // Frames 0, s, 2s, ... and possibly a final knot after the last multiple of s.
-        let regular = |i: usize| p.frames[i] == i * p.spacing;
-        let last_ok = n < 2 || regular(n - 1) || p.frames[n - 1] < (n - 1) * p.spacing;
+        let at = |i: usize| i.checked_mul(p.spacing);
+        let regular = |i: usize| at(i) == Some(p.frames[i]);
+        let last_ok = n == 0
+            || regular(n - 1)
+            || (n >= 2 && at(n - 1).is_none_or(|next| p.frames[n - 1] < next));
         if !(0..n.saturating_sub(1)).all(regular)
             || !last_ok
             || p.frames.windows(2).any(|w| w[1] <= w[0])
@@ -60,7 +63,9 @@ impl TryFrom<KnotParts> for Knots {
 
 impl Knots {
     /// Knots for the frames of `time` every `spacing` frames. `spacing` is clamped to at
-    /// least 1; an empty `time` gives no knot.
+    /// least 1; an empty `time` gives no knot. `time` should increase strictly, as every
+    /// correction input's does (checked there): knots at other times are refused when read
+    /// back (deserialized).
     pub fn new(time: &[f64], spacing: usize) -> Self {
         let spacing = spacing.max(1);
         let n = time.len();
@@ -155,10 +160,9 @@ impl BiasCurve {
     /// The curve with `values[k]` at knot `k`: one finite value per knot.
     pub fn new(knots: Knots, values: Vec<DeviceVec>) -> Result<Self, CorrectError> {
         if values.len() != knots.len() {
-            return Err(CorrectError::LengthMismatch {
-                what: "bias values (one per knot)",
-                expected: knots.len(),
-                got: values.len(),
+            return Err(CorrectError::BiasLength {
+                knots: knots.len(),
+                values: values.len(),
             });
         }
         if let Some(k) = values.iter().position(|v| !v.is_finite()) {
@@ -242,10 +246,9 @@ mod tests {
         // One value per knot, finite.
         assert_eq!(
             BiasCurve::new(knots.clone(), vec![DeviceVec::ZERO]),
-            Err(CorrectError::LengthMismatch {
-                what: "bias values (one per knot)",
-                expected: 2,
-                got: 1
+            Err(CorrectError::BiasLength {
+                knots: 2,
+                values: 1
             })
         );
         let nan = vec![DeviceVec::ZERO, DeviceVec::new(f64::NAN, 0.0, 0.0)];
@@ -256,6 +259,20 @@ mod tests {
                 frame: 10
             })
         );
+    }
+
+    #[test]
+    fn every_knots_new_reads_back_and_a_lone_knot_must_be_frame_0() {
+        for n in 0..30 {
+            let time: Vec<f64> = (0..n).map(|i| f64::from(i) * 0.005).collect();
+            for spacing in 1..8 {
+                let k = Knots::new(&time, spacing);
+                let json = serde_json::to_string(&k).unwrap();
+                assert_eq!(serde_json::from_str::<Knots>(&json).unwrap(), k, "{json}");
+            }
+        }
+        let lone = r#"{"spacing":5,"frames":[7],"times":[0.0]}"#;
+        assert!(serde_json::from_str::<Knots>(lone).is_err());
     }
 
     #[test]
@@ -271,12 +288,14 @@ mod tests {
             ("[0,5,10,11]", "[0,5,10,17]"),
             ("[0.0,2.5,5.0,5.5]", "[0.0,2.5,5.5,5.0]"),
             ("[0.0,0.0,0.0],[0.0,0.0,0.0]]", "[0.0,0.0,0.0]]"),
+            ("\"spacing\":5", "\"spacing\":9223372036854775808"),
         ] {
             assert!(json.contains(from), "{json}");
             let bad = json.replacen(from, to, 1);
             let e = serde_json::from_str::<BiasCurve>(&bad).unwrap_err();
             assert!(
-                e.to_string().contains("invalid knots") || e.to_string().contains("bias values"),
+                e.to_string().contains("invalid knots")
+                    || e.to_string().contains("one value per knot"),
                 "{bad}: {e}"
             );
         }

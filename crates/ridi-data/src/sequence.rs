@@ -374,10 +374,10 @@ impl Validation {
         let Some(later) = (1..n).find(|&i| too_fast(step_speed(i))) else {
             return Ok(());
         };
-        // A step has two ends; name the frame that disagrees with its other neighbour too (a
-        // one-frame spike), or frame 0 when everything after it agrees.
-        let back_too = later + 1 < n && too_fast(step_speed(later + 1));
-        let index = if later == 1 && !back_too { 0 } else { later };
+        // A step has two ends: the later one starts a spike or a shift, unless the step is the
+        // first and no later step is too fast, when frame 0 alone disagrees with the rest.
+        let first_only = later == 1 && !(2..n).any(|i| too_fast(step_speed(i)));
+        let index = if first_only { 0 } else { later };
         let step = (position[later] - position[later - 1]).to_array();
         let axis = (0..3)
             .max_by(|&a, &b| step[a].abs().total_cmp(&step[b].abs()))
@@ -562,8 +562,7 @@ pub enum SequenceError {
     /// Time does not strictly increase.
     #[error("time does not increase at frame {index}: {previous} s then {next} s")]
     TimeNotIncreasing {
-        /// 0-based index of the suspect frame: the middle of a one-frame spike, frame 0 when
-        /// only the first step is too fast, otherwise the later frame of the first such step.
+        /// 0-based index of the later frame.
         index: usize,
         /// Time of the earlier frame.
         previous: f64,
@@ -687,8 +686,9 @@ pub enum SequenceError {
         jump(*distance, *dt, *max)
     )]
     GroundTruthJump {
-        /// 0-based index of the suspect frame: the middle of a one-frame spike, frame 0 when
-        /// only the first step is too fast, otherwise the later frame of the first such step.
+        /// 0-based index of the suspect frame: the later frame of the first step too fast,
+        /// except frame 0 when that step is the first and every later step is fine (frame 0
+        /// alone disagrees with the rest).
         index: usize,
         /// The axis that moves most: 0 (x), 1 (y) or 2 (z).
         axis: usize,
@@ -1214,12 +1214,21 @@ mod tests {
             "`ground_truth.position.x` at frame 30: jumps 999997.677 m in 0.005 s (2e8 m/s): \
              faster than any pedestrian (speed <= 100 m/s), a corrupt position?"
         );
-        // A spike on the first frame is reported there, not on frame 1.
+        // A spike on the first frame is reported there, not on frame 1; a two-frame glitch
+        // from frame 1 on frame 1.
         let mut first = walk.clone();
         first[0] = WorldVec::new(999_999.0, 0.1, 1.2);
         let e = v.check_speed(&time, &first).unwrap_err();
         assert!(
             matches!(e, SequenceError::GroundTruthJump { index: 0, .. }),
+            "{e:?}"
+        );
+        let mut second = walk.clone();
+        second[1] = WorldVec::new(999_999.0, 0.1, 1.2);
+        second[2] = WorldVec::new(999_999.0, 0.1, 1.2);
+        let e = v.check_speed(&time, &second).unwrap_err();
+        assert!(
+            matches!(e, SequenceError::GroundTruthJump { index: 1, .. }),
             "{e:?}"
         );
         // A lasting shift from frame 30 on is reported at frame 30.

@@ -313,7 +313,7 @@ fn real_mocap_rotations_are_orthonormal_far_inside_the_tolerance() {
             .lookup(&format!("{variable}.RigidBodies.Rotations"))
             .and_then(|v| v.as_numeric())
             .unwrap();
-        // [bodies, 9, frames], column-major: body 0 of frame i is at 9 * bodies * i + c.
+        // [bodies, 9, frames], column-major: entry c of body 0 in frame i is at bodies * (c + 9 i).
         let bodies = if rot.dims.len() == 3 { rot.dims[0] } else { 1 };
         let frames = *rot.dims.last().unwrap();
         for i in 0..frames {

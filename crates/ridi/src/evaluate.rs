@@ -18,14 +18,14 @@ use ridi_eval::{
     ConfusionMatrix, EvalConfig, MethodMetrics, Metric, SequenceReport, TrajectoryMetrics,
     evaluate_trajectory, markdown_confusion, markdown_metric_table, summarize, velocity_mse,
 };
-use ridi_features::compute_targets;
+use ridi_features::{FeatureConfig, compute_targets};
 use ridi_regress::Cascade;
 use serde::Serialize;
 
 use crate::baselines::{Method, trajectory};
 use crate::error::{PipelineError, Result};
 use crate::orientation::oriented;
-use crate::track::{Regressed, TrackOptions, check_trackable, regress};
+use crate::track::{Regressed, TrackOptions, check_frames, check_gaps, regress};
 use crate::train::ground_truth_view;
 
 /// What to evaluate and how.
@@ -127,22 +127,6 @@ fn evaluate_one(seq: &Sequence, model: &Cascade, opts: &EvalOptions) -> Result<E
         .ground_truth()
         .ok_or_else(|| PipelineError::sequence(seq.name(), "has no ground truth to evaluate"))?;
     let gt2 = gt.horizontal();
-    check_trackable(seq, model, opts.track.correction.max_dt)?;
-    // Before the work: the RTE windows are counted in frames at `rate_hz`, which a recording
-    // with many dropped frames (each gap short enough to track across) does not have.
-    if let Err(e) = ridi_eval::check_rate(seq.time(), &opts.metrics) {
-        let message = match e {
-            ridi_eval::EvalError::RateMismatch {
-                timeline_hz,
-                config_hz,
-            } => format!(
-                "averages {timeline_hz:.1} Hz (dropped frames?), but the RTE windows are counted \
-                 at {config_hz} Hz: resample it with `ridi convert --rate {config_hz}`"
-            ),
-            e => e.to_string(),
-        };
-        return Err(PipelineError::sequence(seq.name(), message));
-    }
     let regressions: Vec<Regressed> = if opts.methods.iter().any(|m| m.needs_model()) {
         regress(seq, model, &opts.track)?
     } else {
@@ -235,6 +219,38 @@ pub fn placement_warnings(seqs: &[Sequence], model: &Cascade) -> Vec<String> {
         .collect()
 }
 
+/// Refuses a sequence [`evaluate`] cannot evaluate with a model of feature configuration
+/// `config`: as tracking does (a gap longer than the correction's `max_dt`, a median rate
+/// outside 200 Hz ± 10 %, no whole feature window), and frames that do not average
+/// `opts.metrics.rate_hz` ± 10 %, at which the RTE windows are counted (many dropped frames,
+/// each gap short enough to track across). [`evaluate`] checks every sequence first; call it
+/// to check test sequences before training their model.
+pub fn check_evaluable(seq: &Sequence, config: &FeatureConfig, opts: &EvalOptions) -> Result<()> {
+    check_gaps(seq, opts.track.correction.max_dt)?;
+    check_frames(seq, config)?;
+    match ridi_eval::check_rate(seq.time(), &opts.metrics) {
+        Ok(_) => Ok(()),
+        Err(ridi_eval::EvalError::RateMismatch {
+            timeline_hz,
+            config_hz,
+        }) => {
+            let cause = if timeline_hz < config_hz {
+                "dropped frames?"
+            } else {
+                "extra frames?"
+            };
+            Err(PipelineError::sequence(
+                seq.name(),
+                format!(
+                    "averages {timeline_hz:.1} Hz ({cause}), but the RTE windows are counted at \
+                     {config_hz} Hz: resample it with `ridi convert --rate {config_hz}`"
+                ),
+            ))
+        }
+        Err(e) => Err(PipelineError::sequence(seq.name(), e.to_string())),
+    }
+}
+
 /// Evaluates every method of `opts` on every sequence (ground truth required), in parallel.
 /// Returns the report (with [`placement_warnings`] in its `warnings` when a method uses the
 /// model) and the traces for plots, in sequence order. No sequence is an error.
@@ -245,6 +261,10 @@ pub fn evaluate(
 ) -> Result<(Report, Vec<Traces>)> {
     if seqs.is_empty() {
         return Err(PipelineError::NoSequences("evaluate"));
+    }
+    // Every sequence before any work: a bad one fails in a second, not after the others.
+    for s in seqs {
+        check_evaluable(s, model.feature_config(), opts)?;
     }
     let done: Vec<Evaluated> = seqs
         .par_iter()

@@ -224,7 +224,7 @@ pub fn correct_with(
 /// it is. Readers accept gaps up to a second (features and training live with them); double
 /// integration does not. Called once per sequence by [`track`] and the evaluation, before
 /// the corrections (which would refuse the gap too, by frame only).
-fn check_gaps(seq: &Sequence, max_dt: f64) -> Result<()> {
+pub(crate) fn check_gaps(seq: &Sequence, max_dt: f64) -> Result<()> {
     let t = seq.time();
     match t.windows(2).position(|w| w[1] - w[0] > max_dt) {
         None => Ok(()),
@@ -286,7 +286,7 @@ pub(crate) fn check_frames(seq: &Sequence, config: &FeatureConfig) -> Result<()>
 }
 
 /// [`check_gaps`] and [`check_frames`]: what tracking and evaluation need of a sequence.
-pub(crate) fn check_trackable(seq: &Sequence, model: &Cascade, max_dt: f64) -> Result<()> {
+fn check_trackable(seq: &Sequence, model: &Cascade, max_dt: f64) -> Result<()> {
     check_gaps(seq, max_dt)?;
     check_frames(seq, model.feature_config())
 }
