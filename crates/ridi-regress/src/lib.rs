@@ -93,6 +93,12 @@
 //! assert_eq!(model_file::from_bytes(&bytes)?, model);
 //! # Ok::<(), ridi_regress::RegressError>(())
 //! ```
+//!
+//! # Features
+//!
+//! `linfa` (on by default): [`linfa_impl`], linfa's `Fit` and `Predict` for [`Svr`] and
+//! [`Svc`], and the `linfa` and `ndarray` versions it is built against. Without it
+//! (`default-features = false`) the crate depends on neither.
 
 pub(crate) mod cache;
 pub mod cascade;
@@ -102,6 +108,7 @@ pub(crate) mod expansion;
 pub(crate) mod f16mat;
 pub mod grid;
 pub mod kernel;
+#[cfg(feature = "linfa")]
 pub mod linfa_impl;
 pub mod matrix;
 pub mod model_file;
@@ -128,4 +135,5 @@ pub use smo::SmoSettings;
 pub use svc::{Svc, SvcParams};
 pub use svr::{FitInfo, Svr, SvrParams};
 /// The versions the [`linfa_impl`] adapters are built against.
+#[cfg(feature = "linfa")]
 pub use {linfa, ndarray};
