@@ -182,8 +182,9 @@ pub fn regress(seq: &Sequence, model: &Cascade, opts: &TrackOptions) -> Result<V
     Ok(out)
 }
 
-/// The inputs of a correction of `seq`.
-pub(crate) fn imu_slices(seq: &Sequence) -> ridi_correct::ImuSlices<'_> {
+/// The inputs of a correction of `seq` (its time, linear acceleration, orientation and gravity),
+/// for a correction with other regressions ([`ridi_correct::Corrector`]).
+pub fn imu_slices(seq: &Sequence) -> ridi_correct::ImuSlices<'_> {
     ridi_correct::ImuSlices {
         time: seq.time(),
         linacce: seq.linacce(),
