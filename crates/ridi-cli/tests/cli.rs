@@ -941,15 +941,19 @@ fn demo_writes_model_reports_and_plots_all_or_nothing() {
         .unwrap()
         .map(|e| e.unwrap().path())
         .collect();
-    let run = demo();
-    let err = stderr(&run);
-    assert!(
-        !run.status.success() && err.contains("list_test.txt:2: sequence `short`: has 150 frames"),
-        "{err}"
-    );
-    assert!(
-        !String::from_utf8_lossy(&run.stdout).contains("trained"),
-        "trained first"
+    // Failed, saying each of `says`, without training first.
+    let fails_before_training = |run: std::process::Output, says: &[&str]| {
+        let err = stderr(&run);
+        assert!(
+            !run.status.success() && says.iter().all(|s| err.contains(s)),
+            "{err}"
+        );
+        let out = String::from_utf8_lossy(&run.stdout);
+        assert!(!out.contains("trained"), "trained first: {out}");
+    };
+    fails_before_training(
+        demo(),
+        &["list_test.txt:2: sequence `short`: has 150 frames"],
     );
     let after: Vec<_> = std::fs::read_dir(&out)
         .unwrap()
@@ -966,32 +970,19 @@ fn demo_writes_model_reports_and_plots_all_or_nothing() {
         "--out",
         s(&out.join("report.json/x")),
     ]);
-    let err = stderr(&run);
-    assert!(
-        !run.status.success() && err.contains("cannot write into"),
-        "{err}"
-    );
-    assert!(
-        !String::from_utf8_lossy(&run.stdout).contains("trained"),
-        "trained first"
-    );
+    fails_before_training(run, &["cannot write into"]);
     // A held-out recording that is also a training one is refused before training.
     std::fs::write(
         data.join("list_test.txt"),
         line("Guillaume_Nexus5_NoDist_Swinging", "Swinging"),
     )
     .unwrap();
-    let run = demo();
-    let err = stderr(&run);
-    assert!(
-        !run.status.success()
-            && err.contains("list_test.txt:1: field `path`")
-            && err.contains("already listed at")
-            && err.contains("list_train.txt:2"),
-        "{err}"
-    );
-    assert!(
-        !String::from_utf8_lossy(&run.stdout).contains("trained"),
-        "trained first"
+    fails_before_training(
+        demo(),
+        &[
+            "list_test.txt:1: field `path`",
+            "already listed at",
+            "list_train.txt:2",
+        ],
     );
 }

@@ -25,7 +25,7 @@ use serde::Serialize;
 use crate::baselines::{Method, trajectory};
 use crate::error::{PipelineError, Result};
 use crate::orientation::oriented;
-use crate::track::{Regressed, TrackOptions, check_frames, check_gaps, regress};
+use crate::track::{Regressed, TrackOptions, check_trackable, regress};
 use crate::train::ground_truth_view;
 
 /// What to evaluate and how.
@@ -226,8 +226,7 @@ pub fn placement_warnings(seqs: &[Sequence], model: &Cascade) -> Vec<String> {
 /// each gap short enough to track across). [`evaluate`] checks every sequence first; call it
 /// to check test sequences before training their model.
 pub fn check_evaluable(seq: &Sequence, config: &FeatureConfig, opts: &EvalOptions) -> Result<()> {
-    check_gaps(seq, opts.track.correction.max_dt)?;
-    check_frames(seq, config)?;
+    check_trackable(seq, config, opts.track.correction.max_dt)?;
     match ridi_eval::check_rate(seq.time(), &opts.metrics) {
         Ok(_) => Ok(()),
         Err(ridi_eval::EvalError::RateMismatch {

@@ -225,7 +225,7 @@ pub fn correct_with(
 /// it is. Readers accept gaps up to a second (features and training live with them); double
 /// integration does not. Called once per sequence by [`track`] and the evaluation, before
 /// the corrections (which would refuse the gap too, by frame only).
-pub(crate) fn check_gaps(seq: &Sequence, max_dt: f64) -> Result<()> {
+fn check_gaps(seq: &Sequence, max_dt: f64) -> Result<()> {
     let t = seq.time();
     match t.windows(2).position(|w| w[1] - w[0] > max_dt) {
         None => Ok(()),
@@ -287,9 +287,9 @@ pub(crate) fn check_frames(seq: &Sequence, config: &FeatureConfig) -> Result<()>
 }
 
 /// [`check_gaps`] and [`check_frames`]: what tracking and evaluation need of a sequence.
-fn check_trackable(seq: &Sequence, model: &Cascade, max_dt: f64) -> Result<()> {
+pub(crate) fn check_trackable(seq: &Sequence, config: &FeatureConfig, max_dt: f64) -> Result<()> {
     check_gaps(seq, max_dt)?;
-    check_frames(seq, model.feature_config())
+    check_frames(seq, config)
 }
 
 /// Tracks `seq` with `model`, in the orientation the model was trained with ([`oriented`]).
@@ -298,7 +298,7 @@ fn check_trackable(seq: &Sequence, model: &Cascade, max_dt: f64) -> Result<()> {
 /// Besides the stages' own: a sequence at another rate than [`RATE_HZ`] (± [`RATE_TOLERANCE`]),
 /// shorter than one feature window, or with a gap longer than the correction's `max_dt`.
 pub fn track(seq: &Sequence, model: &Cascade, opts: &TrackOptions) -> Result<Track> {
-    check_trackable(seq, model, opts.correction.max_dt)?;
+    check_trackable(seq, model.feature_config(), opts.correction.max_dt)?;
     if opts.online {
         // The live tracker estimates an estimated orientation on the stream itself; a
         // recorded one must still be there.
