@@ -546,14 +546,14 @@ fn convert_train_track_and_eval() {
     let twice = dir.path().join("twice.txt");
     let same = dir.path().join("same.txt");
     let short_list = dir.path().join("short.txt");
-    for name in ["a", "b"] {
+    // Two recordings of one name (copies of one recording would be refused as such).
+    for (name, from) in [
+        ("a", &test_seq),
+        ("b", &sample().join("Jakob_Nexus5_NoDist_Phoning")),
+    ] {
         let run = dir.path().join(name).join("run/processed");
         std::fs::create_dir_all(&run).unwrap();
-        std::fs::copy(
-            test_seq.join("processed/data.csv.gz"),
-            run.join("data.csv.gz"),
-        )
-        .unwrap();
+        std::fs::copy(from.join("processed/data.csv.gz"), run.join("data.csv.gz")).unwrap();
     }
     std::fs::write(
         &twice,

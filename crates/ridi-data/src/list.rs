@@ -102,11 +102,12 @@ pub fn load_list(path: impl AsRef<Path>, opts: &ReadOptions) -> Result<Vec<Seque
 /// placement is the entry's when it gives one.
 ///
 /// A recording listed twice is refused, also through two paths (a folder and its
-/// `processed/data.csv`, a symbolic link): it would count twice in every mean, and sit on both
-/// sides of a cross-validation split.
+/// `processed/data.csv`, a symbolic link) and, once read, as two files of the same data (a
+/// copy in another folder, the same recording converted to another format): it would count
+/// twice in every mean, and sit on both sides of a cross-validation split.
 pub fn load_entries(entries: &[ListEntry], opts: &ReadOptions) -> Result<Vec<Sequence>> {
     check_entries(entries)?;
-    entries
+    let seqs: Vec<Sequence> = entries
         .iter()
         .map(|e| {
             let mut seq = read_sequence(&e.path, opts)?;
@@ -115,7 +116,35 @@ pub fn load_entries(entries: &[ListEntry], opts: &ReadOptions) -> Result<Vec<Seq
             }
             Ok(seq)
         })
-        .collect()
+        .collect::<Result<_>>()?;
+    for (i, (seq, e)) in seqs.iter().zip(entries).enumerate() {
+        if let Some(j) = seqs[..i].iter().position(|s| same_data(s, seq)) {
+            return Err(DataError::format(
+                e.location().with_field("path"),
+                format!(
+                    "sequence `{}` holds the same recording as `{}`, listed at {}:{} (the same \
+                     timestamps, gyro and accelerometer samples); a recording listed twice would \
+                     count twice, or be tested on after training on it",
+                    e.path.display(),
+                    entries[j].path.display(),
+                    entries[j].list.display(),
+                    entries[j].line
+                ),
+            ));
+        }
+    }
+    Ok(seqs)
+}
+
+/// Whether two sequences are one recording: the same timestamps, gyro and accelerometer
+/// samples, every one of them (compared only when the frame counts and first timestamps agree,
+/// which for phone clocks counting nanoseconds from boot already means a copy).
+fn same_data(a: &Sequence, b: &Sequence) -> bool {
+    a.len() == b.len()
+        && a.time().first() == b.time().first()
+        && a.time() == b.time()
+        && a.gyro() == b.gyro()
+        && a.acce() == b.acce()
 }
 
 /// The checks [`load_entries`] makes before reading anything: every listed path exists and no

@@ -504,7 +504,8 @@ fn dataset() -> tempfile::TempDir {
     .unwrap();
     std::fs::create_dir_all(root.join("plain_seq")).unwrap();
     write_ridi_plain(
-        &sample_sequence("plain_seq", 50, true, false),
+        // Another length: the same samples would be the same recording (`load_entries`).
+        &sample_sequence("plain_seq", 60, true, false),
         root.join("plain_seq/data_plain.txt"),
     )
     .unwrap();
@@ -676,6 +677,48 @@ fn lists_refuse_a_recording_listed_twice_also_through_another_path() {
         e.to_string().contains("other.txt:1: field `path`") && e.to_string().contains("list.txt:1"),
         "{e}"
     );
+    // A copy in another folder, and the same recording written in the plain format, are the
+    // same data; another recording is not.
+    let seq = ridi_data::read_sequence(root.join("csv_seq"), &opts()).unwrap();
+    std::fs::create_dir_all(root.join("copy/processed")).unwrap();
+    std::fs::copy(
+        root.join("csv_seq/processed/data.csv"),
+        root.join("copy/processed/data.csv"),
+    )
+    .unwrap();
+    std::fs::create_dir_all(root.join("as_plain")).unwrap();
+    write_ridi_plain(&seq, root.join("as_plain/data_plain.txt")).unwrap();
+    for copy in ["copy", "as_plain"] {
+        std::fs::write(
+            &list,
+            format!(
+                "csv_seq,handheld
+plain_seq,bag
+{copy},body
+"
+            ),
+        )
+        .unwrap();
+        assert_err(
+            load_list(&list, &opts()),
+            &[
+                &format!(
+                    "list.txt:3: field `path`: sequence `{}",
+                    root.join(copy).display()
+                ),
+                "holds the same recording as",
+                "list.txt:1",
+            ],
+        );
+    }
+    std::fs::write(
+        &list,
+        "csv_seq,handheld
+plain_seq,bag
+",
+    )
+    .unwrap();
+    assert_eq!(load_list(&list, &opts()).unwrap().len(), 2);
 }
 
 // ---- writer ------------------------------------------------------------------------------

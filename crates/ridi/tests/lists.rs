@@ -106,7 +106,8 @@ fn a_label_from_the_source_is_checked_at_its_list_line_too() {
     let dir = tempfile::tempdir().unwrap();
     let run = dir.path().join("Jakob_Nexus5_NoDist_Hovering");
     std::fs::create_dir_all(run.join("processed")).unwrap();
-    let mut s = read_sequence(seq("Jakob_Nexus5_NoDist_Texting"), &ReadOptions::default()).unwrap();
+    // Another recording than the listed one (a copy of it would be refused as such).
+    let mut s = read_sequence(seq("Jakob_Nexus5_NoDist_Phoning"), &ReadOptions::default()).unwrap();
     s.set_placement(None);
     write_ridi_csv(&s, run.join("processed/data.csv")).unwrap();
     let l = list(
