@@ -137,14 +137,10 @@ pub fn load_entries(entries: &[ListEntry], opts: &ReadOptions) -> Result<Vec<Seq
 }
 
 /// Whether two sequences are one recording: the same timestamps, gyro and accelerometer
-/// samples, every one of them (compared only when the frame counts and first timestamps agree,
-/// which for phone clocks counting nanoseconds from boot already means a copy).
+/// samples, every one of them. Slice comparison stops at the first difference, so two
+/// recordings cost a length and a timestamp compare (phone clocks count nanoseconds from boot).
 fn same_data(a: &Sequence, b: &Sequence) -> bool {
-    a.len() == b.len()
-        && a.time().first() == b.time().first()
-        && a.time() == b.time()
-        && a.gyro() == b.gyro()
-        && a.acce() == b.acce()
+    a.time() == b.time() && a.gyro() == b.gyro() && a.acce() == b.acce()
 }
 
 /// The checks [`load_entries`] makes before reading anything: every listed path exists and no
