@@ -5,6 +5,7 @@ use anyhow::Result;
 use clap::{Args, Parser, Subcommand};
 
 mod bench;
+mod bootstrap;
 mod eval_orientation;
 mod eval_tyrex;
 mod sample;
