@@ -1120,6 +1120,8 @@ fn demo(out: &Path, data: Option<PathBuf>, grid: Grid, plots: Plots) -> Result<(
     ridi::data::check_entries(&[train_entries.as_slice(), &test_entries].concat())?;
     let train = load_listed(train_entries, map, Purpose::Training)?;
     let test = load_listed(test_entries, map, Purpose::Evaluation)?;
+    // Also not as a copy in another folder or format (the paths above differ).
+    ridi::data::check_distinct((&train.seqs, &train.entries), (&test.seqs, &test.entries))?;
     outln!(
         "demo: training on {} sequences ({:.0} s), testing on {} held-out sequences",
         train.seqs.len(),

@@ -985,4 +985,22 @@ fn demo_writes_model_reports_and_plots_all_or_nothing() {
             "list_train.txt:2",
         ],
     );
+    // So is a copy of one in another folder.
+    let copy = data.join("copy/processed");
+    std::fs::create_dir_all(&copy).unwrap();
+    let swinging = ridi::data::read_sequence(
+        sample().join("Guillaume_Nexus5_NoDist_Swinging"),
+        &Default::default(),
+    )
+    .unwrap();
+    ridi::data::write_ridi_csv(&swinging, copy.join("data.csv")).unwrap();
+    std::fs::write(data.join("list_test.txt"), "copy,Swinging\n").unwrap();
+    fails_before_training(
+        demo(),
+        &[
+            "list_test.txt:1: field `path`",
+            "holds the same recording as",
+            "list_train.txt:2",
+        ],
+    );
 }

@@ -82,7 +82,9 @@ mod write;
 
 pub use detect::{Format, detect, read_sequence, source_files};
 pub use error::{DataError, Location, Result};
-pub use list::{ListEntry, check_entries, load_entries, load_list, parse_list, read_list};
+pub use list::{
+    ListEntry, check_distinct, check_entries, load_entries, load_list, parse_list, read_list,
+};
 pub use options::ReadOptions;
 pub use ridi_frames;
 pub use sequence::{

@@ -119,21 +119,48 @@ pub fn load_entries(entries: &[ListEntry], opts: &ReadOptions) -> Result<Vec<Seq
         .collect::<Result<_>>()?;
     for (i, (seq, e)) in seqs.iter().zip(entries).enumerate() {
         if let Some(j) = seqs[..i].iter().position(|s| same_data(s, seq)) {
-            return Err(DataError::format(
-                e.location().with_field("path"),
-                format!(
-                    "sequence `{}` holds the same recording as `{}`, listed at {}:{} (the same \
-                     timestamps, gyro and accelerometer samples); a recording listed twice would \
-                     count twice, or be tested on after training on it",
-                    e.path.display(),
-                    entries[j].path.display(),
-                    entries[j].list.display(),
-                    entries[j].line
-                ),
-            ));
+            return Err(copy_error(e, &entries[j]));
         }
     }
     Ok(seqs)
+}
+
+/// Refuses a sequence of `later` that holds the same recording as one of `earlier` (each a
+/// list's sequences with their entries, as [`load_entries`] returns them for its entries): the
+/// check [`load_entries`] makes within its entries, across two lists loaded apart, such as a
+/// training and a test list, where a copy in another folder or format passes
+/// [`check_entries`]. The error names the later entry's list line and the earlier one's.
+pub fn check_distinct(
+    earlier: (&[Sequence], &[ListEntry]),
+    later: (&[Sequence], &[ListEntry]),
+) -> Result<()> {
+    for (seq, e) in later.0.iter().zip(later.1) {
+        if let Some((_, first)) = earlier
+            .0
+            .iter()
+            .zip(earlier.1)
+            .find(|(s, _)| same_data(s, seq))
+        {
+            return Err(copy_error(e, first));
+        }
+    }
+    Ok(())
+}
+
+/// `e` lists the recording that `first` listed already.
+fn copy_error(e: &ListEntry, first: &ListEntry) -> DataError {
+    DataError::format(
+        e.location().with_field("path"),
+        format!(
+            "sequence `{}` holds the same recording as `{}`, listed at {}:{} (the same \
+             timestamps, gyro and accelerometer samples); a recording listed twice would \
+             count twice, or be tested on after training on it",
+            e.path.display(),
+            first.path.display(),
+            first.list.display(),
+            first.line
+        ),
+    )
 }
 
 /// Whether two sequences are one recording: the same timestamps, gyro and accelerometer

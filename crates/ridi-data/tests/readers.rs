@@ -719,6 +719,40 @@ plain_seq,bag
     )
     .unwrap();
     assert_eq!(load_list(&list, &opts()).unwrap().len(), 2);
+
+    // Across two lists loaded apart (training and test): a copy on the second is named at its
+    // line with the first list's line; distinct recordings pass.
+    let test = root.join("test.txt");
+    std::fs::write(&test, "plain_seq,bag\nas_plain,body\n").unwrap();
+    let train_entries = ridi_data::read_list(&list).unwrap();
+    let test_entries = ridi_data::read_list(&test).unwrap();
+    let train = ridi_data::load_entries(&train_entries, &opts()).unwrap();
+    let held_out = ridi_data::load_entries(&test_entries, &opts()).unwrap();
+    let e = ridi_data::check_distinct((&train, &train_entries), (&held_out, &test_entries))
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("test.txt:1: field `path`")
+            && e.contains("plain_seq")
+            && e.contains("holds the same recording as")
+            && e.contains("list.txt:2"),
+        "{e}"
+    );
+    let e = ridi_data::check_distinct(
+        (&train, &train_entries),
+        (&held_out[1..], &test_entries[1..]),
+    )
+    .unwrap_err()
+    .to_string();
+    assert!(
+        e.contains("test.txt:2: field `path`") && e.contains("list.txt:1"),
+        "{e}"
+    );
+    ridi_data::check_distinct(
+        (&train[1..], &train_entries[1..]),
+        (&held_out[1..], &test_entries[1..]),
+    )
+    .unwrap();
 }
 
 // ---- writer ------------------------------------------------------------------------------
