@@ -7,9 +7,7 @@
 //! features, gamma 1/1200, C = 10, epsilon = 0.01, the Android rotation vector as orientation,
 //! each window's own placement label, start at rest). Variants that differ only at test time
 //! share their trained models. RTE 5 s means come with 95 % intervals over the runs, and each
-//! variant's difference from ridi's defaults with its own ([`crate::bootstrap`]): three
-//! people's runs resolve differences in it only from about 0.1-0.2 m on under the 10-s
-//! alignment.
+//! variant's difference from ridi's defaults with its own ([`crate::bootstrap`]).
 
 use std::collections::BTreeMap;
 use std::fmt::Write as _;
@@ -543,7 +541,10 @@ fn resolution(md: &mut String, rows: &[(Variant, Row)]) {
          the sequences of three people is uncertain. 95 % intervals from a bootstrap over the \
          runs ({} resamples of whole runs, a run's parts together, fixed seed): of each \
          variant's mean, and of its difference from ridi's defaults on the same runs. A \
-         difference whose interval holds 0 is one the protocol cannot tell from none; bold: one it resolves.\n",
+         difference whose interval holds 0 is one the protocol cannot tell from none; bold: one it resolves. \
+         The runs are drawn as if independent, though a person's runs share that person and one \
+         model: the intervals hold for these three people, not for others; and with two \
+         differences per variant, about one in twenty would leave out 0 by chance alone.\n",
         bootstrap::DRAWS
     );
     let _ = writeln!(
@@ -941,35 +942,39 @@ mod tests {
         assert!((m[0] - m[2]).abs() < 1e-12 && (m[3] - 2.0 * m[2]).abs() < 1e-12);
         assert_eq!((m[4], m[5]), (1.0, 1.0));
     }
+
     #[test]
     fn resolution_pairs_each_variant_with_the_defaults() {
+        // Six runs of two parts each.
+        let names: Vec<String> = (0..12)
+            .map(|i| format!("P{}_Run{}_part{}", i / 4, i / 2, 1 + i % 2))
+            .collect();
         let rows_of = |shift: f64| -> Vec<SeqRow> {
-            (0..12)
-                .map(|i| {
-                    let name = format!("P{}_Run{}_part{}", i % 3, i / 2, 1 + i % 2);
-                    let mut s = seq(&name, 100, 1.0 + 0.3 * (i % 4) as f64 + shift);
+            names
+                .iter()
+                .enumerate()
+                .map(|(i, name)| {
+                    let mut s = seq(name, 100, 1.0 + 0.3 * (i % 4) as f64 + shift);
                     s.rte_5s_whole = 0.8 + 0.3 * (i % 4) as f64;
                     s
                 })
                 .collect()
         };
-        let row = |shift| Row {
-            per_sequence: rows_of(shift),
+        let row = |per_sequence| Row {
+            per_sequence,
             ..Row::default()
         };
+        let renamed = {
+            let mut r = rows_of(0.0);
+            r[5].result.name = "P1_Other".into();
+            r
+        };
+        let variant = |name| Variant { name, ..DEFAULTS };
         let rows = vec![
-            (PAPER, row(0.25)),
-            (DEFAULTS, row(0.0)),
-            (
-                Variant {
-                    name: "another test set",
-                    ..DEFAULTS
-                },
-                Row {
-                    per_sequence: rows_of(0.0)[1..].to_vec(),
-                    ..Row::default()
-                },
-            ),
+            (PAPER, row(rows_of(0.25))),
+            (DEFAULTS, row(rows_of(0.0))),
+            (variant("fewer sequences"), row(rows_of(0.0)[1..].to_vec())),
+            (variant("one renamed"), row(renamed)),
         ];
         let mut md = String::new();
         resolution(&mut md, &rows);
@@ -984,13 +989,30 @@ mod tests {
         let paper = line(PAPER.name);
         assert!(paper.contains("**+0.250 [+0.250, +0.250]**"), "{paper}");
         assert!(paper.ends_with("| +0.000 [+0.000, +0.000] |"), "{paper}");
-        // The defaults are the reference; a variant on other sequences is not paired.
+        // A mean's interval resamples runs, the parts of a run together.
+        let runs: Vec<&str> = names.iter().map(|n| run_of(n)).collect();
+        assert_eq!(runs[2], "P0_Run1");
+        let values: Vec<f64> = (0..12).map(|i| 1.0 + 0.3 * (i % 4) as f64).collect();
+        let by_run = bootstrap::mean_interval(&values, &runs).unwrap();
+        let by_part = bootstrap::mean_interval(
+            &values,
+            &names.iter().map(String::as_str).collect::<Vec<_>>(),
+        )
+        .unwrap();
+        assert_ne!(by_run, by_part);
         let defaults = line(DEFAULTS.name);
+        assert!(
+            defaults.starts_with(&format!(
+                "| {} | {} |",
+                DEFAULTS.name,
+                interval_cell(Some(by_run), false)
+            )),
+            "{defaults}"
+        );
+        // The defaults are the reference; variants on other sequences are not paired.
         assert_eq!(defaults.matches("| - ").count(), 2, "{defaults}");
-        assert!(defaults.contains("| 1.450 ["), "{defaults}");
-        assert_eq!(line("another test set").matches("| - ").count(), 2);
-        // Runs, not parts, are resampled.
-        assert_eq!(run_of("P0_Run3_part2"), "P0_Run3");
+        assert_eq!(line("fewer sequences").matches("| - ").count(), 2);
+        assert_eq!(line("one renamed").matches("| - ").count(), 2);
         assert_eq!(run_of("C_partial"), "C_partial");
     }
 }

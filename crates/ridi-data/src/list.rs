@@ -130,10 +130,14 @@ pub fn load_entries(entries: &[ListEntry], opts: &ReadOptions) -> Result<Vec<Seq
 /// check [`load_entries`] makes within its entries, across two lists loaded apart, such as a
 /// training and a test list, where a copy in another folder or format passes
 /// [`check_entries`]. The error names the later entry's list line and the earlier one's.
+///
+/// Each pair holds as many sequences as entries (debug builds assert it).
 pub fn check_distinct(
     earlier: (&[Sequence], &[ListEntry]),
     later: (&[Sequence], &[ListEntry]),
 ) -> Result<()> {
+    debug_assert_eq!(earlier.0.len(), earlier.1.len(), "one entry per sequence");
+    debug_assert_eq!(later.0.len(), later.1.len(), "one entry per sequence");
     for (seq, e) in later.0.iter().zip(later.1) {
         if let Some((_, first)) = earlier
             .0
