@@ -299,8 +299,13 @@ pub struct Evaluation {
 /// ground truth. `progress` receives one line per run.
 pub fn evaluate(data: &Path, mut progress: impl FnMut(&str)) -> Result<Evaluation> {
     let data = &xtask::tyrex_root(Some(data.to_path_buf()))?;
-    let dirs = tyrex::list_sequences(data)
-        .with_context(|| format!("listing Tyrex runs in {}", data.display()))?;
+    // The protocol's runs: the 24 Nexus 5 runs without magnetic disturbance.
+    let dirs: Vec<_> = tyrex::list_sequences(data)
+        .with_context(|| format!("listing Tyrex runs in {}", data.display()))?
+        .runs
+        .into_iter()
+        .filter(|d| d.to_string_lossy().contains("_Nexus5_NoDist_"))
+        .collect();
     let configs = configs();
     let default_only = &configs[..1];
     let opts = TyrexOptions {

@@ -328,7 +328,7 @@ struct Row {
 
 fn load(data: &Path) -> Result<Vec<Sequence>> {
     let mut seqs = Vec::new();
-    for dir in tyrex::list_sequences(data)? {
+    for dir in tyrex::list_sequences(data)?.runs {
         let name = dir.file_name().unwrap_or_default().to_string_lossy();
         if name.contains("_Nexus5_NoDist_") {
             seqs.extend(tyrex::read(&dir, &TyrexOptions::default())?.sequences);

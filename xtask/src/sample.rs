@@ -31,7 +31,7 @@ struct Entry {
 /// Builds the sample from the Tyrex root `data` into `out` (replacing its sequence folders and
 /// lists; other files such as the licence are left alone).
 pub fn build(data: &Path, out: &Path) -> Result<()> {
-    let runs = tyrex::list_sequences(data)?;
+    let runs = tyrex::list_sequences(data)?.runs;
     let mut lines: Vec<Entry> = Vec::new();
     std::fs::create_dir_all(out).with_context(|| format!("creating {}", out.display()))?;
     for dir in runs {

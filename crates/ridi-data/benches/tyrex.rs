@@ -36,7 +36,12 @@ fn bench(c: &mut Criterion) {
     g.bench_function("read_one", |b| {
         b.iter(|| black_box(tyrex::read(&dir, &opts).unwrap()))
     });
-    let dirs = tyrex::list_sequences(&root).unwrap();
+    let dirs: Vec<_> = tyrex::list_sequences(&root)
+        .unwrap()
+        .runs
+        .into_iter()
+        .filter(|d| d.to_string_lossy().contains("_Nexus5_NoDist_"))
+        .collect();
     g.sample_size(10);
     g.bench_function("read_all_24", |b| {
         b.iter(|| {

@@ -88,8 +88,9 @@ pub use list::{
 pub use options::ReadOptions;
 pub use ridi_frames;
 pub use sequence::{
-    Channel, GYRO_SCALE_MIN_RATE, GroundTruth, LINACCE_SCALE_MIN_RMS, OrientationSource, Sequence,
-    SequenceError, SequenceParts, Validation,
+    Channel, GYRO_SCALE_MIN_RATE, GroundTruth, LINACCE_SCALE_MIN_RMS, ORIENTATION_JUMP_RATE,
+    OrientationJump, OrientationSource, Sequence, SequenceError, SequenceParts, Validation,
+    orientation_jumps,
 };
 pub use write::{
     Precision, RoundTrip, write_atomically, write_ridi_csv, write_ridi_csv_with, write_ridi_plain,

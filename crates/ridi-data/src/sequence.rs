@@ -410,7 +410,9 @@ impl Validation {
     /// Checks the gyro against the rotation rate of `orientation` over `time` with
     /// [`Self::gyro_scale_range`]; passes when the orientation hardly turns
     /// ([`GYRO_SCALE_MIN_RATE`]). Magnitudes only, so that an orientation given for another
-    /// device frame than the gyro's still compares.
+    /// device frame than the gyro's still compares. Steps inside an [`orientation_jumps`]
+    /// stretch are left out of the fit: a few frames of an OS orientation turning at hundreds
+    /// of rad/s would otherwise outweigh thousands that agree.
     pub fn check_gyro_scale(
         &self,
         time: &[f64],
@@ -418,14 +420,10 @@ impl Validation {
         orientation: &[WorldFromDevice],
     ) -> Result<(), SequenceError> {
         let (mut gw, mut ww, mut n) = (0.0, 0.0, 0usize);
-        for k in 1..time.len().min(gyro.len()).min(orientation.len()) {
-            let dt = time[k] - time[k - 1];
-            if dt <= 0.0 {
+        for (_, _, w, g) in step_rates(time, gyro, orientation) {
+            if w - g > ORIENTATION_JUMP_RATE {
                 continue;
             }
-            let w = orientation[k - 1].angle_to(&orientation[k]) / dt;
-            // The rate between two frames is the mean of their gyro readings.
-            let g = ((*gyro[k - 1].vector() + *gyro[k].vector()) * 0.5).norm();
             gw += g * w;
             ww += w * w;
             n += 1;
@@ -471,6 +469,109 @@ impl Validation {
             Err(SequenceError::LinacceScale { scale, min, max })
         }
     }
+}
+
+/// How much faster than the gyro the orientation may turn between two frames, rad/s, before
+/// the step belongs to an orientation jump (see [`orientation_jumps`]). Where the orientation
+/// is right the two agree within 2 rad/s in every clean Tyrex run (hand swinging and running
+/// included); the OS orientation's magnetic corrections and resets turn at 5-460 rad/s while
+/// the gyro reads under 2.
+pub const ORIENTATION_JUMP_RATE: f64 = 5.0;
+
+/// Steps closer than this, seconds, belong to one [`OrientationJump`]: a rotation vector that
+/// updates slower than the timeline shows one correction as several bursts.
+const JUMP_JOIN_S: f64 = 0.1;
+
+/// A stretch where the orientation turns much faster than the gyro: the OS orientation
+/// (Android's rotation vector, Core Motion's attitude) corrected its heading against the
+/// magnetometer or reset, which the phone itself never did.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct OrientationJump {
+    /// Frames `start..end` (the frame before the first fast step to the last frame of it).
+    pub frames: (usize, usize),
+    /// Time of the first and the last of those frames, seconds.
+    pub time: (f64, f64),
+    /// The fastest the orientation turns in it, rad/s.
+    pub peak_rate: f64,
+    /// The angle the orientation turns in it beyond the gyro's, radians (summed over steps).
+    pub excess_angle: f64,
+}
+
+/// Per step `k - 1 -> k`: `k`, the time step, the orientation's rotation rate and the gyro's
+/// (the mean of the two readings), rad/s; steps whose time does not increase are skipped.
+fn step_rates<'a>(
+    time: &'a [f64],
+    gyro: &'a [DeviceVec],
+    orientation: &'a [WorldFromDevice],
+) -> impl Iterator<Item = (usize, f64, f64, f64)> + 'a {
+    let n = time.len().min(gyro.len()).min(orientation.len());
+    (1..n).filter_map(move |k| {
+        let dt = time[k] - time[k - 1];
+        (dt > 0.0).then(|| {
+            let w = orientation[k - 1].angle_to(&orientation[k]) / dt;
+            let g = ((*gyro[k - 1].vector() + *gyro[k].vector()) * 0.5).norm();
+            (k, dt, w, g)
+        })
+    })
+}
+
+/// The stretches where `orientation` turns more than [`ORIENTATION_JUMP_RATE`] faster than
+/// `gyro` (magnitudes, so the two may be given in different device frames), in time order;
+/// steps less than 0.1 s apart are one jump. What [`Validation::check_gyro_scale`] leaves out,
+/// and what readers report as a warning.
+pub fn orientation_jumps(
+    time: &[f64],
+    gyro: &[DeviceVec],
+    orientation: &[WorldFromDevice],
+) -> Vec<OrientationJump> {
+    let mut out: Vec<OrientationJump> = Vec::new();
+    for (k, dt, w, g) in step_rates(time, gyro, orientation) {
+        if w - g <= ORIENTATION_JUMP_RATE {
+            continue;
+        }
+        let excess = (w - g) * dt;
+        match out.last_mut() {
+            Some(j) if time[k - 1] - j.time.1 <= JUMP_JOIN_S => {
+                j.frames.1 = k;
+                j.time.1 = time[k];
+                j.peak_rate = j.peak_rate.max(w);
+                j.excess_angle += excess;
+            }
+            _ => out.push(OrientationJump {
+                frames: (k - 1, k),
+                time: (time[k - 1], time[k]),
+                peak_rate: w,
+                excess_angle: excess,
+            }),
+        }
+    }
+    out
+}
+
+/// One line for a reader's warnings about `jumps` in the orientation read from `file`:
+/// how many, where (the first few), how fast; `None` without jumps.
+pub(crate) fn orientation_jump_warning(file: &str, jumps: &[OrientationJump]) -> Option<String> {
+    const SHOWN: usize = 5;
+    let peak = jumps.iter().map(|j| j.peak_rate).fold(0.0, f64::max);
+    let frames: usize = jumps.iter().map(|j| j.frames.1 - j.frames.0).sum();
+    let mut at: Vec<String> = jumps
+        .iter()
+        .take(SHOWN)
+        .map(|j| format!("{:.2}-{:.2} s", j.time.0, j.time.1))
+        .collect();
+    if jumps.len() > SHOWN {
+        at.push(format!("and {} more", jumps.len() - SHOWN));
+    }
+    (!jumps.is_empty()).then(|| {
+        format!(
+            "{file}: the orientation jumps {} time(s) ({frames} frame steps turning at up to {} \
+             rad/s, more than {ORIENTATION_JUMP_RATE} rad/s faster than the gyro) at {} (phone \
+             clock): OS heading corrections or resets, left out of the gyro check",
+            jumps.len(),
+            short(peak),
+            at.join(", ")
+        )
+    })
 }
 
 /// Smallest RMS rotation rate of the orientation, rad/s, at which
@@ -924,6 +1025,10 @@ impl Sequence {
     pub fn orientation(&self) -> &[WorldFromDevice] {
         &self.parts.orientation
     }
+    /// Where the orientation jumps against the gyro ([`orientation_jumps`]).
+    pub fn orientation_jumps(&self) -> Vec<OrientationJump> {
+        orientation_jumps(&self.parts.time, &self.parts.gyro, &self.parts.orientation)
+    }
     /// Where the device orientation comes from.
     pub fn orientation_source(&self) -> Option<OrientationSource> {
         self.parts.orientation_source
@@ -1123,6 +1228,76 @@ mod tests {
         assert!(e.to_string().contains("another recording or device"), "{e}");
         // Turning at 0.05 rad/s is too little to judge, whatever the gyro says.
         turn(0.05, 57.3).unwrap();
+    }
+
+    /// A walk turning back and forth (yaw 0.8 sin(2 t), at most 1.6 rad/s) at 200 Hz, with the
+    /// orientation jumping by `jump` rad for 3 frames at each of `at`; the gyro is
+    /// `gyro_scale` times the true rate, or with `other` that of another, slower walk.
+    fn jumpy_walk(
+        jump: f64,
+        at: &[usize],
+        gyro_scale: f64,
+        other: bool,
+    ) -> (Vec<f64>, Vec<DeviceVec>, Vec<WorldFromDevice>) {
+        let n = 6000;
+        let time: Vec<f64> = (0..n).map(|i| i as f64 * 0.005).collect();
+        let yaw = |t: f64| 0.8 * (2.0 * t).sin();
+        let orientation = time
+            .iter()
+            .enumerate()
+            .map(|(i, &t)| {
+                let glitch = at.iter().any(|&a| (a..a + 3).contains(&i));
+                let z = yaw(t) + if glitch { jump } else { 0.0 };
+                WorldFromDevice::from_scaled_axis(ridi_frames::nalgebra::Vector3::new(0.0, 0.0, z))
+            })
+            .collect();
+        let gyro = time
+            .iter()
+            .map(|&t| {
+                let rate = if other {
+                    0.2 * (0.7 * t).cos()
+                } else {
+                    1.6 * (2.0 * t).cos()
+                };
+                DeviceVec::new(0.0, 0.0, rate * gyro_scale)
+            })
+            .collect();
+        (time, gyro, orientation)
+    }
+
+    #[test]
+    fn a_few_orientation_jumps_neither_fail_nor_hide_a_wrong_gyro() {
+        let v = Validation::default();
+        let check = |w: &(Vec<f64>, Vec<DeviceVec>, Vec<WorldFromDevice>)| {
+            v.check_gyro_scale(&w.0, &w.1, &w.2)
+        };
+        // Four jumps of 2.5 rad (500 rad/s): with them in the fit the scale was about 0.01.
+        let at = [700, 2100, 3900, 5200];
+        let walk = jumpy_walk(2.5, &at, 1.0, false);
+        check(&walk).unwrap();
+        let jumps = orientation_jumps(&walk.0, &walk.1, &walk.2);
+        assert_eq!(jumps.len(), 4, "{jumps:?}");
+        for (j, a) in jumps.iter().zip(at) {
+            assert_eq!(j.frames, (a - 1, a + 3), "{j:?}");
+            assert!((j.peak_rate - 500.0).abs() < 2.0, "{j:?}");
+        }
+        assert!(
+            orientation_jumps(&walk.0, &walk.1, &jumpy_walk(0.0, &[], 1.0, false).2).is_empty()
+        );
+        // A gyro in deg/s, of zeros, or of a slower walk is still refused. (Magnitudes only:
+        // a gyro of a walk that turns as much, at other times, is not caught.)
+        for (scale, other, expect) in [
+            (
+                180.0 / std::f64::consts::PI,
+                false,
+                "deg/s instead of rad/s",
+            ),
+            (0.0, false, "another recording or device"),
+            (1.0, true, "another recording or device"),
+        ] {
+            let e = check(&jumpy_walk(2.5, &at, scale, other)).unwrap_err();
+            assert!(e.to_string().contains(expect), "{scale} {other}: {e}");
+        }
     }
 
     #[test]

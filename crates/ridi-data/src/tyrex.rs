@@ -60,8 +60,12 @@
 //! use ridi_data::tyrex::{self, TyrexOptions};
 //!
 //! let root = std::path::Path::new("tyrex-attitude-smartphones");
-//! for dir in tyrex::list_sequences(root)? {
-//!     let read = tyrex::read(&dir, &TyrexOptions::default())?;
+//! let listed = tyrex::list_sequences(root)?;
+//! if let Some(w) = listed.warning() {
+//!     eprintln!("{w}");
+//! }
+//! for dir in &listed.runs {
+//!     let read = tyrex::read(dir, &TyrexOptions::default())?;
 //!     for w in &read.warnings {
 //!         eprintln!("{}: {w}", dir.display());
 //!     }
@@ -84,6 +88,7 @@ use crate::options::ReadOptions;
 use crate::resample::{interpolate_rot, interpolate_vec3, uniform_timeline};
 use crate::sequence::{
     Channel, GroundTruth, OrientationSource, Sequence, SequenceError, SequenceParts, Validation,
+    orientation_jump_warning,
 };
 use crate::text::{self, Nan};
 
@@ -209,10 +214,41 @@ pub fn motion_of(name: &str) -> Option<&'static str> {
         .copied()
 }
 
-/// The sequence folders under a Tyrex root, sorted by name. `root` may be the dataset root
-/// (with `datasets/android/`), its `datasets/` folder, or the `android/` folder itself; a
-/// sequence folder is one that holds `accelerometer.txt`.
-pub fn list_sequences(root: impl AsRef<Path>) -> Result<Vec<PathBuf>> {
+/// The run folders of a Tyrex root, as [`list_sequences`] finds them.
+#[derive(Debug, Clone, Default, PartialEq, Eq)]
+pub struct TyrexRuns {
+    /// Runs with a Qualisys file, sorted by name: the ones to convert, train and evaluate on.
+    pub runs: Vec<PathBuf>,
+    /// Runs without one (the source keeps an earlier take, `Jakob_Nexus5_Dist_Swinging_old`,
+    /// without motion capture), sorted by name.
+    pub without_mocap: Vec<PathBuf>,
+}
+
+impl TyrexRuns {
+    /// One line naming the runs without motion capture and saying they were skipped; `None`
+    /// when every run has it.
+    pub fn warning(&self) -> Option<String> {
+        (!self.without_mocap.is_empty()).then(|| {
+            let names: Vec<String> = self
+                .without_mocap
+                .iter()
+                .map(|p| p.display().to_string())
+                .collect();
+            format!(
+                "{} run folder(s) without a Qualisys file in ../../qualisys/ skipped: {}",
+                names.len(),
+                names.join(", ")
+            )
+        })
+    }
+}
+
+/// The run folders under a Tyrex root. `root` may be the dataset root (with
+/// `datasets/android/`), its `datasets/` folder, or the `android/` folder itself; a run folder
+/// is one that holds `accelerometer.txt`. Runs without a Qualisys file are listed apart
+/// ([`TyrexRuns::without_mocap`]): a root is converted for its ground truth, and one such
+/// folder must not fail it. Read one alone with [`read`] (without ground truth).
+pub fn list_sequences(root: impl AsRef<Path>) -> Result<TyrexRuns> {
     let root = root.as_ref();
     let base = [
         root.join("datasets").join("android"),
@@ -236,20 +272,28 @@ pub fn list_sequences(root: impl AsRef<Path>) -> Result<Vec<PathBuf>> {
         )
     })?;
     let entries = std::fs::read_dir(&base).map_err(|e| DataError::io(&base, e))?;
-    let mut out = Vec::new();
+    let mut out = TyrexRuns::default();
     for entry in entries {
         let path = entry.map_err(|e| DataError::io(&base, e))?.path();
-        if path.join("accelerometer.txt").is_file() {
-            out.push(path);
+        if !path.join("accelerometer.txt").is_file() {
+            continue;
+        }
+        // `exists`, not `is_file`: a Qualisys path that is no regular file is the reader's
+        // error to report, not a reason to skip the run.
+        if mat_path(&path).is_some_and(|m| m.exists()) {
+            out.runs.push(path);
+        } else {
+            out.without_mocap.push(path);
         }
     }
-    if out.is_empty() {
+    if out.runs.is_empty() && out.without_mocap.is_empty() {
         return Err(DataError::format(
             Location::file(&base),
             "no Tyrex sequence folder (with accelerometer.txt) here or in datasets/android/",
         ));
     }
-    out.sort();
+    out.runs.sort();
+    out.without_mocap.sort();
     Ok(out)
 }
 
@@ -671,7 +715,7 @@ pub fn read(dir: impl AsRef<Path>, options: &TyrexOptions) -> Result<TyrexRead> 
     spans = intersect(&spans, &stream_intervals(&gyro, gap, &mut warnings));
     spans = intersect(&spans, &stream_intervals(&rv, gap, &mut warnings));
 
-    let mat = mat_path(dir).filter(|p| options.ground_truth && p.is_file());
+    let mat = mat_path(dir).filter(|p| options.ground_truth && p.exists());
     let mut time_diff_s = None;
     // Valid mocap frames on the phone clock.
     let mut truth: Option<(Vec<f64>, Vec<WorldVec>, Vec<WorldFromDevice>)> = None;
@@ -770,6 +814,11 @@ pub fn read(dir: impl AsRef<Path>, options: &TyrexOptions) -> Result<TyrexRead> 
             };
             text::sequence_error(path, None, &TyrexFields, e)
         })?;
+        let jumps = seq.orientation_jumps();
+        warnings.extend(orientation_jump_warning(
+            &rv.path.display().to_string(),
+            &jumps,
+        ));
         sequences.push(seq);
     }
     Ok(TyrexRead {

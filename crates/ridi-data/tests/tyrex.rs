@@ -277,10 +277,30 @@ fn lists_sequence_folders_from_the_root() {
     let fx = Fixture::standard();
     std::fs::create_dir_all(fx.root.join("datasets/android/not_a_sequence")).unwrap();
     let found = tyrex::list_sequences(&fx.root).unwrap();
-    assert_eq!(found, std::slice::from_ref(&fx.dir));
+    assert_eq!(found.runs, std::slice::from_ref(&fx.dir));
+    assert!(found.without_mocap.is_empty() && found.warning().is_none());
     assert_eq!(
         tyrex::list_sequences(fx.root.join("datasets/android")).unwrap(),
         found
+    );
+    // An earlier take kept without motion capture is listed apart, with one warning.
+    let old = fx
+        .root
+        .join("datasets/android/Ann_Nexus5_NoDist_Texting_old");
+    std::fs::create_dir_all(&old).unwrap();
+    std::fs::copy(
+        fx.dir.join("accelerometer.txt"),
+        old.join("accelerometer.txt"),
+    )
+    .unwrap();
+    let found = tyrex::list_sequences(&fx.root).unwrap();
+    assert_eq!(found.runs, std::slice::from_ref(&fx.dir));
+    assert_eq!(found.without_mocap, std::slice::from_ref(&old));
+    let warning = found.warning().unwrap();
+    assert!(
+        warning.starts_with("1 run folder(s) without a Qualisys file")
+            && warning.ends_with(&format!("skipped: {}", old.display())),
+        "{warning}"
     );
     let e = tyrex::list_sequences(fx.root.join("datasets/qualisys")).unwrap_err();
     assert!(e.to_string().contains("no Tyrex sequence folder"), "{e}");
@@ -752,4 +772,58 @@ fn source_files_of_a_run_include_its_ground_truth_beside_the_android_folder() {
         files.contains(&fx.dir.join("rotation-vector.txt")),
         "{files:?}"
     );
+}
+
+/// The OS orientation of a real run (`Jakob_Nexus5_Dist_BackPocket`) jumps for a few frames at
+/// hundreds of rad/s; one least-squares fit over all frames took that for a gyro in another
+/// unit. The run reads, with one warning giving the jumps' times.
+#[test]
+fn os_orientation_jumps_are_a_warning_not_a_gyro_unit_error() {
+    let fx = Fixture::standard();
+    // Three jumps: the rotation vector turns by 1.5 rad for 4 frames (300 rad/s) and back.
+    fx.edit("rotation-vector.txt", |old| {
+        old.lines()
+            .enumerate()
+            .map(|(i, l)| {
+                let c: Vec<f64> = l.split(' ').map(|v| v.parse().unwrap()).collect();
+                let glitch = [1000..1004, 3000..3004, 5000..5004]
+                    .iter()
+                    .any(|r| r.contains(&i));
+                let q = yaw(OMEGA * c[0] + if glitch { 1.5 } else { 0.0 });
+                let [x, y, z, w] = q.to_xyzw();
+                format!("{} {x} {y} {z} {w} {}\n", c[0], c[5])
+            })
+            .collect()
+    });
+    let read = tyrex::read(&fx.dir, &TyrexOptions::default()).unwrap();
+    let [seq] = read.sequences.as_slice() else {
+        panic!("{} parts", read.sequences.len())
+    };
+    let jumps = seq.orientation_jumps();
+    assert_eq!(jumps.len(), 3, "{jumps:?}");
+    // Phone time 0.003 + 0.005 i; the jump spans the frames around the glitch.
+    for (j, i) in jumps.iter().zip([1000, 3000, 5000]) {
+        let t = 0.003 + 0.005 * i as f64;
+        assert!(j.time.0 <= t && j.time.1 >= t + 0.015, "{j:?} vs {t}");
+        assert!(j.peak_rate > 100.0, "{j:?}");
+        // Out by 1.5 rad and back.
+        assert!((j.excess_angle - 3.0).abs() < 0.2, "{j:?}");
+    }
+    let warning: Vec<&String> = read
+        .warnings
+        .iter()
+        .filter(|w| w.contains("orientation jumps"))
+        .collect();
+    assert_eq!(warning.len(), 1, "{:?}", read.warnings);
+    assert!(
+        warning[0].contains("rotation-vector.txt: the orientation jumps 3 time(s)")
+            && warning[0].contains("at 5.00-5.03 s, 14.99-15.03 s, 25.00-25.02 s (phone clock)")
+            && warning[0].contains("left out of the gyro check"),
+        "{}",
+        warning[0]
+    );
+    // A clean run has none.
+    let clean = Fixture::standard();
+    let read = tyrex::read(&clean.dir, &TyrexOptions::default()).unwrap();
+    assert!(read.sequences[0].orientation_jumps().is_empty());
 }

@@ -93,6 +93,19 @@ fn qtm_file_structure_is_read() {
     assert!((pos.as_numeric().unwrap().real[0] - -7.18589189).abs() < 1e-8);
 }
 
+/// The 24 Nexus 5 runs without magnetic disturbance: those `derived/groundtruth/` covers.
+fn nodist_nexus5_runs(root: &Path) -> Vec<PathBuf> {
+    let runs: Vec<PathBuf> = tyrex::list_sequences(root)
+        .unwrap()
+        .runs
+        .into_iter()
+        .filter(|d| d.to_string_lossy().contains("_Nexus5_NoDist_"))
+        .collect();
+    assert_eq!(runs.len(), 24);
+    runs
+}
+
+/// The 24 Nexus 5 NoDist runs, the ones `derived/groundtruth/` has an independent conversion of.
 #[test]
 fn mocap_frames_match_the_independent_csv_conversion() {
     let Some(root) = root() else { return };
@@ -101,7 +114,7 @@ fn mocap_frames_match_the_independent_csv_conversion() {
     let mut worst_quat = 0.0f64;
     let mut worst_phone_t = 0.0f64;
     let mut files = 0;
-    for dir in tyrex::list_sequences(&root).unwrap() {
+    for dir in nodist_nexus5_runs(&root) {
         let name = dir.file_name().unwrap().to_string_lossy().into_owned();
         let track = tyrex::read_ground_truth(tyrex::mat_path(&dir).unwrap()).unwrap();
         let time_diff: f64 = std::fs::read_to_string(dir.join("timeAlignment.txt"))
@@ -178,12 +191,26 @@ fn resampled_ground_truth_matches_the_csv_between_frames() {
     assert!(worst < 5e-5, "{worst}");
 }
 
+/// Parts of the shared runs whose mocap orientation is wrong (tilt against the phone's gravity
+/// 0-70 degrees, erratic; 43-54 s phone clock).
+const MOCAP_MISSOLVED: [&str; 1] = ["Thibaud_Nexus5_Dist_FrontPocket_part3"];
+
+/// Every Android run with motion capture: the 24 Nexus 5 runs and the 18 near magnetic
+/// disturbance (`Jakob_Nexus5_Dist_Swinging_old`, an earlier take without motion capture, is
+/// listed apart).
 #[test]
-fn all_24_sequences_read_fast_with_plausible_content() {
+fn every_android_run_with_mocap_reads_fast_with_plausible_content() {
     let Some(root) = root() else { return };
     let started = Instant::now();
-    let dirs = tyrex::list_sequences(&root).unwrap();
-    assert_eq!(dirs.len(), 24);
+    let listed = tyrex::list_sequences(&root).unwrap();
+    let dirs = listed.runs;
+    assert_eq!(dirs.len(), 42);
+    let old: Vec<_> = listed
+        .without_mocap
+        .iter()
+        .map(|d| d.file_name().unwrap().to_string_lossy())
+        .collect();
+    assert_eq!(old, ["Jakob_Nexus5_Dist_Swinging_old"]);
     let opts = TyrexOptions::default();
     for dir in &dirs {
         let read = tyrex::read(dir, &opts).unwrap();
@@ -196,13 +223,20 @@ fn all_24_sequences_read_fast_with_plausible_content() {
             total += seq.duration();
             path += seq.path_length().unwrap();
             // Tilt from the rotation vector vs tilt from the mocap: same device frame, both z up.
+            // The median, as the mocap mis-solves the body in short bursts in some runs.
             let gt = seq.ground_truth().unwrap();
-            let mut tilt = 0.0;
-            for (q, g) in gt.orientation.iter().zip(seq.gravity()) {
-                let up = q.inverse() * WorldVec::new(0.0, 0.0, 1.0);
-                tilt += (up.dot(*g) / g.norm()).clamp(-1.0, 1.0).acos();
-            }
-            let tilt = (tilt / seq.len() as f64).to_degrees();
+            let mut tilts: Vec<f64> = gt
+                .orientation
+                .iter()
+                .zip(seq.gravity())
+                .map(|(q, g)| {
+                    let up = q.inverse() * WorldVec::new(0.0, 0.0, 1.0);
+                    (up.dot(*g) / g.norm()).clamp(-1.0, 1.0).acos().to_degrees()
+                })
+                .collect();
+            let bursts = tilts.iter().filter(|&&t| t > 20.0).count() as f64 / seq.len() as f64;
+            tilts.sort_by(f64::total_cmp);
+            let tilt = tilts[tilts.len() / 2];
             // Over minutes the world-frame acceleration averages to zero, so the accelerometer
             // rotated to the world by the rotation vector averages to +g on z.
             let acce = seq
@@ -213,12 +247,21 @@ fn all_24_sequences_read_fast_with_plausible_content() {
                 .sum::<f64>()
                 / seq.len() as f64;
             eprintln!(
-                "{:45} {:6.1} s {:6.1} m mean tilt diff {tilt:5.2} deg mean world acce z {acce:.2}",
+                "{:45} {:6.1} s {:6.1} m median tilt diff {tilt:5.2} deg ({:4.1} % over 20) \
+                 mean world acce z {acce:.2}",
                 seq.name(),
                 seq.duration(),
                 seq.path_length().unwrap(),
+                bursts * 100.0,
             );
-            assert!(tilt < 5.0, "{}: {tilt} deg", seq.name());
+            // In one part the mocap mis-solves the rigid body throughout: its tilt swings 0-70
+            // degrees from the phone's while the phone's own accelerometer agrees with the
+            // rotation vector (docs/datasets.md). Named so that a fix, or a new defect, shows.
+            if MOCAP_MISSOLVED.contains(&seq.name()) {
+                assert!(tilt > 20.0, "{}: {tilt} deg: mended?", seq.name());
+            } else {
+                assert!(tilt < 5.0, "{}: {tilt} deg", seq.name());
+            }
             // Running saturates the accelerometer (2 g), which biases this mean.
             if !name.contains("Running") {
                 assert!((9.5..10.3).contains(&acce), "{}: {acce}", seq.name());
@@ -241,9 +284,9 @@ fn all_24_sequences_read_fast_with_plausible_content() {
         assert!((10.0..300.0).contains(&path), "{name}: path {path} m");
     }
     let elapsed = started.elapsed();
-    eprintln!("24 sequences read in {elapsed:.2?}");
+    eprintln!("{} runs read in {elapsed:.2?}", dirs.len());
     // Seconds even in the test profile; release is much faster (docs/benchmarks.md).
-    assert!(elapsed.as_secs_f64() < 30.0);
+    assert!(elapsed.as_secs_f64() < 60.0);
 }
 
 #[test]
@@ -296,17 +339,24 @@ fn read_sequence_reads_a_single_part_tyrex_run_and_refuses_a_split_one() {
     );
 }
 
-/// The measurement behind `Rot::ORTHONORMALITY_TOLERANCE`: every tracked Qualisys rotation of
-/// the 24 runs is orthonormal to single precision (largest |R'R - I| entry 9.8e-8), far inside
-/// the tolerance, and each converts to a unit quaternion.
+/// The measurement behind `Rot::ORTHONORMALITY_TOLERANCE`: every tracked rotation of every
+/// Qualisys file (66: the Nexus 5 runs with and without disturbance and the iPhone 4S runs) is
+/// orthonormal to single precision, far inside the tolerance, and each converts to a unit
+/// quaternion.
 #[test]
 fn real_mocap_rotations_are_orthonormal_far_inside_the_tolerance() {
     use ridi_data::ridi_frames::nalgebra::Matrix3;
     let Some(root) = root() else { return };
     let mut worst = (0.0f64, String::new(), 0);
     let mut tracked = 0;
-    for dir in tyrex::list_sequences(&root).unwrap() {
-        let path = tyrex::mat_path(&dir).unwrap();
+    let mut files: Vec<PathBuf> = std::fs::read_dir(root.join("datasets/qualisys"))
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.extension().is_some_and(|x| x == "mat"))
+        .collect();
+    files.sort();
+    assert_eq!(files.len(), 66);
+    for path in files {
         let m = MatFile::read(&path).unwrap();
         let variable = tyrex::read_ground_truth(&path).unwrap().variable;
         let rot = m
@@ -335,7 +385,7 @@ fn real_mocap_rotations_are_orthonormal_far_inside_the_tolerance() {
         "{tracked} tracked mocap rotations: largest |R'R - I| {:.2e} ({} frame {})",
         worst.0, worst.1, worst.2
     );
-    assert!(tracked > 150_000, "{tracked}");
+    assert!(tracked > 400_000, "{tracked}");
     assert!(worst.0 < 2e-7, "{worst:?}");
     assert!(worst.0 * 1000.0 < WorldFromDevice::ORTHONORMALITY_TOLERANCE);
 }

@@ -57,23 +57,57 @@ const RESAMPLE_MAX_GAP_FRAMES: f64 = 5.0;
 /// What converting one source produced: the sequences written and the warnings.
 type Written = (Vec<Converted>, Vec<String>);
 
-/// The sources under `source`: one sequence, the runs of a Tyrex root, the sequences one
-/// level below a folder (a RIDI dataset folder), or else the Indoor Location Competition path
-/// files in the folder and its sub-folders. With `from`, only sources of that format: a
-/// `source` of another format is an error saying so.
-fn sources(source: &Path, from: Option<Format>) -> Result<Vec<PathBuf>, DataError> {
+/// What [`sources`] found: the sources to convert, and a warning about what it skipped.
+#[derive(Debug, PartialEq)]
+struct Sources {
+    paths: Vec<PathBuf>,
+    /// Tyrex run folders without motion capture in a root.
+    skipped: Option<String>,
+}
+
+impl From<Vec<PathBuf>> for Sources {
+    fn from(paths: Vec<PathBuf>) -> Self {
+        Self {
+            paths,
+            skipped: None,
+        }
+    }
+}
+
+/// The runs with motion capture of a Tyrex root, and a warning naming those without.
+fn tyrex_sources(source: &Path) -> Result<Sources, DataError> {
+    let runs = tyrex::list_sequences(source)?;
+    let skipped = runs.warning();
+    if runs.runs.is_empty() {
+        return Err(DataError::format(
+            Location::file(source),
+            "no Tyrex run here has a Qualisys file in ../../qualisys/: convert a run folder \
+             itself to read it without ground truth",
+        ));
+    }
+    Ok(Sources {
+        paths: runs.runs,
+        skipped,
+    })
+}
+
+/// The sources under `source`: one sequence, the runs of a Tyrex root (those with motion
+/// capture), the sequences one level below a folder (a RIDI dataset folder), or else the Indoor
+/// Location Competition path files in the folder and its sub-folders. With `from`, only sources
+/// of that format: a `source` of another format is an error saying so.
+fn sources(source: &Path, from: Option<Format>) -> Result<Sources, DataError> {
     let Some(want) = from else {
         return detected_sources(source);
     };
     if is_a(source, want) {
-        return Ok(vec![source.to_path_buf()]);
+        return Ok(vec![source.to_path_buf()].into());
     }
     if detect(source).is_ok() || !source.is_dir() {
         return Err(not_a(source, want));
     }
     let found = match want {
-        Format::Tyrex => tyrex::list_sequences(source),
-        Format::Ilc => ilc::list_paths(source),
+        Format::Tyrex => tyrex_sources(source),
+        Format::Ilc => ilc::list_paths(source).map(Sources::from),
         _ => sub_folders(source, |p| is_a(p, want)).and_then(|found| {
             if found.is_empty() {
                 Err(DataError::format(
@@ -81,13 +115,13 @@ fn sources(source: &Path, from: Option<Format>) -> Result<Vec<PathBuf>, DataErro
                     format!("no {want} here or one level below: {}", want.layout()),
                 ))
             } else {
-                Ok(found)
+                Ok(found.into())
             }
         }),
     };
     // A folder of another format: say what it holds rather than only what it lacks.
     found.map_err(|e| match detected_sources(source) {
-        Ok(other) if !other.is_empty() => {
+        Ok(Sources { paths: other, .. }) if !other.is_empty() => {
             let what = detect(&other[0]).map_or_else(
                 |_| "a sequence".to_string(),
                 |f| with_article(&f.to_string()),
@@ -107,22 +141,22 @@ fn sources(source: &Path, from: Option<Format>) -> Result<Vec<PathBuf>, DataErro
 }
 
 /// [`sources`] without a format given: whatever is detected.
-fn detected_sources(source: &Path) -> Result<Vec<PathBuf>, DataError> {
+fn detected_sources(source: &Path) -> Result<Sources, DataError> {
     if detect(source).is_ok() {
-        return Ok(vec![source.to_path_buf()]);
+        return Ok(vec![source.to_path_buf()].into());
     }
-    if let Ok(runs) = tyrex::list_sequences(source) {
+    if let Ok(runs) = tyrex_sources(source) {
         return Ok(runs);
     }
     if !source.is_dir() {
         // Say why the file is not a sequence rather than that it is not a folder.
-        return detect(source).map(|_| vec![source.to_path_buf()]);
+        return detect(source).map(|_| vec![source.to_path_buf()].into());
     }
     let found = sub_folders(source, |p| detect(p).is_ok())?;
     if !found.is_empty() {
-        return Ok(found);
+        return Ok(found.into());
     }
-    ilc::list_paths(source).map_err(|_| {
+    ilc::list_paths(source).map(Sources::from).map_err(|_| {
         DataError::format(
             Location::file(source),
             "no sequence found: expected a RIDI data.csv, data_plain.txt or raw folder, a Tyrex \
@@ -261,7 +295,10 @@ pub fn convert(
     opts: &ConvertOptions,
 ) -> Result<ConvertSummary, DataError> {
     let from = opts.from;
-    let dirs = sources(source, from)?;
+    let Sources {
+        paths: dirs,
+        skipped,
+    } = sources(source, from)?;
     let listed = labels_from_lists(source);
     let labels = &listed.labels;
     let staging = Staging::new(out)?;
@@ -304,6 +341,7 @@ pub fn convert(
         })
         .collect();
     let mut summary = ConvertSummary::default();
+    summary.warnings.extend(skipped);
     summary.warnings.extend(listed.warnings.iter().cloned());
     for r in results {
         let (written, warnings) = r?;
@@ -368,10 +406,13 @@ mod tests {
             .iter()
             .map(|n| floor.join("path_data_files").join(n))
             .collect();
-        assert_eq!(sources(dir.path(), None).unwrap(), want);
-        assert_eq!(sources(dir.path(), Some(Format::Ilc)).unwrap(), want);
-        assert_eq!(sources(&want[1], Some(Format::Ilc)).unwrap(), &want[1..]);
-        assert_eq!(sources(&want[1], None).unwrap(), &want[1..]);
+        assert_eq!(sources(dir.path(), None).unwrap().paths, want);
+        assert_eq!(sources(dir.path(), Some(Format::Ilc)).unwrap().paths, want);
+        assert_eq!(
+            sources(&want[1], Some(Format::Ilc)).unwrap().paths,
+            &want[1..]
+        );
+        assert_eq!(sources(&want[1], None).unwrap().paths, &want[1..]);
         let e = sources(&floor.join("notes.txt"), Some(Format::Ilc)).unwrap_err();
         assert!(
             e.to_string().contains(

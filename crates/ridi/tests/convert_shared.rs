@@ -18,6 +18,8 @@ fn shared(dataset: &str, probe: &str) -> Option<PathBuf> {
     }
 }
 
+/// Every Android run with motion capture in the shared root (the 24 Nexus 5 runs and the 18
+/// near magnetic disturbance); the one run folder without it is skipped with one warning.
 #[test]
 fn the_whole_tyrex_root_converts_with_one_list_per_person() {
     let Some(root) = shared("tyrex-attitude-smartphones", "datasets/android") else {
@@ -25,9 +27,39 @@ fn the_whole_tyrex_root_converts_with_one_list_per_person() {
     };
     let out = tempfile::tempdir().unwrap();
     let summary = ridi::convert::convert(&root, out.path(), &Default::default()).unwrap();
-    // 24 runs, some split at long mocap or sensor gaps into parts, each named and listed.
-    assert!(summary.sequences.len() >= 24, "{}", summary.sequences.len());
-    assert!(!summary.warnings.is_empty(), "splits are reported");
+    // 42 runs, some split at long mocap or sensor gaps into parts, each named and listed.
+    let mut runs: Vec<&str> = summary
+        .sequences
+        .iter()
+        .map(|c| c.name.split("_part").next().unwrap())
+        .collect();
+    runs.dedup();
+    assert_eq!(runs.len(), 42, "{runs:?}");
+    assert_eq!(runs.iter().filter(|r| r.contains("_Dist_")).count(), 18);
+    let skipped: Vec<&String> = summary
+        .warnings
+        .iter()
+        .filter(|w| w.contains("without a Qualisys file"))
+        .collect();
+    assert_eq!(skipped.len(), 1, "{:?}", summary.warnings);
+    assert!(
+        skipped[0].contains("1 run folder(s)")
+            && skipped[0].ends_with("Jakob_Nexus5_Dist_Swinging_old"),
+        "{}",
+        skipped[0]
+    );
+    assert!(
+        summary
+            .warnings
+            .iter()
+            .any(|w| w.contains("recording split")),
+        "splits are reported"
+    );
+    assert!(
+        summary.warnings.iter().any(|w| w
+            .contains("Jakob_Nexus5_Dist_BackPocket/rotation-vector.txt: the orientation jumps")),
+        "the run the gyro check refused reads, with its orientation jumps reported"
+    );
     let all = read_list(out.path().join("list_all.txt")).unwrap();
     assert_eq!(all.len(), summary.sequences.len());
     let mut per_person = 0;
