@@ -49,3 +49,8 @@ pub use placement::PlacementMap;
 pub use source::{Loaded, read_any};
 pub use track::{Track, TrackOptions, track};
 pub use train::{GridChoice, TrainOptions, train};
+
+/// The README's Rust example, compiled by `cargo test --doc` so that it cannot drift from the API.
+#[cfg(doctest)]
+#[doc = include_str!("../../../README.md")]
+struct ReadmeDoctests;
