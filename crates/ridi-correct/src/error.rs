@@ -11,22 +11,22 @@ pub enum CorrectError {
     #[error("the sequence is empty")]
     Empty,
     /// Two per-frame slices have different lengths.
-    #[error("{what} has {got} entries, expected {expected} (one per frame)")]
+    #[error("{what} has {found} entries, expected {expected} (one per frame)")]
     LengthMismatch {
         /// Which input.
         what: &'static str,
         /// Number of frames (length of `time`).
         expected: usize,
         /// Length found.
-        got: usize,
+        found: usize,
     },
     /// A NaN or infinite value.
-    #[error("{what} is not finite at frame {frame}")]
+    #[error("{what} is not finite at frame {index}")]
     NonFinite {
         /// Which input.
         what: &'static str,
         /// Frame index.
-        frame: usize,
+        index: usize,
     },
     /// A velocity target with a NaN or infinite component.
     #[error("velocity target {index} (frame {frame}) is not finite")]

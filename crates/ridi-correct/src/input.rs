@@ -47,7 +47,7 @@ impl ImuSlices<'_> {
                 return Err(CorrectError::LengthMismatch {
                     what,
                     expected: n,
-                    got,
+                    found: got,
                 });
             }
         }
@@ -69,13 +69,13 @@ impl ImuSlices<'_> {
             if !self.linacce[f].is_finite() {
                 return Err(CorrectError::NonFinite {
                     what: "linacce",
-                    frame: f,
+                    index: f,
                 });
             }
             if !self.gravity[f].is_finite() {
                 return Err(CorrectError::NonFinite {
                     what: "gravity",
-                    frame: f,
+                    index: f,
                 });
             }
             if !self.orientation[f]
@@ -86,7 +86,7 @@ impl ImuSlices<'_> {
             {
                 return Err(CorrectError::NonFinite {
                     what: "orientation",
-                    frame: f,
+                    index: f,
                 });
             }
         }
@@ -110,7 +110,7 @@ pub(crate) fn validate_time(time: &[f64], max_dt: f64) -> Result<(), CorrectErro
         if !t.is_finite() {
             return Err(CorrectError::NonFinite {
                 what: "time",
-                frame: f,
+                index: f,
             });
         }
         if f > 0 {

@@ -91,20 +91,20 @@ pub fn integrate(
         return Err(CorrectError::LengthMismatch {
             what: "acc_world",
             expected: time.len(),
-            got: acc_world.len(),
+            found: acc_world.len(),
         });
     }
     validate_time(time, f64::INFINITY)?;
     if let Some(f) = acc_world.iter().position(|a| !a.is_finite()) {
         return Err(CorrectError::NonFinite {
             what: "acc_world",
-            frame: f,
+            index: f,
         });
     }
     if !(v0.is_finite() && p0.is_finite()) {
         return Err(CorrectError::NonFinite {
             what: "initial state",
-            frame: 0,
+            index: 0,
         });
     }
     Ok(integrate_unchecked(time, acc_world, v0, p0))
@@ -191,7 +191,7 @@ mod tests {
         a[1] = WorldVec::new(f64::NAN, 0.0, 0.0);
         assert!(matches!(
             integrate(&t, &a, WorldVec::ZERO, WorldVec::ZERO),
-            Err(CorrectError::NonFinite { frame: 1, .. })
+            Err(CorrectError::NonFinite { index: 1, .. })
         ));
         assert!(matches!(
             integrate(&t, &a[..2], WorldVec::ZERO, WorldVec::ZERO),
@@ -227,7 +227,7 @@ mod tests {
         let short = Err(CorrectError::LengthMismatch {
             what: "orientation",
             expected: 20,
-            got: 10,
+            found: 10,
         });
         assert_eq!(world_acceleration(&imu), short);
         assert_eq!(corrected_acceleration(&imu, &bias), short);

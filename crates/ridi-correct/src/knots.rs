@@ -168,7 +168,7 @@ impl BiasCurve {
         if let Some(k) = values.iter().position(|v| !v.is_finite()) {
             return Err(CorrectError::NonFinite {
                 what: "bias",
-                frame: knots.frames()[k],
+                index: knots.frames()[k],
             });
         }
         Ok(Self { knots, values })
@@ -256,7 +256,7 @@ mod tests {
             BiasCurve::new(knots, nan),
             Err(CorrectError::NonFinite {
                 what: "bias",
-                frame: 10
+                index: 10
             })
         );
     }

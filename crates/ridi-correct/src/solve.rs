@@ -223,7 +223,7 @@ impl Corrector {
         {
             return Err(CorrectError::NonFinite {
                 what: "initial velocity",
-                frame: 0,
+                index: 0,
             });
         }
         if targets.is_empty() && initial == InitialVelocity::Estimate {

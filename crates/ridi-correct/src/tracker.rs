@@ -167,10 +167,10 @@ pub struct Sample {
 #[derive(Debug, Clone, PartialEq, Error)]
 pub enum TrackError {
     /// A sample field is NaN or infinite; the sample was dropped and the tracker is unchanged.
-    #[error("sample field {field} is not finite")]
+    #[error("sample field {what} is not finite")]
     NonFinite {
         /// The offending field.
-        field: &'static str,
+        what: &'static str,
     },
     /// The sample is not after the previous one; dropped, tracker unchanged.
     #[error("sample time {time} is not after the previous sample's {previous}")]
@@ -887,7 +887,7 @@ fn corrected_world(q: WorldFromDevice, lin: DeviceVec, bias: DeviceVec) -> World
 }
 
 fn check_sample(s: &Sample) -> Result<(), TrackError> {
-    let bad = |field| Err(TrackError::NonFinite { field });
+    let bad = |what| Err(TrackError::NonFinite { what });
     if !s.time.is_finite() {
         return bad("time");
     }

@@ -312,7 +312,7 @@ fn bad_input_is_a_clear_error() {
         c.solve(&imu, &targets),
         Err(CorrectError::NonFinite {
             what: "linacce",
-            frame: 123
+            index: 123
         })
     );
 

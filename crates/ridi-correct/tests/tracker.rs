@@ -241,13 +241,13 @@ fn bad_samples_are_refused_without_harm() {
     nan.linacce = DeviceVec::new(0.0, f64::NAN, 0.0);
     assert_eq!(
         tracker.push(&nan),
-        Err(TrackError::NonFinite { field: "linacce" })
+        Err(TrackError::NonFinite { what: "linacce" })
     );
     let mut nan = s[300];
     nan.time = f64::INFINITY;
     assert_eq!(
         tracker.push(&nan),
-        Err(TrackError::NonFinite { field: "time" })
+        Err(TrackError::NonFinite { what: "time" })
     );
     assert!(matches!(
         tracker.push(&s[100]),

@@ -390,9 +390,7 @@ pub fn read(folder: impl AsRef<Path>, opts: &ReadOptions) -> Result<Sequence> {
 fn stream_file(e: &SequenceError) -> Option<&'static str> {
     let field = match e {
         SequenceError::Gravity { .. } => "gravity",
-        SequenceError::NotFinite { field, .. } | SequenceError::LengthMismatch { field, .. } => {
-            field
-        }
+        SequenceError::NonFinite { what, .. } | SequenceError::LengthMismatch { what, .. } => what,
         _ => return None,
     };
     match field {

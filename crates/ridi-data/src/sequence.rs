@@ -643,20 +643,20 @@ pub enum SequenceError {
     #[error("sequence has no frames")]
     Empty,
     /// A channel's length differs from the timeline's.
-    #[error("`{field}` has {found} frames, the timeline has {expected}")]
+    #[error("`{what}` has {found} frames, the timeline has {expected}")]
     LengthMismatch {
         /// The channel.
-        field: &'static str,
+        what: &'static str,
         /// Length of the timeline.
         expected: usize,
         /// Length of the channel.
         found: usize,
     },
     /// NaN or infinity.
-    #[error("`{field}` is not finite at frame {index}")]
-    NotFinite {
+    #[error("`{what}` is not finite at frame {index}")]
+    NonFinite {
         /// The channel.
-        field: &'static str,
+        what: &'static str,
         /// 0-based frame index.
         index: usize,
     },
@@ -844,7 +844,7 @@ fn check_len(field: &'static str, expected: usize, found: usize) -> Result<(), S
         Ok(())
     } else {
         Err(SequenceError::LengthMismatch {
-            field,
+            what: field,
             expected,
             found,
         })
@@ -877,7 +877,7 @@ fn check_steps(time: &[f64], max_gap_s: f64) -> Result<(), SequenceError> {
 fn check_vecs(field: &'static str, n: usize, v: &[DeviceVec]) -> Result<(), SequenceError> {
     check_len(field, n, v.len())?;
     match v.iter().position(|x| !x.is_finite()) {
-        Some(index) => Err(SequenceError::NotFinite { field, index }),
+        Some(index) => Err(SequenceError::NonFinite { what: field, index }),
         None => Ok(()),
     }
 }
@@ -898,8 +898,8 @@ impl Sequence {
             return Err(SequenceError::Empty);
         }
         if let Some(index) = parts.time.iter().position(|t| !t.is_finite()) {
-            return Err(SequenceError::NotFinite {
-                field: "time",
+            return Err(SequenceError::NonFinite {
+                what: "time",
                 index,
             });
         }
@@ -917,8 +917,8 @@ impl Sequence {
             check_len("ground_truth.orientation", n, gt.orientation.len())?;
             check_len("ground_truth.position", n, gt.position.len())?;
             if let Some(index) = gt.position.iter().position(|p| !p.is_finite()) {
-                return Err(SequenceError::NotFinite {
-                    field: "ground_truth.position",
+                return Err(SequenceError::NonFinite {
+                    what: "ground_truth.position",
                     index,
                 });
             }
@@ -926,8 +926,8 @@ impl Sequence {
         if let Some(steps) = &parts.steps {
             check_len("steps", n, steps.len())?;
             if let Some(index) = steps.iter().position(|s| !s.is_finite()) {
-                return Err(SequenceError::NotFinite {
-                    field: "steps",
+                return Err(SequenceError::NonFinite {
+                    what: "steps",
                     index,
                 });
             }

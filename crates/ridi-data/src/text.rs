@@ -247,7 +247,7 @@ pub(crate) fn sequence_error(
         DataError::format(at, message)
     };
     let (index, field, message) = match &e {
-        SequenceError::NotFinite { index, field } => (*index, (*field).to_owned(), e.to_string()),
+        SequenceError::NonFinite { index, what } => (*index, (*what).to_owned(), e.to_string()),
         SequenceError::TimeNotIncreasing { index, .. } | SequenceError::Gap { index, .. } => {
             (*index, "time".to_owned(), e.to_string())
         }

@@ -13,14 +13,14 @@ pub enum EvalError {
         what: &'static str,
     },
     /// Two inputs that must describe the same frames have different lengths.
-    #[error("{what}: lengths differ ({left} vs {right})")]
+    #[error("{what}: lengths differ ({expected} vs {found})")]
     LengthMismatch {
         /// Which pair of inputs.
         what: &'static str,
-        /// Length of the first input.
-        left: usize,
+        /// Length of the first input, the one the second must match.
+        expected: usize,
         /// Length of the second input.
-        right: usize,
+        found: usize,
     },
     /// An input holds NaN or an infinity.
     #[error("{what}: non-finite value at index {index}")]
@@ -113,7 +113,11 @@ pub(crate) fn check_same_len(what: &'static str, left: usize, right: usize) -> R
     if left == right {
         Ok(())
     } else {
-        Err(EvalError::LengthMismatch { what, left, right })
+        Err(EvalError::LengthMismatch {
+            what,
+            expected: left,
+            found: right,
+        })
     }
 }
 

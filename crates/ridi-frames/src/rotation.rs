@@ -36,7 +36,7 @@ pub type StabFromWorld = Rot<Stabilized, World>;
 pub enum QuatError {
     /// A component of the quaternion, or an entry of the matrix ([`Rot::from_matrix`]), is NaN
     /// or infinite.
-    NotFinite,
+    NonFinite,
     /// The norm is too far from 1 to be a rotation (see [`Rot::NORM_TOLERANCE`]).
     NotUnit {
         /// The norm found.
@@ -56,7 +56,7 @@ pub enum QuatError {
 impl fmt::Display for QuatError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {
-            QuatError::NotFinite => write!(f, "a component is NaN or infinite"),
+            QuatError::NonFinite => write!(f, "a component is NaN or infinite"),
             QuatError::NotUnit { norm } => {
                 write!(f, "quaternion norm {norm} is not close to 1")
             }
@@ -115,7 +115,7 @@ impl<To: Frame, From: Frame> Rot<To, From> {
     /// normalized unit quaternion.
     ///
     /// # Errors
-    /// [`QuatError::NotFinite`] when an entry is NaN or infinite; [`QuatError::NotRotation`]
+    /// [`QuatError::NonFinite`] when an entry is NaN or infinite; [`QuatError::NotRotation`]
     /// (with the orthonormality error and the determinant) when `M` is further than the
     /// tolerance from orthonormal, e.g. a scaled rotation, or when its determinant is not
     /// positive: a reflection such as `diag(−1, 1, 1)` is orthonormal but not a rotation.
@@ -138,7 +138,7 @@ impl<To: Frame, From: Frame> Rot<To, From> {
     /// ```
     pub fn from_matrix(m: &Matrix3<f64>) -> Result<Self, QuatError> {
         if !m.iter().all(|v| v.is_finite()) {
-            return Err(QuatError::NotFinite);
+            return Err(QuatError::NonFinite);
         }
         let orthonormality_error = (m.transpose() * m - Matrix3::identity()).abs().max();
         let determinant = m.determinant();
@@ -192,7 +192,7 @@ impl<To: Frame, From: Frame> Rot<To, From> {
 
     fn checked(q: Quaternion<f64>) -> Result<Self, QuatError> {
         if !q.coords.iter().all(|c| c.is_finite()) {
-            return Err(QuatError::NotFinite);
+            return Err(QuatError::NonFinite);
         }
         let norm = q.norm();
         if (norm - 1.0).abs() > Self::NORM_TOLERANCE {
@@ -373,7 +373,7 @@ mod tests {
             m[(1, 2)] = bad;
             assert_eq!(
                 WorldFromDevice::from_matrix(&m),
-                Err(QuatError::NotFinite),
+                Err(QuatError::NonFinite),
                 "{bad}"
             );
         }

@@ -9,30 +9,33 @@ pub enum PipelineError {
     /// Reading or writing data.
     #[error(transparent)]
     Data(#[from] ridi_data::DataError),
+    // The layers' errors below print their cause after a prefix and do not also chain it as
+    // `source()`: an error prints its cause or chains it, never both (a reporter walking the
+    // chain would print it twice).
     /// Features or targets.
     #[error("features: {0}")]
-    Features(#[from] ridi_features::FeatureError),
+    Features(ridi_features::FeatureError),
     /// Training or prediction.
     #[error("regression: {0}")]
-    Regress(#[from] ridi_regress::RegressError),
+    Regress(ridi_regress::RegressError),
     /// Correction or integration.
     #[error("correction: {0}")]
-    Correct(#[from] ridi_correct::CorrectError),
+    Correct(ridi_correct::CorrectError),
     /// Metrics.
     #[error("evaluation: {0}")]
-    Eval(#[from] ridi_eval::EvalError),
+    Eval(ridi_eval::EvalError),
     /// Orientation estimation.
     #[error("orientation: {0}")]
-    Orientation(#[from] ridi_frames::EstimateError),
+    Orientation(ridi_frames::EstimateError),
     /// The streaming tracker refused a sample or its configuration.
     #[error("tracking: {0}")]
-    Track(#[from] ridi_correct::TrackError),
+    Track(ridi_correct::TrackError),
     /// A live stream's sample lacks what the model needs.
     #[error("live tracking: {0}")]
     Live(String),
     /// Drawing a plot.
     #[error("plot: {0}")]
-    Plot(#[from] crate::plot::PlotError),
+    Plot(crate::plot::PlotError),
     /// A sequence lacks what a stage needs (ground truth, placement, enough frames).
     #[error("sequence `{sequence}`: {message}")]
     Sequence {
@@ -53,6 +56,27 @@ pub enum PipelineError {
         message: String,
     },
 }
+
+/// `From` for the variants that print their cause (see above).
+macro_rules! printed_cause {
+    ($($variant:ident($error:ty)),* $(,)?) => {$(
+        impl From<$error> for PipelineError {
+            fn from(e: $error) -> Self {
+                PipelineError::$variant(e)
+            }
+        }
+    )*};
+}
+
+printed_cause!(
+    Features(ridi_features::FeatureError),
+    Regress(ridi_regress::RegressError),
+    Correct(ridi_correct::CorrectError),
+    Eval(ridi_eval::EvalError),
+    Orientation(ridi_frames::EstimateError),
+    Track(ridi_correct::TrackError),
+    Plot(crate::plot::PlotError),
+);
 
 impl PipelineError {
     pub(crate) fn sequence(name: &str, message: impl Into<String>) -> Self {
