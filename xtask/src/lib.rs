@@ -6,6 +6,7 @@ pub mod checksum;
 pub mod download;
 pub mod fetch;
 pub mod manifest;
+pub mod tidy;
 
 use std::path::PathBuf;
 

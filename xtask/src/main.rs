@@ -47,6 +47,9 @@ enum Task {
         #[arg(long)]
         trust_unpinned: bool,
     },
+    /// Fast convention checks (no build): each crate's dependencies match the layer table of
+    /// docs/ARCHITECTURE.md, no error enum uses a retired spelling, no new public module.
+    Tidy,
     /// Print the sha256sum list of every file under a folder (sorted), e.g. to regenerate
     /// datasets/<name>.sha256.
     Checksums { folder: PathBuf },
@@ -182,6 +185,7 @@ fn run(cli: Cli) -> Result<()> {
                 }
             }
         }
+        Task::Tidy => xtask::tidy::run(&xtask::workspace_root())?,
         Task::Checksums { folder } => {
             let list = checksum::list_tree(&folder)?;
             print!("{}", checksum::format_list(&list));

@@ -1,5 +1,6 @@
-//! Checks against the real Tyrex data in `../shared` (beside the checkout). Each test returns
-//! early with a note when the data are not there; the CI script runs them where they are.
+//! Checks against the real Tyrex data in `../shared` (beside the checkout). The tests are
+//! `#[ignore]`d, so that `cargo test` shows them as not run; `.ci/run` runs them with
+//! `--ignored`.
 
 mod common;
 
@@ -10,7 +11,7 @@ use ridi_data::mat::MatFile;
 use ridi_data::ridi_frames::{WorldFromDevice, WorldVec};
 use ridi_data::tyrex::{self, TyrexOptions};
 
-fn root() -> Option<PathBuf> {
+fn root() -> PathBuf {
     common::shared_dataset("tyrex-attitude-smartphones", "datasets/android")
 }
 
@@ -60,8 +61,9 @@ fn quat_diff(q: &WorldFromDevice, wxyz: [f64; 4]) -> f64 {
 }
 
 #[test]
+#[ignore = "needs ../shared beside the checkout: `cargo test --workspace --tests -- --ignored` (.ci/run)"]
 fn qtm_file_structure_is_read() {
-    let Some(root) = root() else { return };
+    let root = root();
     let path = root.join("datasets/qualisys/Guillaume_Nexus5_NoDist_Texting.mat");
     let m = MatFile::read(&path).unwrap();
     assert!(
@@ -107,8 +109,9 @@ fn nodist_nexus5_runs(root: &Path) -> Vec<PathBuf> {
 
 /// The 24 Nexus 5 NoDist runs, the ones `derived/groundtruth/` has an independent conversion of.
 #[test]
+#[ignore = "needs ../shared beside the checkout: `cargo test --workspace --tests -- --ignored` (.ci/run)"]
 fn mocap_frames_match_the_independent_csv_conversion() {
-    let Some(root) = root() else { return };
+    let root = root();
     let started = Instant::now();
     let mut worst_pos = 0.0f64;
     let mut worst_quat = 0.0f64;
@@ -153,8 +156,9 @@ fn mocap_frames_match_the_independent_csv_conversion() {
 }
 
 #[test]
+#[ignore = "needs ../shared beside the checkout: `cargo test --workspace --tests -- --ignored` (.ci/run)"]
 fn resampled_ground_truth_matches_the_csv_between_frames() {
-    let Some(root) = root() else { return };
+    let root = root();
     let name = "Guillaume_Nexus5_NoDist_Texting";
     let read = tyrex::read(
         root.join("datasets/android").join(name),
@@ -199,8 +203,9 @@ const MOCAP_MISSOLVED: [&str; 1] = ["Thibaud_Nexus5_Dist_FrontPocket_part3"];
 /// disturbance (`Jakob_Nexus5_Dist_Swinging_old`, an earlier take without motion capture, is
 /// listed apart).
 #[test]
+#[ignore = "needs ../shared beside the checkout: `cargo test --workspace --tests -- --ignored` (.ci/run)"]
 fn every_android_run_with_mocap_reads_fast_with_plausible_content() {
-    let Some(root) = root() else { return };
+    let root = root();
     let started = Instant::now();
     let listed = tyrex::list_sequences(&root).unwrap();
     let dirs = listed.runs;
@@ -290,8 +295,9 @@ fn every_android_run_with_mocap_reads_fast_with_plausible_content() {
 }
 
 #[test]
+#[ignore = "needs ../shared beside the checkout: `cargo test --workspace --tests -- --ignored` (.ci/run)"]
 fn damaged_copies_of_a_real_qtm_file_give_errors_not_panics() {
-    let Some(root) = root() else { return };
+    let root = root();
     let bytes =
         std::fs::read(root.join("datasets/qualisys/Guillaume_Nexus5_NoDist_Texting.mat")).unwrap();
     let parse = |b: &[u8]| {
@@ -322,8 +328,9 @@ fn damaged_copies_of_a_real_qtm_file_give_errors_not_panics() {
 }
 
 #[test]
+#[ignore = "needs ../shared beside the checkout: `cargo test --workspace --tests -- --ignored` (.ci/run)"]
 fn read_sequence_reads_a_single_part_tyrex_run_and_refuses_a_split_one() {
-    let Some(root) = root() else { return };
+    let root = root();
     let android = root.join("datasets/android");
     let opts = ridi_data::ReadOptions::default();
     let whole = ridi_data::read_sequence(android.join("Guillaume_Nexus5_NoDist_Texting"), &opts)
@@ -344,9 +351,10 @@ fn read_sequence_reads_a_single_part_tyrex_run_and_refuses_a_split_one() {
 /// orthonormal to single precision, far inside the tolerance, and each converts to a unit
 /// quaternion.
 #[test]
+#[ignore = "needs ../shared beside the checkout: `cargo test --workspace --tests -- --ignored` (.ci/run)"]
 fn real_mocap_rotations_are_orthonormal_far_inside_the_tolerance() {
     use ridi_data::ridi_frames::nalgebra::Matrix3;
-    let Some(root) = root() else { return };
+    let root = root();
     let mut worst = (0.0f64, String::new(), 0);
     let mut tracked = 0;
     let mut files: Vec<PathBuf> = std::fs::read_dir(root.join("datasets/qualisys"))
@@ -393,8 +401,9 @@ fn real_mocap_rotations_are_orthonormal_far_inside_the_tolerance() {
 /// `read_sequence` returns the sequence and drops the reader's warnings (documented there):
 /// `tyrex::read` is the way to see them.
 #[test]
+#[ignore = "needs ../shared beside the checkout: `cargo test --workspace --tests -- --ignored` (.ci/run)"]
 fn read_sequence_drops_the_tyrex_warnings_that_tyrex_read_returns() {
-    let Some(root) = root() else { return };
+    let root = root();
     let dir = root.join("datasets/android/Guillaume_Nexus5_NoDist_AR");
     let opts = ridi_data::ReadOptions::default();
     let seq = ridi_data::read_sequence(&dir, &opts).unwrap();

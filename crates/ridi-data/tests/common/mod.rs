@@ -147,21 +147,18 @@ pub fn write_files(dir: &Path, files: &[(&str, String)]) {
     }
 }
 
-/// `../shared/data/raw/<dataset>` beside the checkout when it holds `probe`; otherwise `None`,
-/// after a note that the checks against it are skipped.
-pub fn shared_dataset(dataset: &str, probe: &str) -> Option<std::path::PathBuf> {
+/// `../shared/data/raw/<dataset>` beside the checkout, which must hold `probe` (the tests that
+/// call this are `#[ignore]`d: they run only when asked for).
+pub fn shared_dataset(dataset: &str, probe: &str) -> std::path::PathBuf {
     let p = Path::new(env!("CARGO_MANIFEST_DIR"))
         .join("../../../shared/data/raw")
         .join(dataset);
-    if p.join(probe).exists() {
-        Some(p)
-    } else {
-        eprintln!(
-            "note: {} not found: shared-data checks skipped",
-            p.display()
-        );
-        None
-    }
+    assert!(
+        p.join(probe).exists(),
+        "{} not found: these checks need the shared data beside the checkout",
+        p.join(probe).display()
+    );
+    p
 }
 
 /// Asserts that `r` failed with a message containing every one of `parts`.

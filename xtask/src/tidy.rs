@@ -1,0 +1,409 @@
+//! `cargo xtask tidy`: fast checks that keep the codebase's conventions true.
+//!
+//! - Every workspace crate's dependencies on other workspace crates are exactly the row of the
+//!   layer table in `docs/ARCHITECTURE.md` (normal and build dependencies; dev-dependencies
+//!   may only name crates of that row, or `ridi-test-support`).
+//! - No error enum uses a retired spelling: `NotFinite`, and `LengthMismatch` / `NonFinite`
+//!   variants with other fields than `what`, `expected`, `found`, `index` (and a plot's
+//!   `series`).
+//! - No crate declares a public module outside [`PUBLIC_MODULES`]: new items are re-exported at
+//!   the crate root from private modules, as ripgrep's crates do.
+//!
+//! It reads files only (no build), so it takes well under a second.
+
+use std::collections::{BTreeMap, BTreeSet};
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+
+use anyhow::{Context, Result, bail};
+
+/// The public modules each crate still has. The list may only shrink: a new public item goes
+/// into a private module and is re-exported at the crate root.
+pub const PUBLIC_MODULES: &[(&str, &[&str])] = &[
+    ("ridi-frames", &["estimate"]),
+    (
+        "ridi-data",
+        &[
+            "ilc",
+            "mat",
+            "processed",
+            "resample",
+            "ridi_csv",
+            "ridi_plain",
+            "ridi_raw",
+            "tyrex",
+        ],
+    ),
+    ("ridi-features", &["gaussian"]),
+    (
+        "ridi-regress",
+        &[
+            "cascade",
+            "config",
+            "error",
+            "grid",
+            "kernel",
+            "linfa_impl",
+            "matrix",
+            "model_file",
+            "progress",
+            "smo",
+            "svc",
+            "svr",
+        ],
+    ),
+    ("ridi-correct", &["tracker"]),
+    ("ridi-eval", &["align", "metrics", "pdr", "report"]),
+    (
+        "ridi",
+        &[
+            "baselines",
+            "convert",
+            "evaluate",
+            "inspect",
+            "lists",
+            "live",
+            "orientation",
+            "placement",
+            "plot",
+            "source",
+            "staging",
+            "track",
+            "train",
+        ],
+    ),
+];
+
+/// The names a field of a `LengthMismatch` or `NonFinite` variant may have.
+const ERROR_FIELDS: &[&str] = &["what", "expected", "found", "index", "series"];
+
+/// Runs every check under the workspace `root`; the error lists every problem found.
+pub fn run(root: &Path) -> Result<()> {
+    let mut problems = Vec::new();
+    let crates = workspace_crates(root)?;
+    let table = layer_table(&root.join("docs/ARCHITECTURE.md"))?;
+    check_layers(&crates, &table, &mut problems);
+    // xtask's own errors are anyhow's, and this file names the retired spellings.
+    for krate in crates.values().filter(|k| !k.dir.ends_with("xtask")) {
+        for file in rust_files(&krate.dir.join("src"))? {
+            let text = std::fs::read_to_string(&file)
+                .with_context(|| format!("reading {}", file.display()))?;
+            let shown = file
+                .strip_prefix(root)
+                .unwrap_or(&file)
+                .display()
+                .to_string();
+            check_error_spellings(&shown, &text, &mut problems);
+        }
+        check_public_modules(root, krate, &mut problems)?;
+    }
+    if problems.is_empty() {
+        println!(
+            "tidy: {} crates: layers, error spellings and public modules as documented",
+            crates.len()
+        );
+        return Ok(());
+    }
+    let mut text = String::new();
+    for p in &problems {
+        let _ = writeln!(text, "  {p}");
+    }
+    bail!("tidy found {} problem(s):\n{text}", problems.len())
+}
+
+/// A workspace crate: its folder and the workspace crates it depends on.
+#[derive(Debug)]
+pub struct Crate {
+    /// The folder holding its Cargo.toml.
+    pub dir: PathBuf,
+    /// Workspace crates among its normal and build dependencies.
+    pub deps: BTreeSet<String>,
+    /// Workspace crates among its dev-dependencies.
+    pub dev_deps: BTreeSet<String>,
+}
+
+/// The crates under `crates/` and `xtask/`, by package name.
+pub fn workspace_crates(root: &Path) -> Result<BTreeMap<String, Crate>> {
+    let mut dirs: Vec<PathBuf> = std::fs::read_dir(root.join("crates"))
+        .context("reading crates/")?
+        .map(|e| e.map(|e| e.path()))
+        .collect::<std::io::Result<_>>()?;
+    dirs.push(root.join("xtask"));
+    let mut manifests = BTreeMap::new();
+    for dir in dirs {
+        let path = dir.join("Cargo.toml");
+        if !path.is_file() {
+            continue;
+        }
+        let text = std::fs::read_to_string(&path)?;
+        let doc: toml::Table =
+            toml::from_str(&text).with_context(|| format!("parsing {}", path.display()))?;
+        let name = doc
+            .get("package")
+            .and_then(|p| p.get("name"))
+            .and_then(|n| n.as_str())
+            .with_context(|| format!("{}: no package.name", path.display()))?
+            .to_owned();
+        manifests.insert(name, (dir, doc));
+    }
+    let names: BTreeSet<String> = manifests.keys().cloned().collect();
+    let deps_of = |doc: &toml::Table, sections: &[&str]| -> BTreeSet<String> {
+        sections
+            .iter()
+            .filter_map(|s| doc.get(*s).and_then(|t| t.as_table()))
+            .flat_map(|t| t.keys())
+            .filter(|k| names.contains(*k))
+            .cloned()
+            .collect()
+    };
+    Ok(manifests
+        .into_iter()
+        .map(|(name, (dir, doc))| {
+            let deps = deps_of(&doc, &["dependencies", "build-dependencies"]);
+            let dev_deps = deps_of(&doc, &["dev-dependencies"]);
+            (
+                name,
+                Crate {
+                    dir,
+                    deps,
+                    dev_deps,
+                },
+            )
+        })
+        .collect())
+}
+
+/// The rows of the table under `## Layer table` in ARCHITECTURE.md: crate -> the workspace
+/// crates it depends on (`-` for none).
+pub fn layer_table(path: &Path) -> Result<BTreeMap<String, BTreeSet<String>>> {
+    let text =
+        std::fs::read_to_string(path).with_context(|| format!("reading {}", path.display()))?;
+    let section = text
+        .split("\n## ")
+        .find(|s| s.starts_with("Layer table"))
+        .with_context(|| format!("{}: no `## Layer table` section", path.display()))?;
+    let mut out = BTreeMap::new();
+    for line in section.lines().filter(|l| l.starts_with("| `")) {
+        let cells: Vec<&str> = line.trim_matches('|').split('|').map(str::trim).collect();
+        let [krate, deps, ..] = cells.as_slice() else {
+            bail!(
+                "{}: layer table row `{line}` has no second cell",
+                path.display()
+            );
+        };
+        let name = |s: &str| s.trim().trim_matches('`').to_owned();
+        let deps: BTreeSet<String> = deps
+            .split(',')
+            .map(name)
+            .filter(|d| !d.is_empty() && d != "-")
+            .collect();
+        out.insert(name(krate), deps);
+    }
+    if out.is_empty() {
+        bail!("{}: the layer table has no rows", path.display());
+    }
+    Ok(out)
+}
+
+/// Compares each crate's workspace dependencies with its row of the table.
+pub fn check_layers(
+    crates: &BTreeMap<String, Crate>,
+    table: &BTreeMap<String, BTreeSet<String>>,
+    problems: &mut Vec<String>,
+) {
+    for (name, krate) in crates {
+        let Some(allowed) = table.get(name) else {
+            problems.push(format!(
+                "{name}: not in the layer table of docs/ARCHITECTURE.md: add its row"
+            ));
+            continue;
+        };
+        for extra in krate.deps.difference(allowed) {
+            problems.push(format!(
+                "{name} depends on {extra}, which its row of the layer table \
+                 (docs/ARCHITECTURE.md) does not allow"
+            ));
+        }
+        for missing in allowed.difference(&krate.deps) {
+            problems.push(format!(
+                "{name}: the layer table says it depends on {missing}, its Cargo.toml does not: \
+                 correct the table"
+            ));
+        }
+        for dev in &krate.dev_deps {
+            if !allowed.contains(dev) && dev != "ridi-test-support" {
+                problems.push(format!(
+                    "{name} has a dev-dependency on {dev}, outside its row of the layer table"
+                ));
+            }
+        }
+    }
+    for name in table.keys().filter(|n| !crates.contains_key(*n)) {
+        problems.push(format!(
+            "the layer table of docs/ARCHITECTURE.md lists {name}, which is no workspace crate"
+        ));
+    }
+}
+
+/// Retired spellings in the error enums of one source file.
+pub fn check_error_spellings(file: &str, text: &str, problems: &mut Vec<String>) {
+    let lines: Vec<&str> = text.lines().collect();
+    for (i, line) in lines.iter().enumerate() {
+        let code = line.split("//").next().unwrap_or("");
+        if contains_word(code, "NotFinite") {
+            problems.push(format!(
+                "{file}:{}: `NotFinite` is retired: the variant is `NonFinite`",
+                i + 1
+            ));
+        }
+        let t = line.trim();
+        // A variant definition, not a use (`Error::LengthMismatch {` or a pattern).
+        let variant = ["LengthMismatch {", "NonFinite {"]
+            .into_iter()
+            .find(|v| t == *v);
+        let Some(variant) = variant else { continue };
+        for (j, field_line) in lines.iter().enumerate().skip(i + 1) {
+            let f = field_line.trim();
+            if f.starts_with('}') {
+                break;
+            }
+            if f.starts_with("//") || f.starts_with('#') {
+                continue;
+            }
+            let Some((field, _)) = f.split_once(':') else {
+                continue;
+            };
+            let field = field.trim().trim_start_matches("pub ").trim();
+            if !ERROR_FIELDS.contains(&field) {
+                problems.push(format!(
+                    "{file}:{}: field `{field}` of `{}`: the fields are spelled {}",
+                    j + 1,
+                    variant.trim_end_matches(" {"),
+                    ERROR_FIELDS.join(", ")
+                ));
+            }
+        }
+    }
+}
+
+fn contains_word(text: &str, word: &str) -> bool {
+    text.match_indices(word).any(|(at, _)| {
+        let before = text[..at].chars().next_back();
+        let after = text[at + word.len()..].chars().next();
+        let ident = |c: Option<char>| c.is_some_and(|c| c.is_alphanumeric() || c == '_');
+        !ident(before) && !ident(after)
+    })
+}
+
+/// `pub mod` declarations of the crate root outside [`PUBLIC_MODULES`].
+fn check_public_modules(root: &Path, krate: &Crate, problems: &mut Vec<String>) -> Result<()> {
+    let lib = krate.dir.join("src/lib.rs");
+    if !lib.is_file() {
+        return Ok(());
+    }
+    let name = krate
+        .dir
+        .file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    let allowed: &[&str] = PUBLIC_MODULES
+        .iter()
+        .find(|(c, _)| *c == name)
+        .map(|(_, m)| *m)
+        .unwrap_or(&[]);
+    let text = std::fs::read_to_string(&lib)?;
+    let shown = lib.strip_prefix(root).unwrap_or(&lib).display().to_string();
+    for (i, line) in text.lines().enumerate() {
+        let Some(module) = line.trim().strip_prefix("pub mod ") else {
+            continue;
+        };
+        let module = module.trim_end_matches(';').trim();
+        if !allowed.contains(&module) {
+            problems.push(format!(
+                "{shown}:{}: `pub mod {module}`: make the module private and re-export its \
+                 items at the crate root (xtask/src/tidy.rs, PUBLIC_MODULES)",
+                i + 1
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// Every `.rs` file under `dir`, sorted.
+fn rust_files(dir: &Path) -> Result<Vec<PathBuf>> {
+    let mut out = Vec::new();
+    if !dir.is_dir() {
+        return Ok(out);
+    }
+    let mut stack = vec![dir.to_path_buf()];
+    while let Some(d) = stack.pop() {
+        for entry in std::fs::read_dir(&d).with_context(|| format!("reading {}", d.display()))? {
+            let path = entry?.path();
+            if path.is_dir() {
+                stack.push(path);
+            } else if path.extension().is_some_and(|e| e == "rs") {
+                out.push(path);
+            }
+        }
+    }
+    out.sort();
+    Ok(out)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn retired_error_spellings_are_named_with_file_and_line() {
+        let text = "pub enum E {\n    LengthMismatch {\n        /// Which.\n        what: &'static str,\n        left: usize,\n    },\n    NotFinite,\n}\nfn f() { E::LengthMismatch {\n left: 1 }; }\n";
+        let mut problems = Vec::new();
+        check_error_spellings("x.rs", text, &mut problems);
+        assert_eq!(
+            problems,
+            [
+                "x.rs:5: field `left` of `LengthMismatch`: the fields are spelled what, \
+                 expected, found, index, series",
+                "x.rs:7: `NotFinite` is retired: the variant is `NonFinite`",
+            ]
+        );
+        let mut none = Vec::new();
+        check_error_spellings(
+            "y.rs",
+            "enum E { NonFiniteTarget }\n// NotFinite\n",
+            &mut none,
+        );
+        assert!(none.is_empty(), "{none:?}");
+    }
+
+    #[test]
+    fn a_dependency_outside_the_table_and_a_stale_row_are_problems() {
+        let krate = |deps: &[&str], dev: &[&str]| Crate {
+            dir: PathBuf::new(),
+            deps: deps.iter().map(|s| s.to_string()).collect(),
+            dev_deps: dev.iter().map(|s| s.to_string()).collect(),
+        };
+        let crates = BTreeMap::from([
+            ("low".to_owned(), krate(&["high"], &["ridi-test-support"])),
+            ("high".to_owned(), krate(&["low"], &["other"])),
+        ]);
+        let set = |s: &[&str]| s.iter().map(|s| s.to_string()).collect::<BTreeSet<_>>();
+        let table = BTreeMap::from([
+            ("low".to_owned(), set(&[])),
+            ("high".to_owned(), set(&["low", "mid"])),
+            ("gone".to_owned(), set(&[])),
+        ]);
+        let mut problems = Vec::new();
+        check_layers(&crates, &table, &mut problems);
+        assert_eq!(problems.len(), 4, "{problems:#?}");
+        assert!(problems[0].starts_with("high: the layer table says it depends on mid"));
+        assert!(problems[1].starts_with("high has a dev-dependency on other"));
+        assert!(problems[2].starts_with("low depends on high"));
+        assert!(problems[3].contains("lists gone, which is no workspace crate"));
+    }
+
+    #[test]
+    fn the_workspace_is_tidy() {
+        run(&crate::workspace_root()).unwrap();
+    }
+}
