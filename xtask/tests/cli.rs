@@ -4,15 +4,13 @@ use std::fs;
 use std::path::Path;
 use std::process::{Command, Output};
 
+use ridi_test_support::{shared_dataset, stderr};
+
 fn xtask(args: &[&str]) -> Output {
     Command::new(env!("CARGO_BIN_EXE_xtask"))
         .args(args)
         .output()
         .unwrap()
-}
-
-fn stderr(o: &Output) -> String {
-    String::from_utf8_lossy(&o.stderr).into_owned()
 }
 
 #[test]
@@ -57,8 +55,7 @@ layout = ["x"]
 #[test]
 #[ignore = "needs ../shared beside the checkout: `cargo test --workspace --tests -- --ignored` (.ci/run)"]
 fn tyrex_from_the_shared_folder_installs_then_is_a_no_op() {
-    let shared = xtask::workspace_root().join("../shared/data/raw/tyrex-attitude-smartphones");
-    assert!(shared.is_dir(), "{} not found", shared.display());
+    let shared = shared_dataset("tyrex-attitude-smartphones", "datasets/android");
     let tmp = tempfile::tempdir().unwrap();
     let d = tmp.path().to_str().unwrap();
     let from = shared.to_str().unwrap();

@@ -10,6 +10,7 @@ use std::sync::{Arc, Mutex};
 use std::thread::JoinHandle;
 use std::time::{Duration, Instant};
 
+use ridi_test_support::{file_names, shared_dataset};
 use xtask::checksum::{self, ListEntry};
 use xtask::fetch::{self, MARKER, Marker, Options, Outcome};
 use xtask::manifest::Dataset;
@@ -253,17 +254,6 @@ fn options(dir: &Path) -> Options {
     }
 }
 
-fn entries_of(dir: &Path) -> Vec<String> {
-    let mut names: Vec<String> = fs::read_dir(dir)
-        .map(|rd| {
-            rd.map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
-                .collect()
-        })
-        .unwrap_or_default();
-    names.sort();
-    names
-}
-
 fn assert_installed(dir: &Path) {
     let root = dir.join("demo");
     for (name, content) in FILES {
@@ -275,7 +265,7 @@ fn assert_installed(dir: &Path) {
     }
     assert!(root.join(MARKER).is_file());
     // Nothing but the dataset: no .part, no staging folder.
-    assert_eq!(entries_of(dir), vec!["demo".to_string()]);
+    assert_eq!(file_names(dir), vec!["demo".to_string()]);
 }
 
 fn err_text(r: anyhow::Result<Outcome>) -> String {
@@ -374,7 +364,7 @@ fn a_changed_pin_replaces_the_stale_dataset() {
         !root.join("seq2").exists(),
         "content of the old archive survived"
     );
-    assert_eq!(entries_of(tmp.path()), vec!["demo".to_string()]);
+    assert_eq!(file_names(tmp.path()), vec!["demo".to_string()]);
 }
 
 #[test]
@@ -387,9 +377,9 @@ fn wrong_checksum_is_rejected_and_nothing_is_left() {
     let err = err_text(fetch::fetch(&ds, &options(tmp.path())));
     assert!(err.contains("sha256 mismatch"), "{err}");
     assert!(
-        entries_of(tmp.path()).is_empty(),
+        file_names(tmp.path()).is_empty(),
         "left behind: {:?}",
-        entries_of(tmp.path())
+        file_names(tmp.path())
     );
 }
 
@@ -462,9 +452,9 @@ fn server_error_fails_with_the_status_and_leaves_nothing() {
     assert!(err.contains("HTTP 500"), "{err}");
     assert!(!err.contains('\n'), "error is not one line: {err}");
     assert!(
-        entries_of(tmp.path()).is_empty(),
+        file_names(tmp.path()).is_empty(),
         "left behind: {:?}",
-        entries_of(tmp.path())
+        file_names(tmp.path())
     );
 }
 
@@ -511,9 +501,9 @@ fn archive_with_parent_dir_entries_is_rejected() {
         assert!(!p.exists(), "{} was written", p.display());
     }
     assert!(
-        entries_of(&dir).is_empty(),
+        file_names(&dir).is_empty(),
         "left behind: {:?}",
-        entries_of(&dir)
+        file_names(&dir)
     );
 }
 
@@ -557,9 +547,9 @@ fn missing_layout_path_is_reported_and_nothing_installed() {
     let err = err_text(fetch::fetch(&ds, &options(tmp.path())));
     assert!(err.contains("seq3/data.csv"), "{err}");
     assert!(
-        entries_of(tmp.path()).is_empty(),
+        file_names(tmp.path()).is_empty(),
         "left behind: {:?}",
-        entries_of(tmp.path())
+        file_names(tmp.path())
     );
 }
 
@@ -667,9 +657,9 @@ fn from_local_folder_with_a_modified_file_is_rejected() {
     assert!(err.contains("2 of 3 files"), "{err}");
     assert!(err.contains("list.txt: missing"), "{err}");
     assert!(
-        entries_of(&dir).is_empty(),
+        file_names(&dir).is_empty(),
         "left behind: {:?}",
-        entries_of(&dir)
+        file_names(&dir)
     );
 }
 
@@ -739,16 +729,19 @@ fn a_folder_not_made_by_fetch_is_never_overwritten() {
 #[ignore = "needs ../shared beside the checkout: `cargo test --workspace --tests -- --ignored` (.ci/run)"]
 fn committed_lists_match_the_shared_local_copies() {
     let root = xtask::workspace_root();
-    let shared = root.join("../shared/data/raw");
-    for (list, folder) in [
-        ("tyrex.sha256", "tyrex-attitude-smartphones"),
+    for (list, folder, probe) in [
+        (
+            "tyrex.sha256",
+            "tyrex-attitude-smartphones",
+            "datasets/android",
+        ),
         (
             "indoor-location-competition-20.sha256",
             "indoor-location-competition-20",
+            "data",
         ),
     ] {
-        let folder = shared.join(folder);
-        assert!(folder.is_dir(), "{} not found", folder.display());
+        let folder = shared_dataset(folder, probe);
         let text = fs::read_to_string(root.join("datasets").join(list)).unwrap();
         let committed = checksum::parse_list(&text, Path::new(list)).unwrap();
         let actual: Vec<ListEntry> = checksum::list_tree(&folder).unwrap();

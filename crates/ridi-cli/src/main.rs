@@ -13,7 +13,7 @@ use ridi::data::{Format, ListEntry, ReadOptions, Sequence};
 use ridi::eval::{AlignWindow, EvalConfig};
 use ridi::features::FeatureConfig;
 use ridi::frames::UpAxis;
-use ridi::regress::{Cascade, ProgressEvent, RegressError, Stage, Storage, model_file};
+use ridi::regress::{Cascade, MODEL_MAGIC, ProgressEvent, RegressError, Stage, Storage};
 use ridi::source::{ReadFiles, folder_of, resolved};
 use ridi::staging::Staging;
 use ridi::{
@@ -490,7 +490,8 @@ fn run(cli: Cli) -> Result<()> {
                 }
             })?;
             print_training(&model);
-            model_file::save(&model, &out)
+            model
+                .save(&out)
                 .with_context(|| format!("cannot write {}", out.display()))?;
             outln!("model: {}", out.display());
         }
@@ -773,7 +774,7 @@ fn load_listed(entries: Vec<ListEntry>, map: Option<&str>, purpose: Purpose) -> 
 }
 
 fn load_model(path: &Path) -> Result<Cascade> {
-    model_file::load(path).with_context(|| format!("cannot load model {}", path.display()))
+    Cascade::load(path).with_context(|| format!("cannot load model {}", path.display()))
 }
 
 fn bar(len: u64) -> ProgressBar {
@@ -824,7 +825,7 @@ fn is_model_file(path: &Path) -> bool {
         return false;
     };
     let mut head = Vec::new();
-    let magic = &model_file::MAGIC;
+    let magic = &MODEL_MAGIC;
     file.take(magic.len() as u64).read_to_end(&mut head).is_ok()
         && !head.is_empty()
         && magic.starts_with(&head)
@@ -899,7 +900,8 @@ fn evaluate_and_write(
         Staging::new(out).with_context(|| format!("cannot write into {}", out.display()))?;
     if let Some(name) = model_name {
         let path = staging.file(Path::new(name))?;
-        model_file::save(model, &path)
+        model
+            .save(&path)
             .with_context(|| format!("cannot write {}", out.join(name).display()))?;
     }
     let mut written = Vec::new();

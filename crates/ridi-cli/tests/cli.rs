@@ -5,6 +5,7 @@ use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
 use ridi::frames::UpAxis;
+use ridi_test_support::{assert_names_file, file_names, sample_dataset, stderr};
 
 fn ridi(args: &[&str]) -> Output {
     Command::new(env!("CARGO_BIN_EXE_ridi"))
@@ -13,21 +14,13 @@ fn ridi(args: &[&str]) -> Output {
         .expect("run ridi")
 }
 
-fn sample() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("../../datasets/sample")
-}
-
 fn s(p: &Path) -> &str {
     p.to_str().unwrap()
 }
 
-fn stderr(o: &Output) -> String {
-    String::from_utf8_lossy(&o.stderr).into_owned()
-}
-
 #[test]
 fn inspect_prints_text_and_json() {
-    let seq = sample().join("Jakob_Nexus5_NoDist_Texting");
+    let seq = sample_dataset().join("Jakob_Nexus5_NoDist_Texting");
     let out = ridi(&["inspect", s(&seq)]);
     assert!(out.status.success(), "{}", stderr(&out));
     let text = String::from_utf8(out.stdout).unwrap();
@@ -43,7 +36,7 @@ fn inspect_prints_text_and_json() {
     assert_eq!(json["upside_down_fraction"], 0.0);
 
     // Guillaume swings the phone top down: inspect says so.
-    let seq = sample().join("Guillaume_Nexus5_NoDist_Swinging");
+    let seq = sample_dataset().join("Guillaume_Nexus5_NoDist_Swinging");
     let out = ridi(&["inspect", s(&seq), "--json"]);
     let json: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
     assert!(
@@ -94,7 +87,7 @@ fn inspect_prints_text_and_json() {
     // One frame: no rate to speak of, and nothing to do with it.
     let one = dir.path().join("one.csv");
     let seq = ridi::data::read_sequence(
-        sample().join("Jakob_Nexus5_NoDist_Texting"),
+        sample_dataset().join("Jakob_Nexus5_NoDist_Texting"),
         &ridi::data::ReadOptions::default(),
     )
     .unwrap();
@@ -165,17 +158,35 @@ fn errors_are_one_line_with_a_non_zero_exit() {
     // A model file that is not one.
     let model = dir.path().join("m.ridi");
     std::fs::write(&model, b"not a model").unwrap();
-    let seq = sample().join("Jakob_Nexus5_NoDist_Texting");
+    let seq = sample_dataset().join("Jakob_Nexus5_NoDist_Texting");
     let csv = dir.path().join("t.csv");
     let out = ridi(&["track", s(&seq), "--model", s(&model), "--out", s(&csv)]);
     let err = stderr(&out);
     assert!(!out.status.success() && err.contains("m.ridi"), "{err}");
     assert!(!csv.exists(), "no output on failure");
-    // Inspected, a `.ridi` file is judged as a model, whatever its bytes.
-    for bytes in [&b"not a model"[..], b""] {
-        std::fs::write(&model, bytes).unwrap();
-        let err = stderr(&ridi(&["inspect", s(&model)]));
+    // Inspected, a `.ridi` file is judged as a model, whatever its bytes; each way a model file
+    // can be damaged (magic, length, version, checksum, payload) is an error naming the file.
+    let header = |version: u32, len: u64, crc: u32| {
+        let mut h = b"RIDIREG\0".to_vec();
+        h.extend(version.to_le_bytes());
+        h.extend(len.to_le_bytes());
+        h.extend(crc.to_le_bytes());
+        h
+    };
+    for bytes in [
+        b"not a model".to_vec(),
+        Vec::new(),
+        b"RIDIR".to_vec(),
+        header(7, 0, 0)[..20].to_vec(),
+        header(99, 0, 0),
+        header(7, 100, 0),
+        [header(7, 4, 0), b"abcd".to_vec()].concat(),
+        header(7, 0, 0),
+    ] {
+        std::fs::write(&model, &bytes).unwrap();
+        let err = error(&ridi(&["inspect", s(&model)]));
         assert!(err.starts_with("error: cannot load model"), "{err}");
+        assert_names_file(&err, &model);
     }
     // Something that exists but is neither file nor folder is not called missing.
     if cfg!(unix) {
@@ -196,7 +207,7 @@ fn a_closed_stdout_is_no_panic() {
     // `ridi inspect ... | head -0`: the reader is gone before ridi writes.
     let (reader, writer) = std::io::pipe().unwrap();
     drop(reader);
-    let seq = sample().join("Jakob_Nexus5_NoDist_Texting");
+    let seq = sample_dataset().join("Jakob_Nexus5_NoDist_Texting");
     let out = Command::new(env!("CARGO_BIN_EXE_ridi"))
         .args(["inspect", s(&seq)])
         .stdout(writer)
@@ -210,7 +221,7 @@ fn a_closed_stdout_is_no_panic() {
 #[test]
 fn bad_flags_and_outputs_fail_before_any_work() {
     let dir = tempfile::tempdir().unwrap();
-    let list = sample().join("list_Guillaume.txt");
+    let list = sample_dataset().join("list_Guillaume.txt");
     let model = dir.path().join("m.ridi");
     let train = |list: &Path, extra: &[&str]| {
         let mut args = vec!["train", "--list", s(list), "--grid", "none"];
@@ -242,8 +253,8 @@ fn bad_flags_and_outputs_fail_before_any_work() {
     assert!(!printed.contains("placements:"), "trained first: {printed}");
     // A label the placement map does not know is named with its list file and line.
     let typo = dir.path().join("typo.txt");
-    let swing = sample().join("Guillaume_Nexus5_NoDist_Swinging");
-    let texting = sample().join("Guillaume_Nexus5_NoDist_Texting");
+    let swing = sample_dataset().join("Guillaume_Nexus5_NoDist_Swinging");
+    let texting = sample_dataset().join("Guillaume_Nexus5_NoDist_Texting");
     std::fs::write(
         &typo,
         format!("{},Texting\n{},Swingin\n", s(&texting), s(&swing)),
@@ -267,7 +278,7 @@ fn bad_flags_and_outputs_fail_before_any_work() {
     );
     assert_eq!(err.lines().count(), 1, "{err}");
 
-    let seq = sample().join("Jakob_Nexus5_NoDist_Texting");
+    let seq = sample_dataset().join("Jakob_Nexus5_NoDist_Texting");
     let csv = dir.path().join("t.csv");
     let track = |extra: &[&str]| {
         let mut args = vec!["track", s(&seq), "--model", s(&model), "--out", s(&csv)];
@@ -301,7 +312,7 @@ fn bad_flags_and_outputs_fail_before_any_work() {
 fn convert_train_track_and_eval() {
     let dir = tempfile::tempdir().unwrap();
     let conv = dir.path().join("conv");
-    let seq = sample().join("Guillaume_Nexus5_NoDist_Swinging");
+    let seq = sample_dataset().join("Guillaume_Nexus5_NoDist_Swinging");
     let out = ridi(&["convert", s(&seq), "--out", s(&conv)]);
     assert!(out.status.success(), "{}", stderr(&out));
     assert!(
@@ -311,7 +322,7 @@ fn convert_train_track_and_eval() {
     assert!(conv.join("list_all.txt").is_file());
 
     let model = dir.path().join("m.ridi");
-    let list = sample().join("list_Guillaume.txt");
+    let list = sample_dataset().join("list_Guillaume.txt");
     // Guillaume's runs in 4 groups, without grid search, and `extra`.
     let train = |out: &Path, extra: &[&str]| {
         let mut args = vec![
@@ -344,8 +355,8 @@ fn convert_train_track_and_eval() {
     assert!(!printed.contains("speed:"), "{printed}");
     assert!(printed.contains("S built on: device +y\n"), "{printed}");
     assert!(printed.contains("orientation: as recorded"), "{printed}");
-    let paper_model = ridi::regress::model_file::load(&paper).unwrap();
-    let default_model = ridi::regress::model_file::load(&model).unwrap();
+    let paper_model = ridi::regress::Cascade::load(&paper).unwrap();
+    let default_model = ridi::regress::Cascade::load(&model).unwrap();
     assert_eq!(paper_model.feature_config().step, 10);
     assert_eq!(default_model.feature_config().step, 20);
     assert_eq!(paper_model.feature_config().up_axis, UpAxis::PlusY);
@@ -399,7 +410,7 @@ fn convert_train_track_and_eval() {
 
     let csv = dir.path().join("t.csv");
     let png = dir.path().join("t.png");
-    let test_seq = sample().join("Jakob_Nexus5_NoDist_Texting");
+    let test_seq = sample_dataset().join("Jakob_Nexus5_NoDist_Texting");
     let track_to = |input: &Path, out: &Path, extra: &[&str]| {
         let mut args = vec!["track", s(input), "--model", s(&model), "--out", s(out)];
         args.extend_from_slice(extra);
@@ -410,15 +421,14 @@ fn convert_train_track_and_eval() {
     assert_eq!(std::fs::read_to_string(&csv).unwrap().lines().count(), 4801);
     assert!(std::fs::read(&png).unwrap().starts_with(b"\x89PNG"));
     // The trajectory's temporary name is gone once it is in place.
-    let hidden: Vec<_> = std::fs::read_dir(dir.path())
-        .unwrap()
-        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+    let hidden: Vec<_> = file_names(dir.path())
+        .into_iter()
         .filter(|n| n.starts_with('.'))
         .collect();
     assert!(hidden.is_empty(), "{hidden:?}");
 
     let report = dir.path().join("report");
-    let test_list = sample().join("list_Jakob.txt");
+    let test_list = sample_dataset().join("list_Jakob.txt");
     let out = ridi(&[
         "eval",
         "--list",
@@ -524,12 +534,7 @@ fn convert_train_track_and_eval() {
         std::fs::read(report.join("report.json")).unwrap(),
         json_before
     );
-    let mut left: Vec<String> = std::fs::read_dir(&report)
-        .unwrap()
-        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
-        .collect();
-    left.sort();
-    assert_eq!(left, ["report.json", "report.md"]);
+    assert_eq!(file_names(&report), ["report.json", "report.md"]);
     std::fs::remove_dir(report.join("report.md")).unwrap();
     // A file where the plots go is named before the evaluation.
     std::fs::write(report.join("plots"), "mine").unwrap();
@@ -549,7 +554,7 @@ fn convert_train_track_and_eval() {
     // Two recordings of one name (copies of one recording would be refused as such).
     for (name, from) in [
         ("a", &test_seq),
-        ("b", &sample().join("Jakob_Nexus5_NoDist_Phoning")),
+        ("b", &sample_dataset().join("Jakob_Nexus5_NoDist_Phoning")),
     ] {
         let run = dir.path().join(name).join("run/processed");
         std::fs::create_dir_all(&run).unwrap();
@@ -813,7 +818,7 @@ fn raw_folders_name_the_file_to_blame() {
 fn convert_writes_all_or_nothing() {
     let dir = tempfile::tempdir().unwrap();
     let src = dir.path().join("src");
-    let texting = sample().join("Thibaud_Nexus5_NoDist_Texting");
+    let texting = sample_dataset().join("Thibaud_Nexus5_NoDist_Texting");
     for name in ["a_seq", "b_seq", "c_seq"] {
         let out = ridi(&["convert", s(&texting), "--out", s(&dir.path().join("tmp"))]);
         assert!(out.status.success());
@@ -896,7 +901,7 @@ fn demo_writes_model_reports_and_plots_all_or_nothing() {
     let dir = tempfile::tempdir().unwrap();
     let data = dir.path().join("data");
     std::fs::create_dir_all(&data).unwrap();
-    let line = |name: &str, label: &str| format!("{},{label}\n", s(&sample().join(name)));
+    let line = |name: &str, label: &str| format!("{},{label}\n", s(&sample_dataset().join(name)));
     std::fs::write(
         data.join("list_train.txt"),
         line("Guillaume_Nexus5_NoDist_Texting", "Texting")
@@ -921,7 +926,7 @@ fn demo_writes_model_reports_and_plots_all_or_nothing() {
     assert!(run.status.success(), "{}", stderr(&run));
     let report = std::fs::read(out.join("report.json")).unwrap();
     let model = std::fs::read(out.join("model.ridi")).unwrap();
-    ridi::regress::model_file::from_bytes(&model).unwrap();
+    ridi::regress::Cascade::from_bytes(&model).unwrap();
     assert!(
         out.join("plots/Jakob_Nexus5_NoDist_Texting.trajectory.svg")
             .is_file()
@@ -930,7 +935,7 @@ fn demo_writes_model_reports_and_plots_all_or_nothing() {
     // A held-out recording too short to track fails the demo at its list line, before
     // training, and the earlier demo's files stay as they were (none added, no staging left).
     let seq = ridi::data::read_sequence(
-        sample().join("Jakob_Nexus5_NoDist_Swinging"),
+        sample_dataset().join("Jakob_Nexus5_NoDist_Swinging"),
         &Default::default(),
     )
     .unwrap();
@@ -989,7 +994,7 @@ fn demo_writes_model_reports_and_plots_all_or_nothing() {
     let copy = data.join("copy/processed");
     std::fs::create_dir_all(&copy).unwrap();
     let swinging = ridi::data::read_sequence(
-        sample().join("Guillaume_Nexus5_NoDist_Swinging"),
+        sample_dataset().join("Guillaume_Nexus5_NoDist_Swinging"),
         &Default::default(),
     )
     .unwrap();

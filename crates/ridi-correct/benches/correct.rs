@@ -15,7 +15,7 @@ use std::hint::black_box;
 use std::time::Duration;
 
 use criterion::{Criterion, criterion_group, criterion_main};
-use ridi_correct::{CorrectionConfig, Corrector, ImuSlices, InitialVelocity, solve_dense};
+use ridi_correct::{CorrectionConfig, Corrector, InitialVelocity, solve_dense};
 use ridi_frames::WorldVec;
 
 fn bench(c: &mut Criterion) {
@@ -43,12 +43,7 @@ fn bench(c: &mut Criterion) {
     });
     g.finish();
 
-    let imu = ImuSlices {
-        time: &w.time[..1000],
-        linacce: &w.linacce[..1000],
-        orientation: &w.orientation[..1000],
-        gravity: &w.gravity[..1000],
-    };
+    let imu = w.imu().slice(0..1000);
     let window_targets: Vec<_> = targets.iter().copied().filter(|t| t.frame < 1000).collect();
     let mut g = c.benchmark_group("window");
     g.sample_size(50).measurement_time(Duration::from_secs(3));
@@ -66,12 +61,7 @@ fn bench(c: &mut Criterion) {
     g.finish();
 
     let n = 12_000;
-    let imu = ImuSlices {
-        time: &w.time[..n],
-        linacce: &w.linacce[..n],
-        orientation: &w.orientation[..n],
-        gravity: &w.gravity[..n],
-    };
+    let imu = w.imu().slice(0..n);
     let t1: Vec<_> = targets.iter().copied().filter(|t| t.frame < n).collect();
     let mut g = c.benchmark_group("dense_vs_banded");
     g.sample_size(10).measurement_time(Duration::from_secs(4));

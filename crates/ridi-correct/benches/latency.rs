@@ -10,9 +10,9 @@ use std::time::Instant;
 
 use ridi_correct::{
     CorrectionConfig, CorrectionOutcome, Corrector, FrameWindow, Regression, RegressorError,
-    Sample, Tracker, TrackerConfig, VelocityRegressor, solve_dense,
+    Tracker, TrackerConfig, VelocityRegressor, solve_dense,
 };
-use ridi_frames::WorldVec;
+use ridi_frames::{ImuSample, WorldVec};
 
 /// Replays a lap's exact velocities (frame modulo lap length): a regression costs nothing,
 /// so the measurements isolate integration and correction.
@@ -77,8 +77,8 @@ fn percentile(sorted: &[f64], p: f64) -> f64 {
 fn main() {
     // One-minute lap, replayed on a continuous clock.
     let lap = common::walk(12_000, 50, WorldVec::ZERO, true);
-    let lap_samples: Vec<Sample> = (0..lap.time.len())
-        .map(|f| Sample {
+    let lap_samples: Vec<ImuSample> = (0..lap.time.len())
+        .map(|f| ImuSample {
             time: lap.time[f],
             gyro: lap.gyro[f],
             linacce: lap.linacce[f],
@@ -203,12 +203,7 @@ fn main() {
     );
 
     // One streaming window (1,000 frames, 20 targets), warm.
-    let imu = ridi_correct::ImuSlices {
-        time: &ten.time[..1000],
-        linacce: &ten.linacce[..1000],
-        orientation: &ten.orientation[..1000],
-        gravity: &ten.gravity[..1000],
-    };
+    let imu = ten.imu().slice(0..1000);
     let wt: Vec<_> = targets.iter().copied().filter(|t| t.frame < 1000).collect();
     corrector.solve(&imu, &wt).unwrap();
     let (wall, cpu) = timed(20_000, || {

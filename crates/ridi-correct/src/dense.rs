@@ -10,21 +10,22 @@ use ridi_frames::{DeviceVec, WorldVec};
 
 use crate::config::{CorrectionConfig, InitialVelocity};
 use crate::error::CorrectError;
-use crate::input::{ImuSlices, VelocityTarget, validate_targets};
+use crate::input::{VelocityTarget, validate_imu, validate_targets};
 use crate::integrate::{corrected_acceleration_unchecked, integrate_unchecked};
 use crate::knots::{BiasCurve, Knots};
 use crate::solve::Correction;
+use ridi_frames::ImuFrames;
 
 /// The value of the correction objective (see the [crate docs](crate#the-objective)) for a
 /// given bias and initial velocity, computed by integrating the corrected accelerations.
 pub fn objective(
     config: &CorrectionConfig,
-    imu: &ImuSlices<'_>,
+    imu: &ImuFrames<'_>,
     targets: &[VelocityTarget],
     correction: &Correction,
 ) -> Result<f64, CorrectError> {
     config.validate()?;
-    imu.validate(config.max_dt)?;
+    validate_imu(imu, config.max_dt)?;
     validate_targets(targets, imu.len())?;
     let acc = corrected_acceleration_unchecked(imu, &correction.bias);
     let poses = integrate_unchecked(imu.time, &acc, correction.initial_velocity, WorldVec::ZERO);
@@ -54,11 +55,11 @@ pub fn objective(
 /// number of knots; meant for verification and benchmarks.
 pub fn solve_dense(
     config: &CorrectionConfig,
-    imu: &ImuSlices<'_>,
+    imu: &ImuFrames<'_>,
     targets: &[VelocityTarget],
 ) -> Result<Correction, CorrectError> {
     config.validate()?;
-    imu.validate(config.max_dt)?;
+    validate_imu(imu, config.max_dt)?;
     validate_targets(targets, imu.len())?;
     let knots = Knots::new(imu.time, config.knot_spacing);
     let estimate = config.initial_velocity == InitialVelocity::Estimate;

@@ -99,3 +99,18 @@ pub enum CorrectError {
     #[error("out of memory while factorizing the correction system")]
     OutOfMemory,
 }
+
+impl From<ridi_frames::ImuError> for CorrectError {
+    fn from(e: ridi_frames::ImuError) -> Self {
+        let ridi_frames::ImuError::LengthMismatch {
+            what,
+            expected,
+            found,
+        } = e;
+        CorrectError::LengthMismatch {
+            what,
+            expected,
+            found,
+        }
+    }
+}

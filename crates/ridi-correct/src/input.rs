@@ -1,97 +1,59 @@
-//! Inputs of a correction: per-frame IMU slices and regressed velocity targets.
+//! Inputs of a correction: checks of its frames, and regressed velocity targets.
 
-use ridi_frames::{DeviceVec, StabHorizontal, WorldFromDevice};
+use ridi_frames::{ImuFrames, StabHorizontal};
 use serde::{Deserialize, Serialize};
 
 use crate::error::CorrectError;
 
-/// Per-frame inputs of a correction, as plain slices (one entry per frame).
-///
-/// All slices must have the length of `time`.
-#[derive(Debug, Clone, Copy)]
-pub struct ImuSlices<'a> {
-    /// Timestamps, seconds, strictly increasing.
-    pub time: &'a [f64],
-    /// Linear acceleration (gravity removed), device frame, m/s².
-    pub linacce: &'a [DeviceVec],
-    /// Device orientation, world-from-device.
-    pub orientation: &'a [WorldFromDevice],
-    /// Gravity as the Android gravity sensor reports it (pointing up), device frame. Only the
-    /// target frames use it, to build the stabilized frame S.
-    pub gravity: &'a [DeviceVec],
-}
-
-impl ImuSlices<'_> {
-    /// Number of frames.
-    pub fn len(&self) -> usize {
-        self.time.len()
+/// Checks a correction's frames: not empty, every stream as long as `time`, time finite and
+/// increasing by at most `max_dt`, and linear acceleration, gravity and orientation finite (the
+/// gyro is not read).
+pub(crate) fn validate_imu(imu: &ImuFrames<'_>, max_dt: f64) -> Result<(), CorrectError> {
+    let n = imu.len();
+    if n == 0 {
+        return Err(CorrectError::Empty);
     }
-
-    /// `true` when there is no frame.
-    pub fn is_empty(&self) -> bool {
-        self.time.is_empty()
+    imu.check_lengths()?;
+    validate_time(imu.time, max_dt)?;
+    // Branch-free scan first (one pass, no early exit); the loop below only runs to name
+    // the culprit.
+    let mut ok = true;
+    for f in 0..n {
+        let (a, g) = (imu.linacce[f].vector(), imu.gravity[f].vector());
+        let q = &imu.orientation[f].quaternion().coords;
+        let s = a.x + a.y + a.z + g.x + g.y + g.z + q.x + q.y + q.z + q.w;
+        // A sum of finite values can only overflow, which the slow path then clears.
+        ok &= s.is_finite();
     }
-
-    /// Checks lengths, finiteness, increasing time and the largest step `max_dt`.
-    pub fn validate(&self, max_dt: f64) -> Result<(), CorrectError> {
-        let n = self.time.len();
-        if n == 0 {
-            return Err(CorrectError::Empty);
-        }
-        for (what, got) in [
-            ("linacce", self.linacce.len()),
-            ("orientation", self.orientation.len()),
-            ("gravity", self.gravity.len()),
-        ] {
-            if got != n {
-                return Err(CorrectError::LengthMismatch {
-                    what,
-                    expected: n,
-                    found: got,
-                });
-            }
-        }
-        validate_time(self.time, max_dt)?;
-        // Branch-free scan first (one pass, no early exit); the loop below only runs to name
-        // the culprit.
-        let mut ok = true;
-        for f in 0..n {
-            let (a, g) = (self.linacce[f].vector(), self.gravity[f].vector());
-            let q = &self.orientation[f].quaternion().coords;
-            let s = a.x + a.y + a.z + g.x + g.y + g.z + q.x + q.y + q.z + q.w;
-            // A sum of finite values can only overflow, which the slow path then clears.
-            ok &= s.is_finite();
-        }
-        if ok {
-            return Ok(());
-        }
-        for f in 0..n {
-            if !self.linacce[f].is_finite() {
-                return Err(CorrectError::NonFinite {
-                    what: "linacce",
-                    index: f,
-                });
-            }
-            if !self.gravity[f].is_finite() {
-                return Err(CorrectError::NonFinite {
-                    what: "gravity",
-                    index: f,
-                });
-            }
-            if !self.orientation[f]
-                .quaternion()
-                .coords
-                .iter()
-                .all(|c| c.is_finite())
-            {
-                return Err(CorrectError::NonFinite {
-                    what: "orientation",
-                    index: f,
-                });
-            }
-        }
-        Ok(())
+    if ok {
+        return Ok(());
     }
+    for f in 0..n {
+        if !imu.linacce[f].is_finite() {
+            return Err(CorrectError::NonFinite {
+                what: "linacce",
+                index: f,
+            });
+        }
+        if !imu.gravity[f].is_finite() {
+            return Err(CorrectError::NonFinite {
+                what: "gravity",
+                index: f,
+            });
+        }
+        if !imu.orientation[f]
+            .quaternion()
+            .coords
+            .iter()
+            .all(|c| c.is_finite())
+        {
+            return Err(CorrectError::NonFinite {
+                what: "orientation",
+                index: f,
+            });
+        }
+    }
+    Ok(())
 }
 
 /// Checks that `time` is finite, strictly increasing, with steps of at most `max_dt`.

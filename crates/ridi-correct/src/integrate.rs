@@ -16,8 +16,9 @@ use ridi_frames::{WorldVec, nalgebra::Vector3};
 use serde::{Deserialize, Serialize};
 
 use crate::error::CorrectError;
-use crate::input::{ImuSlices, validate_time};
+use crate::input::{validate_imu, validate_time};
 use crate::knots::BiasCurve;
+use ridi_frames::ImuFrames;
 
 /// Position and velocity of one frame, world frame.
 #[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
@@ -128,9 +129,9 @@ pub(crate) fn integrate_unchecked(
 /// World-frame accelerations `R_WI(f) a_I(f)` (no bias correction).
 ///
 /// # Errors
-/// What [`ImuSlices::validate`] refuses (any time step is accepted).
-pub fn world_acceleration(imu: &ImuSlices<'_>) -> Result<Vec<WorldVec>, CorrectError> {
-    imu.validate(f64::INFINITY)?;
+/// Refuses frames a correction refuses (any time step is accepted).
+pub fn world_acceleration(imu: &ImuFrames<'_>) -> Result<Vec<WorldVec>, CorrectError> {
+    validate_imu(imu, f64::INFINITY)?;
     Ok(imu
         .orientation
         .iter()
@@ -143,18 +144,18 @@ pub fn world_acceleration(imu: &ImuSlices<'_>) -> Result<Vec<WorldVec>, CorrectE
 /// past its last knot take the last knot's value).
 ///
 /// # Errors
-/// What [`ImuSlices::validate`] refuses (any time step is accepted).
+/// Refuses frames a correction refuses (any time step is accepted).
 pub fn corrected_acceleration(
-    imu: &ImuSlices<'_>,
+    imu: &ImuFrames<'_>,
     bias: &BiasCurve,
 ) -> Result<Vec<WorldVec>, CorrectError> {
-    imu.validate(f64::INFINITY)?;
+    validate_imu(imu, f64::INFINITY)?;
     Ok(corrected_acceleration_unchecked(imu, bias))
 }
 
 /// [`corrected_acceleration`] of slices already validated.
 pub(crate) fn corrected_acceleration_unchecked(
-    imu: &ImuSlices<'_>,
+    imu: &ImuFrames<'_>,
     bias: &BiasCurve,
 ) -> Vec<WorldVec> {
     (0..imu.len())
@@ -211,12 +212,8 @@ mod tests {
         let linacce = vec![DeviceVec::new(0.1, 0.0, 0.0); 20];
         let orientation = vec![WorldFromDevice::identity(); 20];
         let gravity = vec![DeviceVec::new(0.0, 0.0, 9.81); 20];
-        let mut imu = ImuSlices {
-            time: &time,
-            linacce: &linacce,
-            orientation: &orientation,
-            gravity: &gravity,
-        };
+        let gyro = vec![DeviceVec::ZERO; 20];
+        let mut imu = ImuFrames::new(&time, &gyro, &linacce, &gravity, &orientation).unwrap();
         let bias = BiasCurve::zero(Knots::new(&time, 5));
         assert_eq!(
             world_acceleration(&imu).unwrap()[3],

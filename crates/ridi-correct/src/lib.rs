@@ -34,8 +34,8 @@
 //! # Example
 //!
 //! ```
-//! use ridi_correct::{CorrectionConfig, Corrector, ImuSlices, VelocityTarget};
-//! use ridi_frames::{DeviceVec, StabHorizontal, WorldFromDevice};
+//! use ridi_correct::{CorrectionConfig, Corrector, VelocityTarget};
+//! use ridi_frames::{DeviceVec, ImuFrames, StabHorizontal, WorldFromDevice};
 //!
 //! // Two seconds at 200 Hz of a phone lying flat, its accelerometer biased by 0.05 m/s² along
 //! // device x, while the walker stands still (regressed velocity zero every 10 frames).
@@ -44,7 +44,8 @@
 //! let linacce = vec![DeviceVec::new(0.05, 0.0, 0.0); n];
 //! let orientation = vec![WorldFromDevice::identity(); n];
 //! let gravity = vec![DeviceVec::new(0.0, 0.0, 9.81); n];
-//! let imu = ImuSlices { time: &time, linacce: &linacce, orientation: &orientation, gravity: &gravity };
+//! let gyro = vec![DeviceVec::ZERO; n];
+//! let imu = ImuFrames::new(&time, &gyro, &linacce, &gravity, &orientation)?;
 //! let targets: Vec<VelocityTarget> =
 //!     (10..n).step_by(10).map(|frame| VelocityTarget { frame, velocity: StabHorizontal::ZERO }).collect();
 //!
@@ -55,10 +56,10 @@
 //! assert!(end[0].abs() < 1e-3 && end[1].abs() < 1e-3);
 //! // The bias is what the correction adds to the measurement: -0.05 along x.
 //! assert!((trajectory.correction.bias.at(200, 1.0).x() + 0.05).abs() < 1e-3);
-//! # Ok::<(), ridi_correct::CorrectError>(())
+//! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
 //!
-//! For a live stream, feed [`Sample`]s to a [`Tracker`] with a [`VelocityRegressor`]; see the
+//! For a live stream, feed [`ImuSample`](ridi_frames::ImuSample)s to a [`Tracker`] with a [`VelocityRegressor`]; see the
 //! [`tracker`] module for the exact semantics of its windowed corrections.
 
 mod config;
@@ -76,7 +77,7 @@ pub mod tracker;
 pub use config::{CorrectionConfig, InitialVelocity};
 pub use dense::{objective, solve_dense};
 pub use error::CorrectError;
-pub use input::{ImuSlices, VelocityTarget};
+pub use input::VelocityTarget;
 pub use integrate::{Integrator, Pose, corrected_acceleration, integrate, world_acceleration};
 pub use knots::{BiasCurve, Knots};
 pub use placement::{PlacementFilter, PlacementSmoother, TrailingMajority};
@@ -85,6 +86,6 @@ pub use regressor::{FrameWindow, Regression, RegressorError, VelocityRegressor};
 pub use ridi_frames;
 pub use solve::{Correction, Corrector, Trajectory, correct};
 pub use tracker::{
-    CorrectionOutcome, GapPolicy, MAX_BUFFER, RegressionOutcome, Revision, Sample, Segment,
-    TrackError, Tracker, TrackerConfig, TrackerStats, Update,
+    CorrectionOutcome, GapPolicy, MAX_BUFFER, RegressionOutcome, Revision, Segment, TrackError,
+    Tracker, TrackerConfig, TrackerStats, Update,
 };

@@ -1,35 +1,26 @@
 //! The interface between the tracker and a velocity regressor.
 
-use ridi_frames::{DeviceVec, StabHorizontal, UpAxis, WorldFromDevice};
+use ridi_frames::{ImuFrames, StabHorizontal, UpAxis};
 
-/// A view of the most recent frames of the stream, oldest first, one entry per frame in
-/// each slice. The last frame is the one to regress.
+/// The most recent frames of the stream, oldest first; the last frame is the one to regress.
 #[derive(Debug, Clone, Copy)]
 pub struct FrameWindow<'a> {
     /// Stream index of the first frame of the view (frames are counted from 0 since the
     /// tracker was created, across restarts).
     pub first_frame: u64,
-    /// Timestamps, seconds.
-    pub time: &'a [f64],
-    /// Angular rate, device frame, rad/s.
-    pub gyro: &'a [DeviceVec],
-    /// Linear acceleration, device frame, m/s².
-    pub linacce: &'a [DeviceVec],
-    /// Gravity (pointing up), device frame, m/s².
-    pub gravity: &'a [DeviceVec],
-    /// Device orientation, world-from-device.
-    pub orientation: &'a [WorldFromDevice],
+    /// The frames.
+    pub frames: ImuFrames<'a>,
 }
 
 impl FrameWindow<'_> {
     /// Number of frames in the view.
     pub fn len(&self) -> usize {
-        self.time.len()
+        self.frames.len()
     }
 
     /// `true` when the view holds no frame.
     pub fn is_empty(&self) -> bool {
-        self.time.is_empty()
+        self.frames.is_empty()
     }
 
     /// Stream index of the last frame (the one to regress).

@@ -5,7 +5,7 @@
 //! is therefore a contiguous slice (what a regressor and a window solve want) at an amortized
 //! cost of one extra copy per frame, and memory stays flat whatever the stream length.
 
-use ridi_frames::{DeviceVec, WorldFromDevice};
+use ridi_frames::{DeviceVec, ImuFrames, WorldFromDevice};
 
 use crate::integrate::Pose;
 use crate::regressor::FrameWindow;
@@ -90,11 +90,18 @@ impl FrameRing {
         let a = self.len().saturating_sub(n);
         FrameWindow {
             first_frame: self.first + a as u64,
-            time: &self.time[a..],
-            gyro: &self.gyro[a..],
-            linacce: &self.linacce[a..],
-            gravity: &self.gravity[a..],
-            orientation: &self.orientation[a..],
+            frames: self.frames(a..self.len()),
+        }
+    }
+
+    /// Frames `range` (local indices).
+    pub fn frames(&self, range: std::ops::Range<usize>) -> ImuFrames<'_> {
+        ImuFrames {
+            time: &self.time[range.clone()],
+            gyro: &self.gyro[range.clone()],
+            linacce: &self.linacce[range.clone()],
+            gravity: &self.gravity[range.clone()],
+            orientation: &self.orientation[range],
         }
     }
 }

@@ -14,9 +14,10 @@ use serde::{Deserialize, Serialize};
 
 use crate::config::{CorrectionConfig, InitialVelocity};
 use crate::error::CorrectError;
-use crate::input::{ImuSlices, VelocityTarget, validate_targets};
+use crate::input::{VelocityTarget, validate_imu, validate_targets};
 use crate::integrate::{Pose, corrected_acceleration_unchecked, integrate_unchecked};
 use crate::knots::{BiasCurve, Knots};
+use ridi_frames::ImuFrames;
 
 /// Result of a correction solve.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -201,7 +202,7 @@ impl Corrector {
     /// and the velocity `targets`, with the configured initial velocity.
     pub fn solve(
         &mut self,
-        imu: &ImuSlices<'_>,
+        imu: &ImuFrames<'_>,
         targets: &[VelocityTarget],
     ) -> Result<Correction, CorrectError> {
         let initial = self.config.initial_velocity;
@@ -212,11 +213,11 @@ impl Corrector {
     /// window's start to its earlier output).
     pub fn solve_from(
         &mut self,
-        imu: &ImuSlices<'_>,
+        imu: &ImuFrames<'_>,
         targets: &[VelocityTarget],
         initial: InitialVelocity,
     ) -> Result<Correction, CorrectError> {
-        imu.validate(self.config.max_dt)?;
+        validate_imu(imu, self.config.max_dt)?;
         validate_targets(targets, imu.len())?;
         if let InitialVelocity::Fixed(v) = initial
             && !v.is_finite()
@@ -235,7 +236,7 @@ impl Corrector {
     /// Solve followed by integration from the origin: the corrected trajectory.
     pub fn correct(
         &mut self,
-        imu: &ImuSlices<'_>,
+        imu: &ImuFrames<'_>,
         targets: &[VelocityTarget],
     ) -> Result<Trajectory, CorrectError> {
         let correction = self.solve(imu, targets)?;
@@ -247,7 +248,7 @@ impl Corrector {
 
     pub(crate) fn solve_validated(
         &mut self,
-        imu: &ImuSlices<'_>,
+        imu: &ImuFrames<'_>,
         targets: &[VelocityTarget],
         initial: InitialVelocity,
     ) -> Result<Correction, CorrectError> {
@@ -325,7 +326,7 @@ impl Corrector {
     /// Segment integrals: `d_j` (uncorrected world acceleration) and the blocks `G_j`.
     fn assemble_segments(
         &mut self,
-        imu: &ImuSlices<'_>,
+        imu: &ImuFrames<'_>,
         targets: &[VelocityTarget],
         knots: &Knots,
     ) {
@@ -400,7 +401,7 @@ impl Corrector {
     /// Per-target `P_j⁻¹` and `P_j⁻¹ M_jᵀ u_j`.
     fn target_blocks(
         &mut self,
-        imu: &ImuSlices<'_>,
+        imu: &ImuFrames<'_>,
         targets: &[VelocityTarget],
     ) -> Result<(), CorrectError> {
         let (wh, wv) = (self.config.horizontal_weight, self.config.vertical_weight);
@@ -574,7 +575,7 @@ impl Corrector {
 /// One-shot batch correction with `config`: solve, then integrate from the origin.
 pub fn correct(
     config: CorrectionConfig,
-    imu: &ImuSlices<'_>,
+    imu: &ImuFrames<'_>,
     targets: &[VelocityTarget],
 ) -> Result<Trajectory, CorrectError> {
     Corrector::new(config)?.correct(imu, targets)

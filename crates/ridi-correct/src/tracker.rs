@@ -51,13 +51,13 @@ use std::collections::VecDeque;
 use std::sync::mpsc::{Receiver, SyncSender, sync_channel};
 use std::thread::JoinHandle;
 
-use ridi_frames::{DeviceVec, StabHorizontal, WorldFromDevice, WorldVec};
+use ridi_frames::{DeviceVec, ImuFrames, ImuSample, StabHorizontal, WorldFromDevice, WorldVec};
 use serde::{Deserialize, Serialize};
 use thiserror::Error;
 
 use crate::config::{CorrectionConfig, InitialVelocity};
 use crate::error::CorrectError;
-use crate::input::{ImuSlices, VelocityTarget};
+use crate::input::VelocityTarget;
 use crate::integrate::{Integrator, Pose};
 use crate::knots::BiasCurve;
 use crate::placement::PlacementFilter;
@@ -146,21 +146,6 @@ impl TrackerConfig {
         }
         Ok(())
     }
-}
-
-/// One IMU sample.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-pub struct Sample {
-    /// Timestamp, seconds.
-    pub time: f64,
-    /// Angular rate, device frame, rad/s (only passed on to the regressor).
-    pub gyro: DeviceVec,
-    /// Linear acceleration, device frame, m/s².
-    pub linacce: DeviceVec,
-    /// Gravity (pointing up), device frame, m/s².
-    pub gravity: DeviceVec,
-    /// Device orientation, world-from-device.
-    pub orientation: WorldFromDevice,
 }
 
 /// Why the tracker refused a sample or an operation.
@@ -295,6 +280,7 @@ struct StoredTarget {
 #[derive(Default)]
 struct Job {
     time: Vec<f64>,
+    gyro: Vec<DeviceVec>,
     linacce: Vec<DeviceVec>,
     orientation: Vec<WorldFromDevice>,
     gravity: Vec<DeviceVec>,
@@ -303,12 +289,13 @@ struct Job {
 }
 
 impl Job {
-    fn imu(&self) -> ImuSlices<'_> {
-        ImuSlices {
+    fn imu(&self) -> ImuFrames<'_> {
+        ImuFrames {
             time: &self.time,
+            gyro: &self.gyro,
             linacce: &self.linacce,
-            orientation: &self.orientation,
             gravity: &self.gravity,
+            orientation: &self.orientation,
         }
     }
 }
@@ -347,6 +334,7 @@ struct Pending {
 
 struct History {
     time: Vec<f64>,
+    gyro: Vec<DeviceVec>,
     linacce: Vec<DeviceVec>,
     orientation: Vec<WorldFromDevice>,
     gravity: Vec<DeviceVec>,
@@ -441,6 +429,7 @@ impl<R: VelocityRegressor> Tracker<R> {
         };
         let history = config.keep_history.then(|| History {
             time: Vec::new(),
+            gyro: Vec::new(),
             linacce: Vec::new(),
             orientation: Vec::new(),
             gravity: Vec::new(),
@@ -499,7 +488,7 @@ impl<R: VelocityRegressor> Tracker<R> {
 
     /// Feeds a chunk of samples; stops at the first refused sample and returns its error
     /// together with the updates of the samples accepted before it.
-    pub fn push_all(&mut self, samples: &[Sample]) -> (Vec<Update>, Option<TrackError>) {
+    pub fn push_all(&mut self, samples: &[ImuSample]) -> (Vec<Update>, Option<TrackError>) {
         let mut out = Vec::with_capacity(samples.len());
         for s in samples {
             match self.push(s) {
@@ -511,7 +500,7 @@ impl<R: VelocityRegressor> Tracker<R> {
     }
 
     /// Feeds one sample and returns its frame's pose plus what happened at this frame.
-    pub fn push(&mut self, sample: &Sample) -> Result<Update, TrackError> {
+    pub fn push(&mut self, sample: &ImuSample) -> Result<Update, TrackError> {
         check_sample(sample)?;
         let mut restarted = false;
         // Time must increase even across a restart: the history and the stream indices would
@@ -553,6 +542,7 @@ impl<R: VelocityRegressor> Tracker<R> {
         );
         if let Some(h) = &mut self.history {
             h.time.push(sample.time);
+            h.gyro.push(sample.gyro);
             h.linacce.push(sample.linacce);
             h.orientation.push(sample.orientation);
             h.gravity.push(sample.gravity);
@@ -643,11 +633,12 @@ impl<R: VelocityRegressor> Tracker<R> {
                 continue;
             }
             let first_frame = a as u64;
-            let imu = ImuSlices {
+            let imu = ImuFrames {
                 time: &h.time[a..b],
+                gyro: &h.gyro[a..b],
                 linacce: &h.linacce[a..b],
-                orientation: &h.orientation[a..b],
                 gravity: &h.gravity[a..b],
+                orientation: &h.orientation[a..b],
             };
             let stored: Vec<&StoredTarget> = h
                 .targets
@@ -773,12 +764,7 @@ impl<R: VelocityRegressor> Tracker<R> {
         };
         match &mut self.solver {
             Solver::Inline(corrector) => {
-                let imu = ImuSlices {
-                    time: &self.ring.time[a..=b],
-                    linacce: &self.ring.linacce[a..=b],
-                    orientation: &self.ring.orientation[a..=b],
-                    gravity: &self.ring.gravity[a..=b],
-                };
+                let imu = self.ring.frames(a..b + 1);
                 let initial = job.initial.unwrap_or_default();
                 pending.result = Some(corrector.solve_validated(&imu, &job.targets, initial));
                 self.spare = Some(job);
@@ -786,6 +772,8 @@ impl<R: VelocityRegressor> Tracker<R> {
             Solver::Background { jobs, .. } => {
                 job.time.clear();
                 job.time.extend_from_slice(&self.ring.time[a..=b]);
+                job.gyro.clear();
+                job.gyro.extend_from_slice(&self.ring.gyro[a..=b]);
                 job.linacce.clear();
                 job.linacce.extend_from_slice(&self.ring.linacce[a..=b]);
                 job.orientation.clear();
@@ -886,7 +874,7 @@ fn corrected_world(q: WorldFromDevice, lin: DeviceVec, bias: DeviceVec) -> World
     q * (lin + bias)
 }
 
-fn check_sample(s: &Sample) -> Result<(), TrackError> {
+fn check_sample(s: &ImuSample) -> Result<(), TrackError> {
     let bad = |what| Err(TrackError::NonFinite { what });
     if !s.time.is_finite() {
         return bad("time");

@@ -6,11 +6,11 @@ mod common;
 use common::{max_position_error, walk};
 use proptest::prelude::*;
 use ridi_correct::{
-    BiasCurve, CorrectError, CorrectionConfig, Corrector, ImuSlices, InitialVelocity,
-    VelocityTarget, integrate, objective, solve_dense, world_acceleration,
+    BiasCurve, CorrectError, CorrectionConfig, Corrector, InitialVelocity, VelocityTarget,
+    integrate, objective, solve_dense, world_acceleration,
 };
 use ridi_frames::{
-    DeviceVec, Rot, StabHorizontal, UpAxis, WorldFromDevice, WorldVec, nalgebra::Vector3,
+    DeviceVec, ImuFrames, Rot, StabHorizontal, UpAxis, WorldFromDevice, WorldVec, nalgebra::Vector3,
 };
 
 fn max_bias_diff(a: &[DeviceVec], b: &[DeviceVec]) -> f64 {
@@ -132,11 +132,12 @@ fn targets_are_read_in_the_configured_s() {
             .iter()
             .all(|g| g.y() < UpAxis::FLIP_COSINE * g.norm())
     );
-    let imu = ImuSlices {
+    let imu = ImuFrames {
         time: &w.time,
+        gyro: &w.gyro,
         linacce: &linacce,
-        orientation: &orientation,
         gravity: &gravity,
+        orientation: &orientation,
     };
     let targets = w.targets(10, 10);
     let error = |up_axis| {
@@ -304,7 +305,7 @@ fn bad_input_is_a_clear_error() {
 
     let mut lin = w.linacce.clone();
     lin[123] = DeviceVec::new(f64::NAN, 0.0, 0.0);
-    let imu = ImuSlices {
+    let imu = ImuFrames {
         linacce: &lin,
         ..w.imu()
     };
@@ -318,7 +319,7 @@ fn bad_input_is_a_clear_error() {
 
     let mut time = w.time.clone();
     time[200] = time[198];
-    let imu = ImuSlices {
+    let imu = ImuFrames {
         time: &time,
         ..w.imu()
     };
@@ -331,7 +332,7 @@ fn bad_input_is_a_clear_error() {
     for t in &mut time[300..] {
         *t += 4.4;
     }
-    let imu = ImuSlices {
+    let imu = ImuFrames {
         time: &time,
         ..w.imu()
     };
@@ -340,7 +341,7 @@ fn bad_input_is_a_clear_error() {
         Err(CorrectError::Gap { frame: 300, .. })
     ));
 
-    let imu = ImuSlices {
+    let imu = ImuFrames {
         gravity: &w.gravity[..399],
         ..w.imu()
     };
@@ -382,7 +383,7 @@ fn bad_input_is_a_clear_error() {
     // Gravity perpendicular to the orientation's vertical: S is undefined.
     let mut grav = w.gravity.clone();
     grav[100] = w.orientation[100].inverse() * WorldVec::new(9.81, 0.0, 0.0);
-    let imu = ImuSlices {
+    let imu = ImuFrames {
         gravity: &grav,
         ..w.imu()
     };
@@ -418,11 +419,12 @@ fn bad_input_is_a_clear_error() {
             Err(CorrectError::InvalidConfig(_))
         ));
     }
-    let empty = ImuSlices {
+    let empty = ImuFrames {
         time: &[],
+        gyro: &[],
         linacce: &[],
-        orientation: &[],
         gravity: &[],
+        orientation: &[],
     };
     assert_eq!(c.solve(&empty, &[]), Err(CorrectError::Empty));
 }
@@ -458,12 +460,7 @@ fn single_frame_and_target_at_start() {
     let lin = [DeviceVec::new(1.0, 0.0, 0.0)];
     let ori = [WorldFromDevice::identity()];
     let grav = [DeviceVec::new(0.0, 0.0, 9.8)];
-    let imu = ImuSlices {
-        time: &time,
-        linacce: &lin,
-        orientation: &ori,
-        gravity: &grav,
-    };
+    let imu = ImuFrames::new(&time, &[DeviceVec::ZERO], &lin, &grav, &ori).unwrap();
     let targets = [VelocityTarget {
         frame: 0,
         velocity: StabHorizontal::new(1.0, 0.0),
@@ -487,6 +484,8 @@ fn single_frame_and_target_at_start() {
 /// A random problem: irregular clock, random accelerations and orientations, random targets.
 struct Problem {
     time: Vec<f64>,
+    /// Zeros: the correction does not read the gyro.
+    gyro: Vec<DeviceVec>,
     lin: Vec<DeviceVec>,
     ori: Vec<WorldFromDevice>,
     grav: Vec<DeviceVec>,
@@ -494,12 +493,13 @@ struct Problem {
 }
 
 impl Problem {
-    fn imu(&self) -> ImuSlices<'_> {
-        ImuSlices {
+    fn imu(&self) -> ImuFrames<'_> {
+        ImuFrames {
             time: &self.time,
+            gyro: &self.gyro,
             linacce: &self.lin,
-            orientation: &self.ori,
             gravity: &self.grav,
+            orientation: &self.ori,
         }
     }
 }
@@ -543,6 +543,7 @@ fn random_problem(seed: u64, n: usize, every: usize, first: usize) -> Problem {
         })
         .collect();
     Problem {
+        gyro: vec![DeviceVec::ZERO; time.len()],
         time,
         lin,
         ori,

@@ -5,12 +5,12 @@ mod common;
 
 use common::{Walk, max_position_error, walk};
 use ridi_correct::{
-    CorrectionConfig, CorrectionOutcome, Corrector, FrameWindow, GapPolicy, ImuSlices,
-    InitialVelocity, PlacementFilter, Regression, RegressionOutcome, RegressorError, Sample,
-    TrackError, Tracker, TrackerConfig, VelocityRegressor, VelocityTarget, corrected_acceleration,
-    integrate, world_acceleration,
+    CorrectionConfig, CorrectionOutcome, Corrector, FrameWindow, GapPolicy, InitialVelocity,
+    PlacementFilter, Regression, RegressionOutcome, RegressorError, TrackError, Tracker,
+    TrackerConfig, VelocityRegressor, VelocityTarget, corrected_acceleration, integrate,
+    world_acceleration,
 };
-use ridi_frames::{DeviceVec, StabHorizontal, WorldVec};
+use ridi_frames::{DeviceVec, ImuSample, StabHorizontal, WorldVec};
 
 /// Returns the exact S velocity of the walk at the regressed frame; can be told to fail or
 /// to flip placement labels.
@@ -53,9 +53,9 @@ impl VelocityRegressor for Truth {
     }
 }
 
-fn samples(w: &Walk) -> Vec<Sample> {
+fn samples(w: &Walk) -> Vec<ImuSample> {
     (0..w.time.len())
-        .map(|f| Sample {
+        .map(|f| ImuSample {
             time: w.time[f],
             gyro: w.gyro[f],
             linacce: w.linacce[f],
@@ -113,13 +113,7 @@ fn each_window_starts_from_raw_data_and_the_earlier_output() {
         // The window problem, solved from scratch on the raw slice, starting from the pose
         // the tracker had output for the window's first frame.
         let start_pose = before.expect("the window start was pushed earlier");
-        let sl = start..=f;
-        let imu = ImuSlices {
-            time: &w.time[sl.clone()],
-            linacce: &w.linacce[sl.clone()],
-            orientation: &w.orientation[sl.clone()],
-            gravity: &w.gravity[sl.clone()],
-        };
+        let imu = w.imu().slice(start..f + 1);
         let targets: Vec<VelocityTarget> = (200..=f)
             .step_by(50)
             .filter(|&g| g >= start)
@@ -275,8 +269,8 @@ fn bad_samples_are_refused_without_harm() {
     assert_eq!(tracker.stats().restarts, 1);
 }
 
-fn late_sample(s: &Sample, dt: f64) -> Sample {
-    Sample {
+fn late_sample(s: &ImuSample, dt: f64) -> ImuSample {
+    ImuSample {
         time: s.time + dt,
         ..*s
     }

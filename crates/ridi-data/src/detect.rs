@@ -3,9 +3,9 @@
 use std::fmt;
 use std::path::{Path, PathBuf};
 
+use crate::Sequence;
 use crate::error::{DataError, Location, Result};
 use crate::options::ReadOptions;
-use crate::sequence::Sequence;
 use crate::{ilc, ridi_csv, ridi_plain, ridi_raw, tyrex};
 
 /// The dataset formats ridi-data knows.

@@ -3,7 +3,7 @@
 use std::fmt;
 use std::path::{Path, PathBuf};
 
-use crate::sequence::SequenceError;
+use crate::SequenceError;
 
 /// Where in which file something went wrong.
 #[derive(Debug, Clone, PartialEq)]

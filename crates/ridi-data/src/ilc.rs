@@ -96,10 +96,8 @@ use crate::android;
 use crate::error::{DataError, Location, Result};
 use crate::options::ReadOptions;
 use crate::resample::{interpolate_rot, interpolate_vec3, uniform_timeline};
-use crate::sequence::{
-    Channel, GroundTruth, OrientationSource, Sequence, SequenceParts, Validation,
-};
 use crate::text::{self, Nan};
+use crate::{Channel, GroundTruth, OrientationSource, Sequence, SequenceParts, Validation};
 
 /// Placement label of every path unless [`IlcOptions::placement`] says otherwise.
 pub const DEFAULT_PLACEMENT: &str = "hand";

@@ -76,8 +76,10 @@ pub mod ridi_csv;
 pub mod ridi_plain;
 pub mod ridi_raw;
 mod sequence;
+mod sequence_error;
 mod text;
 pub mod tyrex;
+mod validation;
 mod write;
 
 pub use detect::{Format, detect, read_sequence, source_files};
@@ -87,9 +89,10 @@ pub use list::{
 };
 pub use options::ReadOptions;
 pub use ridi_frames;
-pub use sequence::{
-    Channel, GYRO_SCALE_MIN_RATE, GroundTruth, LINACCE_SCALE_MIN_RMS, ORIENTATION_JUMP_RATE,
-    OrientationJump, OrientationSource, Sequence, SequenceError, SequenceParts, Validation,
+pub use sequence::{Channel, GroundTruth, OrientationSource, Sequence, SequenceParts};
+pub use sequence_error::SequenceError;
+pub use validation::{
+    GYRO_SCALE_MIN_RATE, LINACCE_SCALE_MIN_RMS, ORIENTATION_JUMP_RATE, OrientationJump, Validation,
     orientation_jumps,
 };
 pub use write::{

@@ -7,10 +7,10 @@
 
 use std::path::{Path, PathBuf};
 
+use crate::Sequence;
 use crate::detect::{read_sequence, source_files};
 use crate::error::{DataError, Location, Result};
 use crate::options::ReadOptions;
-use crate::sequence::Sequence;
 use crate::text;
 
 /// One line of a list file.

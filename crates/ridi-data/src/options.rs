@@ -1,6 +1,6 @@
 //! Options shared by every reader.
 
-use crate::sequence::Validation;
+use crate::Validation;
 
 /// How readers build and check sequences. [`ReadOptions::default`] follows the original RIDI
 /// processing.

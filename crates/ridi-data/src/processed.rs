@@ -8,8 +8,8 @@ use ridi_frames::{DeviceVec, QuatError, WorldFromDevice};
 
 use crate::error::{DataError, Location, Result};
 use crate::options::ReadOptions;
-use crate::sequence::{Channel, GroundTruth, OrientationSource, Sequence, SequenceParts};
 use crate::text;
+use crate::{Channel, GroundTruth, OrientationSource, Sequence, SequenceParts};
 
 /// The 27 columns of the RIDI processed layout, in the order the original writes them. `time`
 /// is in nanoseconds; `ori_*` is the Tango ground-truth orientation and `rv_*` the game

@@ -9,10 +9,10 @@
 
 use std::path::Path;
 
+use crate::Sequence;
 use crate::error::{DataError, Location, Result};
 use crate::options::ReadOptions;
 use crate::processed::{self, COLUMNS, MAGNET, POS, RV, Table};
-use crate::sequence::Sequence;
 use crate::text;
 
 /// Reads a RIDI processed `data.csv`. The sequence is named after its capture folder (see

@@ -6,10 +6,10 @@
 
 use std::path::Path;
 
+use crate::Sequence;
 use crate::error::{DataError, Location, Result};
 use crate::options::ReadOptions;
 use crate::processed::{self, COLUMNS, Table};
-use crate::sequence::Sequence;
 use crate::text;
 
 /// Reads a `data_plain.txt`.

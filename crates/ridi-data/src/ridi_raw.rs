@@ -33,10 +33,10 @@ use ridi_frames::{DeviceVec, Vec3, WorldFromDevice, WorldVec};
 use crate::error::{DataError, Location, Result};
 use crate::options::ReadOptions;
 use crate::resample::{interpolate_rot, interpolate_scalar, interpolate_vec3, uniform_timeline};
-use crate::sequence::{
+use crate::text;
+use crate::{
     Channel, GroundTruth, OrientationSource, Sequence, SequenceError, SequenceParts, Validation,
 };
-use crate::text;
 
 const XYZ: &[&str] = &["t", "x", "y", "z"];
 const QUAT: &[&str] = &["t", "x", "y", "z", "w"];

@@ -4,7 +4,8 @@
 use std::path::Path;
 
 use crate::error::{DataError, Location, Result};
-use crate::sequence::{AXES, Channel, SequenceError, Validation, beyond, jump};
+use crate::sequence_error::{AXES, beyond, jump};
+use crate::{Channel, SequenceError, Validation};
 
 /// Reads a whole file; the readers parse from memory because one pass over a byte slice is much
 /// faster than buffered line reading with a `String` per line.

@@ -86,11 +86,11 @@ use crate::error::{DataError, Location, Result};
 use crate::mat::{MatFile, MatValue, dims_text};
 use crate::options::ReadOptions;
 use crate::resample::{interpolate_rot, interpolate_vec3, uniform_timeline};
-use crate::sequence::{
-    Channel, GroundTruth, OrientationSource, Sequence, SequenceError, SequenceParts, Validation,
-    orientation_jump_warning,
-};
 use crate::text::{self, Nan};
+use crate::validation::orientation_jump_warning;
+use crate::{
+    Channel, GroundTruth, OrientationSource, Sequence, SequenceError, SequenceParts, Validation,
+};
 
 /// Mocap frame rate assumed when a `.mat` has no `FrameRate` (the Tyrex captures are 60 Hz).
 pub const DEFAULT_MOCAP_RATE_HZ: f64 = 60.0;

@@ -21,9 +21,9 @@ use std::fmt::{self, Write as _};
 use std::io::Write;
 use std::path::Path;
 
+use crate::Sequence;
 use crate::error::{DataError, Result};
 use crate::processed::COLUMNS;
-use crate::sequence::Sequence;
 
 /// The 27 values of frame `i` in [`COLUMNS`] order, time excluded (slot 0 is unused).
 fn row(seq: &Sequence, i: usize) -> [f64; 27] {

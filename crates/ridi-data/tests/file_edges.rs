@@ -10,6 +10,7 @@ use std::path::Path;
 use common::*;
 use ridi_data::ridi_frames::DeviceVec;
 use ridi_data::{ReadOptions, Sequence, ridi_csv, ridi_plain, write_ridi_csv, write_ridi_plain};
+use ridi_test_support::{assert_err, edit_cells, edit_file, with_cell};
 
 /// `text` without its final line break and the last `n` characters of its last value, and the
 /// number of its last line.

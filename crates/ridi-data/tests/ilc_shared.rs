@@ -2,8 +2,6 @@
 //! checkout). The tests are `#[ignore]`d, so that `cargo test` shows them as not run; `.ci/run`
 //! runs them with `--ignored`.
 
-mod common;
-
 use std::f64::consts::PI;
 use std::path::{Path, PathBuf};
 
@@ -13,7 +11,7 @@ use ridi_data::ridi_frames::{DeviceVec, WorldVec};
 use ridi_data::{Format, OrientationSource, ReadOptions, detect, read_sequence};
 
 fn root() -> PathBuf {
-    common::shared_dataset(
+    ridi_test_support::shared_dataset(
         "indoor-location-competition-20",
         "data/site1/F1/path_data_files",
     )

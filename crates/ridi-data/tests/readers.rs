@@ -9,6 +9,7 @@ use ridi_data::{
     DataError, Format, ReadOptions, Sequence, detect, load_list, parse_list, read_list,
     read_sequence, ridi_csv, ridi_plain, ridi_raw, write_ridi_csv, write_ridi_plain,
 };
+use ridi_test_support::{assert_err, edit_file, edit_rows, with_cell, write_files};
 
 fn opts() -> ReadOptions {
     ReadOptions::default()

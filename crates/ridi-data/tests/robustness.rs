@@ -1,5 +1,6 @@
-//! Random and mutated input to every reader: each must return `Ok` or `Err`, never panic.
-//! Mutations start from valid files so that most cases get deep into the parsers.
+//! Random and mutated input to every reader: each must return `Ok` or an error that names the
+//! file (and the line and field where there is one), never panic. Mutations start from valid
+//! files so that most cases get deep into the parsers.
 
 mod common;
 
@@ -10,6 +11,9 @@ use common::*;
 use proptest::prelude::*;
 use ridi_data::ilc::{self, IlcOptions};
 use ridi_data::{ReadOptions, parse_list, ridi_csv, ridi_plain, ridi_raw};
+use ridi_test_support::{
+    assert_err, assert_names_file, edit_cells, edit_file, edit_rows, with_cell, write_files,
+};
 
 static CSV: LazyLock<Vec<u8>> = LazyLock::new(|| valid_csv(12));
 static PLAIN: LazyLock<Vec<u8>> = LazyLock::new(|| valid_plain(12));
@@ -103,38 +107,59 @@ fn unmutated_fixtures_are_valid() {
     ilc::parse(ILC, Path::new("path.txt"), &IlcOptions::default()).unwrap();
 }
 
+/// The project's rule for an error of a reader on `bytes` read as `file`: it names the file, and
+/// a line it names is one of the file's lines.
+fn assert_error_names<T>(r: ridi_data::Result<T>, file: &str, bytes: &[u8]) {
+    if let Err(e) = r {
+        assert_names_file(&e, Path::new(file)).assert_line_in(bytes);
+    }
+}
+
 proptest! {
     #![proptest_config(config(256))]
 
     #[test]
     fn csv_reader_survives_mutations(edits in edits()) {
-        let _ = ridi_csv::parse(&mutate(&CSV, &edits), Path::new("data.csv"), &opts());
+        let bytes = mutate(&CSV, &edits);
+        let r = ridi_csv::parse(&bytes, Path::new("data.csv"), &opts());
+        assert_error_names(r, "data.csv", &bytes);
     }
 
     #[test]
     fn plain_reader_survives_mutations(edits in edits()) {
-        let _ = ridi_plain::parse(&mutate(&PLAIN, &edits), Path::new("data_plain.txt"), &opts());
+        let bytes = mutate(&PLAIN, &edits);
+        let r = ridi_plain::parse(&bytes, Path::new("data_plain.txt"), &opts());
+        assert_error_names(r, "data_plain.txt", &bytes);
     }
 
     #[test]
     fn text_readers_survive_random_bytes(bytes in prop::collection::vec(interesting_byte(), 0..400)) {
-        let _ = ridi_csv::parse(&bytes, Path::new("data.csv"), &opts());
-        let _ = ridi_plain::parse(&bytes, Path::new("data_plain.txt"), &opts());
-        let _ = parse_list(&bytes, Path::new("list.txt"));
-        let _ = ilc::parse(&bytes, Path::new("path.txt"), &IlcOptions::default());
+        let csv = ridi_csv::parse(&bytes, Path::new("data.csv"), &opts());
+        assert_error_names(csv, "data.csv", &bytes);
+        let plain = ridi_plain::parse(&bytes, Path::new("data_plain.txt"), &opts());
+        assert_error_names(plain, "data_plain.txt", &bytes);
+        assert_error_names(parse_list(&bytes, Path::new("list.txt")), "list.txt", &bytes);
+        let path = ilc::parse(&bytes, Path::new("path.txt"), &IlcOptions::default());
+        assert_error_names(path, "path.txt", &bytes);
         let _ = ilc::looks_like_path_file(&bytes);
     }
 
     #[test]
     fn ilc_reader_survives_mutations(edits in edits()) {
-        let _ = ilc::parse(&mutate(ILC, &edits), Path::new("path.txt"), &IlcOptions::default());
+        let bytes = mutate(ILC, &edits);
+        let r = ilc::parse(&bytes, Path::new("path.txt"), &IlcOptions::default());
+        assert_error_names(r, "path.txt", &bytes);
     }
 
     #[test]
     fn list_parser_survives_mutations(edits in edits()) {
         let base = b"# train\nseq_a,body\n/abs/seq_b , bag\n\nseq_c\n";
-        if let Ok(entries) = parse_list(&mutate(base, &edits), Path::new("/d/list.txt")) {
-            prop_assert!(entries.iter().all(|e| !e.path.as_os_str().is_empty()));
+        let bytes = mutate(base, &edits);
+        match parse_list(&bytes, Path::new("/d/list.txt")) {
+            Ok(entries) => prop_assert!(entries.iter().all(|e| !e.path.as_os_str().is_empty())),
+            Err(e) => {
+                assert_names_file(&e, Path::new("/d/list.txt")).assert_line_in(&bytes);
+            }
         }
     }
 }
@@ -152,7 +177,13 @@ proptest! {
         write_files(dir.path(), &files);
         std::fs::write(dir.path().join(raw_files(30, true)[file].0), content).unwrap();
         let opts = ReadOptions { pose_trim: trim, ..ReadOptions::default() };
-        let _ = ridi_raw::read(dir.path(), &opts);
+        if let Err(e) = ridi_raw::read(dir.path(), &opts) {
+            // The folder, or one of its files (whose lines the error may name).
+            let blame = assert_names_file(&e, dir.path());
+            if blame.file != dir.path() {
+                blame.assert_line_in(&std::fs::read(&blame.file).unwrap());
+            }
+        }
     }
 }
 

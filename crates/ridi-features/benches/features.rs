@@ -12,15 +12,13 @@ use criterion::{Criterion, criterion_group, criterion_main};
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use ridi_features::{
-    FeatureConfig, FeatureExtractor, FeatureMatrix, GroundTruthView, ImuView, SampleSchedule,
+    FeatureConfig, FeatureExtractor, FeatureMatrix, GroundTruthView, SampleSchedule,
     compute_targets,
 };
-use ridi_frames::{DeviceVec, WorldFromDevice, WorldVec};
+use ridi_frames::{DeviceVec, ImuFrames, WorldFromDevice, WorldVec};
+use ridi_test_support::naive_features;
 use std::hint::black_box;
 use std::time::Duration;
-
-#[path = "../tests/common/naive.rs"]
-mod naive;
 
 const N: usize = 120_000;
 
@@ -93,7 +91,8 @@ fn bench(c: &mut Criterion) {
         .expect("schedule")
         .frames(N);
     let fx = FeatureExtractor::new(config.clone()).expect("config");
-    let imu = ImuView::new(&d.gyro, &d.linacce, &d.gravity).expect("imu");
+    let imu =
+        ImuFrames::new(&d.time, &d.gyro, &d.linacce, &d.gravity, &d.orientation).expect("imu");
     let gt = GroundTruthView {
         time: &d.time,
         position: &d.position,
@@ -123,7 +122,7 @@ fn bench(c: &mut Criterion) {
     }
     g.bench_function("naive_tenth/1t", |b| {
         b.iter(|| {
-            black_box(naive::features(
+            black_box(naive_features(
                 &d.gyro, &d.linacce, &d.gravity, &tenth, 200, 2.0, 4.0,
             ))
         })
@@ -161,7 +160,7 @@ fn bench(c: &mut Criterion) {
         p.install(|| black_box(compute_targets(&gt, &config, &frames).expect("targets")));
     });
     cpu("naive_tenth", &mut || {
-        black_box(naive::features(
+        black_box(naive_features(
             &d.gyro, &d.linacce, &d.gravity, &tenth, 200, 2.0, 4.0,
         ));
     });

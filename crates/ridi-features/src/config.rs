@@ -286,7 +286,7 @@ impl StandardizationFit {
                     for row in chunk.chunks_exact(dim) {
                         acc.add_row(row)?;
                     }
-                    Ok(acc)
+                    Ok::<_, FeatureError>(acc)
                 },
             )
             .try_reduce(

@@ -50,3 +50,18 @@ pub enum FeatureError {
     #[error("invalid feature configuration: {0}")]
     InvalidConfig(String),
 }
+
+impl From<ridi_frames::ImuError> for FeatureError {
+    fn from(e: ridi_frames::ImuError) -> Self {
+        let ridi_frames::ImuError::LengthMismatch {
+            what,
+            expected,
+            found,
+        } = e;
+        FeatureError::LengthMismatch {
+            what,
+            expected,
+            found,
+        }
+    }
+}

@@ -1,69 +1,18 @@
 //! Feature windows: gyro and linear acceleration in S, smoothed, flattened time-major.
 
 use rayon::prelude::*;
-use ridi_frames::{DeviceVec, UpAxis};
+use ridi_frames::{DeviceVec, ImuFrames, UpAxis};
 
 use crate::FeatureError;
 use crate::config::{FeatureChannel, FeatureConfig};
 use crate::gaussian::{filter_strided_f32, half_kernel};
 use crate::matrix::FeatureMatrix;
 
-/// The IMU streams features are computed from, one entry per frame on a common timeline, all in
-/// the device frame. `gravity` is the gravity sensor (pointing up); it defines each frame's S.
-#[derive(Debug, Clone, Copy)]
-pub struct ImuView<'a> {
-    /// Gyroscope, rad/s.
-    pub gyro: &'a [DeviceVec],
-    /// Linear acceleration, m/s^2.
-    pub linacce: &'a [DeviceVec],
-    /// Gravity, m/s^2, pointing up.
-    pub gravity: &'a [DeviceVec],
-}
-
-impl<'a> ImuView<'a> {
-    /// Bundles the three streams; fails if their lengths differ.
-    pub fn new(
-        gyro: &'a [DeviceVec],
-        linacce: &'a [DeviceVec],
-        gravity: &'a [DeviceVec],
-    ) -> Result<Self, FeatureError> {
-        let v = Self {
-            gyro,
-            linacce,
-            gravity,
-        };
-        v.check_lengths()?;
-        Ok(v)
-    }
-
-    /// Number of frames (of `gravity`, which the others must match).
-    pub fn len(&self) -> usize {
-        self.gravity.len()
-    }
-
-    /// `true` without frames.
-    pub fn is_empty(&self) -> bool {
-        self.gravity.is_empty()
-    }
-
-    fn check_lengths(&self) -> Result<(), FeatureError> {
-        for (what, len) in [("gyro", self.gyro.len()), ("linacce", self.linacce.len())] {
-            if len != self.gravity.len() {
-                return Err(FeatureError::LengthMismatch {
-                    what,
-                    expected: self.gravity.len(),
-                    found: len,
-                });
-            }
-        }
-        Ok(())
-    }
-
-    fn channel(&self, c: FeatureChannel) -> &'a [DeviceVec] {
-        match c {
-            FeatureChannel::Gyro => self.gyro,
-            FeatureChannel::LinearAcceleration => self.linacce,
-        }
+/// The stream a feature channel reads.
+fn channel<'a>(imu: &ImuFrames<'a>, c: FeatureChannel) -> &'a [DeviceVec] {
+    match c {
+        FeatureChannel::Gyro => imu.gyro,
+        FeatureChannel::LinearAcceleration => imu.linacce,
     }
 }
 
@@ -80,7 +29,7 @@ impl StabilizedChannels {
     /// Rotates every frame's `channels` into S with `up_axis.align(gravity[i])`. Fails on
     /// mismatched lengths, non-finite values or an empty channel list.
     pub fn new(
-        imu: &ImuView<'_>,
+        imu: &ImuFrames<'_>,
         channels: &[FeatureChannel],
         up_axis: UpAxis,
     ) -> Result<Self, FeatureError> {
@@ -91,7 +40,7 @@ impl StabilizedChannels {
             ));
         }
         let streams: Vec<(&'static str, &[DeviceVec])> = std::iter::once(("gravity", imu.gravity))
-            .chain(channels.iter().map(|&c| (channel_name(c), imu.channel(c))))
+            .chain(channels.iter().map(|&c| (channel_name(c), channel(imu, c))))
             .collect();
         for (what, s) in &streams {
             if let Some(index) = s.iter().position(|v| !v.is_finite()) {
@@ -110,7 +59,7 @@ impl StabilizedChannels {
                     // sandwich per vector.
                     let m = up_axis.align(imu.gravity[i]).matrix();
                     for (c, out) in channels.iter().zip(row.chunks_exact_mut(3)) {
-                        let v = m * imu.channel(*c)[i].vector();
+                        let v = m * channel(imu, *c)[i].vector();
                         out[0] = v.x as f32;
                         out[1] = v.y as f32;
                         out[2] = v.z as f32;
@@ -232,7 +181,7 @@ impl FeatureExtractor {
     }
 
     /// The per-frame S channels of a sequence, for [`Self::features`] and [`Self::row_into`].
-    pub fn stabilize(&self, imu: &ImuView<'_>) -> Result<StabilizedChannels, FeatureError> {
+    pub fn stabilize(&self, imu: &ImuFrames<'_>) -> Result<StabilizedChannels, FeatureError> {
         StabilizedChannels::new(imu, &self.config.channels, self.config.up_axis)
     }
 
@@ -332,7 +281,7 @@ impl FeatureExtractor {
 /// Features of `imu` at `frames` with `config`: [`FeatureExtractor::new`], then
 /// [`FeatureExtractor::stabilize`] and [`FeatureExtractor::features`].
 pub fn compute_features(
-    imu: &ImuView<'_>,
+    imu: &ImuFrames<'_>,
     config: &FeatureConfig,
     frames: &[usize],
 ) -> Result<FeatureMatrix, FeatureError> {

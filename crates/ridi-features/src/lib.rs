@@ -51,9 +51,9 @@
 //!
 //! ```
 //! use ridi_features::{
-//!     FeatureConfig, FeatureExtractor, GroundTruthView, ImuView, SampleSchedule, compute_targets,
+//!     FeatureConfig, FeatureExtractor, GroundTruthView, SampleSchedule, compute_targets,
 //! };
-//! use ridi_frames::{DeviceVec, WorldFromDevice, WorldVec};
+//! use ridi_frames::{DeviceVec, ImuFrames, WorldFromDevice, WorldVec};
 //!
 //! // Ten seconds at 200 Hz of a flat phone walking along world +y at 1.2 m/s.
 //! let n = 2000;
@@ -69,7 +69,8 @@
 //! assert_eq!(frames.len(), 180); // 200, 210, ..., 1990
 //!
 //! let fx = FeatureExtractor::new(config.clone())?;
-//! let stab = fx.stabilize(&ImuView::new(&gyro, &linacce, &gravity)?)?;
+//! let imu = ImuFrames::new(&time, &gyro, &linacce, &gravity, &orientation)?;
+//! let stab = fx.stabilize(&imu)?;
 //! let x = fx.features(&stab, &frames)?;
 //! assert_eq!((x.rows(), x.cols()), (180, 1200));
 //! // A flat phone's z axis is S-up (y): the gyro's z rate appears as S-y.
@@ -92,9 +93,7 @@ mod turn;
 
 pub use config::{FeatureChannel, FeatureConfig, Orientation, Standardization, StandardizationFit};
 pub use error::FeatureError;
-pub use features::{
-    FeatureExtractor, ImuView, SampleSchedule, StabilizedChannels, compute_features,
-};
+pub use features::{FeatureExtractor, SampleSchedule, StabilizedChannels, compute_features};
 pub use gaussian::{gaussian_filter1d, gaussian_kernel};
 pub use matrix::FeatureMatrix;
 /// The frame types the inputs are built from.

@@ -121,9 +121,9 @@ pub fn turned_copies(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::{FeatureConfig, FeatureExtractor, GroundTruthView, ImuView, compute_targets};
+    use crate::{FeatureConfig, FeatureExtractor, GroundTruthView, compute_targets};
     use ridi_frames::nalgebra::Vector3;
-    use ridi_frames::{DeviceVec, WorldFromDevice, WorldVec};
+    use ridi_frames::{DeviceVec, ImuFrames, WorldFromDevice, WorldVec};
 
     /// A flat phone with heading `yaw` (about world up) walking along world +y at 1 m/s, its
     /// gyro and linear acceleration given in the world and measured in the device frame.
@@ -144,7 +144,7 @@ mod tests {
         let frames: Vec<usize> = vec![300, 600, 900];
         let fx = FeatureExtractor::new(config.clone()).unwrap();
         let stab = fx
-            .stabilize(&ImuView::new(&gyro, &linacce, &gravity).unwrap())
+            .stabilize(&ImuFrames::new(&time, &gyro, &linacce, &gravity, &orientation).unwrap())
             .unwrap();
         let x = fx.features(&stab, &frames).unwrap();
         let gt = GroundTruthView {

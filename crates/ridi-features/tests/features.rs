@@ -1,20 +1,54 @@
 //! Feature extraction against the naive reference, schedules, configuration and errors.
 
-mod common;
-
-use common::naive;
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use ridi_features::{
-    FeatureChannel, FeatureConfig, FeatureError, FeatureExtractor, FeatureMatrix, ImuView,
-    SampleSchedule, Standardization, StandardizationFit, compute_features,
+    FeatureChannel, FeatureConfig, FeatureError, FeatureExtractor, FeatureMatrix, SampleSchedule,
+    Standardization, StandardizationFit, compute_features,
 };
-use ridi_frames::{DeviceVec, UpAxis};
+use ridi_frames::{DeviceVec, ImuFrames, UpAxis, WorldFromDevice};
+use ridi_test_support::naive_features;
 
 struct Imu {
+    time: Vec<f64>,
     gyro: Vec<DeviceVec>,
     linacce: Vec<DeviceVec>,
     gravity: Vec<DeviceVec>,
+    orientation: Vec<WorldFromDevice>,
+}
+
+impl Imu {
+    /// Features read gyro, linear acceleration and gravity; time and orientation fill the rest.
+    fn new(gyro: Vec<DeviceVec>, linacce: Vec<DeviceVec>, gravity: Vec<DeviceVec>) -> Self {
+        let n = gravity.len();
+        Imu {
+            time: (0..n).map(|i| i as f64 / 200.0).collect(),
+            gyro,
+            linacce,
+            gravity,
+            orientation: vec![WorldFromDevice::identity(); n],
+        }
+    }
+
+    fn view(&self) -> ImuFrames<'_> {
+        ImuFrames::new(
+            &self.time,
+            &self.gyro,
+            &self.linacce,
+            &self.gravity,
+            &self.orientation,
+        )
+        .unwrap()
+    }
+
+    /// The same frames with other gravity or linear acceleration.
+    fn with<'a>(&'a self, linacce: &'a [DeviceVec], gravity: &'a [DeviceVec]) -> ImuFrames<'a> {
+        ImuFrames {
+            linacce,
+            gravity,
+            ..self.view()
+        }
+    }
 }
 
 fn random_imu(n: usize, seed: u64) -> Imu {
@@ -40,17 +74,7 @@ fn random_imu(n: usize, seed: u64) -> Imu {
         gravity[2] = DeviceVec::new(1e-9, -9.8, 0.0);
         gravity[3] = DeviceVec::new(0.0, 9.8, 0.0);
     }
-    Imu {
-        gyro,
-        linacce,
-        gravity,
-    }
-}
-
-impl Imu {
-    fn view(&self) -> ImuView<'_> {
-        ImuView::new(&self.gyro, &self.linacce, &self.gravity).unwrap()
-    }
+    Imu::new(gyro, linacce, gravity)
 }
 
 fn max_rel_diff(fast: &FeatureMatrix, slow: &[Vec<f32>]) -> f64 {
@@ -72,7 +96,7 @@ fn matches_naive_reference_on_random_data() {
     let frames = SampleSchedule::every(&config, 7).unwrap().frames(900);
     assert_eq!(*frames.last().unwrap(), 893);
     let fast = compute_features(&imu.view(), &config, &frames).unwrap();
-    let slow = naive::features(
+    let slow = naive_features(
         &imu.gyro,
         &imu.linacce,
         &imu.gravity,
@@ -86,7 +110,7 @@ fn matches_naive_reference_on_random_data() {
     assert!(worst < 1e-6, "max relative difference {worst}");
     // The last valid frame is the sequence length (window [n - 200, n)).
     let end = compute_features(&imu.view(), &config, &[900]).unwrap();
-    let slow_end = naive::features(&imu.gyro, &imu.linacce, &imu.gravity, &[900], 200, 2.0, 4.0);
+    let slow_end = naive_features(&imu.gyro, &imu.linacce, &imu.gravity, &[900], 200, 2.0, 4.0);
     assert!(max_rel_diff(&end, &slow_end) < 1e-6);
 }
 
@@ -110,7 +134,7 @@ fn matches_naive_reference_for_short_windows_and_other_sigmas() {
         let frames = SampleSchedule::every(&config, 3).unwrap().frames(120);
         let fast = compute_features(&imu.view(), &config, &frames).unwrap();
         assert_eq!(fast.cols(), window * 6);
-        let slow = naive::features(
+        let slow = naive_features(
             &imu.gyro,
             &imu.linacce,
             &imu.gravity,
@@ -132,8 +156,8 @@ fn layout_is_time_major_gyro_then_linacce() {
     let gyro = vec![DeviceVec::new(1.0, 2.0, 3.0); n];
     let linacce = vec![DeviceVec::new(4.0, 5.0, 6.0); n];
     let gravity = vec![DeviceVec::new(0.0, 0.0, 9.81); n];
-    let imu = ImuView::new(&gyro, &linacce, &gravity).unwrap();
-    let x = compute_features(&imu, &FeatureConfig::default(), &[200, 250]).unwrap();
+    let imu = Imu::new(gyro, linacce, gravity);
+    let x = compute_features(&imu.view(), &FeatureConfig::default(), &[200, 250]).unwrap();
     let expected = [1.0, 3.0, -2.0, 4.0, 6.0, -5.0];
     for r in 0..2 {
         for t in 0..200 {
@@ -148,14 +172,14 @@ fn layout_is_time_major_gyro_then_linacce() {
         channels: vec![FeatureChannel::LinearAcceleration, FeatureChannel::Gyro],
         ..FeatureConfig::default()
     };
-    let y = compute_features(&imu, &swapped, &[200]).unwrap();
+    let y = compute_features(&imu.view(), &swapped, &[200]).unwrap();
     assert!((y.row(0)[0] - 4.0).abs() < 2e-6 && (y.row(0)[3] - 1.0).abs() < 2e-6);
     let gyro_only = FeatureConfig {
         channels: vec![FeatureChannel::Gyro],
         ..FeatureConfig::default()
     };
     assert_eq!(gyro_only.feature_dim(), 600);
-    let z = compute_features(&imu, &gyro_only, &[200]).unwrap();
+    let z = compute_features(&imu.view(), &gyro_only, &[200]).unwrap();
     assert!((z.row(0)[599] + 2.0).abs() < 2e-6);
 }
 
@@ -174,12 +198,12 @@ fn each_frame_uses_its_own_gravity() {
             }
         })
         .collect();
-    let imu = ImuView::new(&gyro, &linacce, &gravity).unwrap();
+    let imu = Imu::new(gyro, linacce, gravity);
     let config = FeatureConfig {
         feature_sigma: 0.0,
         ..FeatureConfig::default()
     };
-    let x = compute_features(&imu, &config, &[210]).unwrap();
+    let x = compute_features(&imu.view(), &config, &[210]).unwrap();
     // Frame 10 of the window (device frame 10, gravity along y): device y is S-up.
     assert_eq!(&x.row(0)[10 * 6..10 * 6 + 3], &[0.0, 1.0, 0.0]);
     // Last frame (gravity along z): device y is S-forward, -z.
@@ -196,11 +220,11 @@ fn plus_or_minus_y_gives_an_upside_down_phone_the_upright_features() {
         *g = DeviceVec::new(0.5 * g.x(), 9.8, 0.5 * g.z());
     }
     let turn = |v: &DeviceVec| DeviceVec::new(-v.x(), -v.y(), v.z());
-    let top_down = Imu {
-        gyro: upright.gyro.iter().map(turn).collect(),
-        linacce: upright.linacce.iter().map(turn).collect(),
-        gravity: upright.gravity.iter().map(turn).collect(),
-    };
+    let top_down = Imu::new(
+        upright.gyro.iter().map(turn).collect(),
+        upright.linacce.iter().map(turn).collect(),
+        upright.gravity.iter().map(turn).collect(),
+    );
     let frames = [200, 377, 599];
     let with = |axis| FeatureConfig {
         up_axis: axis,
@@ -265,15 +289,15 @@ fn short_sequences_give_zero_samples() {
 fn bad_input_is_an_error_not_a_panic() {
     let imu = random_imu(300, 4);
     let config = FeatureConfig::default();
+    let short = ImuFrames {
+        gyro: &imu.gyro[..299],
+        ..imu.view()
+    };
     assert!(matches!(
-        ImuView::new(&imu.gyro[..299], &imu.linacce, &imu.gravity),
+        compute_features(&short, &config, &[200]),
         Err(FeatureError::LengthMismatch { what: "gyro", .. })
     ));
-    let unchecked = ImuView {
-        gyro: &imu.gyro,
-        linacce: &imu.linacce[..10],
-        gravity: &imu.gravity,
-    };
+    let unchecked = imu.with(&imu.linacce[..10], &imu.gravity);
     assert!(matches!(
         compute_features(&unchecked, &config, &[200]),
         Err(FeatureError::LengthMismatch {
@@ -287,7 +311,7 @@ fn bad_input_is_an_error_not_a_panic() {
     }
     let mut g = imu.gravity.clone();
     g[123] = DeviceVec::new(f64::NAN, 0.0, 9.8);
-    let v = ImuView::new(&imu.gyro, &imu.linacce, &g).unwrap();
+    let v = imu.with(&imu.linacce, &g);
     assert_eq!(
         compute_features(&v, &config, &[200]).unwrap_err(),
         FeatureError::NonFinite {
@@ -297,7 +321,7 @@ fn bad_input_is_an_error_not_a_panic() {
     );
     let mut a = imu.linacce.clone();
     a[7] = DeviceVec::new(0.0, f64::INFINITY, 0.0);
-    let v = ImuView::new(&imu.gyro, &a, &imu.gravity).unwrap();
+    let v = imu.with(&a, &imu.gravity);
     assert!(matches!(
         compute_features(&v, &config, &[200]),
         Err(FeatureError::NonFinite {

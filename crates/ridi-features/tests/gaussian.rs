@@ -1,10 +1,8 @@
 //! Gaussian smoothing against hand-derived values of scipy's definition.
 
-mod common;
-
-use common::naive;
 use ridi_features::gaussian::{half_kernel, kernel_radius};
 use ridi_features::{gaussian_filter1d, gaussian_kernel};
+use ridi_test_support::naive_smooth;
 
 fn close(a: f64, b: f64, tol: f64) -> bool {
     (a - b).abs() <= tol * (1.0 + b.abs())
@@ -130,7 +128,7 @@ fn agrees_with_the_padded_reference() {
         .collect();
     for (sigma, n) in [(2.0, 500), (30.0, 500), (30.0, 100), (0.7, 9), (5.0, 2)] {
         let y = gaussian_filter1d(&x[..n], sigma, 4.0).unwrap();
-        let r = naive::smooth(&x[..n], sigma, 4.0);
+        let r = naive_smooth(&x[..n], sigma, 4.0);
         for (a, b) in y.iter().zip(&r) {
             assert!(close(*a, *b, 1e-13), "sigma {sigma} n {n}: {a} vs {b}");
         }

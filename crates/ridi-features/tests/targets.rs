@@ -1,8 +1,5 @@
 //! Velocity targets on synthetic walks with analytically known answers.
 
-mod common;
-
-use common::naive;
 use ridi_features::{
     FeatureConfig, FeatureError, GroundTruthView, SampleSchedule, compute_targets,
     stabilized_velocity,
@@ -11,6 +8,7 @@ use ridi_frames::nalgebra::Vector3;
 use ridi_frames::{
     DeviceVec, Rot, StabHorizontal, UpAxis, World, WorldFromDevice, WorldVec, gravity_in_device,
 };
+use ridi_test_support::naive_smooth;
 
 struct Walk {
     time: Vec<f64>,
@@ -164,7 +162,7 @@ fn smoothing_and_rotation_match_a_naive_computation() {
             c.push(x);
         }
     }
-    let smoothed: Vec<Vec<f64>> = comps.iter().map(|c| naive::smooth(c, 30.0, 4.0)).collect();
+    let smoothed: Vec<Vec<f64>> = comps.iter().map(|c| naive_smooth(c, 30.0, 4.0)).collect();
     for i in 0..n {
         let got = v[i].to_array();
         for c in 0..3 {
@@ -195,7 +193,7 @@ fn long_sequences_are_smoothed_in_blocks_identically() {
             (walk.position[j + 1].x() - walk.position[j].x()) / 0.005
         })
         .collect();
-    let expected = naive::smooth(&sx, 30.0, 4.0);
+    let expected = naive_smooth(&sx, 30.0, 4.0);
     for i in 0..n {
         assert!(
             (v[i].x() - expected[i]).abs() < 1e-11,

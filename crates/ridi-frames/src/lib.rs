@@ -78,6 +78,7 @@ pub mod estimate;
 mod frame;
 mod gravity;
 mod horizontal;
+mod imu;
 mod rotation;
 mod vector;
 
@@ -92,6 +93,7 @@ pub use gravity::{
     stab_from_world,
 };
 pub use horizontal::{Horizontal, StabHorizontal, WorldHorizontal};
+pub use imu::{ImuError, ImuFrames, ImuSample};
 pub use rotation::{QuatError, Rot, StabFromDevice, StabFromWorld, WorldFromDevice};
 pub use vector::{DeviceVec, StabVec, Vec3, WorldVec};
 

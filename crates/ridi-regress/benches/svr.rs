@@ -1,6 +1,9 @@
 //! Criterion benchmarks on synthetic IMU-like data (`benches/synth.rs`). Long runs (17k-sample
 //! fits, full grid, scikit-learn comparison) are in `examples/svr_timing.rs` and
 //! `docs/benchmarks.md`.
+//!
+//! `gram_2000x1200` times the kernel internals `ridi_regress::{sq_norms, gram}`, which the
+//! feature `bench-internals` exposes (turned on here by the crate's dev-dependency on itself).
 
 mod synth;
 
@@ -8,7 +11,7 @@ use criterion::{Criterion, criterion_group, criterion_main};
 use ridi_features::FeatureConfig;
 use ridi_regress::{
     Cascade, CascadeParams, MatrixRef, NoProgress, RegressorChoice, Storage, Svc, SvcParams, Svr,
-    SvrParams, TrainingSet, kernel,
+    SvrParams, TrainingSet,
 };
 
 fn benches(c: &mut Criterion) {
@@ -18,9 +21,9 @@ fn benches(c: &mut Criterion) {
     let mut g = c.benchmark_group("regress");
     g.sample_size(10);
 
-    let norms = kernel::sq_norms(x);
+    let norms = ridi_regress::sq_norms(x);
     g.bench_function("gram_2000x1200", |b| {
-        b.iter(|| kernel::gram(x, &norms, gamma))
+        b.iter(|| ridi_regress::gram(x, &norms, gamma))
     });
 
     let y: Vec<f64> = data.y.iter().map(|v| v[1]).collect();

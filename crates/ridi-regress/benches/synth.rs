@@ -5,6 +5,7 @@
 #![allow(dead_code)]
 
 use ridi_features::ridi_frames::StabHorizontal;
+use ridi_test_support::SplitMix64;
 
 pub struct Synth {
     pub x: Vec<f32>,
@@ -14,24 +15,12 @@ pub struct Synth {
     pub dim: usize,
 }
 
-struct Rng(u64);
-
-impl Rng {
-    fn next(&mut self) -> f64 {
-        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        ((z ^ (z >> 31)) >> 11) as f64 / (1u64 << 53) as f64
-    }
-}
-
 /// `n` samples over `placements` classes, sequences of `per_seq` samples (10-frame steps).
 pub fn generate(n: usize, placements: usize, per_seq: usize, seed: u64) -> Synth {
     const FRAMES: usize = 200;
     const CH: usize = 6;
     let dim = FRAMES * CH;
-    let mut rng = Rng(seed);
+    let mut rng = SplitMix64(seed);
     let mut s = Synth {
         x: Vec::with_capacity(n * dim),
         y: Vec::with_capacity(n),
@@ -41,18 +30,18 @@ pub fn generate(n: usize, placements: usize, per_seq: usize, seed: u64) -> Synth
     };
     // Placement signatures: gain and second-harmonic weight per channel.
     let sig: Vec<[(f64, f64); CH]> = (0..placements)
-        .map(|_| std::array::from_fn(|_| (0.3 + 1.2 * rng.next(), rng.next())))
+        .map(|_| std::array::from_fn(|_| (0.3 + 1.2 * rng.unit(), rng.unit())))
         .collect();
     let mut seq = 0u64;
     while s.y.len() < n {
         let p = (seq as usize) % placements;
-        let cadence = 1.5 + 0.7 * rng.next();
-        let phase0 = std::f64::consts::TAU * rng.next();
-        let heading = 0.6 * (rng.next() - 0.5);
-        let speed0 = 0.8 + 0.8 * rng.next();
-        let phases: [f64; CH] = std::array::from_fn(|_| std::f64::consts::TAU * rng.next());
+        let cadence = 1.5 + 0.7 * rng.unit();
+        let phase0 = std::f64::consts::TAU * rng.unit();
+        let heading = 0.6 * (rng.unit() - 0.5);
+        let speed0 = 0.8 + 0.8 * rng.unit();
+        let phases: [f64; CH] = std::array::from_fn(|_| std::f64::consts::TAU * rng.unit());
         // Per-sequence gain jitter (phone, person): placements overlap as in real data.
-        let jitter: [f64; CH] = std::array::from_fn(|_| 0.6 + 0.8 * rng.next());
+        let jitter: [f64; CH] = std::array::from_fn(|_| 0.6 + 0.8 * rng.unit());
         for k in 0..per_seq {
             if s.y.len() >= n {
                 break;
@@ -69,7 +58,7 @@ pub fn generate(n: usize, placements: usize, per_seq: usize, seed: u64) -> Synth
                     let base = (w + phases[c]).sin() + h * (2.0 * w + phases[c]).sin();
                     let v = g * speed * base
                         + 0.2 * turn * (c as f64 - 2.5)
-                        + 0.05 * (rng.next() - 0.5);
+                        + 0.05 * (rng.unit() - 0.5);
                     s.x.push(v as f32);
                 }
             }

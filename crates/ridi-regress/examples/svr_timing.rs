@@ -164,7 +164,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 .position(|a| a == "--save")
                 .and_then(|i| args.get(i + 1))
             {
-                ridi_regress::model_file::save(&model, std::path::Path::new(path))?;
+                model.save(path)?;
                 let mb = std::fs::metadata(path)?.len() as f64 / 1e6;
                 println!("saved {path}: {mb:.1} MB");
             }
@@ -236,13 +236,14 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 .collect();
             std::fs::write(dir.join("group.u32"), grp)?;
             // The cross-validation folds the cascade uses (per placement, default grid seed),
-            // so that scikit-learn can be scored on identical splits.
+            // so that scikit-learn can be scored on identical splits (`assign_folds`: feature
+            // `bench-internals`).
             let mut fold = vec![0u32; n];
             for p in 0..k {
                 let idx: Vec<usize> = (0..n).filter(|&i| data.placement[i] == p).collect();
                 let groups: Vec<u64> = idx.iter().map(|&i| data.group[i]).collect();
                 let spec = GridSpec::default();
-                let (f, _) = ridi_regress::grid::assign_folds(&groups, spec.folds, spec.seed)?;
+                let (f, _) = ridi_regress::assign_folds(&groups, spec.folds, spec.seed)?;
                 for (&i, &fi) in idx.iter().zip(&f) {
                     fold[i] = fi as u32;
                 }
@@ -261,7 +262,7 @@ fn load_query(args: &[String], n: usize, k: usize) -> Result<(), Box<dyn std::er
     let path = args.get(2).ok_or("load-query needs a model path")?;
     let nq: usize = arg(args, "--queries", 2000);
     let t = Instant::now();
-    let model = ridi_regress::model_file::load(std::path::Path::new(path))?;
+    let model = Cascade::load(path)?;
     let stored: Vec<usize> = (0..k).map(|p| model.stored_samples(p)).collect();
     println!(
         "{path}: {:.1} MB, loaded in {:.2} s; stored samples {stored:?}; {:?}",

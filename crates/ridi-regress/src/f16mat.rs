@@ -90,10 +90,10 @@ impl F16Matrix {
         assert_eq!(q.len(), self.dim, "query length");
         let rows = &self.data[r0 * self.dim..(r0 + out.len()) * self.dim];
         #[cfg(target_arch = "x86_64")]
-        if simd::available() {
+        if crate::simd::avx2_f16c() {
             // SAFETY: the CPU supports AVX2, FMA and F16C (checked at run time); `rows`
             // holds `out.len()` rows of `q.len()` values.
-            unsafe { simd::dots(q, rows.reinterpret_cast(), out) };
+            unsafe { crate::simd::f16_dots_avx2(q, rows.reinterpret_cast(), out) };
             return;
         }
         dots_generic(q, rows, out);
@@ -106,96 +106,6 @@ fn dots_generic(q: &[f32], rows: &[f16], out: &mut [f32]) {
     for (o, r) in out.iter_mut().zip(rows.chunks_exact(q.len())) {
         r.convert_to_f32_slice(&mut buf);
         *o = kernel::dot(q, &buf);
-    }
-}
-
-#[cfg(target_arch = "x86_64")]
-mod simd {
-    use std::arch::x86_64::*;
-
-    /// Rows ahead to prefetch: a DRAM stream of several rows at once outruns the hardware
-    /// prefetcher, which then leaves the core waiting on misses.
-    const PREFETCH_ROWS: usize = 8;
-
-    /// Hint only: never faults, so it may point past the matrix.
-    #[inline(always)]
-    fn prefetch(p: *const u16) {
-        // SAFETY: a prefetch does not access memory architecturally.
-        unsafe { _mm_prefetch::<_MM_HINT_T0>(p as *const i8) };
-    }
-
-    pub(super) fn available() -> bool {
-        static FLAG: std::sync::OnceLock<bool> = std::sync::OnceLock::new();
-        *FLAG.get_or_init(|| {
-            is_x86_feature_detected!("avx2")
-                && is_x86_feature_detected!("fma")
-                && is_x86_feature_detected!("f16c")
-        })
-    }
-
-    /// Rows four at a time so that each loaded block of the query feeds four rows, with two
-    /// accumulators per row to cover the FMA latency. Every row is summed in the same order
-    /// whatever block it falls in, so a row's dot product does not depend on its position.
-    #[target_feature(enable = "avx2,fma,f16c")]
-    pub(super) unsafe fn dots(q: &[f32], rows: &[u16], out: &mut [f32]) {
-        let dim = q.len();
-        let mut j = 0;
-        while j + 4 <= out.len() {
-            // SAFETY: rows `j..j + 4` exist (`rows` holds `out.len()` rows of `dim`).
-            let d = unsafe { block::<4>(q, rows.as_ptr().add(j * dim)) };
-            out[j..j + 4].copy_from_slice(&d);
-            j += 4;
-        }
-        while j < out.len() {
-            // SAFETY: as above, row `j`.
-            out[j] = unsafe { block::<1>(q, rows.as_ptr().add(j * dim)) }[0];
-            j += 1;
-        }
-    }
-
-    /// Dot products of `q` with the `R` consecutive rows of `q.len()` values at `p`.
-    #[target_feature(enable = "avx2,fma,f16c")]
-    #[inline]
-    unsafe fn block<const R: usize>(q: &[f32], p: *const u16) -> [f32; R] {
-        let dim = q.len();
-        let main = dim / 16 * 16;
-        let qp = q.as_ptr();
-        let mut acc = [[_mm256_setzero_ps(); 2]; R];
-        let mut k = 0;
-        // SAFETY (all pointer reads): `k + 16 <= main <= dim` inside each row, and the
-        // caller guarantees `R` rows of `dim` values at `p`.
-        unsafe {
-            while k < main {
-                let q0 = _mm256_loadu_ps(qp.add(k));
-                let q1 = _mm256_loadu_ps(qp.add(k + 8));
-                for (r, a) in acc.iter_mut().enumerate() {
-                    let s = p.add(r * dim + k);
-                    if k % 32 == 0 {
-                        prefetch(s.wrapping_add(PREFETCH_ROWS * dim));
-                    }
-                    let s0 = _mm256_cvtph_ps(_mm_loadu_si128(s as *const __m128i));
-                    let s1 = _mm256_cvtph_ps(_mm_loadu_si128(s.add(8) as *const __m128i));
-                    a[0] = _mm256_fmadd_ps(q0, s0, a[0]);
-                    a[1] = _mm256_fmadd_ps(q1, s1, a[1]);
-                }
-                k += 16;
-            }
-        }
-        let mut out = [0.0f32; R];
-        for (r, (o, a)) in out.iter_mut().zip(&acc).enumerate() {
-            let v = _mm256_add_ps(a[0], a[1]);
-            let h = _mm_add_ps(_mm256_castps256_ps128(v), _mm256_extractf128_ps(v, 1));
-            let h = _mm_add_ps(h, _mm_movehl_ps(h, h));
-            let h = _mm_add_ss(h, _mm_shuffle_ps(h, h, 1));
-            let mut s = _mm_cvtss_f32(h);
-            for (c, &qc) in q.iter().enumerate().skip(main) {
-                // SAFETY: `c < dim` inside row `r`.
-                let b = unsafe { *p.add(r * dim + c) };
-                s += qc * half::f16::from_bits(b).to_f32();
-            }
-            *o = s;
-        }
-        out
     }
 }
 

@@ -83,7 +83,7 @@ pub struct GridRow {
 
 /// Assigns whole groups to folds: groups are shuffled with `seed`, then each goes to the fold
 /// with the fewest samples so far. Returns the fold of every sample and the number of folds.
-pub fn assign_folds(
+pub(crate) fn assign_folds(
     groups: &[u64],
     folds: usize,
     seed: u64,

@@ -2,36 +2,21 @@
 //!
 //! `K(a, b) = exp(-gamma * (|a|² + |b|² - 2 a·b))`: with the squared norms precomputed, a block
 //! of kernel values is one matrix product plus an element-wise exponential, which runs at GEMM
-//! speed instead of the memory-bound speed of one distance at a time.
+//! speed instead of the memory-bound speed of one distance at a time. On a CPU with AVX2 the
+//! element-wise loops run compiled for it (`crate::simd`).
 
 use faer::linalg::matmul::matmul;
 use faer::{Accum, MatMut, MatRef, Par};
 use rayon::prelude::*;
-use serde::{Deserialize, Serialize};
 
 use crate::matrix::MatrixRef;
-
-/// Radial basis function kernel `exp(-gamma |a - b|²)`.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-pub struct Rbf {
-    /// Width parameter; the paper uses `1 / 1200`.
-    pub gamma: f32,
-}
-
-impl Rbf {
-    /// Kernel value of two vectors (reference implementation, not the fast path).
-    pub fn eval(&self, a: &[f32], b: &[f32]) -> f32 {
-        let d2: f32 = a.iter().zip(b).map(|(x, y)| (x - y) * (x - y)).sum();
-        (-self.gamma * d2).exp()
-    }
-}
 
 /// Tile edge for blocked kernel computation: large enough for GEMM efficiency with
 /// `dim = 1200`, small enough to give both cores work on a few thousand samples.
 const TILE: usize = 256;
 
 /// Squared Euclidean norm of every row.
-pub fn sq_norms(x: MatrixRef<'_>) -> Vec<f32> {
+pub(crate) fn sq_norms(x: MatrixRef<'_>) -> Vec<f32> {
     (0..x.rows())
         .into_par_iter()
         .with_min_len(64)
@@ -42,15 +27,15 @@ pub fn sq_norms(x: MatrixRef<'_>) -> Vec<f32> {
 /// `a · b` with lane-wise partial sums (vectorizable without reassociation by the compiler).
 pub(crate) fn dot(a: &[f32], b: &[f32]) -> f32 {
     #[cfg(target_arch = "x86_64")]
-    if simd::avx2() {
+    if crate::simd::avx2() {
         // SAFETY: the CPU supports AVX2 and FMA (checked at run time).
-        return unsafe { simd::dot_avx2(a, b) };
+        return unsafe { crate::simd::dot_avx2(a, b) };
     }
     dot_generic(a, b)
 }
 
 #[inline(always)]
-fn dot_generic(a: &[f32], b: &[f32]) -> f32 {
+pub(crate) fn dot_generic(a: &[f32], b: &[f32]) -> f32 {
     const L: usize = 16;
     let n = a.len().min(b.len());
     let (a, b) = (&a[..n], &b[..n]);
@@ -73,9 +58,9 @@ fn dot_generic(a: &[f32], b: &[f32]) -> f32 {
 /// `out[j] = exp(-gamma * max(0, na + nb[j] - 2 out[j]))`.
 pub(crate) fn rbf_from_dots(out: &mut [f32], na: f32, nb: &[f32], gamma: f32) {
     #[cfg(target_arch = "x86_64")]
-    if simd::avx2() {
+    if crate::simd::avx2() {
         // SAFETY: the CPU supports AVX2 and FMA (checked at run time).
-        unsafe { simd::rbf_from_dots_avx2(out, na, nb, gamma) };
+        unsafe { crate::simd::rbf_from_dots_avx2(out, na, nb, gamma) };
         return;
     }
     rbf_from_dots_generic(out, na, nb, gamma)
@@ -89,25 +74,25 @@ pub(crate) fn dist_from_dots(out: &mut [f32], na: f32, nb: &[f32]) {
 }
 
 /// `out[j] = exp(-gamma d2[j])`.
-pub fn exp_neg_scaled(d2: &[f32], gamma: f32, out: &mut [f32]) {
+pub(crate) fn exp_neg_scaled(d2: &[f32], gamma: f32, out: &mut [f32]) {
     #[cfg(target_arch = "x86_64")]
-    if simd::avx2() {
+    if crate::simd::avx2() {
         // SAFETY: the CPU supports AVX2 and FMA (checked at run time).
-        unsafe { simd::exp_neg_scaled_avx2(d2, gamma, out) };
+        unsafe { crate::simd::exp_neg_scaled_avx2(d2, gamma, out) };
         return;
     }
     exp_neg_scaled_generic(d2, gamma, out)
 }
 
 #[inline(always)]
-fn exp_neg_scaled_generic(d2: &[f32], gamma: f32, out: &mut [f32]) {
+pub(crate) fn exp_neg_scaled_generic(d2: &[f32], gamma: f32, out: &mut [f32]) {
     for (o, &d) in out.iter_mut().zip(d2) {
         *o = exp_nonpos(-gamma * d);
     }
 }
 
 #[inline(always)]
-fn rbf_from_dots_generic(out: &mut [f32], na: f32, nb: &[f32], gamma: f32) {
+pub(crate) fn rbf_from_dots_generic(out: &mut [f32], na: f32, nb: &[f32], gamma: f32) {
     for (o, &b) in out.iter_mut().zip(nb) {
         // Cancellation can make the distance slightly negative for near-duplicates.
         let d2 = (na + b - 2.0 * *o).max(0.0);
@@ -134,34 +119,6 @@ pub(crate) fn exp_nonpos(x: f32) -> f32 {
     let e = p * (r * r) + r + 1.0;
     let scale = f32::from_bits((((n as i32) + 127) as u32) << 23);
     e * scale
-}
-
-#[cfg(target_arch = "x86_64")]
-mod simd {
-    use std::sync::OnceLock;
-
-    pub(super) fn avx2() -> bool {
-        static FLAG: OnceLock<bool> = OnceLock::new();
-        *FLAG.get_or_init(|| {
-            std::arch::is_x86_feature_detected!("avx2")
-                && std::arch::is_x86_feature_detected!("fma")
-        })
-    }
-
-    #[target_feature(enable = "avx2,fma")]
-    pub(super) unsafe fn dot_avx2(a: &[f32], b: &[f32]) -> f32 {
-        super::dot_generic(a, b)
-    }
-
-    #[target_feature(enable = "avx2,fma")]
-    pub(super) unsafe fn exp_neg_scaled_avx2(d2: &[f32], gamma: f32, out: &mut [f32]) {
-        super::exp_neg_scaled_generic(d2, gamma, out)
-    }
-
-    #[target_feature(enable = "avx2,fma")]
-    pub(super) unsafe fn rbf_from_dots_avx2(out: &mut [f32], na: f32, nb: &[f32], gamma: f32) {
-        super::rbf_from_dots_generic(out, na, nb, gamma)
-    }
 }
 
 /// `out (ma × mb, row stride ldo) = A Bᵀ` for row-major `A (ma × dim)`, `B (mb × dim)`,
@@ -226,7 +183,7 @@ fn sub(x: MatrixRef<'_>, r0: usize, r1: usize) -> MatrixRef<'_> {
 }
 
 /// Kernel block `out (a.rows() × b.rows(), row-major) = K(a_i, b_j)`, tiled and parallel.
-pub fn cross_kernel(
+pub(crate) fn cross_kernel(
     a: MatrixRef<'_>,
     na: &[f32],
     b: MatrixRef<'_>,
@@ -239,7 +196,13 @@ pub fn cross_kernel(
 
 /// Squared distances `out (a.rows() × b.rows()) = |a_i - b_j|²`, from which kernels of any
 /// width follow with [`exp_neg_scaled`] (the classifier and the regressors may differ).
-pub fn cross_sq_dist(a: MatrixRef<'_>, na: &[f32], b: MatrixRef<'_>, nb: &[f32], out: &mut [f32]) {
+pub(crate) fn cross_sq_dist(
+    a: MatrixRef<'_>,
+    na: &[f32],
+    b: MatrixRef<'_>,
+    nb: &[f32],
+    out: &mut [f32],
+) {
     cross_block(a, na, b, nb, None, out)
 }
 
@@ -283,7 +246,7 @@ fn cross_block(
 
 /// Full symmetric kernel matrix of `x` (row-major `n × n`); only the upper tiles go through
 /// GEMM, the lower ones are mirrored.
-pub fn gram(x: MatrixRef<'_>, norms: &[f32], gamma: f32) -> Vec<f32> {
+pub(crate) fn gram(x: MatrixRef<'_>, norms: &[f32], gamma: f32) -> Vec<f32> {
     let n = x.rows();
     let mut out = vec![0.0f32; n * n];
     if n == 0 {
@@ -352,6 +315,20 @@ pub(crate) fn kernel_rows(
 pub(crate) mod tests {
     use super::*;
     use crate::matrix::Matrix;
+
+    /// Radial basis function kernel `exp(-gamma |a - b|²)`.
+    struct Rbf {
+        /// Width parameter; the paper uses `1 / 1200`.
+        gamma: f32,
+    }
+
+    impl Rbf {
+        /// Kernel value of two vectors (reference implementation, not the fast path).
+        fn eval(&self, a: &[f32], b: &[f32]) -> f32 {
+            let d2: f32 = a.iter().zip(b).map(|(x, y)| (x - y) * (x - y)).sum();
+            (-self.gamma * d2).exp()
+        }
+    }
 
     /// Smooth test rows of magnitude up to about 3 (shared with other modules' tests).
     pub(crate) fn data(n: usize, d: usize) -> Matrix {

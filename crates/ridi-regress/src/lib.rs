@@ -9,7 +9,7 @@
 //!
 //! # Solver
 //!
-//! [`smo`] is libsvm's solver: WSS3 second-order working-set selection, shrinking with
+//! The solver is libsvm's: WSS3 second-order working-set selection, shrinking with
 //! unshrinking and gradient reconstruction, epsilon-SVR as the 2l-variable dual, `rho` with
 //! libsvm's sign (`f(x) = Σ coef K(sv, x) - rho`). Kernel values are `f32` and come from
 //! blocked GEMM (faer) with precomputed squared norms, `K_ij = exp(-γ(|x_i|² + |x_j|² -
@@ -18,12 +18,15 @@
 //! batches. Gradients and dual variables are `f64`, and so are targets and predictions: the
 //! velocities in S ([`StabHorizontal`](ridi_features::ridi_frames::StabHorizontal)) of
 //! ridi-features' targets and ridi-correct's regressions, with
-//! placements as `usize` indices into [`Cascade::placements`].
+//! placements as `usize` indices into [`Cascade::placements`]. On x86-64 the hot loops (kernel
+//! values, the solver's selection and gradient update, half-precision dot products) take AVX2
+//! code paths when the running CPU has AVX2 and FMA, checked once per process.
 //!
 //! # Reuse
 //!
-//! All fits of a placement index one kernel over its samples: the velocity (and speed) channels, every
-//! grid point and every cross-validation fold ([`grid`]). Fits along the `C` axis start from
+//! All fits of a placement index one kernel over its samples: the velocity (and speed)
+//! channels, every grid point and every cross-validation fold of the grid search
+//! ([`GridSpec`]). Fits along the `C` axis start from
 //! the previous solution scaled by `C_new / C_old`. A trained [`Cascade`] stores each
 //! placement's samples once in half precision, by default as coordinates on the few principal
 //! directions that hold 99.99 % of the training features' variance (304 of 1200 on Tyrex
@@ -44,7 +47,9 @@
 //!
 //! # Model files
 //!
-//! [`model_file`]: magic number, format version, CRC32, bincode 2 payload including the
+//! [`Cascade::save`] and [`Cascade::load`] (or [`Cascade::to_bytes`] and
+//! [`Cascade::from_bytes`]): the magic number [`MODEL_MAGIC`], the format version
+//! [`MODEL_FORMAT_VERSION`], a CRC32, and a bincode 2 payload including the
 //! [`ridi_features::FeatureConfig`]; atomic writes, deterministic bytes. That configuration is
 //! how a model is used: its features must be computed with it, and its velocities are in the S
 //! its `up_axis` defines (give the same `up_axis` to a correction of them, ridi-correct's
@@ -55,7 +60,7 @@
 //! ```
 //! use ridi_features::FeatureConfig;
 //! use ridi_features::ridi_frames::StabHorizontal;
-//! use ridi_regress::{Cascade, CascadeParams, MatrixRef, NoProgress, RegressorChoice, TrainingSet, model_file};
+//! use ridi_regress::{Cascade, CascadeParams, MatrixRef, NoProgress, RegressorChoice, TrainingSet};
 //!
 //! // A tiny feature config: a 2-frame window of one channel gives 6 values per sample.
 //! let config = FeatureConfig { window: 2, channels: vec![ridi_features::FeatureChannel::Gyro], ..FeatureConfig::default() };
@@ -89,51 +94,64 @@
 //! assert_eq!(p.placement, 1);
 //! assert!((p.velocity[0] - 1.0 / 60.0).abs() < 0.1);
 //!
-//! let bytes = model_file::to_bytes(&model)?;
-//! assert_eq!(model_file::from_bytes(&bytes)?, model);
+//! let bytes = model.to_bytes()?;
+//! assert_eq!(Cascade::from_bytes(&bytes)?, model);
 //! # Ok::<(), ridi_regress::RegressError>(())
 //! ```
 //!
 //! # Features
 //!
-//! `linfa` (on by default): [`linfa_impl`], linfa's `Fit` and `Predict` for [`Svr`] and
-//! [`Svc`], and the `linfa` and `ndarray` versions it is built against. Without it
-//! (`default-features = false`) the crate depends on neither.
+//! - `linfa` (on by default): linfa's `Fit` for [`SvrParams`] and [`SvcParams`] and `Predict`
+//!   for [`Svr`] and [`Svc`] (on `f32` datasets), and the `linfa` and `ndarray` versions they
+//!   are built against. Without it (`default-features = false`) the crate depends on neither.
+//! - `bench-internals` (off): kernel and cross-validation internals that the crate's benches
+//!   and timing examples measure or reuse; not a supported API.
+//!
+//! # Public surface
+//!
+//! Every public item is at the crate root; the modules are private.
 
-pub(crate) mod cache;
-pub mod cascade;
-pub mod config;
-pub mod error;
-pub(crate) mod expansion;
-pub(crate) mod f16mat;
-pub mod grid;
-pub mod kernel;
+mod cache;
+mod cascade;
+mod config;
+mod error;
+mod expansion;
+mod f16mat;
+mod grid;
+#[cfg(feature = "bench-internals")]
+mod internals;
+mod kernel;
 #[cfg(feature = "linfa")]
-pub mod linfa_impl;
-pub mod matrix;
-pub mod model_file;
-pub mod progress;
-pub(crate) mod projection;
-pub mod smo;
-pub(crate) mod store;
-pub mod svc;
-pub mod svr;
+mod linfa_impl;
+mod matrix;
+mod model_file;
+mod progress;
+mod projection;
+#[cfg(target_arch = "x86_64")]
+mod simd;
+mod smo;
+mod store;
+mod svc;
+mod svr;
 
-pub use cascade::{
+pub use crate::cascade::{
     Cascade, CascadeParams, Gamma, Prediction, RegressorChoice, RoundingEffect, Storage, StoredAs,
     TrainingSet,
 };
-pub use config::{Precompute, SolverConfig};
-pub use error::RegressError;
-pub use grid::{GridRow, GridSpec};
-pub use kernel::Rbf;
-pub use matrix::{Matrix, MatrixRef};
-pub use progress::{NoProgress, Progress, ProgressEvent, Stage};
+pub use crate::config::{Precompute, SolverConfig};
+pub use crate::error::RegressError;
+pub use crate::grid::{GridRow, GridSpec};
+#[cfg(feature = "bench-internals")]
+#[doc(hidden)]
+pub use crate::internals::{assign_folds, gram, sq_norms};
+pub use crate::matrix::{Matrix, MatrixRef};
+pub use crate::model_file::{MODEL_FORMAT_VERSION, MODEL_MAGIC};
+pub use crate::progress::{NoProgress, Progress, ProgressEvent, Stage};
+pub use crate::smo::SmoSettings;
+pub use crate::svc::{Svc, SvcParams};
+pub use crate::svr::{FitInfo, Svr, SvrParams};
 /// The feature configuration a model stores ([`Cascade::feature_config`]).
 pub use ridi_features;
-pub use smo::SmoSettings;
-pub use svc::{Svc, SvcParams};
-pub use svr::{FitInfo, Svr, SvrParams};
-/// The versions the [`linfa_impl`] adapters are built against.
+/// The versions the linfa adapters (feature `linfa`) are built against.
 #[cfg(feature = "linfa")]
 pub use {linfa, ndarray};

@@ -1,11 +1,12 @@
-//! Model file codec.
+//! The model file codec: [`Cascade::to_bytes`], [`Cascade::from_bytes`], [`Cascade::save`] and
+//! [`Cascade::load`].
 //!
 //! Layout (little-endian):
 //!
 //! | bytes | content                                   |
 //! |-------|-------------------------------------------|
-//! | 8     | magic `b"RIDIREG\0"`                      |
-//! | 4     | format version ([`FORMAT_VERSION`])       |
+//! | 8     | magic [`MODEL_MAGIC`], `b"RIDIREG\0"`      |
+//! | 4     | format version ([`MODEL_FORMAT_VERSION`]) |
 //! | 8     | payload length in bytes                   |
 //! | 4     | CRC32 of the payload                      |
 //! | n     | payload: bincode 2 (standard config, serde) of the [`Cascade`] |
@@ -34,10 +35,10 @@ use std::path::{Path, PathBuf};
 use crate::cascade::Cascade;
 use crate::error::RegressError;
 
-/// File magic number.
-pub const MAGIC: [u8; 8] = *b"RIDIREG\0";
-/// Format version written and read by this build.
-pub const FORMAT_VERSION: u32 = 7;
+/// The first bytes of every model file.
+pub const MODEL_MAGIC: [u8; 8] = *b"RIDIREG\0";
+/// The model file format version this build writes and reads.
+pub const MODEL_FORMAT_VERSION: u32 = 7;
 const HEADER: usize = 8 + 4 + 8 + 4;
 /// Refuses to allocate for absurd payload lengths from a corrupt header.
 const MAX_PAYLOAD: u64 = 1 << 40;
@@ -46,31 +47,57 @@ fn bincode_config() -> impl bincode::config::Config {
     bincode::config::standard().with_limit::<{ MAX_PAYLOAD as usize }>()
 }
 
-/// Encodes a model into file bytes.
-pub fn to_bytes(model: &Cascade) -> Result<Vec<u8>, RegressError> {
+impl Cascade {
+    /// Encodes the model into the bytes of a model file; the same model always gives the same
+    /// bytes.
+    pub fn to_bytes(&self) -> Result<Vec<u8>, RegressError> {
+        encode(self)
+    }
+
+    /// Decodes the bytes of a model file, checking magic number, version, length, checksum and
+    /// the model's internal consistency.
+    pub fn from_bytes(bytes: &[u8]) -> Result<Self, RegressError> {
+        decode(bytes)
+    }
+
+    /// Writes the model file atomically: a temporary file in the same directory, `fsync`,
+    /// rename.
+    pub fn save(&self, path: impl AsRef<Path>) -> Result<(), RegressError> {
+        save(self, path.as_ref())
+    }
+
+    /// Reads and validates a model file.
+    pub fn load(path: impl AsRef<Path>) -> Result<Self, RegressError> {
+        let path = path.as_ref();
+        let bytes = std::fs::read(path).map_err(io_err(path))?;
+        decode(&bytes)
+    }
+}
+
+fn encode(model: &Cascade) -> Result<Vec<u8>, RegressError> {
     let payload = bincode::serde::encode_to_vec(model, bincode_config())
         .map_err(|e| RegressError::Encode(e.to_string()))?;
     let mut out = Vec::with_capacity(HEADER + payload.len());
-    out.extend_from_slice(&MAGIC);
-    out.extend_from_slice(&FORMAT_VERSION.to_le_bytes());
+    out.extend_from_slice(&MODEL_MAGIC);
+    out.extend_from_slice(&MODEL_FORMAT_VERSION.to_le_bytes());
     out.extend_from_slice(&(payload.len() as u64).to_le_bytes());
     out.extend_from_slice(&crc32fast::hash(&payload).to_le_bytes());
     out.extend_from_slice(&payload);
     Ok(out)
 }
 
-/// Decodes file bytes into a model, checking magic, version, length, checksum and the
-/// model's internal consistency.
-pub fn from_bytes(bytes: &[u8]) -> Result<Cascade, RegressError> {
-    if bytes.len() < MAGIC.len() || bytes[..MAGIC.len()] != MAGIC {
-        return Err(if bytes.len() < MAGIC.len() && MAGIC.starts_with(bytes) {
-            RegressError::Truncated {
-                expected: HEADER as u64,
-                found: bytes.len() as u64,
-            }
-        } else {
-            RegressError::BadMagic
-        });
+fn decode(bytes: &[u8]) -> Result<Cascade, RegressError> {
+    if bytes.len() < MODEL_MAGIC.len() || bytes[..MODEL_MAGIC.len()] != MODEL_MAGIC {
+        return Err(
+            if bytes.len() < MODEL_MAGIC.len() && MODEL_MAGIC.starts_with(bytes) {
+                RegressError::Truncated {
+                    expected: HEADER as u64,
+                    found: bytes.len() as u64,
+                }
+            } else {
+                RegressError::BadMagic
+            },
+        );
     }
     if bytes.len() < HEADER {
         return Err(RegressError::Truncated {
@@ -84,10 +111,10 @@ pub fn from_bytes(bytes: &[u8]) -> Result<Cascade, RegressError> {
         w
     };
     let version = u32::from_le_bytes(word(8..12)[..4].try_into().unwrap_or([0; 4]));
-    if version != FORMAT_VERSION {
+    if version != MODEL_FORMAT_VERSION {
         return Err(RegressError::UnsupportedVersion {
             found: version,
-            supported: FORMAT_VERSION,
+            supported: MODEL_FORMAT_VERSION,
         });
     }
     let len = u64::from_le_bytes(word(12..20));
@@ -130,10 +157,8 @@ fn io_err(path: &Path) -> impl FnOnce(std::io::Error) -> RegressError + '_ {
     }
 }
 
-/// Writes the model atomically: temporary file in the same directory, `fsync`, rename.
-pub fn save(model: &Cascade, path: impl AsRef<Path>) -> Result<(), RegressError> {
-    let path = path.as_ref();
-    let bytes = to_bytes(model)?;
+fn save(model: &Cascade, path: &Path) -> Result<(), RegressError> {
+    let bytes = encode(model)?;
     let dir = match path.parent() {
         Some(d) if !d.as_os_str().is_empty() => d.to_path_buf(),
         _ => PathBuf::from("."),
@@ -153,11 +178,4 @@ pub fn save(model: &Cascade, path: impl AsRef<Path>) -> Result<(), RegressError>
         let _ = std::fs::remove_file(&tmp);
     }
     result
-}
-
-/// Reads and validates a model file.
-pub fn load(path: impl AsRef<Path>) -> Result<Cascade, RegressError> {
-    let path = path.as_ref();
-    let bytes = std::fs::read(path).map_err(io_err(path))?;
-    from_bytes(&bytes)
 }

@@ -896,49 +896,24 @@ pub(crate) fn solve_with(
 }
 
 /// The two O(active) loops of every iteration, written so that they vectorize (gathers first,
-/// then branch-free arithmetic, then a max reduction and a position search).
-mod hot {
+/// then branch-free arithmetic, then a max reduction and a position search); with AVX2 they
+/// run the hand-written versions of `crate::simd`.
+pub(crate) mod hot {
+    #[cfg(target_arch = "x86_64")]
+    use crate::simd;
+
     /// `out[k] = row[idx[k]]`; every index must be below `row.len()` (checked once per
     /// problem in `solve`).
     pub(crate) fn gather(row: &[f32], idx: &[u32], out: &mut [f32]) {
         #[cfg(target_arch = "x86_64")]
-        if avx2() && row.len() < i32::MAX as usize {
+        if simd::avx2() && row.len() < i32::MAX as usize {
             // SAFETY: AVX2 is available; indices are in bounds (caller contract) and fit i32.
-            unsafe { gather_avx2(row, idx, out) };
+            unsafe { simd::gather_avx2(row, idx, out) };
             return;
         }
         for (o, &i) in out.iter_mut().zip(idx) {
             *o = row[i as usize];
         }
-    }
-
-    #[cfg(target_arch = "x86_64")]
-    #[target_feature(enable = "avx2,fma")]
-    unsafe fn gather_avx2(row: &[f32], idx: &[u32], out: &mut [f32]) {
-        use std::arch::x86_64::*;
-        let n = out.len().min(idx.len());
-        let mut k = 0;
-        while k + 8 <= n {
-            // SAFETY: k + 8 <= n; the gathered indices are below row.len() (caller contract).
-            unsafe {
-                let vi = _mm256_loadu_si256(idx.as_ptr().add(k) as *const __m256i);
-                let v = _mm256_i32gather_ps::<4>(row.as_ptr(), vi);
-                _mm256_storeu_ps(out.as_mut_ptr().add(k), v);
-            }
-            k += 8;
-        }
-        for t in k..n {
-            out[t] = row[idx[t] as usize];
-        }
-    }
-
-    #[cfg(target_arch = "x86_64")]
-    fn avx2() -> bool {
-        static FLAG: std::sync::OnceLock<bool> = std::sync::OnceLock::new();
-        *FLAG.get_or_init(|| {
-            std::arch::is_x86_feature_detected!("avx2")
-                && std::arch::is_x86_feature_detected!("fma")
-        })
     }
 
     /// `y[k] += a x[k]`.
@@ -948,25 +923,13 @@ mod hot {
         }
     }
 
-    /// Largest lane value and the smallest index holding it (`(-inf, usize::MAX)` when every
-    /// value is `-inf`, or below `floor`): the reduction of per-lane "first maximum" trackers.
-    fn reduce_lanes<T: Copy + PartialOrd>(vals: &[T], idx: &[usize], floor: T) -> (T, usize) {
-        let mut best = (floor, usize::MAX);
-        for (&v, &i) in vals.iter().zip(idx) {
-            if v > best.0 || (v == best.0 && i < best.1 && v > floor) {
-                best = (v, i);
-            }
-        }
-        best
-    }
-
     /// `max_{mask} -v` and its first position (`(-inf, usize::MAX)` when the mask is empty);
     /// `mask` is `-inf` for non-members.
     pub(super) fn masked_max_neg(v: &[f64], mask: &[f64]) -> (f64, usize) {
         #[cfg(target_arch = "x86_64")]
-        if avx2() {
+        if simd::avx2() {
             // SAFETY: AVX2 and FMA are available (checked at run time).
-            return unsafe { masked_max_neg_avx2(v, mask) };
+            return unsafe { simd::masked_max_neg_avx2(v, mask) };
         }
         masked_max_neg_generic(v, mask)
     }
@@ -981,14 +944,14 @@ mod hot {
         let n = v.len();
         assert!(x.len() >= n && z.len() >= n && mask.len() >= n);
         #[cfg(target_arch = "x86_64")]
-        if avx2() {
+        if simd::avx2() {
             // SAFETY: AVX2 and FMA are available; lengths checked above.
-            return unsafe { max_pass::<true>(v.as_mut_ptr(), n, (a, x), (b, z), mask) };
+            return unsafe { simd::max_pass::<true>(v.as_mut_ptr(), n, (a, x), (b, z), mask) };
         }
         update_gmax_generic_mut(v, (a, x), (b, z), mask)
     }
 
-    fn masked_max_neg_generic(v: &[f64], mask: &[f64]) -> (f64, usize) {
+    pub(crate) fn masked_max_neg_generic(v: &[f64], mask: &[f64]) -> (f64, usize) {
         let mut best = (f64::NEG_INFINITY, usize::MAX);
         for (k, (&vk, &mk)) in v.iter().zip(mask).enumerate() {
             let m = mk - vk;
@@ -999,7 +962,7 @@ mod hot {
         best
     }
 
-    fn update_gmax_generic_mut(
+    pub(crate) fn update_gmax_generic_mut(
         v: &mut [f64],
         (a, x): (f64, &[f32]),
         (b, z): (f64, &[f32]),
@@ -1009,88 +972,6 @@ mod hot {
             *vk += a * xk as f64 + b * zk as f64;
         }
         masked_max_neg_generic(v, mask)
-    }
-
-    #[cfg(target_arch = "x86_64")]
-    #[target_feature(enable = "avx2,fma")]
-    unsafe fn masked_max_neg_avx2(v: &[f64], mask: &[f64]) -> (f64, usize) {
-        let n = v.len().min(mask.len());
-        // SAFETY: AVX2 is enabled here; without the update `v` is only read.
-        unsafe { max_pass::<false>(v.as_ptr() as *mut f64, n, (0.0, &[]), (0.0, &[]), mask) }
-    }
-
-    /// `max_k mask[k] - v[k]` with the position of its first occurrence, after (with `UPDATE`)
-    /// `v[k] += a x[k] + b z[k]` in the same pass. Per-lane maxima and positions in two
-    /// independent sets of lanes (to overlap the compare-blend latency), then `reduce_lanes`.
-    ///
-    /// # Safety
-    /// AVX2 must be available; `v` and `mask` must hold `n` values, and so must `x` and `z`
-    /// with `UPDATE` (which writes `v`).
-    #[cfg(target_arch = "x86_64")]
-    #[target_feature(enable = "avx2,fma")]
-    unsafe fn max_pass<const UPDATE: bool>(
-        v: *mut f64,
-        n: usize,
-        (a, x): (f64, &[f32]),
-        (b, z): (f64, &[f32]),
-        mask: &[f64],
-    ) -> (f64, usize) {
-        use std::arch::x86_64::*;
-        let (va, vb) = (_mm256_set1_pd(a), _mm256_set1_pd(b));
-        let mut best = [_mm256_set1_pd(f64::NEG_INFINITY); 2];
-        let mut bidx = [_mm256_set1_pd(0.0); 2];
-        let mut idx = [
-            _mm256_setr_pd(0.0, 1.0, 2.0, 3.0),
-            _mm256_setr_pd(4.0, 5.0, 6.0, 7.0),
-        ];
-        let eight = _mm256_set1_pd(8.0);
-        let mut k = 0;
-        while k + 8 <= n {
-            for h in 0..2 {
-                let o = k + 4 * h;
-                // SAFETY: o + 4 <= n, within every slice (caller contract).
-                unsafe {
-                    let mut cur = _mm256_loadu_pd(v.add(o));
-                    if UPDATE {
-                        let xv = _mm256_cvtps_pd(_mm_loadu_ps(x.as_ptr().add(o)));
-                        let zv = _mm256_cvtps_pd(_mm_loadu_ps(z.as_ptr().add(o)));
-                        let d = _mm256_add_pd(_mm256_mul_pd(va, xv), _mm256_mul_pd(vb, zv));
-                        cur = _mm256_add_pd(cur, d);
-                        _mm256_storeu_pd(v.add(o), cur);
-                    }
-                    let m = _mm256_sub_pd(_mm256_loadu_pd(mask.as_ptr().add(o)), cur);
-                    let gt = _mm256_cmp_pd::<_CMP_GT_OQ>(m, best[h]);
-                    best[h] = _mm256_blendv_pd(best[h], m, gt);
-                    bidx[h] = _mm256_blendv_pd(bidx[h], idx[h], gt);
-                }
-                idx[h] = _mm256_add_pd(idx[h], eight);
-            }
-            k += 8;
-        }
-        let (mut vals, mut pos) = ([0.0f64; 8], [0.0f64; 8]);
-        // SAFETY: both arrays hold eight f64.
-        unsafe {
-            for h in 0..2 {
-                _mm256_storeu_pd(vals.as_mut_ptr().add(4 * h), best[h]);
-                _mm256_storeu_pd(pos.as_mut_ptr().add(4 * h), bidx[h]);
-            }
-        }
-        let pos = pos.map(|p| p as usize);
-        let mut out = reduce_lanes(&vals, &pos, f64::NEG_INFINITY);
-        for t in k..n {
-            // SAFETY: t < n (caller contract).
-            let cur = unsafe {
-                if UPDATE {
-                    *v.add(t) += a * x[t] as f64 + b * z[t] as f64;
-                }
-                *v.add(t)
-            };
-            let m = mask[t] - cur;
-            if m > out.0 {
-                out = (m, t);
-            }
-        }
-        out
     }
 
     /// WSS3's second index: second-order gains `(gmax + yG_j)² / (2 - 2 K_ij)` of the `I_low`
@@ -1106,21 +987,26 @@ mod hot {
         let n = v.len();
         assert!(low.len() >= n && kv.len() >= n);
         #[cfg(target_arch = "x86_64")]
-        if avx2() {
+        if simd::avx2() {
             // SAFETY: AVX2 and FMA are available; lengths checked above.
-            return unsafe { wss_select_avx2(v, low, kv, gmax) };
+            return unsafe { simd::wss_select_avx2(v, low, kv, gmax) };
         }
         wss_select_generic(v, low, kv, gmax)
     }
 
     #[inline(always)]
-    fn wss_gain(gmax: f64, m: f64, kv: f32) -> f32 {
+    pub(crate) fn wss_gain(gmax: f64, m: f64, kv: f32) -> f32 {
         let gd = (gmax + m) as f32;
         let q = (2.0 - 2.0 * kv).max(1e-12);
         if gd > 0.0 { gd * gd / q } else { 0.0 }
     }
 
-    fn wss_select_generic(v: &[f64], low: &[f64], kv: &[f32], gmax: f64) -> (f64, Option<usize>) {
+    pub(crate) fn wss_select_generic(
+        v: &[f64],
+        low: &[f64],
+        kv: &[f32],
+        gmax: f64,
+    ) -> (f64, Option<usize>) {
         let mut gmax2 = f64::NEG_INFINITY;
         let mut best = (0.0f32, None);
         for k in 0..v.len() {
@@ -1134,119 +1020,6 @@ mod hot {
             }
         }
         (gmax2, best.1)
-    }
-
-    /// Eight candidates per step: the `f64` sums in two halves, the `f32` gains in one vector.
-    #[cfg(target_arch = "x86_64")]
-    #[target_feature(enable = "avx2,fma")]
-    unsafe fn wss_select_avx2(
-        v: &[f64],
-        low: &[f64],
-        kv: &[f32],
-        gmax: f64,
-    ) -> (f64, Option<usize>) {
-        use std::arch::x86_64::*;
-        let n = v.len();
-        let vg = _mm256_set1_pd(gmax);
-        let two = _mm256_set1_ps(2.0);
-        let tiny = _mm256_set1_ps(1e-12);
-        let zero = _mm256_setzero_ps();
-        let mut acc = [_mm256_set1_pd(f64::NEG_INFINITY); 2];
-        let mut best = _mm256_setzero_ps();
-        let mut bidx = _mm256_setzero_si256();
-        let mut idx = _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7);
-        let eight = _mm256_set1_epi32(8);
-        let mut k = 0;
-        while k + 8 <= n {
-            // SAFETY: k + 8 <= n <= every slice's length (checked by the caller).
-            unsafe {
-                let mut gd = [_mm_setzero_ps(); 2];
-                for h in 0..2 {
-                    let o = k + 4 * h;
-                    let m = _mm256_add_pd(
-                        _mm256_loadu_pd(v.as_ptr().add(o)),
-                        _mm256_loadu_pd(low.as_ptr().add(o)),
-                    );
-                    acc[h] = _mm256_max_pd(acc[h], m);
-                    gd[h] = _mm256_cvtpd_ps(_mm256_add_pd(vg, m));
-                }
-                let gd = _mm256_set_m128(gd[1], gd[0]);
-                let kvv = _mm256_loadu_ps(kv.as_ptr().add(k));
-                let q = _mm256_max_ps(_mm256_sub_ps(two, _mm256_mul_ps(two, kvv)), tiny);
-                let pos = _mm256_cmp_ps::<_CMP_GT_OQ>(gd, zero);
-                let sc = _mm256_and_ps(_mm256_div_ps(_mm256_mul_ps(gd, gd), q), pos);
-                let gt = _mm256_cmp_ps::<_CMP_GT_OQ>(sc, best);
-                best = _mm256_blendv_ps(best, sc, gt);
-                bidx = _mm256_blendv_epi8(bidx, idx, _mm256_castps_si256(gt));
-            }
-            idx = _mm256_add_epi32(idx, eight);
-            k += 8;
-        }
-        let (mut lanes, mut vals, mut pos) = ([0.0f64; 8], [0.0f32; 8], [0i32; 8]);
-        // SAFETY: the arrays hold eight lanes each.
-        unsafe {
-            _mm256_storeu_pd(lanes.as_mut_ptr(), acc[0]);
-            _mm256_storeu_pd(lanes.as_mut_ptr().add(4), acc[1]);
-            _mm256_storeu_ps(vals.as_mut_ptr(), best);
-            _mm256_storeu_si256(pos.as_mut_ptr() as *mut __m256i, bidx);
-        }
-        let pos = pos.map(|p| p as usize);
-        let mut out = reduce_lanes(&vals, &pos, 0.0f32);
-        // The tail, then the lanes: a later position wins only with a strictly larger gain.
-        let (tail_g2, tail_pos) = wss_select_generic(&v[k..], &low[k..], &kv[k..n], gmax);
-        if let Some(t) = tail_pos {
-            let sc = wss_gain(gmax, v[k + t] + low[k + t], kv[k + t]);
-            if sc > out.0 {
-                out = (sc, k + t);
-            }
-        }
-        let gmax2 = lanes
-            .iter()
-            .fold(tail_g2, |a, &b| if b > a { b } else { a });
-        (gmax2, (out.1 != usize::MAX).then_some(out.1))
-    }
-
-    #[cfg(all(test, target_arch = "x86_64"))]
-    mod tests {
-        use super::*;
-
-        #[test]
-        fn vector_kernels_match_the_scalar_ones() {
-            if !avx2() {
-                return;
-            }
-            for n in [0, 1, 3, 4, 7, 8, 33, 257] {
-                let v: Vec<f64> = (0..n)
-                    .map(|k| ((k * 37 % 11) as f64 - 5.0) * 0.25)
-                    .collect();
-                // Ties (repeated values) and non-members.
-                let mask: Vec<f64> = (0..n)
-                    .map(|k| {
-                        if k % 5 == 2 {
-                            f64::NEG_INFINITY
-                        } else {
-                            (k % 3) as f64 * 0.5
-                        }
-                    })
-                    .collect();
-                let kv: Vec<f32> = (0..n).map(|k| ((k * 13 % 7) as f32) / 7.0).collect();
-                let x: Vec<f32> = (0..n).map(|k| (k as f32 * 0.3).sin()).collect();
-                // SAFETY: AVX2 checked above.
-                let fast = unsafe { masked_max_neg_avx2(&v, &mask) };
-                assert_eq!(fast, masked_max_neg_generic(&v, &mask), "n = {n}");
-                for gmax in [-1.0, 0.0, 0.75, 3.0] {
-                    // SAFETY: AVX2 checked above.
-                    let fast = unsafe { wss_select_avx2(&v, &mask, &kv, gmax) };
-                    assert_eq!(fast, wss_select_generic(&v, &mask, &kv, gmax), "n = {n}");
-                }
-                let (mut v1, mut v2) = (v.clone(), v.clone());
-                // SAFETY: AVX2 checked above; all slices have length n.
-                let fast =
-                    unsafe { max_pass::<true>(v1.as_mut_ptr(), n, (0.5, &x), (-2.0, &kv), &mask) };
-                let slow = update_gmax_generic_mut(&mut v2, (0.5, &x), (-2.0, &kv), &mask);
-                assert_eq!((fast, &v1), (slow, &v2), "n = {n}");
-            }
-        }
     }
 }
 

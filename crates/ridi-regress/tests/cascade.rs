@@ -1,13 +1,12 @@
 //! Cascade training and prediction, grid search, model file codec.
 
-mod common;
-
 use ridi_features::ridi_frames::StabHorizontal;
 use ridi_features::{FeatureChannel, FeatureConfig};
 use ridi_regress::{
     Cascade, CascadeParams, GridSpec, MatrixRef, NoProgress, ProgressEvent, RegressError,
-    RegressorChoice, Stage, Storage, StoredAs, Svc, SvcParams, TrainingSet, model_file,
+    RegressorChoice, Stage, Storage, StoredAs, Svc, SvcParams, TrainingSet,
 };
+use ridi_test_support::{SplitMix64, assert_names_file};
 
 struct Data {
     x: Vec<f32>,
@@ -45,7 +44,7 @@ fn make_window(placements: usize, seqs: usize, per_seq: usize, seed: u64, window
         ..FeatureConfig::default()
     };
     let d = config.feature_dim();
-    let mut rng = common::Rng(seed);
+    let mut rng = SplitMix64(seed);
     let mut data = Data {
         x: Vec::new(),
         y: Vec::new(),
@@ -225,7 +224,7 @@ fn speed_regressor_scales_velocities_to_the_regressed_speed() {
     }
     assert!(moved > 0.0, "the speed channel changed nothing");
     assert!(err_scaled < 0.3, "largest speed error {err_scaled}");
-    let back = model_file::from_bytes(&model_file::to_bytes(&model).unwrap()).unwrap();
+    let back = Cascade::from_bytes(&model.to_bytes().unwrap()).unwrap();
     assert_eq!(back.predict(xt).unwrap(), scaled);
 }
 
@@ -235,18 +234,18 @@ fn training_is_deterministic_and_model_files_round_trip() {
     let params = small_grid();
     let a = Cascade::train(&data.set(), &params, &mut NoProgress).unwrap();
     let b = Cascade::train(&data.set(), &params, &mut NoProgress).unwrap();
-    let bytes = model_file::to_bytes(&a).unwrap();
-    assert_eq!(bytes, model_file::to_bytes(&b).unwrap());
+    let bytes = a.to_bytes().unwrap();
+    assert_eq!(bytes, b.to_bytes().unwrap());
     assert_eq!(&bytes[..8], b"RIDIREG\0");
-    let back = model_file::from_bytes(&bytes).unwrap();
+    let back = Cascade::from_bytes(&bytes).unwrap();
     assert_eq!(back, a);
     assert_eq!(back.feature_config(), &data.config);
 
     let dir = std::env::temp_dir().join(format!("ridi-regress-test-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let path = dir.join("model.ridi");
-    model_file::save(&a, &path).unwrap();
-    assert_eq!(model_file::load(&path).unwrap(), a);
+    a.save(&path).unwrap();
+    assert_eq!(Cascade::load(&path).unwrap(), a);
     assert_eq!(
         std::fs::read_dir(&dir).unwrap().count(),
         1,
@@ -258,13 +257,13 @@ fn training_is_deterministic_and_model_files_round_trip() {
     let mid = bytes.len() / 2;
     corrupt[mid] ^= 0x40;
     assert!(matches!(
-        model_file::from_bytes(&corrupt),
+        Cascade::from_bytes(&corrupt),
         Err(RegressError::Checksum { .. })
     ));
     for cut in [0, 5, 20, bytes.len() - 1] {
         assert!(
             matches!(
-                model_file::from_bytes(&bytes[..cut]),
+                Cascade::from_bytes(&bytes[..cut]),
                 Err(RegressError::Truncated { .. })
             ),
             "cut at {cut}"
@@ -273,7 +272,7 @@ fn training_is_deterministic_and_model_files_round_trip() {
     let mut newer = bytes.clone();
     newer[8..12].copy_from_slice(&8u32.to_le_bytes());
     assert!(matches!(
-        model_file::from_bytes(&newer),
+        Cascade::from_bytes(&newer),
         Err(RegressError::UnsupportedVersion {
             found: 8,
             supported: 7
@@ -285,7 +284,7 @@ fn training_is_deterministic_and_model_files_round_trip() {
     for v in [1u32, 2, 3, 4, 5, 6] {
         let mut older = bytes.clone();
         older[8..12].copy_from_slice(&v.to_le_bytes());
-        let err = model_file::from_bytes(&older).unwrap_err();
+        let err = Cascade::from_bytes(&older).unwrap_err();
         assert!(
             matches!(err, RegressError::UnsupportedVersion { found, supported: 7 } if found == v)
         );
@@ -294,10 +293,13 @@ fn training_is_deterministic_and_model_files_round_trip() {
     let mut magic = bytes.clone();
     magic[0] = b'X';
     assert!(matches!(
-        model_file::from_bytes(&magic),
+        Cascade::from_bytes(&magic),
         Err(RegressError::BadMagic)
     ));
-    assert!(model_file::load(std::path::Path::new("/nonexistent/model.ridi")).is_err());
+    // A file that cannot be read is named (decode errors have no file: `from_bytes` takes
+    // bytes, and the `ridi` binary adds the file's name to them, as its tests check).
+    let missing = std::path::Path::new("/nonexistent/model.ridi");
+    assert_names_file(&Cascade::load(missing).unwrap_err(), missing);
 }
 
 #[test]
@@ -342,8 +344,8 @@ fn small_or_degenerate_placements_give_clear_errors_or_documented_fallbacks() {
     let single = make(1, 3, 10, 4);
     let model = Cascade::train(&single.set(), &fixed, &mut NoProgress).unwrap();
     assert_eq!(model.predict_one(&single.x[..24]).unwrap().placement, 0);
-    let bytes = model_file::to_bytes(&model).unwrap();
-    assert_eq!(model_file::from_bytes(&bytes).unwrap(), model);
+    let bytes = model.to_bytes().unwrap();
+    assert_eq!(Cascade::from_bytes(&bytes).unwrap(), model);
     // Mismatched lengths and a feature config of another width.
     let mut short = make(2, 3, 10, 3);
     short.y.pop();
@@ -463,8 +465,8 @@ fn projected_samples_stay_close_to_the_exact_model() {
             );
         }
     }
-    let bytes = model_file::to_bytes(&model).unwrap();
-    assert_eq!(model_file::from_bytes(&bytes).unwrap(), model);
+    let bytes = model.to_bytes().unwrap();
+    assert_eq!(Cascade::from_bytes(&bytes).unwrap(), model);
     // Coordinates beyond the half-precision range are refused like features are.
     let mut big = make_window(2, 3, 10, 3, 40);
     big.x.iter_mut().for_each(|v| *v *= 1.0e4);

@@ -1,8 +1,6 @@
 //! Solver correctness: closed-form two-point problems, KKT conditions at the solution, and
 //! agreement with linfa-svm (libsvm semantics) on small problems.
 
-mod common;
-
 use std::collections::HashMap;
 
 use linfa::prelude::*;
@@ -11,6 +9,7 @@ use ndarray::{Array1, Array2};
 use ridi_regress::{
     MatrixRef, Precompute, SmoSettings, SolverConfig, Svc, SvcParams, Svr, SvrParams,
 };
+use ridi_test_support::{blob_data, regression_data};
 
 fn tight() -> SolverConfig {
     SolverConfig {
@@ -83,7 +82,7 @@ fn coef_by_row(sv: MatrixRef<'_>, coef: &[f64]) -> HashMap<Vec<u32>, f64> {
 
 #[test]
 fn regressor_satisfies_kkt_conditions() {
-    let (x, y) = common::regression(120, 10, 11);
+    let (x, y) = regression_data(120, 10, 11);
     let xm = MatrixRef::new(&x, 10).unwrap();
     let (c, eps) = (3.0, 0.05);
     let mut p = SvrParams::new(c, eps, 0.2);
@@ -129,7 +128,7 @@ fn regressor_satisfies_kkt_conditions() {
 
 #[test]
 fn classifier_satisfies_kkt_conditions() {
-    let (x, y) = common::blobs(40, 6, &[0, 1], 1.2, 5);
+    let (x, y) = blob_data(40, 6, &[0, 1], 1.2, 5);
     let xm = MatrixRef::new(&x, 6).unwrap();
     let c = 2.0;
     let mut p = SvcParams::new(c, 0.3);
@@ -166,9 +165,9 @@ fn classifier_satisfies_kkt_conditions() {
 
 #[test]
 fn regressor_matches_linfa_svm() {
-    let (x, y) = common::regression(80, 8, 3);
+    let (x, y) = regression_data(80, 8, 3);
     let xm = MatrixRef::new(&x, 8).unwrap();
-    let (xt, _) = common::regression(30, 8, 4);
+    let (xt, _) = regression_data(30, 8, 4);
     let gamma = 0.25f32;
     for (c, eps) in [(1.0, 0.01), (10.0, 0.1), (0.1, 0.001)] {
         let mut p = SvrParams::new(c, eps, gamma);
@@ -199,7 +198,7 @@ fn regressor_matches_linfa_svm() {
 
 #[test]
 fn classifier_matches_linfa_svm() {
-    let (x, y) = common::blobs(30, 5, &[0, 1], 1.0, 9);
+    let (x, y) = blob_data(30, 5, &[0, 1], 1.0, 9);
     let xm = MatrixRef::new(&x, 5).unwrap();
     let gamma = 0.5f32;
     for c in [0.5, 10.0] {
@@ -230,18 +229,18 @@ fn classifier_matches_linfa_svm() {
 #[test]
 fn multiclass_separates_blobs_with_arbitrary_labels() {
     let labels = [5usize, 2, 9, 4];
-    let (x, y) = common::blobs(25, 8, &labels, 0.3, 21);
+    let (x, y) = blob_data(25, 8, &labels, 0.3, 21);
     let xm = MatrixRef::new(&x, 8).unwrap();
     let m = Svc::fit(xm, &y, &SvcParams::new(10.0, 0.5)).unwrap();
     assert_eq!(m.labels(), &[2, 4, 5, 9]);
     assert_eq!(m.predict(xm).unwrap(), y);
-    let (xt, yt) = common::blobs(10, 8, &labels, 0.3, 22);
+    let (xt, yt) = blob_data(10, 8, &labels, 0.3, 22);
     assert_eq!(m.predict(MatrixRef::new(&xt, 8).unwrap()).unwrap(), yt);
 }
 
 #[test]
 fn cached_rows_and_full_kernel_give_the_same_model() {
-    let (x, y) = common::regression(150, 12, 8);
+    let (x, y) = regression_data(150, 12, 8);
     let xm = MatrixRef::new(&x, 12).unwrap();
     let mut full = SvrParams::new(5.0, 0.01, 0.1);
     full.solver = tight();
@@ -257,7 +256,7 @@ fn cached_rows_and_full_kernel_give_the_same_model() {
     }
     let mut p = SvcParams::new(1.0, 0.3);
     p.solver = tight();
-    let (xc, yc) = common::blobs(50, 6, &[1, 2, 3], 1.0, 2);
+    let (xc, yc) = blob_data(50, 6, &[1, 2, 3], 1.0, 2);
     let xcm = MatrixRef::new(&xc, 6).unwrap();
     let a = Svc::fit(xcm, &yc, &p).unwrap();
     p.solver.classifier_kernel = Precompute::Auto;

@@ -16,7 +16,7 @@ use std::path::PathBuf;
 use std::time::Instant;
 
 use ridi::data::{ReadOptions, load_list};
-use ridi::regress::{Cascade, MatrixRef, model_file};
+use ridi::regress::{Cascade, MatrixRef};
 
 #[path = "../../ridi-regress/examples/common/timing.rs"]
 mod timing;
@@ -53,7 +53,7 @@ fn main() -> Result<(), Error> {
             _ => lists[which.ok_or("lists follow --train or --test")?].push(a.into()),
         }
     }
-    let model = model_file::load(model_path)?;
+    let model = Cascade::load(model_path)?;
     let bytes = std::fs::metadata(model_path)?.len();
     println!(
         "{model_path}: {:.1} MB, {:?}, stored samples {:?}",

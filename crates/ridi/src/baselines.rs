@@ -23,7 +23,7 @@ use ridi_frames::{StabHorizontal, StabVec, UpAxis, WorldVec};
 use serde::{Deserialize, Serialize};
 
 use crate::error::{PipelineError, Result};
-use crate::track::{Regressed, correct_with, imu_slices};
+use crate::track::{Regressed, correct_with};
 
 /// A trajectory method.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize)]
@@ -171,7 +171,7 @@ pub fn trajectory(
             )
         }
         Method::Raw => {
-            let acc = world_acceleration(&imu_slices(seq))?;
+            let acc = world_acceleration(&seq.imu())?;
             let poses = integrate(seq.time(), &acc, WorldVec::ZERO, WorldVec::ZERO)?;
             Ok(poses
                 .iter()

@@ -34,6 +34,7 @@ pub enum PipelineError {
     #[error("live tracking: {0}")]
     Live(String),
     /// Drawing a plot.
+    #[cfg(feature = "plot")]
     #[error("plot: {0}")]
     Plot(crate::plot::PlotError),
     /// A sequence lacks what a stage needs (ground truth, placement, enough frames).
@@ -75,8 +76,10 @@ printed_cause!(
     Eval(ridi_eval::EvalError),
     Orientation(ridi_frames::EstimateError),
     Track(ridi_correct::TrackError),
-    Plot(crate::plot::PlotError),
 );
+
+#[cfg(feature = "plot")]
+printed_cause!(Plot(crate::plot::PlotError));
 
 impl PipelineError {
     pub(crate) fn sequence(name: &str, message: impl Into<String>) -> Self {

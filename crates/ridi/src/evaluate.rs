@@ -510,6 +510,7 @@ impl Traces {
     /// Draws the trajectory plot (ground truth and every method, aligned) and the velocity plot
     /// (regressed vs true, with predicted placements) of this sequence into `dir` as
     /// `<name>.trajectory.<ext>` and `<name>.velocity.<ext>` (`ext`: `svg` or `png`).
+    #[cfg(feature = "plot")]
     pub fn plot(&self, dir: &Path, ext: &str) -> Result<Vec<PathBuf>> {
         use crate::plot::{
             Placements, Trajectory, TrajectoryOptions, TrajectoryPlot, VelocityOptions,

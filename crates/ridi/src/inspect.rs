@@ -3,8 +3,7 @@
 use ridi_data::{Format, Sequence};
 use ridi_features::FeatureChannel;
 use ridi_frames::UpAxis;
-use ridi_regress::grid::GridRow;
-use ridi_regress::{Cascade, StoredAs, model_file};
+use ridi_regress::{Cascade, GridRow, MODEL_FORMAT_VERSION, StoredAs};
 use serde::Serialize;
 
 use crate::orientation::Orientation;
@@ -252,7 +251,7 @@ impl std::fmt::Display for Inspection {
 /// trained), as JSON with `--json`.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct ModelInspection {
-    /// Model file format version ([`ridi_regress::model_file::FORMAT_VERSION`]).
+    /// Model file format version ([`ridi_regress::MODEL_FORMAT_VERSION`]).
     pub format_version: u32,
     /// Frames per feature window.
     pub window: usize,
@@ -342,7 +341,7 @@ pub fn inspect_model(model: &Cascade) -> ModelInspection {
         })
         .collect();
     ModelInspection {
-        format_version: model_file::FORMAT_VERSION,
+        format_version: MODEL_FORMAT_VERSION,
         window: config.window,
         step: config.step,
         feature_sigma: config.feature_sigma,

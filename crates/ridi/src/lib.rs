@@ -16,6 +16,45 @@
 //! for training and evaluation with the labels they need, [`inspect`] summarizes a recording or a model,
 //! [`orientation`] swaps in an orientation estimated from gyro and accelerometer, [`live`]
 //! tracks a stream sample by sample.
+//!
+//! # Design decisions
+//!
+//! - **The model decides what a sequence must look like.** A trained [`regress::Cascade`]
+//!   carries its feature configuration (window, S definition, orientation source); training,
+//!   tracking and evaluation all pass a sequence through [`oriented`] and derive the
+//!   correction's S from the model ([`TrackOptions::correction_for`]), so a model cannot be
+//!   applied to features it was not trained on.
+//! - **Batch and live tracking are one code path.** `ridi track --online` and [`track()`] with
+//!   [`TrackOptions::online`] feed a recording through [`LiveTracker`] sample by sample, so the
+//!   streaming poses a program gets are the ones the command line tests.
+//! - **Plots are optional.** The `plot` feature (on by default) brings plotters and an embedded
+//!   font; an embedded tracker leaves it out with `default-features = false`.
+//!
+//! # Example
+//!
+//! Train on one person of the bundled sample, track and evaluate another's run:
+//!
+//! ```
+//! use ridi::data::{ReadOptions, load_list};
+//! use ridi::regress::NoProgress;
+//! use ridi::{EvalOptions, GridChoice, PlacementMap, TrackOptions, TrainOptions};
+//!
+//! let sample = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../datasets/sample");
+//! let mut train = load_list(sample.join("list_Guillaume.txt"), &ReadOptions::default())?;
+//! PlacementMap::tyrex_groups().apply(&mut train);
+//! let mut opts = TrainOptions::default();
+//! opts.cascade.regressors = GridChoice::None.regressors(); // fixed C and epsilon: fast
+//! let model = ridi::train(&train, &opts, &mut NoProgress)?;
+//!
+//! let mut test = load_list(sample.join("list_Jakob.txt"), &ReadOptions::default())?;
+//! PlacementMap::tyrex_groups().apply(&mut test);
+//! let track = ridi::track(&test[0], &model, &TrackOptions::default())?;
+//! assert_eq!(track.position.len(), test[0].len());
+//!
+//! let (report, _) = ridi::evaluate(&test[..2], &model, &EvalOptions::default())?;
+//! println!("RIDI RTE 5 s: {:.2} m", report.summary["ridi"].rte_5s_m);
+//! # Ok::<(), Box<dyn std::error::Error>>(())
+//! ```
 
 pub use ridi_correct as correct;
 pub use ridi_data as data;
@@ -33,6 +72,7 @@ pub mod lists;
 pub mod live;
 pub mod orientation;
 pub mod placement;
+#[cfg(feature = "plot")]
 pub mod plot;
 pub mod source;
 pub mod staging;
@@ -43,7 +83,7 @@ pub use baselines::Method;
 pub use error::{PipelineError, Result};
 pub use evaluate::{EvalOptions, Report, evaluate};
 pub use lists::{Purpose, load_lists};
-pub use live::{LiveSample, LiveTracker, Recorded};
+pub use live::{LiveTracker, Recorded, SensorReading};
 pub use orientation::{Orientation, apply_orientation, oriented};
 pub use placement::PlacementMap;
 pub use source::{Loaded, read_any};

@@ -9,12 +9,12 @@
 use std::collections::VecDeque;
 
 use ridi_correct::{
-    FrameWindow, GapPolicy, PlacementSmoother, Regression, Sample, TrackError, Tracker,
-    TrackerConfig, TrailingMajority, Update, VelocityRegressor,
+    FrameWindow, GapPolicy, PlacementSmoother, Regression, TrackError, Tracker, TrackerConfig,
+    TrailingMajority, Update, VelocityRegressor,
 };
 use ridi_data::{Channel, Sequence, Validation};
-use ridi_features::{FeatureExtractor, ImuView, Orientation};
-use ridi_frames::{DeviceVec, FilterConfig, OrientationFilter, WorldFromDevice};
+use ridi_features::{FeatureExtractor, Orientation};
+use ridi_frames::{DeviceVec, FilterConfig, ImuSample, OrientationFilter, WorldFromDevice};
 use ridi_regress::{Cascade, MatrixRef};
 
 use crate::error::{PipelineError, Result};
@@ -32,10 +32,15 @@ pub struct CascadeRegressor<'m> {
     row: Vec<f32>,
     majority: Option<TrailingMajority>,
     /// Every regression made, for reports.
-    pub made: Vec<Regressed>,
+    made: Vec<Regressed>,
 }
 
 impl<'m> CascadeRegressor<'m> {
+    /// Every regression made so far, for reports.
+    pub fn made(&self) -> &[Regressed] {
+        &self.made
+    }
+
     /// A regressor over `model`; with `smoothing`, each placement becomes the majority label of
     /// the window's length of regressions before it (the streaming form of the batch vote).
     pub fn new(model: &'m Cascade, smoothing: Option<PlacementSmoother>) -> Result<Self> {
@@ -66,13 +71,12 @@ impl VelocityRegressor for CascadeRegressor<'_> {
         &mut self,
         frames: &FrameWindow<'_>,
     ) -> std::result::Result<Option<Regression>, ridi_correct::RegressorError> {
-        let imu = ImuView::new(frames.gyro, frames.linacce, frames.gravity)?;
-        let stab = self.extractor.stabilize(&imu)?;
+        let stab = self.extractor.stabilize(&frames.frames)?;
         let len = frames.len();
         self.extractor.row_into(&stab, len - 1, &mut self.row)?;
         let mut p = self.model.predict_one(&self.row)?;
         if let Some(m) = &mut self.majority {
-            let label = m.push(frames.time[len - 1], p.placement);
+            let label = m.push(frames.frames.time[len - 1], p.placement);
             if label != p.placement {
                 let row = MatrixRef::new(&self.row, self.row.len())?;
                 p.velocity = self.model.predict_with_placement(row, label)?[0];
@@ -105,9 +109,12 @@ pub struct Recorded {
     pub linacce: DeviceVec,
 }
 
-/// One sample of a live stream.
+/// One reading of a phone's sensors, as a live stream delivers it: raw gyro and accelerometer,
+/// and the orientation the OS derived where it reports one. [`LiveTracker`] turns readings
+/// into the pipeline's frames (`ridi_frames::ImuSample`), estimating the orientation where
+/// the model wants that.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct LiveSample {
+pub struct SensorReading {
     /// Timestamp, seconds, increasing.
     pub time: f64,
     /// Angular rate, device frame, rad/s.
@@ -120,7 +127,7 @@ pub struct LiveSample {
     pub recorded: Option<Recorded>,
 }
 
-impl LiveSample {
+impl SensorReading {
     /// Frame `frame` of a recording, with its recorded orientation: to play a recording back
     /// as a stream.
     ///
@@ -160,7 +167,7 @@ impl LiveSample {
 /// ```
 /// use ridi::data::{ReadOptions, load_list};
 /// use ridi::regress::NoProgress;
-/// use ridi::{LiveSample, LiveTracker, PlacementMap, TrackOptions, TrainOptions};
+/// use ridi::{SensorReading, LiveTracker, PlacementMap, TrackOptions, TrainOptions};
 ///
 /// let sample = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../datasets/sample");
 /// let mut train = load_list(sample.join("list_Guillaume.txt"), &ReadOptions::default())?;
@@ -174,7 +181,7 @@ impl LiveSample {
 /// let mut live = LiveTracker::new(&model, &TrackOptions::default())?;
 /// let mut updates = Vec::new();
 /// for i in 0..stream.len() {
-///     live.push(&LiveSample::of_frame(stream, i), &mut updates)?;
+///     live.push(&SensorReading::of_frame(stream, i), &mut updates)?;
 /// }
 /// live.finish(&mut updates)?;
 /// assert_eq!(updates.len(), stream.len());
@@ -233,7 +240,7 @@ impl<'m> LiveTracker<'m> {
     /// # Errors
     /// A refused sample ([`TrackError`], [`ridi_frames::EstimateError`]), or a recorded model
     /// given a sample without its recorded orientation; the tracker is unchanged.
-    pub fn push(&mut self, sample: &LiveSample, out: &mut Vec<Update>) -> Result<()> {
+    pub fn push(&mut self, sample: &SensorReading, out: &mut Vec<Update>) -> Result<()> {
         self.check_values(sample)?;
         let Some(est) = &mut self.estimator else {
             let r = sample.recorded.ok_or_else(|| {
@@ -243,7 +250,7 @@ impl<'m> LiveTracker<'m> {
                         .into(),
                 )
             })?;
-            let update = self.tracker.push(&Sample {
+            let update = self.tracker.push(&ImuSample {
                 time: sample.time,
                 gyro: sample.gyro,
                 linacce: r.linacce,
@@ -287,7 +294,7 @@ impl<'m> LiveTracker<'m> {
     /// Refuses a value no phone sensor gives (the readers' [`Validation::limit`]s: a corrupt
     /// sample, or mm/s^2 for m/s^2), naming the field, the sample and its time. NaN passes
     /// here and is refused, by field, where it would be used.
-    fn check_values(&self, sample: &LiveSample) -> Result<()> {
+    fn check_values(&self, sample: &SensorReading) -> Result<()> {
         let index = self.accepted();
         let recorded = sample.recorded.as_ref();
         let vectors = [
@@ -331,7 +338,7 @@ impl<'m> LiveTracker<'m> {
         let known = est.orientations.len().min(est.waiting.len());
         for (q, (time, gyro, acce)) in est.orientations.drain(..).zip(est.waiting.drain(..known)) {
             let (gravity, linacce) = ridi_frames::gravity_and_linacce(q, acce);
-            out.push(self.tracker.push(&Sample {
+            out.push(self.tracker.push(&ImuSample {
                 time,
                 gyro,
                 linacce,

@@ -10,9 +10,8 @@ use ridi_regress::{Cascade, MatrixRef};
 use serde::{Deserialize, Serialize};
 
 use crate::error::{PipelineError, Result};
-use crate::live::{LiveSample, LiveTracker};
+use crate::live::{LiveTracker, SensorReading};
 use crate::orientation::oriented;
-use crate::train::imu_view;
 
 /// How to track.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -144,7 +143,7 @@ pub fn regress(seq: &Sequence, model: &Cascade, opts: &TrackOptions) -> Result<V
     if frames.is_empty() {
         return Ok(Vec::new());
     }
-    let features = fx.features(&fx.stabilize(&imu_view(seq)?)?, &frames)?;
+    let features = fx.features(&fx.stabilize(&seq.imu())?, &frames)?;
     let predictions = model.predict(MatrixRef::try_from(&features)?)?;
     let mut out: Vec<Regressed> = frames
         .iter()
@@ -182,17 +181,6 @@ pub fn regress(seq: &Sequence, model: &Cascade, opts: &TrackOptions) -> Result<V
     Ok(out)
 }
 
-/// The inputs of a correction of `seq` (its time, linear acceleration, orientation and gravity),
-/// for a correction with other regressions ([`ridi_correct::Corrector`]).
-pub fn imu_slices(seq: &Sequence) -> ridi_correct::ImuSlices<'_> {
-    ridi_correct::ImuSlices {
-        time: seq.time(),
-        linacce: seq.linacce(),
-        orientation: seq.orientation(),
-        gravity: seq.gravity(),
-    }
-}
-
 /// Corrects and integrates `seq` so that its velocity follows `regressions` (batch: one
 /// global solve). `seq` must carry the orientation of the model that regressed them
 /// ([`oriented`]), `config` the model's S ([`TrackOptions::correction_for`]).
@@ -209,7 +197,7 @@ pub fn correct_with(
             velocity: r.velocity,
         })
         .collect();
-    let traj = correct(config, &imu_slices(seq), &targets)?;
+    let traj = correct(config, &seq.imu(), &targets)?;
     let bias = &traj.correction.bias;
     Ok(Track {
         time: seq.time().to_vec(),
@@ -322,7 +310,7 @@ fn track_online(seq: &Sequence, model: &Cascade, opts: &TrackOptions) -> Result<
     let mut live = LiveTracker::new(model, opts)?;
     let mut updates = Vec::with_capacity(seq.len());
     for i in 0..seq.len() {
-        live.push(&LiveSample::of_frame(seq, i), &mut updates)
+        live.push(&SensorReading::of_frame(seq, i), &mut updates)
             .map_err(|e| PipelineError::sequence(seq.name(), format!("frame {i}: {e}")))?;
     }
     live.finish(&mut updates)

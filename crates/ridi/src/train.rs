@@ -5,7 +5,7 @@ use std::collections::BTreeSet;
 use rayon::prelude::*;
 use ridi_data::Sequence;
 use ridi_features::{
-    FeatureConfig, FeatureExtractor, FeatureMatrix, GroundTruthView, ImuView, SampleSchedule,
+    FeatureConfig, FeatureExtractor, FeatureMatrix, GroundTruthView, SampleSchedule,
     Standardization, compute_targets,
 };
 use ridi_frames::{StabHorizontal, UpAxis};
@@ -131,11 +131,6 @@ impl TrainingData {
     }
 }
 
-/// The IMU streams of `seq` as feature input.
-pub fn imu_view(seq: &Sequence) -> Result<ImuView<'_>> {
-    Ok(ImuView::new(seq.gyro(), seq.linacce(), seq.gravity())?)
-}
-
 /// Ground truth of `seq` as target input; an error names the sequence when it has none.
 pub fn ground_truth_view(seq: &Sequence) -> Result<GroundTruthView<'_>> {
     let gt = seq
@@ -180,7 +175,7 @@ pub fn training_data(seqs: &[Sequence], config: &FeatureConfig) -> Result<Traini
             let s = oriented(s, config.orientation)?;
             let s = s.as_ref();
             let frames = schedule.frames(s.len());
-            let features = fx.features(&fx.stabilize(&imu_view(s)?)?, &frames)?;
+            let features = fx.features(&fx.stabilize(&s.imu())?, &frames)?;
             let targets = compute_targets(&ground_truth_view(s)?, &config, &frames)?;
             Ok((features, targets.values))
         })

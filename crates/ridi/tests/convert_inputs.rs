@@ -8,11 +8,10 @@ use ridi::data::{
     Format, GroundTruth, ReadOptions, Sequence, SequenceError, SequenceParts, read_sequence,
     write_ridi_csv, write_ridi_plain,
 };
+use ridi_test_support::{file_names, sample_dataset};
 
 fn seq(name: &str) -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../../datasets/sample")
-        .join(name)
+    sample_dataset().join(name)
 }
 
 /// `dir/src` with one RIDI capture (a copy of a sample run) per name.
@@ -250,9 +249,8 @@ fn list_labels_in_the_source_carry_over_and_a_folder_of_another_format_is_named(
         before
     );
     assert!(!src.join("list_all.txt").exists());
-    let left: Vec<_> = std::fs::read_dir(&src)
-        .unwrap()
-        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+    let left: Vec<_> = file_names(&src)
+        .into_iter()
         .filter(|n| n.starts_with(".ridi-staging"))
         .collect();
     assert!(left.is_empty(), "{left:?}");

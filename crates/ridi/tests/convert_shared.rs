@@ -2,29 +2,15 @@
 //! checkout). The tests are `#[ignore]`d, so that `cargo test` shows them as not run; `.ci/run`
 //! runs them with `--ignored`.
 
-use std::path::{Path, PathBuf};
-
 use ridi::data::{ReadOptions, read_list};
-
-/// `../shared/data/raw/<dataset>`, which must hold `probe`.
-fn shared(dataset: &str, probe: &str) -> PathBuf {
-    let root = Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../../../shared/data/raw")
-        .join(dataset);
-    assert!(
-        root.join(probe).is_dir(),
-        "{} not found: these checks need the shared data beside the checkout",
-        root.join(probe).display()
-    );
-    root
-}
+use ridi_test_support::shared_dataset;
 
 /// Every Android run with motion capture in the shared root (the 24 Nexus 5 runs and the 18
 /// near magnetic disturbance); the one run folder without it is skipped with one warning.
 #[test]
 #[ignore = "needs ../shared beside the checkout: `cargo test --workspace --tests -- --ignored` (.ci/run)"]
 fn the_whole_tyrex_root_converts_with_one_list_per_person() {
-    let root = shared("tyrex-attitude-smartphones", "datasets/android");
+    let root = shared_dataset("tyrex-attitude-smartphones", "datasets/android");
     let out = tempfile::tempdir().unwrap();
     let summary = ridi::convert::convert(&root, out.path(), &Default::default()).unwrap();
     // 42 runs, some split at long mocap or sensor gaps into parts, each named and listed.
@@ -81,7 +67,7 @@ fn the_whole_tyrex_root_converts_with_one_list_per_person() {
 #[test]
 #[ignore = "needs ../shared beside the checkout: `cargo test --workspace --tests -- --ignored` (.ci/run)"]
 fn indoor_location_competition_paths_convert_with_the_hand_placement() {
-    let root = shared("indoor-location-competition-20", "data");
+    let root = shared_dataset("indoor-location-competition-20", "data");
     let out = tempfile::tempdir().unwrap();
     let summary = ridi::convert::convert(&root, out.path(), &Default::default()).unwrap();
     assert_eq!(summary.sequences.len(), 12);

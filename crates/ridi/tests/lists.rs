@@ -6,13 +6,10 @@ use std::path::{Path, PathBuf};
 use ridi::data::{ReadOptions, Sequence, read_sequence, write_ridi_csv};
 use ridi::regress::NoProgress;
 use ridi::{EvalOptions, GridChoice, Method, PlacementMap, Purpose, TrainOptions, load_lists};
-
-fn sample() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("../../datasets/sample")
-}
+use ridi_test_support::sample_dataset;
 
 fn seq(name: &str) -> PathBuf {
-    sample().join(name)
+    sample_dataset().join(name)
 }
 
 /// Writes a list file of `lines` into `dir`.

@@ -1,24 +1,20 @@
 //! End to end on the bundled sample: train, track (batch and online), evaluate.
 
-use std::path::{Path, PathBuf};
-
-use ridi::correct::{Sample, Tracker, TrackerConfig};
+use ridi::correct::{Tracker, TrackerConfig};
 use ridi::data::{ReadOptions, Sequence, load_list};
+use ridi::frames::ImuSample;
 use ridi::frames::nalgebra::Vector3;
 use ridi::frames::{DeviceVec, Rot, UpAxis};
 use ridi::live::CascadeRegressor;
-use ridi::regress::{NoProgress, model_file};
+use ridi::regress::{Cascade, NoProgress};
 use ridi::{
-    EvalOptions, GridChoice, LiveSample, LiveTracker, Method, Orientation, PlacementMap,
+    EvalOptions, GridChoice, LiveTracker, Method, Orientation, PlacementMap, SensorReading,
     TrackOptions, TrainOptions, apply_orientation,
 };
-
-fn sample() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("../../datasets/sample")
-}
+use ridi_test_support::sample_dataset;
 
 fn load(list: &str) -> Vec<Sequence> {
-    let mut seqs = load_list(sample().join(list), &ReadOptions::default()).unwrap();
+    let mut seqs = load_list(sample_dataset().join(list), &ReadOptions::default()).unwrap();
     PlacementMap::tyrex_groups().apply(&mut seqs);
     seqs
 }
@@ -50,7 +46,7 @@ fn batch_and_online(seq: &Sequence, model: &ridi::regress::Cascade) -> (ridi::Tr
 }
 
 #[test]
-fn train_track_and_evaluate_on_the_sample() {
+fn train_track_and_evaluate_on_the_sample_dataset() {
     let train = load("list_train.txt");
     let test = load("list_test.txt");
     assert_eq!((train.len(), test.len()), (16, 8));
@@ -60,8 +56,8 @@ fn train_track_and_evaluate_on_the_sample() {
     // The model file round-trips and keeps the feature configuration (with standardization).
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("m.ridi");
-    model_file::save(&model, &path).unwrap();
-    let back = model_file::load(&path).unwrap();
+    model.save(&path).unwrap();
+    let back = Cascade::load(&path).unwrap();
     assert_eq!(back, model);
     assert!(back.feature_config().standardization.is_some());
 
@@ -458,7 +454,7 @@ fn a_model_tracks_in_the_orientation_it_was_trained_with() {
     let e = &pre[0];
     for i in 0..e.len() {
         let u = tracker
-            .push(&Sample {
+            .push(&ImuSample {
                 time: e.time()[i],
                 gyro: e.gyro()[i],
                 linacce: e.linacce()[i],
@@ -469,7 +465,7 @@ fn a_model_tracks_in_the_orientation_it_was_trained_with() {
         assert_eq!(u.pose.position, a.position[i], "frame {i}");
         assert_eq!(u.bias, a.bias[i], "frame {i}");
     }
-    assert_eq!(tracker.regressor().made, a.regressions);
+    assert_eq!(tracker.regressor().made(), a.regressions);
     let (report, _) = ridi::evaluate(&pre, &model, &EvalOptions::default()).unwrap();
     assert!(report.summary["ridi"].rte_5s_m.is_finite());
     // Recorded training options on an estimated sequence: an error naming it.
@@ -483,11 +479,13 @@ fn a_model_tracks_in_the_orientation_it_was_trained_with() {
 }
 
 #[test]
-fn a_live_stream_gets_its_poses_sample_by_sample() {
+fn a_live_stream_gets_its_poses_sample_by_sample_dataset() {
     let seq = load("list_Jakob.txt").swap_remove(7);
-    let sample = |i: usize, recorded: bool| LiveSample {
-        recorded: LiveSample::of_frame(&seq, i).recorded.filter(|_| recorded),
-        ..LiveSample::of_frame(&seq, i)
+    let sample = |i: usize, recorded: bool| SensorReading {
+        recorded: SensorReading::of_frame(&seq, i)
+            .recorded
+            .filter(|_| recorded),
+        ..SensorReading::of_frame(&seq, i)
     };
     let opts = TrackOptions {
         online: true,

@@ -1,11 +1,11 @@
 //! Trajectory and velocity plots written to disk, as SVG and PNG.
-
-use std::path::Path;
+#![cfg(feature = "plot")]
 
 use ridi::plot::{
     Placements, PlotError, PlotFormat, Trajectory, TrajectoryOptions, TrajectoryPlot,
     VelocityOptions, VelocityPlot, VelocityTrack, ViewFit, plot_trajectories, plot_velocity,
 };
+use ridi_test_support::file_names;
 
 /// A 20 m x 10 m loop sampled at 50 points per metre, like a walk at 200 Hz.
 fn walk() -> Vec<[f64; 2]> {
@@ -47,16 +47,6 @@ fn png_dimensions(bytes: &[u8]) -> (u32, u32) {
     assert_eq!(&bytes[12..16], b"IHDR", "first chunk must be IHDR");
     let be = |i: usize| u32::from_be_bytes(bytes[i..i + 4].try_into().expect("four bytes"));
     (be(16), be(20))
-}
-
-/// Files left in `dir`: temporary files must not survive.
-fn entries(dir: &Path) -> Vec<String> {
-    let mut names: Vec<String> = std::fs::read_dir(dir)
-        .expect("read dir")
-        .map(|e| e.expect("entry").file_name().to_string_lossy().into_owned())
-        .collect();
-    names.sort();
-    names
 }
 
 #[test]
@@ -120,7 +110,7 @@ fn trajectories_svg_and_png_clip_the_drifting_estimate() {
     assert_eq!(png_dimensions(&png), options.size);
     assert!(png.len() > 10_000, "PNG is only {} bytes", png.len());
 
-    assert_eq!(entries(dir.path()), ["traj.png", "traj.svg"]);
+    assert_eq!(file_names(dir.path()), ["traj.png", "traj.svg"]);
 }
 
 #[test]
@@ -283,7 +273,7 @@ fn velocity_svg_and_png_with_placements() {
     let png = std::fs::read(&png_path).expect("read png");
     assert_eq!(png_dimensions(&png), options.size);
     assert!(png.len() > 10_000, "PNG is only {} bytes", png.len());
-    assert_eq!(entries(dir.path()), ["velocity.png", "velocity.svg"]);
+    assert_eq!(file_names(dir.path()), ["velocity.png", "velocity.svg"]);
 }
 
 #[test]
@@ -454,9 +444,9 @@ fn bad_input_is_an_error_and_writes_nothing() {
     assert!(matches!(&err, PlotError::LengthMismatch { series, .. } if series == "placements"));
 
     assert!(
-        entries(dir.path()).is_empty(),
+        file_names(dir.path()).is_empty(),
         "left behind: {:?}",
-        entries(dir.path())
+        file_names(dir.path())
     );
 }
 
@@ -492,7 +482,7 @@ fn a_failed_write_leaves_the_previous_plot_intact() {
     let err = plot_trajectories(&missing, &plot, &TrajectoryOptions::default())
         .expect_err("missing folder");
     assert!(matches!(err, PlotError::Io { .. }), "{err}");
-    assert_eq!(entries(dir.path()), ["keep.svg"]);
+    assert_eq!(file_names(dir.path()), ["keep.svg"]);
 }
 
 #[test]
@@ -558,5 +548,5 @@ fn absurd_magnitudes_are_refused_where_they_set_a_range_and_clipped_elsewhere() 
         err.to_string(),
         "series \"regressed\": S-x velocity of magnitude 1e300 at index 1 is beyond the plottable 1e15"
     );
-    assert_eq!(entries(dir.path()), ["d.png"]);
+    assert_eq!(file_names(dir.path()), ["d.png"]);
 }

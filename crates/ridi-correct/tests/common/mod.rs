@@ -1,9 +1,9 @@
 //! Synthetic walks with known truth, shared by the integration tests.
 #![allow(dead_code)]
 
-use ridi_correct::{ImuSlices, Integrator, Knots, Pose, VelocityTarget};
+use ridi_correct::{Integrator, Knots, Pose, VelocityTarget};
 use ridi_frames::nalgebra::Vector3;
-use ridi_frames::{DeviceVec, Rot, World, WorldFromDevice, WorldVec, stab_from_world};
+use ridi_frames::{DeviceVec, ImuFrames, Rot, World, WorldFromDevice, WorldVec, stab_from_world};
 
 /// A walk whose true world acceleration is known, seen through a biased accelerometer.
 pub struct Walk {
@@ -100,13 +100,15 @@ pub fn walk(n: usize, spacing: usize, v0: WorldVec, jitter: bool) -> Walk {
 }
 
 impl Walk {
-    pub fn imu(&self) -> ImuSlices<'_> {
-        ImuSlices {
-            time: &self.time,
-            linacce: &self.linacce,
-            orientation: &self.orientation,
-            gravity: &self.gravity,
-        }
+    pub fn imu(&self) -> ImuFrames<'_> {
+        ImuFrames::new(
+            &self.time,
+            &self.gyro,
+            &self.linacce,
+            &self.gravity,
+            &self.orientation,
+        )
+        .unwrap()
     }
 
     /// Exact regressed velocity (true horizontal S velocity) at `frame`.

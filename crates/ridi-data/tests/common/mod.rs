@@ -1,17 +1,18 @@
 //! Fixtures shared by the integration tests: small valid sequences and files built in code.
+//! They are built from ridi-data's own types, so they stay here; what needs nothing of
+//! ridi-data (error assertions, cell edits, file writing, the shared data) is in
+//! `ridi-test-support`.
 
 #![allow(dead_code)]
 
 use std::fmt::Write as _;
-use std::path::Path;
 
 use ridi_data::ridi_frames::nalgebra::Vector3;
 use ridi_data::ridi_frames::{
     Device, DeviceVec, Rot, WorldFromDevice, WorldVec, gravity_in_device,
 };
-use ridi_data::{
-    DataError, GroundTruth, OrientationSource, ReadOptions, Sequence, SequenceParts, ridi_raw,
-};
+use ridi_data::{GroundTruth, OrientationSource, ReadOptions, Sequence, SequenceParts, ridi_raw};
+use ridi_test_support::write_files;
 
 /// First timestamp of the fixtures, ns (a plausible boot-clock value).
 pub const T0_NS: i64 = 172_364_832_413_231;
@@ -139,66 +140,6 @@ pub fn raw_files(n: usize, with_pose: bool) -> Vec<(&'static str, String)> {
     files
 }
 
-/// Writes `files` into `dir` (created if needed).
-pub fn write_files(dir: &Path, files: &[(&str, String)]) {
-    std::fs::create_dir_all(dir).unwrap();
-    for (name, content) in files {
-        std::fs::write(dir.join(name), content).unwrap();
-    }
-}
-
-/// `../shared/data/raw/<dataset>` beside the checkout, which must hold `probe` (the tests that
-/// call this are `#[ignore]`d: they run only when asked for).
-pub fn shared_dataset(dataset: &str, probe: &str) -> std::path::PathBuf {
-    let p = Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../../../shared/data/raw")
-        .join(dataset);
-    assert!(
-        p.join(probe).exists(),
-        "{} not found: these checks need the shared data beside the checkout",
-        p.join(probe).display()
-    );
-    p
-}
-
-/// Asserts that `r` failed with a message containing every one of `parts`.
-#[track_caller]
-pub fn assert_err<T: std::fmt::Debug>(r: Result<T, DataError>, parts: &[&str]) -> DataError {
-    let e = r.expect_err("expected an error");
-    let msg = e.to_string();
-    for p in parts {
-        assert!(msg.contains(p), "`{msg}` should contain `{p}`");
-    }
-    e
-}
-
-/// `valid_csv` text with cell `col` (0 = pandas index) of 1-based `line` replaced by `value`.
-pub fn with_cell(text: &str, line: usize, col: usize, value: &str) -> String {
-    edit_rows(text, |n, cells| {
-        if n == line {
-            cells[col] = value.to_owned();
-        }
-    })
-}
-
-/// `text` with `f(line, cells)` applied to the comma-separated cells of each 1-based line.
-pub fn edit_rows(text: &str, f: impl FnMut(usize, &mut Vec<String>)) -> String {
-    edit_cells(text, ',', f)
-}
-
-/// `text` with `f(line, cells)` applied to the `sep`-separated cells of each 1-based line; every
-/// line ends in `\n`.
-pub fn edit_cells(text: &str, sep: char, mut f: impl FnMut(usize, &mut Vec<String>)) -> String {
-    let mut out = String::new();
-    for (i, l) in text.lines().enumerate() {
-        let mut cells: Vec<String> = l.split(sep).map(str::to_owned).collect();
-        f(i + 1, &mut cells);
-        out.push_str(&cells.join(&sep.to_string()));
-        out.push('\n');
-    }
-    out
-}
-
 /// Reads a raw folder of `raw_files(60, true)` after `edit`.
 pub fn raw_with(
     edit: impl FnOnce(&mut Vec<(&'static str, String)>),
@@ -209,10 +150,4 @@ pub fn raw_with(
     write_files(dir.path(), &files);
     let r = ridi_raw::read(dir.path(), &raw_options());
     (dir, r)
-}
-
-/// Applies `f` to the content of file `name` among `files`.
-pub fn edit_file(files: &mut [(&'static str, String)], name: &str, f: impl FnOnce(&str) -> String) {
-    let entry = files.iter_mut().find(|(n, _)| *n == name).unwrap();
-    entry.1 = f(&entry.1);
 }

@@ -1,10 +1,12 @@
-//! Deterministic synthetic data shared by the integration tests.
-#![allow(dead_code)]
+//! Deterministic synthetic data: the same numbers on every machine and every run, without a
+//! random-number crate.
 
 /// SplitMix64: tiny, deterministic, good enough for test data.
-pub struct Rng(pub u64);
+#[derive(Debug, Clone)]
+pub struct SplitMix64(pub u64);
 
-impl Rng {
+impl SplitMix64 {
+    /// The next 64 random bits.
     pub fn next_u64(&mut self) -> u64 {
         self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
         let mut z = self.0;
@@ -12,15 +14,21 @@ impl Rng {
         z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
         z ^ (z >> 31)
     }
+
     /// Uniform in [-1, 1).
     pub fn uniform(&mut self) -> f64 {
         (self.next_u64() >> 11) as f64 / (1u64 << 52) as f64 - 1.0
     }
+
+    /// Uniform in [0, 1).
+    pub fn unit(&mut self) -> f64 {
+        (self.next_u64() >> 11) as f64 / (1u64 << 53) as f64
+    }
 }
 
-/// `n × d` features with smooth structure and a nonlinear target.
-pub fn regression(n: usize, d: usize, seed: u64) -> (Vec<f32>, Vec<f64>) {
-    let mut rng = Rng(seed);
+/// `n × d` row-major features with smooth structure and a nonlinear target, from `seed`.
+pub fn regression_data(n: usize, d: usize, seed: u64) -> (Vec<f32>, Vec<f64>) {
+    let mut rng = SplitMix64(seed);
     let mut x = Vec::with_capacity(n * d);
     let mut y = Vec::with_capacity(n);
     for _ in 0..n {
@@ -35,15 +43,16 @@ pub fn regression(n: usize, d: usize, seed: u64) -> (Vec<f32>, Vec<f64>) {
     (x, y)
 }
 
-/// `k` Gaussian-ish blobs in `d` dimensions, `n_per` samples each; labels are `label_of[c]`.
-pub fn blobs(
+/// One blob per entry of `label_of` in `d` dimensions, `n_per` samples each, spread `spread`
+/// about a unit centre; the samples of blob `c` are labelled `label_of[c]`.
+pub fn blob_data(
     n_per: usize,
     d: usize,
     label_of: &[usize],
     spread: f64,
     seed: u64,
 ) -> (Vec<f32>, Vec<usize>) {
-    let mut rng = Rng(seed);
+    let mut rng = SplitMix64(seed);
     let mut x = Vec::new();
     let mut y = Vec::new();
     for (c, &label) in label_of.iter().enumerate() {

@@ -1,13 +1,12 @@
 //! Straightforward reference implementations, written for clarity rather than speed: every
 //! window rotates its own frames, builds explicit padded channel vectors and smooths in f64.
-//! Shared by the tests and the benchmark (which reports the speed ratio).
-
-#![allow(dead_code)]
+//! The oracles of `ridi-features`' tests, and the baseline its benchmark reports the speed
+//! ratio against.
 
 use ridi_frames::{DeviceVec, align_gravity};
 
 /// Gaussian kernel from the scipy recipe, full length `2r + 1`.
-pub fn kernel(sigma: f64, truncate: f64) -> Vec<f64> {
+pub fn naive_kernel(sigma: f64, truncate: f64) -> Vec<f64> {
     let r = (truncate * sigma + 0.5) as i64;
     if r == 0 {
         return vec![1.0];
@@ -20,8 +19,8 @@ pub fn kernel(sigma: f64, truncate: f64) -> Vec<f64> {
 }
 
 /// Position `i` of the reflect extension, found by mirroring step by step at each border
-/// (independent of the closed form the crate uses).
-pub fn mirror(mut i: i64, n: i64) -> usize {
+/// (independent of the closed form `ridi-features` uses).
+pub fn naive_mirror(mut i: i64, n: i64) -> usize {
     loop {
         if i < 0 {
             i = -i - 1;
@@ -34,21 +33,21 @@ pub fn mirror(mut i: i64, n: i64) -> usize {
 }
 
 /// scipy's gaussian_filter1d, mode 'reflect', by explicit padding.
-pub fn smooth(x: &[f64], sigma: f64, truncate: f64) -> Vec<f64> {
-    let k = kernel(sigma, truncate);
+pub fn naive_smooth(x: &[f64], sigma: f64, truncate: f64) -> Vec<f64> {
+    let k = naive_kernel(sigma, truncate);
     let r = (k.len() / 2) as i64;
     let n = x.len() as i64;
     if n == 0 {
         return Vec::new();
     }
-    let padded: Vec<f64> = (-r..n + r).map(|i| x[mirror(i, n)]).collect();
+    let padded: Vec<f64> = (-r..n + r).map(|i| x[naive_mirror(i, n)]).collect();
     (0..x.len())
         .map(|i| k.iter().enumerate().map(|(j, w)| w * padded[i + j]).sum())
         .collect()
 }
 
 /// Feature rows for gyro + linear acceleration, window `window` ending before each frame.
-pub fn features(
+pub fn naive_features(
     gyro: &[DeviceVec],
     linacce: &[DeviceVec],
     gravity: &[DeviceVec],
@@ -72,7 +71,7 @@ pub fn features(
             }
             let smoothed: Vec<Vec<f64>> = channels
                 .iter()
-                .map(|c| smooth(c, sigma, truncate))
+                .map(|c| naive_smooth(c, sigma, truncate))
                 .collect();
             let mut row = Vec::with_capacity(window * 6);
             for t in 0..window {

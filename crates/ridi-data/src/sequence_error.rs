@@ -1,0 +1,263 @@
+//! Why a sequence is refused, and the wording of its messages.
+
+use crate::sequence::Channel;
+
+/// A number for a message: plain with at most 3 decimals, or in scientific notation when very
+/// large or small (`1e308`, not 309 digits).
+pub(crate) fn short(v: f64) -> String {
+    let a = v.abs();
+    if a != 0.0 && !(1e-3..1e6).contains(&a) {
+        let s = format!("{v:.3e}");
+        let (mantissa, exp) = s.split_once('e').unwrap_or((&s, "0"));
+        let mantissa = mantissa.trim_end_matches('0').trim_end_matches('.');
+        format!("{mantissa}e{exp}")
+    } else {
+        let s = format!("{v:.3}");
+        s.trim_end_matches('0').trim_end_matches('.').to_owned()
+    }
+}
+
+/// Axis names of the 3-vector channels.
+pub(crate) const AXES: [&str; 3] = ["x", "y", "z"];
+
+/// What is wrong with a value beyond its channel's bound, e.g. `1e308 m/s^2 is beyond any phone
+/// accelerometer (|value| <= 2000 m/s^2)`.
+pub(crate) fn beyond(channel: Channel, value: f64, limit: f64) -> String {
+    let unit = channel.unit();
+    format!(
+        "{} {unit} is beyond {} (|value| <= {} {unit})",
+        short(value),
+        channel.beyond(),
+        short(limit)
+    )
+}
+
+/// What is wrong with a ground-truth step too fast for a pedestrian, e.g. `jumps 1000 m in
+/// 0.005 s (200000 m/s): faster than any pedestrian (speed <= 100 m/s), a corrupt position?`.
+pub(crate) fn jump(distance: f64, dt: f64, max: f64) -> String {
+    if dt.partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater) {
+        // Only reachable by calling `check_speed` directly: `Sequence::new` refuses such times.
+        return format!(
+            "jumps {} m between frames {} s apart: time must increase",
+            short(distance),
+            short(dt)
+        );
+    }
+    format!(
+        "jumps {} m in {} s ({} m/s): faster than any pedestrian (speed <= {} m/s), a corrupt \
+         position?",
+        short(distance),
+        short(dt),
+        short(distance / dt),
+        short(max)
+    )
+}
+
+/// Why a set of [`SequenceParts`](crate::SequenceParts) is not a valid sequence.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum SequenceError {
+    /// No frames.
+    #[error("sequence has no frames")]
+    Empty,
+    /// A channel's length differs from the timeline's.
+    #[error("`{what}` has {found} frames, the timeline has {expected}")]
+    LengthMismatch {
+        /// The channel.
+        what: &'static str,
+        /// Length of the timeline.
+        expected: usize,
+        /// Length of the channel.
+        found: usize,
+    },
+    /// NaN or infinity.
+    #[error("`{what}` is not finite at frame {index}")]
+    NonFinite {
+        /// The channel.
+        what: &'static str,
+        /// 0-based frame index.
+        index: usize,
+    },
+    /// Time does not strictly increase.
+    #[error("time does not increase at frame {index}: {previous} s then {next} s")]
+    TimeNotIncreasing {
+        /// 0-based index of the later frame.
+        index: usize,
+        /// Time of the earlier frame.
+        previous: f64,
+        /// Time of the later frame.
+        next: f64,
+    },
+    /// Two frames are too far apart.
+    #[error("gap of {gap_s:.3} s before frame {index} (at {time} s) exceeds {max_gap_s} s")]
+    Gap {
+        /// 0-based index of the frame after the gap.
+        index: usize,
+        /// Its time.
+        time: f64,
+        /// Length of the gap.
+        gap_s: f64,
+        /// The limit.
+        max_gap_s: f64,
+    },
+    /// A resampling rate that is not a finite number above 0 ([`Sequence::resampled`](crate::Sequence::resampled)).
+    #[error("cannot resample to {rate_hz} Hz: the rate must be a finite number above 0")]
+    InvalidRate {
+        /// The rate asked for.
+        rate_hz: f64,
+    },
+    /// A value beyond the hard physical bound of its channel ([`Validation::limit`](crate::Validation::limit)): a
+    /// corrupt value or a wrong unit.
+    #[error("`{channel}.{}` at frame {index}: {}", AXES[*axis], beyond(*channel, *value, *limit))]
+    Implausible {
+        /// The channel.
+        channel: Channel,
+        /// 0 (x), 1 (y) or 2 (z).
+        axis: usize,
+        /// 0-based frame index.
+        index: usize,
+        /// The value.
+        value: f64,
+        /// The bound its magnitude exceeds.
+        limit: f64,
+    },
+    /// The median gyro magnitude is too large for rad/s.
+    #[error(
+        "median |gyro| {} rad/s is above {max} rad/s: gyroscope in deg/s instead of rad/s?",
+        short(*median)
+    )]
+    GyroUnits {
+        /// Median magnitude found.
+        median: f64,
+        /// The limit ([`Validation::max_median_gyro`](crate::Validation::max_median_gyro)).
+        max: f64,
+    },
+    /// The mean accelerometer magnitude is far from the mean gravity magnitude.
+    #[error(
+        "mean |acce| {} m/s^2 is {} times mean |gravity| {} m/s^2, outside {min}..{max}: \
+         accelerometer in {}?",
+        short(*acce),
+        short(acce / gravity),
+        short(*gravity),
+        if acce < gravity { "g instead of m/s^2" } else { "another unit than m/s^2" }
+    )]
+    AcceScale {
+        /// Mean accelerometer magnitude.
+        acce: f64,
+        /// Mean gravity magnitude.
+        gravity: f64,
+        /// Lowest accepted ratio.
+        min: f64,
+        /// Highest accepted ratio.
+        max: f64,
+    },
+    /// The gyro does not turn as fast as the orientation.
+    #[error(
+        "the gyro turns {} times as fast as the orientation (least squares over frames), \
+         outside {min}..{max}: {}?",
+        short(*scale),
+        if *scale > 20.0 && *scale < 200.0 {
+            "gyroscope in deg/s instead of rad/s"
+        } else {
+            "a gyro in another unit, or of another recording or device"
+        }
+    )]
+    GyroScale {
+        /// The fitted scale.
+        scale: f64,
+        /// Lowest accepted scale.
+        min: f64,
+        /// Highest accepted scale.
+        max: f64,
+    },
+    /// The linear acceleration does not match accelerometer minus gravity in size.
+    #[error(
+        "accelerometer minus gravity is {} times the linear acceleration (least squares), \
+         outside {min}..{max}: linear acceleration in {}?",
+        short(*scale),
+        if *scale > 5.0 && *scale < 20.0 { "g instead of m/s^2" } else { "another unit than m/s^2, or another column" }
+    )]
+    LinacceScale {
+        /// The fitted scale.
+        scale: f64,
+        /// Lowest accepted scale.
+        min: f64,
+        /// Highest accepted scale.
+        max: f64,
+    },
+    /// The ground truth moves too fast for a pedestrian: positions in another unit than metres.
+    #[error(
+        "the ground truth moves at a median {} m/s, above {max} m/s: positions in mm or cm \
+         instead of metres?",
+        short(*median)
+    )]
+    GroundTruthSpeed {
+        /// Median speed found, m/s.
+        median: f64,
+        /// The limit ([`Validation::max_median_speed`](crate::Validation::max_median_speed)).
+        max: f64,
+    },
+    /// Two consecutive ground-truth positions too far apart for the time between them
+    /// ([`Validation::max_speed`](crate::Validation::max_speed)): a corrupt position.
+    #[error(
+        "`ground_truth.position.{}` at frame {index}: {}",
+        AXES[*axis],
+        jump(*distance, *dt, *max)
+    )]
+    GroundTruthJump {
+        /// 0-based index of the suspect frame: the later frame of the first step too fast,
+        /// except frame 0 when that step is the first and every later step is fine (frame 0
+        /// alone disagrees with the rest).
+        index: usize,
+        /// The axis that moves most: 0 (x), 1 (y) or 2 (z).
+        axis: usize,
+        /// Distance between the two positions, metres.
+        distance: f64,
+        /// Time between them, seconds.
+        dt: f64,
+        /// The limit, m/s.
+        max: f64,
+    },
+    /// The median interval between timestamps is outside [`Validation::time_step_range`](crate::Validation::time_step_range).
+    #[error(
+        "timestamps step by {} s (median), outside {}..{} s: time in the wrong unit?",
+        short(*median),
+        short(*min),
+        short(*max)
+    )]
+    TimeStep {
+        /// Median interval, seconds.
+        median: f64,
+        /// Lower limit.
+        min: f64,
+        /// Upper limit.
+        max: f64,
+    },
+    /// Mean gravity magnitude outside the plausible range: wrong units or a wrong column.
+    #[error(
+        "mean gravity magnitude {mean:.3} m/s^2 is outside {min}..{max}: wrong units or column?"
+    )]
+    Gravity {
+        /// Mean magnitude found.
+        mean: f64,
+        /// Lower limit.
+        min: f64,
+        /// Upper limit.
+        max: f64,
+    },
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn numbers_in_messages_are_short() {
+        assert_eq!(short(1e308), "1e308");
+        assert_eq!(short(-5e-12), "-5e-12");
+        assert_eq!(short(4.999_999e-12), "5e-12");
+        assert_eq!(short(57.295_779_5), "57.296");
+        assert_eq!(short(2000.0), "2000");
+        assert_eq!(short(1e6), "1e6");
+        assert_eq!(short(0.0), "0");
+    }
+}

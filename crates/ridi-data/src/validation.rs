@@ -1,0 +1,709 @@
+//! Limits every sequence and stream is checked against, and the orientation jumps those checks
+//! leave out.
+
+use ridi_frames::{DeviceVec, WorldFromDevice, WorldVec};
+
+use crate::sequence::{Channel, norm};
+use crate::sequence_error::{SequenceError, short};
+
+/// The middle value of `v` (the upper one of an even count; NaN when empty), reordering `v`.
+fn median(v: &mut [f64]) -> f64 {
+    if v.is_empty() {
+        return f64::NAN;
+    }
+    let mid = v.len() / 2;
+    *v.select_nth_unstable_by(mid, f64::total_cmp).1
+}
+
+/// Limits applied when a sequence is built, and by the readers to each stream they parse (so
+/// that a bad value is reported on its own line, before any resampling).
+///
+/// Besides time and gravity, the defaults are hard physical bounds on single values and wide
+/// unit checks on whole channels, far from real data. Measured over the 24 bundled samples
+/// (`datasets/sample`), the 24 Tyrex runs (Nexus 5, 34 sequences once split at mocap losses,
+/// including running with the phone in the hand and in a pocket) and the 12 Indoor Location
+/// Competition walks (OPPO PBCM10), streams as read and sequences as built:
+///
+/// | statistic | real data | limit |
+/// | --- | --- | --- |
+/// | largest gyro component | 21.7 rad/s | 100 rad/s |
+/// | median \|gyro\| per recording | 0.24..4.25 rad/s | 10 rad/s |
+/// | largest accelerometer / linear acceleration component | 39.6 / 31.1 m/s^2 | 2000 m/s^2 |
+/// | largest gravity component | 9.81 m/s^2 | 20 m/s^2 |
+/// | mean \|acce\| / mean \|gravity\| | 0.99..1.87 | 0.5..3 |
+/// | largest magnetometer component | 67 uT | 10 000 uT |
+/// | largest position component | 222 m | 10^6 m |
+/// | median interval between timestamps | 5-20 ms | 0.1 ms..1 s |
+/// | median ground-truth speed per Tyrex run | 0.17..2.33 m/s | 20 m/s |
+/// | largest ground-truth speed between consecutive frames (also over 2-20 frames) | 5.7 m/s | 100 m/s |
+///
+/// Not caught: a gyro in deg/s on a phone that hardly turns (median |gyro| under 0.17 rad/s
+/// and the orientation turning at under [`GYRO_SCALE_MIN_RATE`] RMS), and a linear
+/// acceleration alone in g on a phone that hardly moves (RMS of accelerometer minus
+/// gravity under [`LINACCE_SCALE_MIN_RMS`]; there is then too little of it to judge, and too
+/// little to matter).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Validation {
+    /// Largest accepted interval between two frames, seconds.
+    pub max_gap_s: f64,
+    /// Accepted range of the mean gravity magnitude, m/s^2 (catches data in g or in mm/s^2).
+    pub gravity_range: (f64, f64),
+    /// Largest accepted |component| of the gyro, rad/s: 100. Phone gyroscopes saturate at
+    /// about 35 rad/s (2000 deg/s); a larger value is corrupt, or degrees per second.
+    pub max_gyro: f64,
+    /// Largest accepted |component| of the accelerometer and the linear acceleration, m/s^2:
+    /// 2000 (about 200 g, far above the 16-32 g range of phone accelerometers): a larger value
+    /// is corrupt, or in mm/s^2.
+    pub max_acce: f64,
+    /// Largest accepted |component| of gravity, m/s^2: 20, twice its magnitude.
+    pub max_gravity: f64,
+    /// Largest accepted |component| of the magnetometer, microtesla: 10 000. The Earth's field
+    /// is 25-65 uT and phone magnetometers saturate at a few thousand uT; a larger value is
+    /// corrupt, or in nanotesla.
+    pub max_magnet: f64,
+    /// Largest accepted |component| of a ground-truth position, metres: 10^6 (1000 km from the
+    /// origin of a room, building or start-of-service frame).
+    pub max_position: f64,
+    /// Largest accepted median |gyro|, rad/s: 10. Real recordings stay below 4.25 (running
+    /// with the phone in a pocket); a gyro in deg/s multiplies by 57.3, so a recording with a
+    /// median rotation rate above 0.17 rad/s (10 deg/s) is caught: every one measured, whose
+    /// smallest median is 0.24 rad/s (13.6 once in deg/s).
+    pub max_median_gyro: f64,
+    /// Accepted range of mean |acce| / mean |gravity|: 0.5..3. Real data lie within 0.99..1.87
+    /// (the upper end when running); an accelerometer in g beside gravity in m/s^2 gives 0.1.
+    pub acce_gravity_ratio: (f64, f64),
+    /// Accepted range of the median interval between timestamps, seconds: 1e-4..1 (10 kHz to
+    /// 1 Hz; phone sensors deliver 5-500 Hz). Seconds or milliseconds read as nanoseconds step
+    /// by 1e-9 s or less. A unit too coarse shows as gaps instead.
+    pub time_step_range: (f64, f64),
+    /// Accepted range of the scale that best takes the rotation rate of the orientation onto
+    /// the gyro's (magnitudes, least squares over consecutive frames): 0.25..4. Real
+    /// recordings give 0.93-1.0 (Tyrex) and 0.57-0.98 (competition walks, a noisier rotation
+    /// vector at 50 Hz); a gyro in deg/s gives 57, a gyro of zeros 0. Judged only when the
+    /// orientation turns at least [`GYRO_SCALE_MIN_RATE`] (RMS).
+    pub gyro_scale_range: (f64, f64),
+    /// Accepted range of the scale that best takes the linear acceleration onto accelerometer
+    /// minus gravity (least squares over all frames): 0.5..2. Android's linear acceleration
+    /// is that difference (scale 1); one in g beside the others in m/s^2 gives 9.8, one in
+    /// mm/s^2 gives 0.001. Judged only when the RMS of accelerometer minus gravity is at
+    /// least [`LINACCE_SCALE_MIN_RMS`].
+    pub linacce_scale_range: (f64, f64),
+    /// Largest accepted median speed of the ground truth, m/s: 20 (72 km/h). Pedestrians walk
+    /// at 1-2 m/s and run at 3-5; positions in millimetres or centimetres read as metres move
+    /// 100-1000 times faster, which the bound on single positions cannot see.
+    pub max_median_speed: f64,
+    /// Largest accepted speed of the ground truth between two consecutive frames, m/s: 100
+    /// (0.5 m in a 5 ms step). The fastest real motion is 5.7 m/s (a phone in a running
+    /// hand; no faster over 2-20 frames, so mocap jitter adds nothing; measured on Tyrex
+    /// motion capture and competition waypoints, not on RIDI's Tango poses, whose
+    /// relocalization jumps, if any exceed 0.5 m in a frame, would be refused), and the readers
+    /// interpolate across the mocap losses they bridge, which moves no faster; one corrupt
+    /// position jumps metres to kilometres within a step, which the median and the bound on
+    /// single positions cannot see.
+    pub max_speed: f64,
+}
+
+impl Default for Validation {
+    fn default() -> Self {
+        Self {
+            max_gap_s: 1.0,
+            gravity_range: (8.5, 11.0),
+            max_gyro: 100.0,
+            max_acce: 2000.0,
+            max_gravity: 20.0,
+            max_magnet: 1e4,
+            max_position: 1e6,
+            max_median_gyro: 10.0,
+            acce_gravity_ratio: (0.5, 3.0),
+            linacce_scale_range: (0.5, 2.0),
+            gyro_scale_range: (0.25, 4.0),
+            time_step_range: (1e-4, 1.0),
+            max_median_speed: 20.0,
+            max_speed: 100.0,
+        }
+    }
+}
+
+impl Validation {
+    /// Largest accepted |component| of `channel` (infinite for time).
+    pub fn limit(&self, channel: Channel) -> f64 {
+        match channel {
+            Channel::Time => f64::INFINITY,
+            Channel::Gyro => self.max_gyro,
+            Channel::Acce | Channel::Linacce => self.max_acce,
+            Channel::Gravity => self.max_gravity,
+            Channel::Magnet => self.max_magnet,
+            Channel::Position => self.max_position,
+        }
+    }
+
+    /// Checks the 3-vectors of `channel`: for the gyro the median magnitude first (so that a
+    /// gyro in deg/s is reported as such), then every component against [`Self::limit`].
+    /// Indices in the errors count the items of `values`.
+    pub fn check_channel<I>(&self, channel: Channel, values: I) -> Result<(), SequenceError>
+    where
+        I: IntoIterator<Item = [f64; 3]>,
+        I::IntoIter: Clone,
+    {
+        let values = values.into_iter();
+        if channel == Channel::Gyro {
+            let mut norms: Vec<f64> = values.clone().map(norm).collect();
+            let median = median(&mut norms);
+            if median > self.max_median_gyro {
+                return Err(SequenceError::GyroUnits {
+                    median,
+                    max: self.max_median_gyro,
+                });
+            }
+        }
+        for (index, v) in values.enumerate() {
+            self.check_value(channel, index, v)?;
+        }
+        Ok(())
+    }
+
+    /// Checks one 3-vector of `channel`, frame `index`, against [`Self::limit`] (for a stream
+    /// checked as it arrives; a whole channel's statistics need [`Self::check_channel`]).
+    pub fn check_value(
+        &self,
+        channel: Channel,
+        index: usize,
+        v: [f64; 3],
+    ) -> Result<(), SequenceError> {
+        let limit = self.limit(channel);
+        match v.iter().position(|c| c.abs() > limit) {
+            Some(axis) => Err(SequenceError::Implausible {
+                channel,
+                axis,
+                index,
+                value: v[axis],
+                limit,
+            }),
+            None => Ok(()),
+        }
+    }
+
+    /// Checks the median interval of `time` (seconds, increasing) against
+    /// [`Self::time_step_range`]; fewer than two times pass.
+    pub fn check_time_step(&self, time: &[f64]) -> Result<(), SequenceError> {
+        let mut steps: Vec<f64> = time.windows(2).map(|w| w[1] - w[0]).collect();
+        if steps.is_empty() {
+            return Ok(());
+        }
+        let median = median(&mut steps);
+        let (min, max) = self.time_step_range;
+        if (min..=max).contains(&median) {
+            Ok(())
+        } else {
+            Err(SequenceError::TimeStep { median, min, max })
+        }
+    }
+
+    /// Checks the speed of `position` over `time` (seconds, increasing): the median against
+    /// [`Self::max_median_speed`] first (so that positions in another unit are reported as
+    /// such), then each step between consecutive frames against [`Self::max_speed`]; fewer
+    /// than two frames pass.
+    pub fn check_speed(&self, time: &[f64], position: &[WorldVec]) -> Result<(), SequenceError> {
+        let step_speed =
+            |i: usize| (position[i] - position[i - 1]).norm() / (time[i] - time[i - 1]);
+        let n = time.len().min(position.len());
+        let mut speeds: Vec<f64> = (1..n).map(step_speed).collect();
+        if speeds.is_empty() {
+            return Ok(());
+        }
+        let median = median(&mut speeds);
+        if median > self.max_median_speed {
+            return Err(SequenceError::GroundTruthSpeed {
+                median,
+                max: self.max_median_speed,
+            });
+        }
+        // A NaN speed (equal times) must not pass either.
+        let too_fast = |v: f64| v.is_nan() || v > self.max_speed;
+        let Some(later) = (1..n).find(|&i| too_fast(step_speed(i))) else {
+            return Ok(());
+        };
+        // A step has two ends: the later one starts a spike or a shift, unless the step is the
+        // first and no later step is too fast, when frame 0 alone disagrees with the rest.
+        let first_only = later == 1 && !(2..n).any(|i| too_fast(step_speed(i)));
+        let index = if first_only { 0 } else { later };
+        let step = (position[later] - position[later - 1]).to_array();
+        let axis = (0..3)
+            .max_by(|&a, &b| step[a].abs().total_cmp(&step[b].abs()))
+            .unwrap_or(0);
+        Err(SequenceError::GroundTruthJump {
+            index,
+            axis,
+            distance: norm(step),
+            dt: time[later] - time[later - 1],
+            max: self.max_speed,
+        })
+    }
+
+    /// Checks mean |acce| against mean |gravity| (both m/s^2) with
+    /// [`Self::acce_gravity_ratio`].
+    pub fn check_acce_scale(&self, acce: f64, gravity: f64) -> Result<(), SequenceError> {
+        let (min, max) = self.acce_gravity_ratio;
+        if (min * gravity..=max * gravity).contains(&acce) {
+            Ok(())
+        } else {
+            Err(SequenceError::AcceScale {
+                acce,
+                gravity,
+                min,
+                max,
+            })
+        }
+    }
+
+    /// Checks the gyro against the rotation rate of `orientation` over `time` with
+    /// [`Self::gyro_scale_range`]; passes when the orientation hardly turns
+    /// ([`GYRO_SCALE_MIN_RATE`]). Magnitudes only, so that an orientation given for another
+    /// device frame than the gyro's still compares. Steps inside an [`orientation_jumps`]
+    /// stretch are left out of the fit: a few frames of an OS orientation turning at hundreds
+    /// of rad/s would otherwise outweigh thousands that agree.
+    pub fn check_gyro_scale(
+        &self,
+        time: &[f64],
+        gyro: &[DeviceVec],
+        orientation: &[WorldFromDevice],
+    ) -> Result<(), SequenceError> {
+        let (mut gw, mut ww, mut n) = (0.0, 0.0, 0usize);
+        for (_, _, w, g) in step_rates(time, gyro, orientation) {
+            if w - g > ORIENTATION_JUMP_RATE {
+                continue;
+            }
+            gw += g * w;
+            ww += w * w;
+            n += 1;
+        }
+        if n == 0 || (ww / n as f64).sqrt() < GYRO_SCALE_MIN_RATE {
+            return Ok(());
+        }
+        let scale = gw / ww;
+        let (min, max) = self.gyro_scale_range;
+        if (min..=max).contains(&scale) {
+            Ok(())
+        } else {
+            Err(SequenceError::GyroScale { scale, min, max })
+        }
+    }
+
+    /// Checks the linear acceleration's scale against accelerometer minus gravity (all in the
+    /// same frame, one triple per frame) with [`Self::linacce_scale_range`]; passes when that
+    /// difference is too small to judge ([`LINACCE_SCALE_MIN_RMS`]).
+    pub fn check_linacce_scale<I>(&self, frames: I) -> Result<(), SequenceError>
+    where
+        I: IntoIterator<Item = ([f64; 3], [f64; 3], [f64; 3])>,
+    {
+        let (mut dl, mut ll, mut dd, mut n) = (0.0, 0.0, 0.0, 0usize);
+        for (acce, gravity, linacce) in frames {
+            for k in 0..3 {
+                let d = acce[k] - gravity[k];
+                dl += d * linacce[k];
+                ll += linacce[k] * linacce[k];
+                dd += d * d;
+            }
+            n += 1;
+        }
+        if n == 0 || (dd / n as f64).sqrt() < LINACCE_SCALE_MIN_RMS {
+            return Ok(());
+        }
+        // acce - gravity ~ scale * linacce; an all-zero linear acceleration is no scale at all.
+        let scale = if ll > 0.0 { dl / ll } else { f64::INFINITY };
+        let (min, max) = self.linacce_scale_range;
+        if (min..=max).contains(&scale) {
+            Ok(())
+        } else {
+            Err(SequenceError::LinacceScale { scale, min, max })
+        }
+    }
+}
+
+/// How much faster than the gyro the orientation may turn between two frames, rad/s, before
+/// the step belongs to an orientation jump (see [`orientation_jumps`]). Where the orientation
+/// is right the two agree within 2 rad/s in every clean Tyrex run (hand swinging and running
+/// included); the OS orientation's magnetic corrections and resets turn at 5-460 rad/s while
+/// the gyro reads under 2.
+pub const ORIENTATION_JUMP_RATE: f64 = 5.0;
+
+/// Steps closer than this, seconds, belong to one [`OrientationJump`]: a rotation vector that
+/// updates slower than the timeline shows one correction as several bursts.
+const JUMP_JOIN_S: f64 = 0.1;
+
+/// A stretch where the orientation turns much faster than the gyro: the OS orientation
+/// (Android's rotation vector, Core Motion's attitude) corrected its heading against the
+/// magnetometer or reset, which the phone itself never did.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct OrientationJump {
+    /// Frames `start..end` (the frame before the first fast step to the last frame of it).
+    pub frames: (usize, usize),
+    /// Time of the first and the last of those frames, seconds.
+    pub time: (f64, f64),
+    /// The fastest the orientation turns in it, rad/s.
+    pub peak_rate: f64,
+    /// The angle the orientation turns in it beyond the gyro's, radians (summed over steps).
+    pub excess_angle: f64,
+}
+
+/// Per step `k - 1 -> k`: `k`, the time step, the orientation's rotation rate and the gyro's
+/// (the mean of the two readings), rad/s; steps whose time does not increase are skipped.
+fn step_rates<'a>(
+    time: &'a [f64],
+    gyro: &'a [DeviceVec],
+    orientation: &'a [WorldFromDevice],
+) -> impl Iterator<Item = (usize, f64, f64, f64)> + 'a {
+    let n = time.len().min(gyro.len()).min(orientation.len());
+    (1..n).filter_map(move |k| {
+        let dt = time[k] - time[k - 1];
+        (dt > 0.0).then(|| {
+            let w = orientation[k - 1].angle_to(&orientation[k]) / dt;
+            let g = ((*gyro[k - 1].vector() + *gyro[k].vector()) * 0.5).norm();
+            (k, dt, w, g)
+        })
+    })
+}
+
+/// The stretches where `orientation` turns more than [`ORIENTATION_JUMP_RATE`] faster than
+/// `gyro` (magnitudes, so the two may be given in different device frames), in time order;
+/// steps less than 0.1 s apart are one jump. What [`Validation::check_gyro_scale`] leaves out,
+/// and what readers report as a warning.
+pub fn orientation_jumps(
+    time: &[f64],
+    gyro: &[DeviceVec],
+    orientation: &[WorldFromDevice],
+) -> Vec<OrientationJump> {
+    let mut out: Vec<OrientationJump> = Vec::new();
+    for (k, dt, w, g) in step_rates(time, gyro, orientation) {
+        if w - g <= ORIENTATION_JUMP_RATE {
+            continue;
+        }
+        let excess = (w - g) * dt;
+        match out.last_mut() {
+            Some(j) if time[k - 1] - j.time.1 <= JUMP_JOIN_S => {
+                j.frames.1 = k;
+                j.time.1 = time[k];
+                j.peak_rate = j.peak_rate.max(w);
+                j.excess_angle += excess;
+            }
+            _ => out.push(OrientationJump {
+                frames: (k - 1, k),
+                time: (time[k - 1], time[k]),
+                peak_rate: w,
+                excess_angle: excess,
+            }),
+        }
+    }
+    out
+}
+
+/// One line for a reader's warnings about `jumps` in the orientation read from `file`:
+/// how many, where (the first few), how fast; `None` without jumps.
+pub(crate) fn orientation_jump_warning(file: &str, jumps: &[OrientationJump]) -> Option<String> {
+    const SHOWN: usize = 5;
+    let peak = jumps.iter().map(|j| j.peak_rate).fold(0.0, f64::max);
+    let frames: usize = jumps.iter().map(|j| j.frames.1 - j.frames.0).sum();
+    let mut at: Vec<String> = jumps
+        .iter()
+        .take(SHOWN)
+        .map(|j| format!("{:.2}-{:.2} s", j.time.0, j.time.1))
+        .collect();
+    if jumps.len() > SHOWN {
+        at.push(format!("and {} more", jumps.len() - SHOWN));
+    }
+    (!jumps.is_empty()).then(|| {
+        format!(
+            "{file}: the orientation jumps {} time(s) ({frames} frame steps turning at up to {} \
+             rad/s, more than {ORIENTATION_JUMP_RATE} rad/s faster than the gyro) at {} (phone \
+             clock): OS heading corrections or resets, left out of the gyro check",
+            jumps.len(),
+            short(peak),
+            at.join(", ")
+        )
+    })
+}
+
+/// Smallest RMS rotation rate of the orientation, rad/s, at which
+/// [`Validation::check_gyro_scale`] judges the gyro's scale (the Tyrex and competition walks
+/// turn at 0.5-2.6 rad/s RMS).
+pub const GYRO_SCALE_MIN_RATE: f64 = 0.1;
+
+/// Smallest RMS of accelerometer minus gravity, m/s^2, at which [`Validation::check_linacce_scale`]
+/// judges the linear acceleration's scale: a phone lying still has mostly sensor noise there,
+/// whose fit says nothing (walking gives 1-14 m/s^2).
+pub const LINACCE_SCALE_MIN_RMS: f64 = 0.5;
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_gyro_in_deg_per_s_is_named_as_such_before_any_single_value() {
+        let v = Validation::default();
+        // 2 of 3 samples at 20 rad/s: the median says deg/s, although 200 is also too large.
+        let gyro = [[0.0, 0.0, 20.0], [200.0, 0.0, 0.0], [0.0, 20.0, 0.0]];
+        let e = v.check_channel(Channel::Gyro, gyro).unwrap_err();
+        assert!(
+            matches!(e, SequenceError::GyroUnits { median: 20.0, .. }),
+            "{e}"
+        );
+        let gyro = [[0.0, 0.0, 0.2], [0.0, -200.0, 0.0], [0.0, 0.3, 0.0]];
+        let e = v.check_channel(Channel::Gyro, gyro).unwrap_err();
+        assert_eq!(
+            e.to_string(),
+            "`gyro.y` at frame 1: -200 rad/s is beyond any phone gyroscope (|value| <= 100 rad/s)"
+        );
+    }
+
+    #[test]
+    fn the_gyro_scale_is_judged_on_a_turning_phone_only() {
+        let v = Validation::default();
+        // A slow turn of 0.15 rad/s (8.6 deg/s): below the median bound even in deg/s.
+        let turn = |rate: f64, gyro_scale: f64| {
+            let time: Vec<f64> = (0..400).map(|i| i as f64 * 0.005).collect();
+            let orientation: Vec<WorldFromDevice> = time
+                .iter()
+                .map(|&t| {
+                    WorldFromDevice::from_scaled_axis(ridi_frames::nalgebra::Vector3::new(
+                        0.0,
+                        0.0,
+                        rate * t,
+                    ))
+                })
+                .collect();
+            let gyro = vec![DeviceVec::new(0.0, 0.0, rate * gyro_scale); time.len()];
+            v.check_gyro_scale(&time, &gyro, &orientation)
+        };
+        turn(0.15, 1.0).unwrap();
+        let e = turn(0.15, 180.0 / std::f64::consts::PI).unwrap_err();
+        assert!(
+            matches!(e, SequenceError::GyroScale { scale, .. } if (scale - 57.29578).abs() < 1e-3),
+            "{e}"
+        );
+        assert!(
+            e.to_string()
+                .ends_with("gyroscope in deg/s instead of rad/s?"),
+            "{e}"
+        );
+        let e = turn(0.15, 0.0).unwrap_err();
+        assert!(e.to_string().contains("another recording or device"), "{e}");
+        // Turning at 0.05 rad/s is too little to judge, whatever the gyro says.
+        turn(0.05, 57.3).unwrap();
+    }
+
+    /// A walk turning back and forth (yaw 0.8 sin(2 t), at most 1.6 rad/s) at 200 Hz, with the
+    /// orientation jumping by `jump` rad for 3 frames at each of `at`; the gyro is
+    /// `gyro_scale` times the true rate, or with `other` that of another, slower walk.
+    fn jumpy_walk(
+        jump: f64,
+        at: &[usize],
+        gyro_scale: f64,
+        other: bool,
+    ) -> (Vec<f64>, Vec<DeviceVec>, Vec<WorldFromDevice>) {
+        let n = 6000;
+        let time: Vec<f64> = (0..n).map(|i| i as f64 * 0.005).collect();
+        let yaw = |t: f64| 0.8 * (2.0 * t).sin();
+        let orientation = time
+            .iter()
+            .enumerate()
+            .map(|(i, &t)| {
+                let glitch = at.iter().any(|&a| (a..a + 3).contains(&i));
+                let z = yaw(t) + if glitch { jump } else { 0.0 };
+                WorldFromDevice::from_scaled_axis(ridi_frames::nalgebra::Vector3::new(0.0, 0.0, z))
+            })
+            .collect();
+        let gyro = time
+            .iter()
+            .map(|&t| {
+                let rate = if other {
+                    0.2 * (0.7 * t).cos()
+                } else {
+                    1.6 * (2.0 * t).cos()
+                };
+                DeviceVec::new(0.0, 0.0, rate * gyro_scale)
+            })
+            .collect();
+        (time, gyro, orientation)
+    }
+
+    #[test]
+    fn a_few_orientation_jumps_neither_fail_nor_hide_a_wrong_gyro() {
+        let v = Validation::default();
+        let check = |w: &(Vec<f64>, Vec<DeviceVec>, Vec<WorldFromDevice>)| {
+            v.check_gyro_scale(&w.0, &w.1, &w.2)
+        };
+        // Four jumps of 2.5 rad (500 rad/s): with them in the fit the scale was about 0.01.
+        let at = [700, 2100, 3900, 5200];
+        let walk = jumpy_walk(2.5, &at, 1.0, false);
+        check(&walk).unwrap();
+        let jumps = orientation_jumps(&walk.0, &walk.1, &walk.2);
+        assert_eq!(jumps.len(), 4, "{jumps:?}");
+        for (j, a) in jumps.iter().zip(at) {
+            assert_eq!(j.frames, (a - 1, a + 3), "{j:?}");
+            assert!((j.peak_rate - 500.0).abs() < 2.0, "{j:?}");
+        }
+        assert!(
+            orientation_jumps(&walk.0, &walk.1, &jumpy_walk(0.0, &[], 1.0, false).2).is_empty()
+        );
+        // A gyro in deg/s, of zeros, or of a slower walk is still refused. (Magnitudes only:
+        // a gyro of a walk that turns as much, at other times, is not caught.)
+        for (scale, other, expect) in [
+            (
+                180.0 / std::f64::consts::PI,
+                false,
+                "deg/s instead of rad/s",
+            ),
+            (0.0, false, "another recording or device"),
+            (1.0, true, "another recording or device"),
+        ] {
+            let e = check(&jumpy_walk(2.5, &at, scale, other)).unwrap_err();
+            assert!(e.to_string().contains(expect), "{scale} {other}: {e}");
+        }
+    }
+
+    #[test]
+    fn the_linear_acceleration_scale_is_judged_on_a_moving_phone_only() {
+        let v = Validation::default();
+        let g = [0.0, 0.0, 9.8];
+        let frames = |motion: f64, scale: f64| {
+            (0..100).map(move |i| {
+                let m = [
+                    motion * (i as f64 * 0.3).sin(),
+                    motion * (i as f64 * 0.7).cos(),
+                    0.0,
+                ];
+                let acce = [m[0] + g[0], m[1] + g[1], m[2] + g[2]];
+                (acce, g, [m[0] / scale, m[1] / scale, m[2] / scale])
+            })
+        };
+        v.check_linacce_scale(frames(2.0, 1.0)).unwrap();
+        let e = v.check_linacce_scale(frames(2.0, 9.80665)).unwrap_err();
+        assert!(
+            matches!(e, SequenceError::LinacceScale { scale, .. } if (scale - 9.80665).abs() < 1e-9),
+            "{e}"
+        );
+        assert!(
+            e.to_string()
+                .ends_with("linear acceleration in g instead of m/s^2?"),
+            "{e}"
+        );
+        let e = v.check_linacce_scale(frames(2.0, 1e-3)).unwrap_err();
+        assert!(e.to_string().contains("another unit than m/s^2"), "{e}");
+        // All zero while the phone moves: no linear acceleration at all.
+        let zero = frames(2.0, 1.0).map(|(a, g, _)| (a, g, [0.0; 3]));
+        assert!(v.check_linacce_scale(zero).is_err());
+        // A phone lying still (sensor noise only) is not judged, whatever the unit.
+        v.check_linacce_scale(frames(0.05, 9.80665)).unwrap();
+        v.check_linacce_scale(std::iter::empty()).unwrap();
+    }
+
+    #[test]
+    fn time_steps_and_accelerometer_scale_have_wide_bands() {
+        let v = Validation::default();
+        v.check_time_step(&[0.0, 0.005, 0.01]).unwrap();
+        v.check_time_step(&[0.0]).unwrap();
+        assert!(matches!(
+            v.check_time_step(&[0.0, 5e-12, 1e-11]),
+            Err(SequenceError::TimeStep { .. })
+        ));
+        v.check_acce_scale(1.87 * 9.8, 9.8).unwrap();
+        let e = v.check_acce_scale(1.0, 9.80665).unwrap_err().to_string();
+        assert!(
+            e.contains("0.102 times") && e.contains("in g instead"),
+            "{e}"
+        );
+        let e = v
+            .check_acce_scale(9806.65, 9.80665)
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("in another unit"), "{e}");
+    }
+
+    #[test]
+    fn a_single_ground_truth_spike_is_caught_on_its_frame() {
+        let v = Validation::default();
+        // Walking at 1.4 m/s at 200 Hz, with a 0.8 s gap (no frames) in the middle.
+        let time: Vec<f64> = (0..50)
+            .map(|i| i as f64 * 0.005 + if i >= 25 { 0.8 } else { 0.0 })
+            .collect();
+        let walk: Vec<WorldVec> = time
+            .iter()
+            .map(|t| WorldVec::new(1.4 * t, 0.1, 1.2))
+            .collect();
+        v.check_speed(&time, &walk).unwrap();
+        // The fastest real motion, 5.7 m/s, passes.
+        let fast: Vec<WorldVec> = time
+            .iter()
+            .map(|t| WorldVec::new(0.0, 5.7 * t, 0.0))
+            .collect();
+        v.check_speed(&time, &fast).unwrap();
+
+        let mut spiked = walk.clone();
+        spiked[30] = WorldVec::new(999_999.0, 0.1, 1.2);
+        let e = v.check_speed(&time, &spiked).unwrap_err();
+        assert!(
+            matches!(e, SequenceError::GroundTruthJump { index: 30, axis: 0, dt, .. } if (dt - 0.005).abs() < 1e-12),
+            "{e:?}"
+        );
+        assert_eq!(
+            e.to_string(),
+            "`ground_truth.position.x` at frame 30: jumps 999997.677 m in 0.005 s (2e8 m/s): \
+             faster than any pedestrian (speed <= 100 m/s), a corrupt position?"
+        );
+        // A spike on the first frame is reported there, not on frame 1; a two-frame glitch
+        // from frame 1 on frame 1.
+        let mut first = walk.clone();
+        first[0] = WorldVec::new(999_999.0, 0.1, 1.2);
+        let e = v.check_speed(&time, &first).unwrap_err();
+        assert!(
+            matches!(e, SequenceError::GroundTruthJump { index: 0, .. }),
+            "{e:?}"
+        );
+        let mut second = walk.clone();
+        second[1] = WorldVec::new(999_999.0, 0.1, 1.2);
+        second[2] = WorldVec::new(999_999.0, 0.1, 1.2);
+        let e = v.check_speed(&time, &second).unwrap_err();
+        assert!(
+            matches!(e, SequenceError::GroundTruthJump { index: 1, .. }),
+            "{e:?}"
+        );
+        // A lasting shift from frame 30 on is reported at frame 30.
+        let shifted: Vec<WorldVec> = walk
+            .iter()
+            .enumerate()
+            .map(|(i, p)| {
+                if i >= 30 {
+                    *p + WorldVec::new(1e4, 0.0, 0.0)
+                } else {
+                    *p
+                }
+            })
+            .collect();
+        let e = v.check_speed(&time, &shifted).unwrap_err();
+        assert!(
+            matches!(e, SequenceError::GroundTruthJump { index: 30, .. }),
+            "{e:?}"
+        );
+        // Equal times (which `Sequence::new` refuses before) give no "NaN m/s".
+        let mut still_time = time.clone();
+        still_time[10] = still_time[9];
+        let e = v.check_speed(&still_time, &walk).unwrap_err();
+        assert_eq!(
+            e.to_string(),
+            "`ground_truth.position.x` at frame 10: jumps 0.007 m between frames 0 s apart: time \
+             must increase"
+        );
+        // The limit is the caller's to move.
+        let lax = Validation {
+            max_speed: f64::INFINITY,
+            ..Validation::default()
+        };
+        lax.check_speed(&time, &spiked).unwrap();
+        // Positions in millimetres are named by their median first, not as a jump.
+        let mm: Vec<WorldVec> = walk.iter().map(|p| *p * 1000.0).collect();
+        assert!(matches!(
+            v.check_speed(&time, &mm),
+            Err(SequenceError::GroundTruthSpeed { .. })
+        ));
+    }
+}

@@ -1,0 +1,168 @@
+//! The RIDI cascade: a placement classifier, then two epsilon-SVRs per placement for the two
+//! horizontal velocity components in the stabilized frame S.
+//!
+//! Storage: each placement keeps its samples once in half precision, as coordinates on the
+//! leading principal directions of the training features or as the features themselves
+//! ([`Storage`]: a query is bound by the bytes it streams), ordered so that the classifier's
+//! support vectors of that placement come first, followed by the other samples that either
+//! regressor uses.
+//! Prediction computes the squared distances of a query to the classifier part of every
+//! placement, classifies, and then reuses those distances for the regressors of the predicted
+//! placement, so every stored row is read once. A query is projected first when the samples
+//! are. Batches go through GEMM (half-precision rows widened to `f32` a tile at a time); a
+//! single query streams the rows once (a fused half-precision GEMV for half-precision rows)
+//! and reuses thread-local buffers.
+//!
+//! One module per job: `params` (what to train with), `train` (the training set, its checks and
+//! the fits), `predict` (the batched and the single-query path), `rounding` (what the compact
+//! storage changes) and `validate` (the consistency checks of a decoded model file). This
+//! module holds the trained model and what it reports about itself.
+
+mod params;
+mod predict;
+mod rounding;
+mod train;
+mod validate;
+
+use ridi_features::FeatureConfig;
+use serde::{Deserialize, Serialize};
+
+use crate::grid::GridRow;
+use crate::projection::Projection;
+use crate::store::SampleRows;
+use crate::svr::FitInfo;
+
+pub use self::params::{CascadeParams, Gamma, RegressorChoice, Storage};
+pub use self::predict::Prediction;
+pub use self::rounding::RoundingEffect;
+pub use self::train::TrainingSet;
+
+/// A trained cascade (what the model file holds).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Cascade {
+    feature_config: FeatureConfig,
+    dim: usize,
+    placements: Vec<String>,
+    classifier: Option<ClassifierHead>,
+    regressor_gamma: f32,
+    classes: Vec<ClassModel>,
+    grid: Vec<GridRow>,
+    /// Principal directions the samples are stored on (`None`: half-precision features).
+    projection: Option<Projection>,
+}
+
+/// How a trained model stores its samples ([`Cascade::stored_as`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum StoredAs {
+    /// Every feature value in half precision.
+    Half,
+    /// Principal-component coordinates.
+    Projected {
+        /// Coordinates per sample.
+        components: usize,
+        /// Share of the training variance they hold.
+        energy: f64,
+    },
+}
+
+/// The one-vs-one placement classifier: its width, `C`, class pairs `(a, b)` (`a < b`), their
+/// offsets and fit reports; the coefficients are stored with each placement's samples.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+struct ClassifierHead {
+    gamma: f32,
+    c: f64,
+    pairs: Vec<(u32, u32)>,
+    rho: Vec<f64>,
+    info: Vec<FitInfo>,
+}
+
+/// One placement: samples stored once, shared by the classifier (first `n_classifier` rows)
+/// and both regressors.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+struct ClassModel {
+    samples: SampleRows,
+    /// Squared norms as the distances need them ([`SampleRows::norms`]): recomputed on load,
+    /// not stored.
+    #[serde(skip)]
+    norms: Vec<f32>,
+    n_classifier: usize,
+    /// The classifier pairs (one-vs-one) this placement takes part in, ascending: its samples
+    /// have coefficients in those only.
+    clf_pairs: Vec<u32>,
+    /// `n_classifier × clf_pairs` row-major.
+    clf_coef: Vec<f64>,
+    /// `samples × 2` row-major.
+    reg_coef: Vec<f64>,
+    reg_rho: [f64; 2],
+    /// `(C, epsilon)` per channel.
+    reg_params: [(f64, f64); 2],
+    reg_info: [FitInfo; 2],
+    /// The speed regressor ([`CascadeParams::speed`]); its coefficients are the third column
+    /// of `reg_coef`.
+    speed: Option<SpeedRegressor>,
+    n_train: usize,
+}
+
+/// Offset, `(C, epsilon)` and fit report of a placement's speed regressor.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+struct SpeedRegressor {
+    rho: f64,
+    params: (f64, f64),
+    info: FitInfo,
+}
+
+impl ClassModel {
+    /// Columns of `reg_coef`: S-x, S-z and, with a speed regressor, the speed.
+    fn channels(&self) -> usize {
+        2 + usize::from(self.speed.is_some())
+    }
+}
+
+impl Cascade {
+    /// Placement names, in class-index order.
+    pub fn placements(&self) -> &[String] {
+        &self.placements
+    }
+
+    /// Feature configuration the model was trained with.
+    pub fn feature_config(&self) -> &FeatureConfig {
+        &self.feature_config
+    }
+
+    /// Feature dimension.
+    pub fn dim(&self) -> usize {
+        self.dim
+    }
+
+    /// Grid-search results table (empty when the regressor parameters were fixed).
+    pub fn grid_results(&self) -> &[GridRow] {
+        &self.grid
+    }
+
+    /// Chosen `(C, epsilon)` of the two regressors of placement `p`.
+    pub fn regressor_params(&self, p: usize) -> Option<[(f64, f64); 2]> {
+        self.classes.get(p).map(|c| c.reg_params)
+    }
+
+    /// Chosen `(C, epsilon)` of the speed regressor of placement `p`, if the model has one
+    /// ([`CascadeParams::speed`]).
+    pub fn speed_params(&self, p: usize) -> Option<(f64, f64)> {
+        self.classes.get(p)?.speed.as_ref().map(|s| s.params)
+    }
+
+    /// How the samples are stored.
+    pub fn stored_as(&self) -> StoredAs {
+        match &self.projection {
+            None => StoredAs::Half,
+            Some(p) => StoredAs::Projected {
+                components: p.dim(),
+                energy: p.energy(),
+            },
+        }
+    }
+
+    /// Stored samples of placement `p` (shared by its classifier part and both regressors).
+    pub fn stored_samples(&self, p: usize) -> usize {
+        self.classes.get(p).map_or(0, |c| c.samples.rows())
+    }
+}
