@@ -24,7 +24,7 @@ pub(crate) struct FrameRing {
 }
 
 impl FrameRing {
-    pub fn new(cap: usize) -> Self {
+    pub(crate) fn new(cap: usize) -> Self {
         let cap = cap.max(1);
         Self {
             cap,
@@ -38,12 +38,12 @@ impl FrameRing {
         }
     }
 
-    pub fn len(&self) -> usize {
+    pub(crate) fn len(&self) -> usize {
         self.time.len()
     }
 
     /// Drops everything; the next pushed frame gets stream index `first`.
-    pub fn clear(&mut self, first: u64) {
+    pub(crate) fn clear(&mut self, first: u64) {
         self.first = first;
         self.time.clear();
         self.gyro.clear();
@@ -53,7 +53,7 @@ impl FrameRing {
         self.pose.clear();
     }
 
-    pub fn push(
+    pub(crate) fn push(
         &mut self,
         time: f64,
         gyro: DeviceVec,
@@ -80,13 +80,13 @@ impl FrameRing {
     }
 
     /// Local index of stream frame `frame`, if it is still held.
-    pub fn index(&self, frame: u64) -> Option<usize> {
+    pub(crate) fn index(&self, frame: u64) -> Option<usize> {
         let i = frame.checked_sub(self.first)? as usize;
         (i < self.len()).then_some(i)
     }
 
     /// The last `n` frames (fewer if fewer are held).
-    pub fn last(&self, n: usize) -> FrameWindow<'_> {
+    pub(crate) fn last(&self, n: usize) -> FrameWindow<'_> {
         let a = self.len().saturating_sub(n);
         FrameWindow {
             first_frame: self.first + a as u64,
@@ -95,7 +95,7 @@ impl FrameRing {
     }
 
     /// Frames `range` (local indices).
-    pub fn frames(&self, range: std::ops::Range<usize>) -> ImuFrames<'_> {
+    pub(crate) fn frames(&self, range: std::ops::Range<usize>) -> ImuFrames<'_> {
         ImuFrames {
             time: &self.time[range.clone()],
             gyro: &self.gyro[range.clone()],

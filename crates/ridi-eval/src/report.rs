@@ -127,6 +127,7 @@ impl Metric {
         }
     }
 
+    /// The value as report tables print it: 3 decimals (2 for MPE in %), `n/a` when missing.
     pub fn format(self, v: Option<f64>) -> String {
         match (self, v) {
             (_, None) => "n/a".to_owned(),

@@ -7,7 +7,7 @@
 use ridi_features::ridi_frames::StabHorizontal;
 use ridi_test_support::SplitMix64;
 
-pub struct Synth {
+pub(crate) struct Synth {
     pub x: Vec<f32>,
     pub y: Vec<StabHorizontal>,
     pub placement: Vec<usize>,
@@ -16,7 +16,7 @@ pub struct Synth {
 }
 
 /// `n` samples over `placements` classes, sequences of `per_seq` samples (10-frame steps).
-pub fn generate(n: usize, placements: usize, per_seq: usize, seed: u64) -> Synth {
+pub(crate) fn generate(n: usize, placements: usize, per_seq: usize, seed: u64) -> Synth {
     const FRAMES: usize = 200;
     const CH: usize = 6;
     let dim = FRAMES * CH;

@@ -6,7 +6,7 @@ use ridi_frames::nalgebra::Vector3;
 use ridi_frames::{DeviceVec, ImuFrames, Rot, World, WorldFromDevice, WorldVec, stab_from_world};
 
 /// A walk whose true world acceleration is known, seen through a biased accelerometer.
-pub struct Walk {
+pub(crate) struct Walk {
     pub time: Vec<f64>,
     pub gyro: Vec<DeviceVec>,
     pub linacce: Vec<DeviceVec>,
@@ -25,7 +25,7 @@ pub struct Walk {
 /// Walk of `n` frames at about 200 Hz (slightly irregular when `jitter`), starting with
 /// world velocity `v0`, with a low-frequency bias that is piecewise linear on knots every
 /// `spacing` frames.
-pub fn walk(n: usize, spacing: usize, v0: WorldVec, jitter: bool) -> Walk {
+pub(crate) fn walk(n: usize, spacing: usize, v0: WorldVec, jitter: bool) -> Walk {
     let time: Vec<f64> = (0..n)
         .map(|i| {
             let j = if jitter {
@@ -100,7 +100,7 @@ pub fn walk(n: usize, spacing: usize, v0: WorldVec, jitter: bool) -> Walk {
 }
 
 impl Walk {
-    pub fn imu(&self) -> ImuFrames<'_> {
+    pub(crate) fn imu(&self) -> ImuFrames<'_> {
         ImuFrames::new(
             &self.time,
             &self.gyro,
@@ -112,7 +112,7 @@ impl Walk {
     }
 
     /// Exact regressed velocity (true horizontal S velocity) at `frame`.
-    pub fn target(&self, frame: usize) -> VelocityTarget {
+    pub(crate) fn target(&self, frame: usize) -> VelocityTarget {
         let vs = stab_from_world(self.orientation[frame], self.gravity[frame])
             * self.poses_true[frame].velocity;
         VelocityTarget {
@@ -122,7 +122,7 @@ impl Walk {
     }
 
     /// Exact targets at `start, start + every, ...`.
-    pub fn targets(&self, start: usize, every: usize) -> Vec<VelocityTarget> {
+    pub(crate) fn targets(&self, start: usize, every: usize) -> Vec<VelocityTarget> {
         (start..self.time.len())
             .step_by(every)
             .map(|f| self.target(f))
@@ -130,7 +130,7 @@ impl Walk {
     }
 }
 
-pub fn max_position_error(a: &[Pose], b: &[Pose]) -> f64 {
+pub(crate) fn max_position_error(a: &[Pose], b: &[Pose]) -> f64 {
     a.iter()
         .zip(b)
         .map(|(p, q)| (p.position - q.position).norm())

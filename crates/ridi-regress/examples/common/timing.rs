@@ -6,7 +6,7 @@ use std::time::Instant;
 use ridi_regress::{Cascade, MatrixRef};
 
 /// Peak resident memory of the process, MB (`VmHWM`).
-pub fn peak_mb() -> f64 {
+pub(crate) fn peak_mb() -> f64 {
     std::fs::read_to_string("/proc/self/status")
         .ok()
         .and_then(|s| {
@@ -18,7 +18,7 @@ pub fn peak_mb() -> f64 {
 }
 
 /// CPU time of the calling thread, seconds (`/proc/thread-self/schedstat`).
-pub fn thread_cpu_s() -> f64 {
+pub(crate) fn thread_cpu_s() -> f64 {
     std::fs::read_to_string("/proc/thread-self/schedstat")
         .ok()
         .and_then(|s| s.split_whitespace().next()?.parse::<f64>().ok())
@@ -27,7 +27,7 @@ pub fn thread_cpu_s() -> f64 {
 
 /// Times `predict_one` over `rows` (in that order) on the calling thread: (wall, CPU) seconds
 /// per query.
-pub fn time_one(model: &Cascade, q: MatrixRef<'_>, rows: &[usize]) -> Result<(f64, f64), String> {
+pub(crate) fn time_one(model: &Cascade, q: MatrixRef<'_>, rows: &[usize]) -> Result<(f64, f64), String> {
     let (t, c) = (Instant::now(), thread_cpu_s());
     for &i in rows {
         std::hint::black_box(model.predict_one(q.row(i)).map_err(|e| e.to_string())?);
@@ -37,7 +37,7 @@ pub fn time_one(model: &Cascade, q: MatrixRef<'_>, rows: &[usize]) -> Result<(f6
 }
 
 /// `0..n` in a fixed pseudo-random order (xorshift Fisher-Yates: the same order every run).
-pub fn shuffled(n: usize) -> Vec<usize> {
+pub(crate) fn shuffled(n: usize) -> Vec<usize> {
     let mut order: Vec<usize> = (0..n).collect();
     let mut s = 0x2545_f491_4f6c_dd1du64;
     for i in (1..n).rev() {
