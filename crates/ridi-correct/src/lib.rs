@@ -60,7 +60,7 @@
 //! ```
 //!
 //! For a live stream, feed [`ImuSample`](ridi_frames::ImuSample)s to a [`Tracker`] with a [`VelocityRegressor`]; see the
-//! [`tracker`] module for the exact semantics of its windowed corrections.
+//! [`Tracker`] docs for the exact semantics of its windowed corrections.
 
 mod config;
 mod dense;
@@ -72,7 +72,7 @@ mod placement;
 mod regressor;
 mod ring;
 mod solve;
-pub mod tracker;
+mod tracker;
 
 pub use config::{CorrectionConfig, InitialVelocity};
 pub use dense::{objective, solve_dense};

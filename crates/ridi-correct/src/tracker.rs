@@ -1,51 +1,5 @@
 //! The streaming tracker: integration every frame, regression every few frames, a windowed
 //! correction every few hundred frames, in bounded memory.
-//!
-//! # What a window correction means
-//!
-//! At frame `e` (every `correct_every` frames of a segment) the tracker solves the batch
-//! objective over the window `W = [s, e]` of the latest `window` frames, with
-//!
-//! - the **raw** accelerations of `W` (never accelerations corrected by an earlier window, so
-//!   overlapping windows do not stack their corrections: the original's bug),
-//! - the velocity targets regressed inside `W`,
-//! - the initial velocity fixed to the tracker's current estimate at `s` (the output of the
-//!   previous windows), or, for a window starting at the segment start, the configured
-//!   initial velocity (fixed or estimated).
-//!
-//! The solution revises the stored poses of `W`: they are re-integrated from the current
-//! estimate of the pose at `s` with the window's bias. Frames after `e` use the bias at the
-//! end of the window (held constant) until the next correction. The result of a solve is
-//! applied `apply_delay` frames after `e` (frames `(e, e + apply_delay]` are then
-//! re-integrated too), in both the inline and the background mode, which makes the two
-//! produce bit-identical trajectories.
-//!
-//! Each frame's pose in an [`Update`] is the live estimate at that moment; later revisions
-//! can be read back with [`Tracker::pose`] while the frame is still buffered.
-//!
-//! Consequences: a window covering the whole stream reproduces the batch solve exactly, and
-//! [`Tracker::global_pass`] *is* the batch solve over the stored history (both are tested).
-//!
-//! # Schedule
-//!
-//! Frame `f` of a segment (counted from the segment's first frame) is regressed when `f` is a
-//! multiple of `regress_every` and the segment holds the regressor's window; a correction is
-//! started when `f > 0` is a multiple of `correct_every`. Align the two (the defaults do) so
-//! that each window ends on a target and its final bias, carried forward, is well determined.
-//!
-//! # Bad input and recovery
-//!
-//! - A sample with a NaN or infinite field, or not after the previous one: refused with an
-//!   error, the tracker unchanged; pushing the next good sample continues the stream.
-//! - A gap longer than `max_dt`: refused ([`GapPolicy::Reject`]) or a restart
-//!   ([`GapPolicy::Restart`], or [`Tracker::restart`] by hand): position held, velocity and
-//!   bias reset, window emptied. Nothing is integrated across the gap.
-//! - A regression that fails, or returns a non-finite velocity: reported in the update,
-//!   counted, and left out; windows do without it. A window without any target is skipped and
-//!   the current bias kept, as is a window whose solve fails.
-//! - The placement-change filter, when enabled, re-evaluates the labels at every window with
-//!   the labels known by then (the ±radius neighbourhood of the newest targets is one-sided
-//!   until later labels arrive); the global pass sees them all.
 
 use std::collections::VecDeque;
 use std::sync::mpsc::{Receiver, SyncSender, sync_channel};
@@ -344,7 +298,53 @@ struct History {
     segments: Vec<usize>,
 }
 
-/// The streaming RIDI tracker (see the [module docs](self) for the exact semantics).
+/// The streaming RIDI tracker.
+///
+/// # What a window correction means
+///
+/// At frame `e` (every `correct_every` frames of a segment) the tracker solves the batch
+/// objective over the window `W = [s, e]` of the latest `window` frames, with
+///
+/// - the **raw** accelerations of `W` (never accelerations corrected by an earlier window, so
+///   overlapping windows do not stack their corrections: the original's bug),
+/// - the velocity targets regressed inside `W`,
+/// - the initial velocity fixed to the tracker's current estimate at `s` (the output of the
+///   previous windows), or, for a window starting at the segment start, the configured
+///   initial velocity (fixed or estimated).
+///
+/// The solution revises the stored poses of `W`: they are re-integrated from the current
+/// estimate of the pose at `s` with the window's bias. Frames after `e` use the bias at the
+/// end of the window (held constant) until the next correction. The result of a solve is
+/// applied `apply_delay` frames after `e` (frames `(e, e + apply_delay]` are then
+/// re-integrated too), in both the inline and the background mode, which makes the two
+/// produce bit-identical trajectories.
+///
+/// Each frame's pose in an [`Update`] is the live estimate at that moment; later revisions
+/// can be read back with [`Tracker::pose`] while the frame is still buffered.
+///
+/// Consequences: a window covering the whole stream reproduces the batch solve exactly, and
+/// [`Tracker::global_pass`] *is* the batch solve over the stored history (both are tested).
+///
+/// # Schedule
+///
+/// Frame `f` of a segment (counted from the segment's first frame) is regressed when `f` is a
+/// multiple of `regress_every` and the segment holds the regressor's window; a correction is
+/// started when `f > 0` is a multiple of `correct_every`. Align the two (the defaults do) so
+/// that each window ends on a target and its final bias, carried forward, is well determined.
+///
+/// # Bad input and recovery
+///
+/// - A sample with a NaN or infinite field, or not after the previous one: refused with an
+///   error, the tracker unchanged; pushing the next good sample continues the stream.
+/// - A gap longer than `max_dt`: refused ([`GapPolicy::Reject`]) or a restart
+///   ([`GapPolicy::Restart`], or [`Tracker::restart`] by hand): position held, velocity and
+///   bias reset, window emptied. Nothing is integrated across the gap.
+/// - A regression that fails, or returns a non-finite velocity: reported in the update,
+///   counted, and left out; windows do without it. A window without any target is skipped and
+///   the current bias kept, as is a window whose solve fails.
+/// - The placement-change filter, when enabled, re-evaluates the labels at every window with
+///   the labels known by then (the ±radius neighbourhood of the newest targets is one-sided
+///   until later labels arrive); the global pass sees them all.
 pub struct Tracker<R: VelocityRegressor> {
     config: TrackerConfig,
     regressor: R,

@@ -3,17 +3,17 @@
 //! Everything here takes plain arrays (`[x, y]` positions in metres, times in seconds, labels
 //! as indices or names), so any pipeline can be evaluated without depending on its types.
 //!
-//! - [`align`]: 2D rigid alignment (rotation + translation, no scale) fitted on an initial
+//! - Alignment ([`align_trajectory`], [`fit_alignment`]): 2D rigid alignment (rotation + translation, no scale) fitted on an initial
 //!   stretch, RIDI's 10 s by default.
-//! - [`metrics`]: MPE (m and % of path length), ATE and RTE in Euclidean and RoNIN
+//! - Metrics ([`evaluate_trajectory`], [`TrajectoryEval`]): MPE (m and % of path length), ATE and RTE in Euclidean and RoNIN
 //!   per-coordinate forms, short-window RTE, path length ratio, velocity MSE, placement accuracy
 //!   and confusion matrix. RTE windows are set in seconds ([`EvalConfig`]) and counted in
 //!   frames at [`EvalConfig::rate_hz`], 200 Hz by default: [`evaluate_trajectory`] refuses a
 //!   timeline whose mean rate is more than 10 % from it ([`EvalError::RateMismatch`]); set
 //!   `rate_hz` to [`estimate_rate_hz`]`(times)` for data at another rate.
-//! - [`report`]: serde report structs (`report.json`), per-method means, markdown tables
+//! - Reports ([`EvalReport`], [`markdown_table`]): serde report structs (`report.json`), per-method means, markdown tables
 //!   (`report.md`).
-//! - [`pdr`]: the step-counting baseline: step detection and step-and-heading integration.
+//! - PDR ([`pdr_trajectory`], [`detect_steps`]): the step-counting baseline: step detection and step-and-heading integration.
 //!
 //! Inputs are validated: empty, mismatched or non-finite inputs give an [`EvalError`], never a
 //! panic.
@@ -57,11 +57,11 @@
 //! # Ok::<(), ridi_eval::EvalError>(())
 //! ```
 
-pub mod align;
+mod align;
 mod error;
-pub mod metrics;
-pub mod pdr;
-pub mod report;
+mod metrics;
+mod pdr;
+mod report;
 
 pub use align::{
     AlignWindow, AlignmentFit, Rigid2, WEAK_ALIGNMENT_EXTENT_M, align_trajectory, fit_alignment,

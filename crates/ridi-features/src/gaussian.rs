@@ -15,7 +15,7 @@ use crate::FeatureError;
 ///
 /// Both arguments must be finite and non-negative (checked by the public constructors that
 /// call this); the result saturates for absurd products rather than wrapping.
-pub fn kernel_radius(sigma: f64, truncate: f64) -> usize {
+pub(crate) fn kernel_radius(sigma: f64, truncate: f64) -> usize {
     // `as` truncates toward zero like Python's int() for the non-negative values allowed here.
     (truncate * sigma + 0.5) as usize
 }
@@ -52,7 +52,7 @@ pub fn gaussian_kernel(sigma: f64, truncate: f64) -> Result<Vec<f64>, FeatureErr
 
 /// The non-negative half of the kernel, `[w_0, w_1, ..., w_r]`, normalized so that the full
 /// symmetric kernel sums to 1.
-pub fn half_kernel(sigma: f64, truncate: f64) -> Result<Vec<f64>, FeatureError> {
+pub(crate) fn half_kernel(sigma: f64, truncate: f64) -> Result<Vec<f64>, FeatureError> {
     check_params(sigma, truncate)?;
     let r = kernel_radius(sigma, truncate);
     if r == 0 {
@@ -68,7 +68,7 @@ pub fn half_kernel(sigma: f64, truncate: f64) -> Result<Vec<f64>, FeatureError> 
 
 /// Index into a signal of length `n >= 1` for any position of its `'reflect'` extension.
 #[inline]
-pub fn reflect_index(i: isize, n: usize) -> usize {
+pub(crate) fn reflect_index(i: isize, n: usize) -> usize {
     debug_assert!(n > 0);
     let period = 2 * n as isize;
     let m = i.rem_euclid(period) as usize;
@@ -259,6 +259,13 @@ fn interior<T: Sample>(src: &[T], start: usize, out: &mut [T], stride: usize, ha
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn half_kernel_is_the_kernel_from_its_centre() {
+        let k = gaussian_kernel(2.0, 4.0).unwrap();
+        assert_eq!(half_kernel(2.0, 4.0).unwrap()[..], k[8..]);
+        assert_eq!(kernel_radius(30.0, 4.0), 120);
+    }
 
     #[test]
     fn radius_matches_scipy_rule() {

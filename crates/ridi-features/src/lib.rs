@@ -86,7 +86,7 @@
 mod config;
 mod error;
 mod features;
-pub mod gaussian;
+mod gaussian;
 mod matrix;
 mod targets;
 mod turn;

@@ -31,7 +31,7 @@
 //!
 //! # Orientation without a magnetometer
 //!
-//! [`estimate`] is a Mahony complementary filter on gyroscope and accelerometer
+//! The orientation estimator is a Mahony complementary filter on gyroscope and accelerometer
 //! ([`estimate_orientation`], gains in [`FilterConfig`]) for recordings without a usable
 //! orientation; [`OrientationFilter`] is the same filter one sample at a time, for live
 //! streams. It starts with heading 0 ([`initial_orientation`]). [`tilt_error`],
@@ -74,7 +74,7 @@
 //! assert!(tilt_error(est[399], truth) < 1e-9);
 //! ```
 
-pub mod estimate;
+mod estimate;
 mod frame;
 mod gravity;
 mod horizontal;
