@@ -11,7 +11,8 @@
 //!   frames at [`EvalConfig::rate_hz`], 200 Hz by default: [`evaluate_trajectory`] refuses a
 //!   timeline whose mean rate is more than 10 % from it ([`EvalError::RateMismatch`]); set
 //!   `rate_hz` to [`estimate_rate_hz`]`(times)` for data at another rate.
-//! - Reports ([`EvalReport`], [`markdown_table`]): serde report structs (`report.json`), per-method means, markdown tables
+//! - Report building blocks ([`SequenceReport`], [`summarize`], [`markdown_table`]): serde
+//!   per-sequence results (`report.json`), per-method means, markdown tables
 //!   (`report.md`).
 //! - PDR ([`pdr_trajectory`], [`detect_steps`]): the step-counting baseline: step detection and step-and-heading integration.
 //!
@@ -69,13 +70,13 @@ pub use align::{
 };
 pub use error::{EvalError, Result};
 pub use metrics::{
-    ConfusionMatrix, EvalConfig, RATE_TOLERANCE, TrajectoryEval, accuracy, ate, ate_ronin,
-    check_rate, estimate_rate_hz, evaluate_trajectory, mean_position_error,
+    ConfusionMatrix, EvalConfig, RATE_TOLERANCE, TrajectoryEval, TrajectoryMetrics, accuracy, ate,
+    ate_ronin, check_rate, estimate_rate_hz, evaluate_trajectory, mean_position_error,
     mean_position_error_percent, path_length, path_length_ratio, rte, rte_ronin, seconds_to_frames,
     trajectory_metrics, velocity_mse,
 };
 pub use pdr::{StepDetectorConfig, detect_steps, detect_steps_in_magnitude, pdr_trajectory};
 pub use report::{
-    EvalReport, MethodMetrics, MethodSummary, Metric, SequenceReport, TrajectoryMetrics,
-    markdown_confusion, markdown_metric_table, markdown_table, summarize,
+    MethodMetrics, MethodSummary, Metric, SequenceReport, markdown_confusion,
+    markdown_metric_table, markdown_table, summarize,
 };

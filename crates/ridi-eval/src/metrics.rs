@@ -19,7 +19,45 @@ use crate::error::{
     EvalError, Result, check_finite_points, check_non_empty, check_pair, check_positive,
     check_same_len, check_times,
 };
-use crate::report::TrajectoryMetrics;
+
+/// Trajectory metrics of one method on one sequence, on an aligned estimate.
+///
+/// With `N` frames, errors `eᵢ = estᵢ − gtᵢ`, `L(·)` the horizontal path length and the RTE
+/// rule of [`rte`]:
+///
+/// | key | formula |
+/// |---|---|
+/// | `mpe_m` | `(1/N) Σ ‖eᵢ‖` (RIDI's MPE) |
+/// | `mpe_pct` | `100 · mpe_m / L(gt)`; `null` if the ground truth does not move |
+/// | `ate_m` | `sqrt((1/N) Σ ‖eᵢ‖²)`, Euclidean |
+/// | `rte_m` | Euclidean RTE, 60 s window by default |
+/// | `ate_ronin_m` | `ate_m / √2`: RoNIN's per-coordinate RMS |
+/// | `rte_ronin_m` | `rte_m / √2`: RoNIN's per-coordinate RTE |
+/// | `rte_5s_m` | Euclidean RTE over a 5 s window by default |
+/// | `path_length_ratio` | `L(est) / L(gt)`; `null` if the ground truth does not move |
+///
+/// The RTE windows are counted in frames at [`EvalConfig::rate_hz`] (60 s = 12000 frames at the
+/// default 200 Hz), so they last their nominal seconds only on data at that rate, which
+/// [`evaluate_trajectory`] checks.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct TrajectoryMetrics {
+    /// Mean positional error, metres.
+    pub mpe_m: f64,
+    /// Mean positional error, % of the ground-truth path length.
+    pub mpe_pct: Option<f64>,
+    /// Absolute trajectory error, Euclidean RMS, metres.
+    pub ate_m: f64,
+    /// Relative trajectory error (long window), Euclidean RMS, metres.
+    pub rte_m: f64,
+    /// Absolute trajectory error, RoNIN per-coordinate RMS, metres.
+    pub ate_ronin_m: f64,
+    /// Relative trajectory error (long window), RoNIN per-coordinate RMS, metres.
+    pub rte_ronin_m: f64,
+    /// Relative trajectory error (short window), Euclidean RMS, metres.
+    pub rte_5s_m: f64,
+    /// Estimated over ground-truth horizontal path length.
+    pub path_length_ratio: Option<f64>,
+}
 
 /// Mean positional error (MPE), metres: `(1/N) Σᵢ ‖estᵢ − gtᵢ‖`.
 ///

@@ -1,53 +1,13 @@
-//! Serializable evaluation reports and their markdown rendering.
-//!
-//! The CLI writes [`EvalReport`] as `report.json` (serde) and [`EvalReport::to_markdown`] as
-//! `report.md`. Method and sequence order is kept as given, so tables read in the order the
-//! pipeline ran things.
+//! The building blocks of an evaluation report: per-sequence metrics (serde, as `report.json`
+//! holds them), per-method means and markdown tables. `ridi::evaluate::Report` assembles them
+//! into `report.json` and `report.md`. Method and sequence order is kept as given, so tables
+//! read in the order the pipeline ran things.
 
 use std::fmt::Write as _;
 
 use serde::{Deserialize, Serialize};
 
-use crate::metrics::{ConfusionMatrix, EvalConfig};
-
-/// Trajectory metrics of one method on one sequence, on an aligned estimate.
-///
-/// With `N` frames, errors `eᵢ = estᵢ − gtᵢ`, `L(·)` the horizontal path length and the RTE
-/// rule of [`crate::metrics::rte`]:
-///
-/// | key | formula |
-/// |---|---|
-/// | `mpe_m` | `(1/N) Σ ‖eᵢ‖` (RIDI's MPE) |
-/// | `mpe_pct` | `100 · mpe_m / L(gt)`; `null` if the ground truth does not move |
-/// | `ate_m` | `sqrt((1/N) Σ ‖eᵢ‖²)`, Euclidean |
-/// | `rte_m` | Euclidean RTE, 60 s window by default |
-/// | `ate_ronin_m` | `ate_m / √2`: RoNIN's per-coordinate RMS |
-/// | `rte_ronin_m` | `rte_m / √2`: RoNIN's per-coordinate RTE |
-/// | `rte_5s_m` | Euclidean RTE over a 5 s window by default |
-/// | `path_length_ratio` | `L(est) / L(gt)`; `null` if the ground truth does not move |
-///
-/// The RTE windows are counted in frames at [`EvalConfig::rate_hz`] (60 s = 12000 frames at the
-/// default 200 Hz), so they last their nominal seconds only on data at that rate, which
-/// [`crate::evaluate_trajectory`] checks.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-pub struct TrajectoryMetrics {
-    /// Mean positional error, metres.
-    pub mpe_m: f64,
-    /// Mean positional error, % of the ground-truth path length.
-    pub mpe_pct: Option<f64>,
-    /// Absolute trajectory error, Euclidean RMS, metres.
-    pub ate_m: f64,
-    /// Relative trajectory error (long window), Euclidean RMS, metres.
-    pub rte_m: f64,
-    /// Absolute trajectory error, RoNIN per-coordinate RMS, metres.
-    pub ate_ronin_m: f64,
-    /// Relative trajectory error (long window), RoNIN per-coordinate RMS, metres.
-    pub rte_ronin_m: f64,
-    /// Relative trajectory error (short window), Euclidean RMS, metres.
-    pub rte_5s_m: f64,
-    /// Estimated over ground-truth horizontal path length.
-    pub path_length_ratio: Option<f64>,
-}
+use crate::metrics::{ConfusionMatrix, TrajectoryMetrics};
 
 /// One field of [`TrajectoryMetrics`], to pick a column.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
@@ -220,73 +180,6 @@ pub fn summarize(sequences: &[SequenceReport]) -> Vec<MethodSummary> {
 fn mean(values: impl Iterator<Item = f64>) -> Option<f64> {
     let (sum, n) = values.fold((0.0, 0usize), |(s, n), v| (s + v, n + 1));
     (n > 0).then(|| sum / n as f64)
-}
-
-/// A complete evaluation run: what `report.json` holds.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct EvalReport {
-    /// Settings the metrics were computed with.
-    pub config: EvalConfig,
-    /// Per-sequence results.
-    pub sequences: Vec<SequenceReport>,
-    /// Per-method means over sequences ([`summarize`]).
-    pub summary: Vec<MethodSummary>,
-    /// Placement classification results, when a classifier was evaluated.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub placement: Option<ConfusionMatrix>,
-    /// Velocity regression MSE per horizontal channel, (m/s)², when evaluated.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub velocity_mse: Option<[f64; 2]>,
-}
-
-impl EvalReport {
-    /// Builds a report from per-sequence results, computing the summary.
-    pub fn new(config: EvalConfig, sequences: Vec<SequenceReport>) -> Self {
-        let summary = summarize(&sequences);
-        Self {
-            config,
-            sequences,
-            summary,
-            placement: None,
-            velocity_mse: None,
-        }
-    }
-
-    /// Renders the report as markdown: the trajectory table ([`markdown_table`]), then the
-    /// placement confusion matrix and velocity MSE when present.
-    pub fn to_markdown(&self) -> String {
-        let c = &self.config;
-        let mut out = String::from("# Evaluation\n\n");
-        let _ = writeln!(
-            out,
-            "Alignment: {}. RTE window {} s, short RTE window {} s, at {} Hz. \
-             ATE/RTE are Euclidean RMS; the RoNIN columns are per-coordinate (Euclidean / √2).\n",
-            describe_window(c.align),
-            c.rte_window_s,
-            c.short_rte_window_s,
-            c.rate_hz
-        );
-        out.push_str("## Trajectories\n\n");
-        out.push_str(&markdown_table(&self.sequences));
-        if let Some(cm) = &self.placement {
-            out.push_str("\n## Placement classification\n\n");
-            out.push_str(&markdown_confusion(cm));
-        }
-        if let Some([a, b]) = self.velocity_mse {
-            out.push_str("\n## Velocity regression\n\n");
-            let _ = writeln!(out, "MSE per channel: {a:.4} / {b:.4} (m/s)²");
-        }
-        out
-    }
-}
-
-fn describe_window(w: crate::align::AlignWindow) -> String {
-    use crate::align::AlignWindow;
-    match w {
-        AlignWindow::Seconds(s) => format!("2D rigid fit on the first {s} s"),
-        AlignWindow::Frames(n) => format!("2D rigid fit on the first {n} frames"),
-        AlignWindow::All => "2D rigid fit on the whole sequence".to_owned(),
-    }
 }
 
 /// Markdown-safe cell text: pipes would split the cell, newlines would end the row.
@@ -473,15 +366,10 @@ mod tests {
     }
 
     #[test]
-    fn report_round_trips_through_json() {
-        let mut report = EvalReport::new(EvalConfig::default(), sample());
-        report.placement =
-            Some(ConfusionMatrix::from_indices(&[0, 1, 1], &[0, 1, 0], &["leg", "bag"]).unwrap());
-        report.velocity_mse = Some([0.016, 0.015]);
-        let text = serde_json::to_string(&report).unwrap();
-        let back: EvalReport = serde_json::from_str(&text).unwrap();
-        assert_eq!(back, report);
-        // Undefined metrics are explicit nulls, not missing keys.
+    fn undefined_metrics_are_explicit_nulls_in_json() {
+        let text = serde_json::to_string(&sample()).unwrap();
+        let back: Vec<SequenceReport> = serde_json::from_str(&text).unwrap();
+        assert_eq!(back, sample());
         assert!(text.contains("\"mpe_pct\":null"));
     }
 
@@ -528,13 +416,5 @@ mod tests {
         assert!(md.contains("| leg | 1 | 0 | 100.00 % |"));
         assert!(md.contains("| bag | 1 | 2 | 66.67 % |"));
         assert!(md.contains("Accuracy: 75.00 % over 4 samples."));
-
-        let mut report = EvalReport::new(EvalConfig::default(), sample());
-        report.placement = Some(cm);
-        report.velocity_mse = Some([0.016, 0.015]);
-        let full = report.to_markdown();
-        assert!(full.contains("first 10 s"));
-        assert!(full.contains("## Placement classification"));
-        assert!(full.contains("0.0160 / 0.0150"));
     }
 }
