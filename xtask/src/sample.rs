@@ -1,11 +1,12 @@
 //! `cargo xtask sample`: the small real sample bundled in `datasets/sample`, cut from the Tyrex
 //! smartphone benchmark and converted to the RIDI processed layout.
 //!
-//! Every person and motion of the Nexus 5 runs, `SECONDS` seconds each from the longest usable
-//! part of the run (skipping its first `SKIP_S` seconds, where the mocap and the walker
-//! settle), written as gzip-compressed `data.csv.gz` with `f32` precision to stay under 15 MB.
-//! List files: one per person, `list_all.txt`, and the demo split `list_train.txt` (Guillaume,
-//! Jakob) / `list_test.txt` (Thibaud). Placements are the motion names.
+//! Every person and motion of the Nexus 5 runs without magnetic disturbance, `SECONDS` seconds
+//! each from the longest usable part of the run (skipping its first `SKIP_S` seconds, where
+//! the mocap and the walker settle), written as gzip-compressed `data.csv.gz` with `f32`
+//! precision to stay under 15 MB. List files: one per person, `list_all.txt`, and the demo
+//! split `list_train.txt` (Guillaume, Jakob) / `list_test.txt` (Thibaud). Placements are the
+//! motion names.
 
 use std::path::Path;
 

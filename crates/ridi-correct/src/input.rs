@@ -1,19 +1,19 @@
 //! Inputs of a correction: checks of its frames, and regressed velocity targets.
 
-use ridi_frames::{ImuFrames, StabHorizontal};
+use ridi_frames::{ImuFrames, ImuStream, StabHorizontal};
 use serde::{Deserialize, Serialize};
 
 use crate::error::CorrectError;
 
-/// Checks a correction's frames: not empty, every stream as long as `time`, time finite and
-/// increasing by at most `max_dt`, and linear acceleration, gravity and orientation finite (the
-/// gyro is not read).
+/// Checks a correction's frames: not empty; linear acceleration, gravity and orientation as
+/// long as `time` and finite; time finite and increasing by at most `max_dt`. The gyro is not
+/// read (it may be empty).
 pub(crate) fn validate_imu(imu: &ImuFrames<'_>, max_dt: f64) -> Result<(), CorrectError> {
     let n = imu.len();
     if n == 0 {
         return Err(CorrectError::Empty);
     }
-    imu.check_lengths()?;
+    imu.check_streams(&[ImuStream::Linacce, ImuStream::Gravity, ImuStream::Orientation])?;
     validate_time(imu.time, max_dt)?;
     // Branch-free scan first (one pass, no early exit); the loop below only runs to name
     // the culprit.

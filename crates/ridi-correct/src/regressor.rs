@@ -9,18 +9,18 @@ pub struct FrameWindow<'a> {
     /// tracker was created, across restarts).
     pub first_frame: u64,
     /// The frames.
-    pub frames: ImuFrames<'a>,
+    pub imu: ImuFrames<'a>,
 }
 
 impl FrameWindow<'_> {
     /// Number of frames in the view.
     pub fn len(&self) -> usize {
-        self.frames.len()
+        self.imu.len()
     }
 
     /// `true` when the view holds no frame.
     pub fn is_empty(&self) -> bool {
-        self.frames.is_empty()
+        self.imu.is_empty()
     }
 
     /// Stream index of the last frame (the one to regress).

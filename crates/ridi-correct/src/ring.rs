@@ -90,7 +90,7 @@ impl FrameRing {
         let a = self.len().saturating_sub(n);
         FrameWindow {
             first_frame: self.first + a as u64,
-            frames: self.frames(a..self.len()),
+            imu: self.frames(a..self.len()),
         }
     }
 

@@ -234,7 +234,6 @@ struct StoredTarget {
 #[derive(Default)]
 struct Job {
     time: Vec<f64>,
-    gyro: Vec<DeviceVec>,
     linacce: Vec<DeviceVec>,
     orientation: Vec<WorldFromDevice>,
     gravity: Vec<DeviceVec>,
@@ -244,9 +243,10 @@ struct Job {
 
 impl Job {
     fn imu(&self) -> ImuFrames<'_> {
+        // The correction reads no gyro.
         ImuFrames {
             time: &self.time,
-            gyro: &self.gyro,
+            gyro: &[],
             linacce: &self.linacce,
             gravity: &self.gravity,
             orientation: &self.orientation,
@@ -288,7 +288,6 @@ struct Pending {
 
 struct History {
     time: Vec<f64>,
-    gyro: Vec<DeviceVec>,
     linacce: Vec<DeviceVec>,
     orientation: Vec<WorldFromDevice>,
     gravity: Vec<DeviceVec>,
@@ -429,7 +428,6 @@ impl<R: VelocityRegressor> Tracker<R> {
         };
         let history = config.keep_history.then(|| History {
             time: Vec::new(),
-            gyro: Vec::new(),
             linacce: Vec::new(),
             orientation: Vec::new(),
             gravity: Vec::new(),
@@ -542,7 +540,6 @@ impl<R: VelocityRegressor> Tracker<R> {
         );
         if let Some(h) = &mut self.history {
             h.time.push(sample.time);
-            h.gyro.push(sample.gyro);
             h.linacce.push(sample.linacce);
             h.orientation.push(sample.orientation);
             h.gravity.push(sample.gravity);
@@ -635,7 +632,7 @@ impl<R: VelocityRegressor> Tracker<R> {
             let first_frame = a as u64;
             let imu = ImuFrames {
                 time: &h.time[a..b],
-                gyro: &h.gyro[a..b],
+                gyro: &[],
                 linacce: &h.linacce[a..b],
                 gravity: &h.gravity[a..b],
                 orientation: &h.orientation[a..b],
@@ -772,8 +769,6 @@ impl<R: VelocityRegressor> Tracker<R> {
             Solver::Background { jobs, .. } => {
                 job.time.clear();
                 job.time.extend_from_slice(&self.ring.time[a..=b]);
-                job.gyro.clear();
-                job.gyro.extend_from_slice(&self.ring.gyro[a..=b]);
                 job.linacce.clear();
                 job.linacce.extend_from_slice(&self.ring.linacce[a..=b]);
                 job.orientation.clear();

@@ -77,7 +77,8 @@ pub struct Validation {
     /// by 1e-9 s or less. A unit too coarse shows as gaps instead.
     pub time_step_range: (f64, f64),
     /// Accepted range of the scale that best takes the rotation rate of the orientation onto
-    /// the gyro's (magnitudes, least squares over consecutive frames): 0.25..4. Real
+    /// the gyro's (magnitudes, least squares over consecutive frames, orientation jumps left
+    /// out as [`Self::check_gyro_scale`] says): 0.25..4. Real
     /// recordings give 0.93-1.0 (Tyrex) and 0.57-0.98 (competition walks, a noisier rotation
     /// vector at 50 Hz); a gyro in deg/s gives 57, a gyro of zeros 0. Judged only when the
     /// orientation turns at least [`GYRO_SCALE_MIN_RATE`] (RMS).
@@ -259,20 +260,27 @@ impl Validation {
     /// Checks the gyro against the rotation rate of `orientation` over `time` with
     /// [`Self::gyro_scale_range`]; passes when the orientation hardly turns
     /// ([`GYRO_SCALE_MIN_RATE`]). Magnitudes only, so that an orientation given for another
-    /// device frame than the gyro's still compares. Steps inside an [`orientation_jumps`]
-    /// stretch are left out of the fit: a few frames of an OS orientation turning at hundreds
-    /// of rad/s would otherwise outweigh thousands that agree.
+    /// device frame than the gyro's still compares. The steps where the orientation turns more
+    /// than [`ORIENTATION_JUMP_RATE`] faster than the gyro are left out of the fit while they
+    /// are at most [`MAX_JUMP_SHARE`] of the steps: a few frames of an OS orientation turning
+    /// at hundreds of rad/s would otherwise outweigh thousands that agree. More such steps are
+    /// no glitches but a gyro that disagrees (a slow gyro of another recording under a fast
+    /// swing): then every step counts.
     pub fn check_gyro_scale(
         &self,
         time: &[f64],
         gyro: &[DeviceVec],
         orientation: &[WorldFromDevice],
     ) -> Result<(), SequenceError> {
+        let rates: Vec<(f64, f64)> = step_rates(time, gyro, orientation)
+            .map(|(_, _, w, g)| (w, g))
+            .collect();
+        let is_jump = |&(w, g): &(f64, f64)| w - g > ORIENTATION_JUMP_RATE;
+        let jumps = rates.iter().filter(|r| is_jump(r)).count();
+        let leave_out = jumps as f64 <= MAX_JUMP_SHARE * rates.len() as f64;
         let (mut gw, mut ww, mut n) = (0.0, 0.0, 0usize);
-        for (_, _, w, g) in step_rates(time, gyro, orientation) {
-            if w - g > ORIENTATION_JUMP_RATE {
-                continue;
-            }
+        for r in rates.iter().filter(|r| !(leave_out && is_jump(r))) {
+            let &(w, g) = r;
             gw += g * w;
             ww += w * w;
             n += 1;
@@ -327,6 +335,12 @@ impl Validation {
 /// the gyro reads under 2.
 pub const ORIENTATION_JUMP_RATE: f64 = 5.0;
 
+/// The largest share of a recording's steps that [`Validation::check_gyro_scale`] leaves out
+/// as orientation jumps: the disturbed Tyrex runs have at most 1.4 % (a part with a magnetic
+/// correction every few seconds); a gyro of another, slower recording under a swinging phone
+/// would have a fifth to most of its steps left out.
+pub const MAX_JUMP_SHARE: f64 = 0.05;
+
 /// Steps closer than this, seconds, belong to one [`OrientationJump`]: a rotation vector that
 /// updates slower than the timeline shows one correction as several bursts.
 const JUMP_JOIN_S: f64 = 0.1;
@@ -336,8 +350,12 @@ const JUMP_JOIN_S: f64 = 0.1;
 /// magnetometer or reset, which the phone itself never did.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct OrientationJump {
-    /// Frames `start..end` (the frame before the first fast step to the last frame of it).
+    /// First and last frame, inclusive (the frame before the first fast step to the last frame
+    /// of the last).
     pub frames: (usize, usize),
+    /// Steps in it where the orientation turns more than [`ORIENTATION_JUMP_RATE`] faster than
+    /// the gyro.
+    pub fast_steps: usize,
     /// Time of the first and the last of those frames, seconds.
     pub time: (f64, f64),
     /// The fastest the orientation turns in it, rad/s.
@@ -382,12 +400,14 @@ pub fn orientation_jumps(
         match out.last_mut() {
             Some(j) if time[k - 1] - j.time.1 <= JUMP_JOIN_S => {
                 j.frames.1 = k;
+                j.fast_steps += 1;
                 j.time.1 = time[k];
                 j.peak_rate = j.peak_rate.max(w);
                 j.excess_angle += excess;
             }
             _ => out.push(OrientationJump {
                 frames: (k - 1, k),
+                fast_steps: 1,
                 time: (time[k - 1], time[k]),
                 peak_rate: w,
                 excess_angle: excess,
@@ -402,7 +422,7 @@ pub fn orientation_jumps(
 pub(crate) fn orientation_jump_warning(file: &str, jumps: &[OrientationJump]) -> Option<String> {
     const SHOWN: usize = 5;
     let peak = jumps.iter().map(|j| j.peak_rate).fold(0.0, f64::max);
-    let frames: usize = jumps.iter().map(|j| j.frames.1 - j.frames.0).sum();
+    let steps: usize = jumps.iter().map(|j| j.fast_steps).sum();
     let mut at: Vec<String> = jumps
         .iter()
         .take(SHOWN)
@@ -413,7 +433,7 @@ pub(crate) fn orientation_jump_warning(file: &str, jumps: &[OrientationJump]) ->
     }
     (!jumps.is_empty()).then(|| {
         format!(
-            "{file}: the orientation jumps {} time(s) ({frames} frame steps turning at up to {} \
+            "{file}: the orientation jumps {} time(s) ({steps} frame steps turning at up to {} \
              rad/s, more than {ORIENTATION_JUMP_RATE} rad/s faster than the gyro) at {} (phone \
              clock): OS heading corrections or resets, left out of the gyro check",
             jumps.len(),
@@ -559,6 +579,21 @@ mod tests {
             let e = check(&jumpy_walk(2.5, &at, scale, other)).unwrap_err();
             assert!(e.to_string().contains(expect), "{scale} {other}: {e}");
         }
+        // A phone swung fast (up to 15 rad/s) under the gyro of a slow walk: most steps turn
+        // far faster than that gyro, too many to be jumps, so they all count and it is refused.
+        let (time, slow_gyro, _) = jumpy_walk(0.0, &[], 1.0, false);
+        let omega = 2.0 * std::f64::consts::PI * 1.5;
+        let swing: Vec<WorldFromDevice> = time
+            .iter()
+            .map(|&t| {
+                let yaw = 15.0 / omega * (1.0 - (omega * t).cos());
+                WorldFromDevice::from_scaled_axis(ridi_frames::nalgebra::Vector3::new(
+                    0.0, 0.0, yaw,
+                ))
+            })
+            .collect();
+        let e = v.check_gyro_scale(&time, &slow_gyro, &swing).unwrap_err();
+        assert!(e.to_string().contains("another recording or device"), "{e}");
     }
 
     #[test]

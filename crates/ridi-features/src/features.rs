@@ -1,7 +1,7 @@
 //! Feature windows: gyro and linear acceleration in S, smoothed, flattened time-major.
 
 use rayon::prelude::*;
-use ridi_frames::{DeviceVec, ImuFrames, UpAxis};
+use ridi_frames::{DeviceVec, ImuFrames, ImuStream, UpAxis};
 
 use crate::FeatureError;
 use crate::config::{FeatureChannel, FeatureConfig};
@@ -33,7 +33,12 @@ impl StabilizedChannels {
         channels: &[FeatureChannel],
         up_axis: UpAxis,
     ) -> Result<Self, FeatureError> {
-        imu.check_lengths()?;
+        let mut streams = vec![ImuStream::Gravity];
+        streams.extend(channels.iter().map(|&c| match c {
+            FeatureChannel::Gyro => ImuStream::Gyro,
+            FeatureChannel::LinearAcceleration => ImuStream::Linacce,
+        }));
+        imu.check_streams(&streams)?;
         if channels.is_empty() {
             return Err(FeatureError::InvalidConfig(
                 "at least one channel is needed".into(),

@@ -22,13 +22,47 @@ pub enum ImuError {
     },
 }
 
+/// One stream of [`ImuFrames`] besides `time`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum ImuStream {
+    /// `gyro`.
+    Gyro,
+    /// `linacce`.
+    Linacce,
+    /// `gravity`.
+    Gravity,
+    /// `orientation`.
+    Orientation,
+}
+
+impl ImuStream {
+    /// Every stream, in field order.
+    pub const ALL: [ImuStream; 4] = [
+        ImuStream::Gyro,
+        ImuStream::Linacce,
+        ImuStream::Gravity,
+        ImuStream::Orientation,
+    ];
+
+    /// The field's name, as errors give it.
+    pub fn name(self) -> &'static str {
+        match self {
+            ImuStream::Gyro => "gyro",
+            ImuStream::Linacce => "linacce",
+            ImuStream::Gravity => "gravity",
+            ImuStream::Orientation => "orientation",
+        }
+    }
+}
+
 /// The IMU streams of consecutive frames, borrowed, one entry per frame in every slice. Features
 /// read gyro, linear acceleration and gravity; the correction reads time, linear acceleration,
 /// orientation and gravity; a streaming regressor gets all of them. One type for all, so that
 /// a recording (`Sequence::imu` in ridi-data) or a stream's window is handed to any stage as is.
 ///
-/// [`ImuFrames::new`] checks the lengths; a value built field by field is checked by every
-/// stage that takes it ([`ImuFrames::check_lengths`]).
+/// [`ImuFrames::new`] checks every length; a value built field by field is checked by every
+/// stage that takes it, for the streams it reads ([`ImuFrames::check_streams`]): a stream no
+/// stage of a caller reads may be left empty.
 #[derive(Debug, Clone, Copy)]
 pub struct ImuFrames<'a> {
     /// Timestamps, seconds, increasing.
@@ -66,16 +100,24 @@ impl<'a> ImuFrames<'a> {
 
     /// Checks that every stream has the length of `time`.
     pub fn check_lengths(&self) -> Result<(), ImuError> {
+        self.check_streams(&ImuStream::ALL)
+    }
+
+    /// Checks that `streams` have the length of `time`: what a stage that reads only those
+    /// checks, so that a caller may leave the others empty (the correction never reads the
+    /// gyro, features never read the orientation).
+    pub fn check_streams(&self, streams: &[ImuStream]) -> Result<(), ImuError> {
         let expected = self.time.len();
-        for (what, found) in [
-            ("gyro", self.gyro.len()),
-            ("linacce", self.linacce.len()),
-            ("gravity", self.gravity.len()),
-            ("orientation", self.orientation.len()),
-        ] {
+        for &stream in streams {
+            let found = match stream {
+                ImuStream::Gyro => self.gyro.len(),
+                ImuStream::Linacce => self.linacce.len(),
+                ImuStream::Gravity => self.gravity.len(),
+                ImuStream::Orientation => self.orientation.len(),
+            };
             if found != expected {
                 return Err(ImuError::LengthMismatch {
-                    what,
+                    what: stream.name(),
                     expected,
                     found,
                 });
@@ -137,6 +179,14 @@ mod tests {
         assert_eq!((frames.len(), frames.slice(1..2).len()), (2, 1));
         let e = ImuFrames::new(&t, &v, &v[..1], &v, &q).unwrap_err();
         assert_eq!(e.to_string(), "linacce has 1 frames, time has 2");
+        let correction = ImuFrames {
+            gyro: &[],
+            ..frames
+        };
+        correction
+            .check_streams(&[ImuStream::Linacce, ImuStream::Orientation])
+            .unwrap();
+        assert!(correction.check_lengths().is_err());
         let e = ImuFrames::new(&t, &v, &v, &v, &q[..0]).unwrap_err();
         assert_eq!(
             e,

@@ -93,7 +93,7 @@ pub use gravity::{
     stab_from_world,
 };
 pub use horizontal::{Horizontal, StabHorizontal, WorldHorizontal};
-pub use imu::{ImuError, ImuFrames, ImuSample};
+pub use imu::{ImuError, ImuFrames, ImuSample, ImuStream};
 pub use rotation::{QuatError, Rot, StabFromDevice, StabFromWorld, WorldFromDevice};
 pub use vector::{DeviceVec, StabVec, Vec3, WorldVec};
 

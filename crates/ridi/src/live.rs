@@ -71,12 +71,12 @@ impl VelocityRegressor for CascadeRegressor<'_> {
         &mut self,
         frames: &FrameWindow<'_>,
     ) -> std::result::Result<Option<Regression>, ridi_correct::RegressorError> {
-        let stab = self.extractor.stabilize(&frames.frames)?;
+        let stab = self.extractor.stabilize(&frames.imu)?;
         let len = frames.len();
         self.extractor.row_into(&stab, len - 1, &mut self.row)?;
         let mut p = self.model.predict_one(&self.row)?;
         if let Some(m) = &mut self.majority {
-            let label = m.push(frames.frames.time[len - 1], p.placement);
+            let label = m.push(frames.imu.time[len - 1], p.placement);
             if label != p.placement {
                 let row = MatrixRef::new(&self.row, self.row.len())?;
                 p.velocity = self.model.predict_with_placement(row, label)?[0];
