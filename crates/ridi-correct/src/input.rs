@@ -13,7 +13,11 @@ pub(crate) fn validate_imu(imu: &ImuFrames<'_>, max_dt: f64) -> Result<(), Corre
     if n == 0 {
         return Err(CorrectError::Empty);
     }
-    imu.check_streams(&[ImuStream::Linacce, ImuStream::Gravity, ImuStream::Orientation])?;
+    imu.check_streams(&[
+        ImuStream::Linacce,
+        ImuStream::Gravity,
+        ImuStream::Orientation,
+    ])?;
     validate_time(imu.time, max_dt)?;
     // Branch-free scan first (one pass, no early exit); the loop below only runs to name
     // the culprit.

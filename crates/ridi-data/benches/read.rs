@@ -67,6 +67,7 @@ fn sequence() -> Sequence {
         orientation,
         orientation_source: Some(OrientationSource::GameRotationVector),
         steps: None,
+        device: None,
         time,
     })
     .expect("benchmark sequence is valid")

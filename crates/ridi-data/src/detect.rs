@@ -17,7 +17,7 @@ pub enum Format {
     RidiPlain,
     /// RIDI raw recorder folder (see [`ridi_raw`]).
     RidiRaw,
-    /// Tyrex smartphone benchmark folder (`accelerometer.txt` and `gyroscope-calibrated.txt`).
+    /// Tyrex smartphone benchmark run folder, Android or iOS layout (see [`tyrex`]).
     Tyrex,
     /// Indoor Location Competition 2.0 path file (see [`ilc`]).
     Ilc,
@@ -53,7 +53,9 @@ impl Format {
             Format::Tyrex => {
                 "a Tyrex run is a folder <Person>_<Phone>_<Dist>_<Motion> with \
                  accelerometer.txt, gyroscope-calibrated.txt, rotation-vector.txt and \
-                 timeAlignment.txt; a Tyrex root holds the runs in datasets/android/"
+                 timeAlignment.txt (Android), or accelerometer.txt, gyroscope.txt, attitude.txt, \
+                 description.txt and timeAlignment.txt (iOS); a Tyrex root holds the runs in \
+                 datasets/android/ and datasets/ios/"
             }
             Format::Ilc => {
                 "an Indoor Location Competition path file is a `.txt` of \
@@ -114,7 +116,14 @@ fn locate(path: &Path) -> Result<(Format, PathBuf)> {
     }
     // Any of the files a format's folder must have makes it one: its reader then names the
     // others it lacks.
-    if has("accelerometer.txt") || has("gyroscope-calibrated.txt") {
+    if [
+        "accelerometer.txt",
+        "gyroscope-calibrated.txt",
+        "attitude.txt",
+    ]
+    .iter()
+    .any(|f| has(f))
+    {
         return Ok((Format::Tyrex, path.to_path_buf()));
     }
     if ridi_raw::looks_like(path) {
@@ -124,20 +133,27 @@ fn locate(path: &Path) -> Result<(Format, PathBuf)> {
         Location::file(path),
         "not a known dataset folder: expected processed/data.csv, data.csv, data_plain.txt, \
          a RIDI raw folder (gyro.txt, acce.txt, ...) or a Tyrex folder (accelerometer.txt, \
-         gyroscope-calibrated.txt)",
+         gyroscope-calibrated.txt or attitude.txt)",
     ))
 }
 
-/// The files a read of `path` takes data from: the file itself, or for a folder those of its
-/// detected format that exist (a Tyrex run: its text files and its `.mat` ground truth beside
-/// the `android` folder). What a command's output must not overwrite.
+/// The files a read of `path` takes data from: the file itself (and for a processed file its
+/// sidecar, [`sidecar_path`](crate::sidecar_path), when there is one), or for a folder those of
+/// its detected format that exist (a Tyrex run: its text files and its `.mat` ground truth
+/// beside the `android` or `ios` folder). What a command's output must not overwrite.
 ///
 /// # Errors
 /// As [`detect`]: `path` is no sequence of a known format.
 pub fn source_files(path: impl AsRef<Path>) -> Result<Vec<PathBuf>> {
     let (format, at) = locate(path.as_ref())?;
     let mut files = match format {
-        Format::RidiCsv | Format::RidiPlain | Format::Ilc => return Ok(vec![at]),
+        Format::Ilc => return Ok(vec![at]),
+        Format::RidiCsv | Format::RidiPlain => {
+            let sidecar = crate::sidecar_path(&at);
+            let mut files = vec![at];
+            files.extend(sidecar.is_file().then_some(sidecar));
+            return Ok(files);
+        }
         Format::RidiRaw => ridi_raw::FILES
             .iter()
             .map(|(name, _)| at.join(name))
@@ -164,8 +180,9 @@ pub fn source_files(path: impl AsRef<Path>) -> Result<Vec<PathBuf>> {
 /// [`ilc::looks_like_path_file`]) and a `data_plain.txt` otherwise; either may be
 /// gzip-compressed (`*.csv.gz`, `*.txt.gz`). Folders, first match wins: `processed/data.csv`
 /// (or `.csv.gz`), `data.csv` (or `.csv.gz`), `processed/data_plain.txt`, `data_plain.txt`, a
-/// Tyrex folder (`accelerometer.txt` or `gyroscope-calibrated.txt`), a RIDI raw folder (any
-/// of [`ridi_raw::REQUIRED`]). A folder with only some of the files its format needs is
+/// Tyrex folder of either layout (`accelerometer.txt`, `gyroscope-calibrated.txt` or
+/// `attitude.txt`; [`tyrex::layout_of`] tells which), a RIDI raw folder (any of
+/// [`ridi_raw::REQUIRED`]). A folder with only some of the files its format needs is
 /// detected as that format, and reading it names the files it lacks.
 pub fn detect(path: impl AsRef<Path>) -> Result<Format> {
     locate(path.as_ref()).map(|(f, _)| f)

@@ -59,6 +59,9 @@
 //! - Placement: [`IlcOptions::placement`], `hand` by default (the competition's phones were held
 //!   flat in front of the body); a list file's placement overrides it.
 //! - Name: the file name without `.txt` (the path id).
+//! - Device: `Brand Model` from the header (`OPPO PBCM10`; none when the header names neither
+//!   or names it unusably, as [`DeviceInfo::new`] says), its IMU rate the slower of the
+//!   accelerometer's and the gyroscope's records (about 50 Hz).
 //!
 //! # Errors
 //! Every error names the file, and the line and field when one is to blame: a non-numeric or
@@ -97,7 +100,9 @@ use crate::error::{DataError, Location, Result};
 use crate::options::ReadOptions;
 use crate::resample::{interpolate_rot, interpolate_vec3, uniform_timeline};
 use crate::text::{self, Nan};
-use crate::{Channel, GroundTruth, OrientationSource, Sequence, SequenceParts, Validation};
+use crate::{
+    Channel, DeviceInfo, GroundTruth, OrientationSource, Sequence, SequenceParts, Validation,
+};
 
 /// Placement label of every path unless [`IlcOptions::placement`] says otherwise.
 pub const DEFAULT_PLACEMENT: &str = "hand";
@@ -300,6 +305,22 @@ impl Header {
         }
     }
 
+    /// The phone as a sequence's device: `Brand Model` (no Android version), with the IMU rate
+    /// of the records; `None` when the header does not name it or names it unusably.
+    fn phone(&self, streams: &[Stream; 5]) -> Option<DeviceInfo> {
+        let name = match (&self.brand, &self.model) {
+            (Some(b), Some(m)) => format!("{b} {m}"),
+            (Some(x), None) | (None, Some(x)) => x.clone(),
+            (None, None) => return None,
+        };
+        let device = DeviceInfo::new(&name).ok()?;
+        Some(crate::device::with_imu_rate(
+            device,
+            &streams[ACCE].time,
+            &streams[GYRO].time,
+        ))
+    }
+
     fn device(&self) -> Option<String> {
         let name = match (&self.brand, &self.model) {
             (Some(b), Some(m)) => format!("{b} {m}"),
@@ -427,6 +448,7 @@ pub fn parse(bytes: &[u8], path: &Path, options: &IlcOptions) -> Result<IlcPath>
         orientation_source: Some(OrientationSource::RotationVector),
         ground_truth: Some(ground_truth),
         steps: None,
+        device: header.phone(&streams),
         time,
     };
     let sequence = Sequence::with_validation(parts, limits)

@@ -16,7 +16,7 @@
 //! | RIDI processed `data.csv`: pandas index, then the 27 [`processed::COLUMNS`], time in ns | [`ridi_csv::read`] | [`write_ridi_csv`] |
 //! | RIDI `data_plain.txt`: `N 27`, then N tab-separated rows | [`ridi_plain::read`] | [`write_ridi_plain`] |
 //! | RIDI raw recorder folder (`gyro.txt`, `acce.txt`, ..., `pose.txt`) | [`ridi_raw::read`] | |
-//! | Tyrex smartphone benchmark folder (Android text files, Qualisys `.mat` ground truth) | [`tyrex::read`] | |
+//! | Tyrex smartphone benchmark run folder (Android or iOS text files, Qualisys `.mat` ground truth) | [`tyrex::read`] | |
 //! | Indoor Location Competition 2.0 path file (`unix_ms<TAB>TYPE_...` records, waypoints) | [`ilc::read`] | |
 //! | dataset list file (`path,placement` per line) | [`read_list`], [`load_list`], [`load_entries`] | |
 //!
@@ -28,7 +28,9 @@
 //! Conventions at the file edges: time is nanoseconds in files and seconds (absolute, `f64`)
 //! in a [`Sequence`]; quaternions are `w, x, y, z` in processed files and `x, y, z, w` in raw
 //! files (Android, Tango). In the processed layout a missing magnetometer is written as zeros and
-//! missing ground truth as `NaN` on every row, and both read back as absent.
+//! missing ground truth as `NaN` on every row, and both read back as absent. The device a
+//! sequence was recorded with ([`DeviceInfo`]) has no column there: it goes to a sidecar beside
+//! the data file ([`sidecar_path`]), optional on read.
 //!
 //! # Example
 //!
@@ -65,6 +67,7 @@
 
 mod android;
 mod detect;
+mod device;
 mod error;
 pub mod ilc;
 mod list;
@@ -77,12 +80,14 @@ pub mod ridi_plain;
 pub mod ridi_raw;
 mod sequence;
 mod sequence_error;
+mod sidecar;
 mod text;
 pub mod tyrex;
 mod validation;
 mod write;
 
 pub use detect::{Format, detect, read_sequence, source_files};
+pub use device::{DeviceError, DeviceInfo};
 pub use error::{DataError, Location, Result};
 pub use list::{
     ListEntry, check_distinct, check_entries, load_entries, load_list, parse_list, read_list,
@@ -91,10 +96,12 @@ pub use options::ReadOptions;
 pub use ridi_frames;
 pub use sequence::{Channel, GroundTruth, OrientationSource, Sequence, SequenceParts};
 pub use sequence_error::SequenceError;
+pub use sidecar::{SIDECAR_SUFFIX, sidecar_path};
 pub use validation::{
-    GYRO_SCALE_MIN_RATE, LINACCE_SCALE_MIN_RMS, ORIENTATION_JUMP_RATE, OrientationJump, Validation,
-    orientation_jumps,
+    GYRO_SCALE_MIN_RATE, LINACCE_SCALE_MIN_RMS, MAX_JUMP_SHARE, ORIENTATION_JUMP_RATE,
+    OrientationJump, Validation, orientation_jumps,
 };
 pub use write::{
-    Precision, RoundTrip, write_atomically, write_ridi_csv, write_ridi_csv_with, write_ridi_plain,
+    PendingFile, Precision, RoundTrip, write_atomically, write_pending, write_ridi_csv,
+    write_ridi_csv_with, write_ridi_plain,
 };

@@ -266,6 +266,7 @@ pub(crate) fn assemble(table: Table, path: &Path, opts: &ReadOptions) -> Result<
         orientation_source: Some(OrientationSource::GameRotationVector),
         ground_truth: ground_truth(&table, path)?,
         steps: None,
+        device: None,
     };
     Sequence::with_validation(parts, &opts.validation)
         .map_err(|e| text::sequence_error(path, Some(&table.lines), &ProcessedFields, e))

@@ -5,7 +5,9 @@
 //! `acce_*`, `linacce_*`, `grav_*`, `rv_*`. Optional: `magnet_*` (all zeros also means "not
 //! recorded"), and `pos_*` with `ori_*` together (NaN on every row also means "no ground
 //! truth"). Time is in nanoseconds and becomes absolute seconds. A last row without a line break
-//! after it is refused: the file was cut off while being written, maybe inside a value.
+//! after it is refused: the file was cut off while being written, maybe inside a value. The
+//! device, which the layout has no column for, comes from the optional sidecar ridi-rs writes
+//! beside the file ([`sidecar_path`](crate::sidecar_path)).
 
 use std::path::Path;
 
@@ -13,16 +15,21 @@ use crate::Sequence;
 use crate::error::{DataError, Location, Result};
 use crate::options::ReadOptions;
 use crate::processed::{self, COLUMNS, MAGNET, POS, RV, Table};
-use crate::text;
+use crate::{sidecar, text};
 
 /// Reads a RIDI processed `data.csv`. The sequence is named after its capture folder (see
-/// [`read_sequence`](crate::read_sequence)), its orientation source is the game rotation vector.
+/// [`read_sequence`](crate::read_sequence)), its orientation source is the game rotation vector,
+/// and its device is the one the optional sidecar beside the file names
+/// ([`sidecar_path`](crate::sidecar_path)).
 pub fn read(path: impl AsRef<Path>, opts: &ReadOptions) -> Result<Sequence> {
     let path = path.as_ref();
-    parse(&text::read_file(path)?, path, opts)
+    let mut seq = parse(&text::read_file(path)?, path, opts)?;
+    seq.set_device(sidecar::read(path)?);
+    Ok(seq)
 }
 
 /// Parses the content of a `data.csv`; `path` names the source in errors and gives the name.
+/// The sidecar is not read: the sequence has no device.
 pub fn parse(bytes: &[u8], path: &Path, opts: &ReadOptions) -> Result<Sequence> {
     let table = parse_table(text::as_text(bytes, path)?, path)?;
     processed::assemble(table, path, opts)

@@ -10,16 +10,19 @@ use crate::Sequence;
 use crate::error::{DataError, Location, Result};
 use crate::options::ReadOptions;
 use crate::processed::{self, COLUMNS, Table};
-use crate::text;
+use crate::{sidecar, text};
 
-/// Reads a `data_plain.txt`.
+/// Reads a `data_plain.txt`, and its device from the optional sidecar beside it
+/// ([`sidecar_path`](crate::sidecar_path)).
 pub fn read(path: impl AsRef<Path>, opts: &ReadOptions) -> Result<Sequence> {
     let path = path.as_ref();
-    parse(&text::read_file(path)?, path, opts)
+    let mut seq = parse(&text::read_file(path)?, path, opts)?;
+    seq.set_device(sidecar::read(path)?);
+    Ok(seq)
 }
 
 /// Parses the content of a `data_plain.txt`; `path` names the source in errors and gives the
-/// name.
+/// name. The sidecar is not read: the sequence has no device.
 pub fn parse(bytes: &[u8], path: &Path, opts: &ReadOptions) -> Result<Sequence> {
     let table = parse_table(text::as_text(bytes, path)?, path)?;
     processed::assemble(table, path, opts)

@@ -367,6 +367,7 @@ pub fn read(folder: impl AsRef<Path>, opts: &ReadOptions) -> Result<Sequence> {
         steps: step
             .as_ref()
             .map(|s| interpolate_scalar(&s.time, &s.values, &time)),
+        device: None,
         time,
     };
     Sequence::with_validation(parts, &opts.validation).map_err(|e| match (&e, stream_file(&e)) {

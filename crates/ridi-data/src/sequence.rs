@@ -6,6 +6,7 @@ use std::ops::Range;
 use ridi_frames::{DeviceVec, ImuFrames, WorldFromDevice, WorldVec};
 use serde::{Deserialize, Serialize};
 
+use crate::device::DeviceInfo;
 use crate::sequence_error::SequenceError;
 use crate::validation::{OrientationJump, Validation, orientation_jumps};
 
@@ -17,6 +18,10 @@ pub enum OrientationSource {
     GameRotationVector,
     /// Android rotation vector (uses the magnetometer; heading is magnetic north).
     RotationVector,
+    /// iOS Core Motion attitude (`CMAttitude`; the Tyrex iPhone runs' heading follows magnetic
+    /// north), turned by the Tyrex authors' 90 degrees so that its world is east-north-up like
+    /// the rotation vector's.
+    CoreMotionAttitude,
     /// Estimated by ridi-frames from gyro and accelerometer.
     Estimated,
     /// Ground-truth orientation (Tango, motion capture) used as the device orientation.
@@ -28,6 +33,7 @@ impl fmt::Display for OrientationSource {
         f.write_str(match self {
             OrientationSource::GameRotationVector => "game rotation vector",
             OrientationSource::RotationVector => "rotation vector",
+            OrientationSource::CoreMotionAttitude => "Core Motion attitude",
             OrientationSource::Estimated => "estimated",
             OrientationSource::GroundTruth => "ground truth",
         })
@@ -79,6 +85,10 @@ pub struct SequenceParts {
     pub ground_truth: Option<GroundTruth>,
     /// Step counter (steps since start), if recorded.
     pub steps: Option<Vec<f64>>,
+    /// The phone it was recorded with, when the source says (Tyrex: `record.properties` or the
+    /// run's name; Indoor Location Competition: the header; RIDI's processed files: the
+    /// optional sidecar ridi-rs writes beside them, see [`sidecar_path`](crate::sidecar_path)).
+    pub device: Option<DeviceInfo>,
 }
 
 /// A channel of a sequence, as named in a [`SequenceError`] and given to the checks of
@@ -384,6 +394,14 @@ impl Sequence {
     pub fn steps(&self) -> Option<&[f64]> {
         self.parts.steps.as_deref()
     }
+    /// The phone it was recorded with, if known.
+    pub fn device(&self) -> Option<&DeviceInfo> {
+        self.parts.device.as_ref()
+    }
+    /// Sets the phone it was recorded with.
+    pub fn set_device(&mut self, device: Option<DeviceInfo>) {
+        self.parts.device = device;
+    }
 
     /// Duration from first to last frame, seconds.
     pub fn duration(&self) -> f64 {
@@ -434,7 +452,7 @@ impl Sequence {
 
     /// The sequence on a uniform timeline at `rate_hz` from its first frame to at most its
     /// last: vectors (IMU and ground-truth positions) linearly interpolated, rotations by
-    /// slerp, step times kept. For a recording at another rate than a model's (RIDI models
+    /// slerp, step times and the device kept. For a recording at another rate than a model's (RIDI models
     /// count frames of a 200 Hz stream); `ridi convert --rate` applies it.
     ///
     /// # Errors
@@ -466,11 +484,12 @@ impl Sequence {
                 orientation: interpolate_rot(t, &gt.orientation, &time),
             }),
             steps: p.steps.clone(),
+            device: p.device.clone(),
             time,
         })
     }
 
-    /// The frames in `range`, as a new sequence with the same name and labels.
+    /// The frames in `range`, as a new sequence with the same name, labels and device.
     ///
     /// # Panics
     /// When `range` is empty or out of bounds.
@@ -499,6 +518,7 @@ impl Sequence {
                     orientation: gt.orientation[r()].to_vec(),
                 }),
                 steps: p.steps.as_ref().map(|s| s[r()].to_vec()),
+                device: p.device.clone(),
             },
         }
     }

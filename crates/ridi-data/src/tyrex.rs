@@ -1,8 +1,8 @@
 //! Reader for the Tyrex smartphone attitude benchmark (Inria Tyrex, "On Attitude Estimation
-//! with Smartphones", PerCom 2017): Android IMU recordings with Qualisys motion-capture ground
-//! truth.
+//! with Smartphones", PerCom 2017): Android (Nexus 5) and iOS (iPhone 4S) IMU recordings with
+//! Qualisys motion-capture ground truth.
 //!
-//! # Layout
+//! # Layouts
 //! ```text
 //! <root>/datasets/android/<Person>_<Phone>_<Dist>_<Motion>/
 //!     accelerometer.txt          t ax ay az            m/s^2, with gravity
@@ -10,33 +10,85 @@
 //!     rotation-vector.txt        t qx qy qz qw [acc]   Android TYPE_ROTATION_VECTOR, x,y,z,w!
 //!     timeAlignment.txt          timeDiff              s
 //!     record.properties          [Device] Model = ..., [Time] StartTime = ...
+//! <root>/datasets/ios/<Person>_<Phone>_<Dist>_<Motion>/
+//!     accelerometer.txt          t ax ay az            g, Core Motion's sign (-1 g up at rest)
+//!     gyroscope.txt              t wx wy wz            rad/s
+//!     attitude.txt               t qw qx qy qz         Core Motion attitude, w,x,y,z
+//!     timeAlignment.txt          timeDiff              s
+//!     description.txt            [Time] BootTime = s   the offset of the time column
 //! <root>/datasets/qualisys/<same name>.mat   QTM "Level 5 MAT-file" export
 //! ```
-//! Text files are space-separated without a header; the first column is seconds on the phone
-//! clock. `linear-acceleration.txt` is not read: it is sparse in some runs, and the linear
-//! acceleration is rebuilt from the accelerometer and the orientation instead.
+//! Text files are space-separated without a header; the first column is seconds.
+//! [`layout_of`] tells the layouts apart by their own files (`rotation-vector.txt`,
+//! `attitude.txt`, ...). `linear-acceleration.txt` (Android) is not read: it is sparse in some
+//! runs, and the linear acceleration is rebuilt from the accelerometer and the orientation
+//! instead. The Qualisys file is matched regardless of ASCII case when no file has the run's
+//! exact name ([`mat_path`]: the source spells one run `Jakob_iPhone4S_NoDist_Backpocket` and its
+//! file `..._BackPocket.mat`). The placement is the motion, matched the same way
+//! ([`motion_of`]); the name stays the folder's.
 //!
 //! # Frames
-//! The device frame is the Android sensor frame. The device orientation is the rotation
-//! vector ([`OrientationSource::RotationVector`]: magnetometer-based, world = east-north-up).
-//! Gravity is `gravity_in_device(orientation, g)` with `g` = [`TyrexOptions::gravity`]
-//! ([`STANDARD_GRAVITY`] by default, the value Android's own gravity sensor uses), and linear
-//! acceleration is accelerometer minus gravity.
+//! The device frame is the Android sensor frame (x right, y to the top, z out of the screen;
+//! the iPhone's is the same). Gravity is `gravity_in_device(orientation, g)` with `g` =
+//! [`TyrexOptions::gravity`] ([`STANDARD_GRAVITY`] by default, the value Android's own gravity
+//! sensor uses), and linear acceleration is accelerometer minus gravity. The device orientation:
+//! - Android: the rotation vector ([`OrientationSource::RotationVector`]: magnetometer-based,
+//!   world = east-north-up).
+//! - iOS: the Core Motion attitude ([`OrientationSource::CoreMotionAttitude`]), turned as the
+//!   authors' loader turns it (see below), so that its world is east-north-up too.
+//!
+//! The iOS files are brought into the Android conventions exactly as the authors' loader
+//! (`src/Import/loadiOSDataset.m` of the source, whose helpers `dcm2quat`, `quatmultiply` and
+//! `Constants` are in its `src/Utils/`) does:
+//! - **Accelerometer** (lines 24-25): `acce = -9.80665 * [ax, ay, az]`. Core Motion reports
+//!   acceleration in g with the opposite sign to Android's (`-1 g` along the upward axis at
+//!   rest, where Android reads `+9.8 m/s^2`); `Constants.STANDARD_GRAVITY` is 9.80665.
+//! - **Gyroscope** (lines 20, 42): taken as it is, rad/s.
+//! - **Attitude** (lines 34-39): `q = h ⊗ [qw, qx, qy, qz]` with `h` the quarter turn `+90°`
+//!   about z (`headingRotation` is the matrix of `+90°`, and the authors' `dcm2quat` returns the
+//!   quaternion of the transpose of its argument, so `dcm2quat(headingRotation')` is `+90°`;
+//!   `quatmultiply` is the Hamilton product). Core Motion's reference frame has x towards
+//!   magnetic north and z up; the turn takes its north onto east-north-up's +y. The result is
+//!   world-from-device like the rotation vector.
+//! - **Time** (lines 47-48): every time column minus `BootTime` of `description.txt`'s `[Time]`
+//!   section (`offsetTimeAllData(-bootTime)`), which puts it near 0 at the start, as the Android
+//!   files' times are; `timeAlignment.txt`'s `timeDiff` applies to that clock, as for Android
+//!   (the authors' `findTimeDiffBetweenQualisysAndSmartphone.m` loads it for the data as
+//!   loaded). "Phone clock" in the warnings means this clock.
+//!
+//! Checked on the shared runs (`tests/tyrex_shared.rs`): the accelerometer averaged over a
+//! second lies within 1-4 degrees (median) of the gravity the motion capture gives for the
+//! hand-held runs of both phones (with the wrong sign it would be 180), and the iOS attitude's
+//! heading, turned, is within a few degrees of the room's, as the rotation vector's is (without
+//! the turn it would be 90 degrees off).
 //!
 //! Ground truth keeps the mocap room frame (z up, metres, origin and heading of the room): the
 //! QTM struct's `RigidBodies.Positions` (1x3xN, mm) divided by 1000, and
-//! `RigidBodies.Rotations` (1x9xN, a column-major 3x3 with `p_room = R p_phone`). The rigid body
-//! was defined to coincide with the Android device frame, so `R` is the world-from-device
-//! rotation directly. Frames where the mocap lost the body are `NaN` in the file. A finite `R`
-//! must be a rotation matrix ([`Rot::from_matrix`](ridi_frames::Rot::from_matrix): determinant
-//! positive, `|RᵀR − I|` within 1e-3; the Tyrex exports are within 1e-7), otherwise reading
-//! fails naming the file, the field and the frame.
+//! `RigidBodies.Rotations` (1x9xN, a column-major 3x3 with `p_room = R p_phone`; the authors'
+//! `loadQualisysDataset.m` line 27 takes `dcm2quat(reshape(R, 3, 3)')`, the same rotation). The
+//! rigid body was defined to coincide with the device frame (of either phone), so `R` is the
+//! world-from-device rotation directly. Frames where the mocap lost the body are `NaN` in the
+//! file. A finite `R` must be a rotation matrix
+//! ([`Rot::from_matrix`](ridi_frames::Rot::from_matrix): determinant positive, `|RᵀR − I|`
+//! within 1e-3; the Tyrex exports are within 1e-7), otherwise reading fails naming the file, the
+//! field and the frame.
 //!
 //! # Time
-//! Mocap frame `i` (0-based, first exported frame) is at mocap time `i / FrameRate`, and
-//! `phone_time + timeDiff = mocap_time` with `timeDiff` from `timeAlignment.txt` (the authors'
-//! estimate; a residual lag of about 0.02 s remains, see [`TyrexOptions::extra_time_diff_s`]). Output sequences are on the phone clock, on a uniform timeline at
-//! [`TyrexOptions::rate_hz`] over the time covered by every phone stream and the ground truth.
+//! Mocap frame `i` (0-based, first exported frame) is at mocap time `i / FrameRate`
+//! (`loadQualisysDataset.m` lines 17-18), and `phone_time + timeDiff = mocap_time` with
+//! `timeDiff` from `timeAlignment.txt` (the authors' estimate; a residual lag of about 0.02 s
+//! remains for the Android runs, see [`TyrexOptions::extra_time_diff_s`]). Output sequences are
+//! on the phone clock, on a uniform timeline at [`TyrexOptions::rate_hz`] (200 Hz: the Nexus 5
+//! logs at about 200 Hz, the iPhone 4S its accelerometer at 90 Hz and its gyroscope and attitude
+//! at 107 Hz, interpolated linearly, the orientation by slerp) over the time covered by every
+//! phone stream and the ground truth.
+//!
+//! # Device
+//! Every sequence's [`Sequence::device`] is the phone: `Model` of `record.properties` (Android;
+//! `Nexus 5` in every shared run) or of a `[Device]` section of `description.txt` (iOS; the
+//! shared runs have none), else the phone part of the run's name ([`phone_of`]: `iPhone4S` is
+//! `iPhone 4S`); its IMU rate is the slower of the accelerometer's and the gyroscope's own rates
+//! (198.6 Hz on the Nexus 5, 90 Hz on the iPhone 4S).
 //!
 //! # Gaps
 //! Mocap losses up to [`TyrexOptions::max_mocap_gap_s`] are interpolated across; a longer one,
@@ -45,15 +97,27 @@
 //! folder with `_part1`, `_part2`, ... when there are several; each split and each dropped part
 //! is reported in [`TyrexRead::warnings`].
 //!
+//! # Warnings
+//! Besides splits and dropped parts: a clipped accelerometer (the Nexus 5 clips at 2 g, 19.553
+//! m/s^2, exactly, in its running runs; the iPhone 4S near 2 g at a limit that differs by axis
+//! and direction and drifts, so there the readings within 3 % of an axis's largest one count, in
+//! its running runs and two of Thibaud's pocket runs), orientation jumps against the gyro (see
+//! [`Sequence::orientation_jumps`]), an unknown motion, an unusable `Model`, and, for iOS files
+//! only, a last record without a line break, which is left out (one shared file,
+//! `Thibaud_iPhone4S_NoDist_RunningHand/attitude.txt`, is cut off so).
+//!
 //! # Errors
-//! Every error names the file, and the line and field when one is to blame. A phone file whose
-//! last line has no line break after it was cut off while being written and is refused
-//! (`timeAlignment.txt` and `record.properties` are not: some shared runs lack it). The
-//! accelerometer, gyroscope and rotation vector files are checked against the [`Validation`]
-//! limits before resampling: their median time step (seconds: milliseconds step by 5 s), and
-//! every accelerometer and gyroscope value against its physical bound (the gyro's median magnitude
-//! too); the accelerometer's scale against gravity is checked on each sequence and reported on
-//! `accelerometer.txt`.
+//! Every error names the file, and the line and field when one is to blame. An Android phone
+//! file whose last line has no line break after it was cut off while being written and is
+//! refused (`timeAlignment.txt`, `record.properties` and `description.txt` are not: small
+//! hand-written files, some shared runs lack the break). The accelerometer, gyroscope and
+//! orientation files are checked against the [`Validation`] limits before resampling (the iOS
+//! accelerometer after its conversion to m/s^2): their median time step (seconds: milliseconds
+//! step by 5 s), and every accelerometer and gyroscope value against its physical bound (the
+//! gyro's median magnitude too); the accelerometer's scale against gravity is checked on each
+//! sequence and reported on `accelerometer.txt`. A quaternion whose norm is not 1 names its line
+//! and `qw`; a missing or malformed `BootTime` names `description.txt` and `BootTime`; a folder
+//! with files of both layouts, or two Qualisys files that differ only in case, is an error.
 //!
 //! # Example
 //! ```no_run
@@ -89,8 +153,11 @@ use crate::resample::{interpolate_rot, interpolate_vec3, uniform_timeline};
 use crate::text::{self, Nan};
 use crate::validation::orientation_jump_warning;
 use crate::{
-    Channel, GroundTruth, OrientationSource, Sequence, SequenceError, SequenceParts, Validation,
+    Channel, DeviceInfo, GroundTruth, OrientationSource, Sequence, SequenceError, SequenceParts,
+    Validation,
 };
+
+mod ios;
 
 /// Mocap frame rate assumed when a `.mat` has no `FrameRate` (the Tyrex captures are 60 Hz).
 pub const DEFAULT_MOCAP_RATE_HZ: f64 = 60.0;
@@ -171,8 +238,74 @@ pub struct TyrexRead {
     pub warnings: Vec<String>,
     /// `timeDiff` from `timeAlignment.txt`, seconds, when ground truth was read.
     pub time_diff_s: Option<f64>,
-    /// Device model from `record.properties`, if present.
+    /// The phone's model, as every sequence's [`Sequence::device`] names it: `Model` of
+    /// `record.properties` (Android) or of `description.txt`'s `[Device]` section (iOS; the
+    /// shared runs have none) when given, else the phone part of the run's name (`Nexus5` is
+    /// `Nexus 5`, `iPhone4S` `iPhone 4S`, any other as it is written).
     pub device_model: Option<String>,
+    /// The layout the run was read in.
+    pub layout: Layout,
+}
+
+/// The two layouts of a Tyrex run folder: the Android recorder's and the iOS recorder's.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum Layout {
+    /// `datasets/android/<run>/`: `accelerometer.txt` (m/s^2), `gyroscope-calibrated.txt`,
+    /// `rotation-vector.txt`, `record.properties`.
+    Android,
+    /// `datasets/ios/<run>/`: `accelerometer.txt` (g, opposite sign), `gyroscope.txt`,
+    /// `attitude.txt` (Core Motion), `description.txt` (`BootTime`).
+    Ios,
+}
+
+impl std::fmt::Display for Layout {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(match self {
+            Layout::Android => "Android",
+            Layout::Ios => "iOS",
+        })
+    }
+}
+
+/// Files only the Android layout has.
+const ANDROID_FILES: [&str; 3] = [
+    "gyroscope-calibrated.txt",
+    "rotation-vector.txt",
+    "record.properties",
+];
+
+/// Which layout the run folder `dir` is in: iOS when it holds `attitude.txt` or
+/// `description.txt`, Android when it holds any of `gyroscope-calibrated.txt`,
+/// `rotation-vector.txt` and `record.properties`; a folder with neither (say only
+/// `accelerometer.txt`) is iOS when it sits in an `ios` folder, Android otherwise, so that
+/// reading it names the files of that layout it lacks.
+///
+/// # Errors
+/// A folder with files of both layouts, naming one of each.
+pub fn layout_of(dir: impl AsRef<Path>) -> Result<Layout> {
+    let dir = dir.as_ref();
+    let has = |f: &&&str| dir.join(f).exists();
+    let android = ANDROID_FILES.iter().find(has);
+    let ios = ios::OWN_FILES.iter().find(has);
+    match (android, ios) {
+        (Some(a), Some(i)) => Err(DataError::format(
+            Location::file(dir),
+            format!(
+                "holds files of both Tyrex layouts: {a} (Android) and {i} (iOS); a run folder \
+                 is one or the other"
+            ),
+        )),
+        (Some(_), None) => Ok(Layout::Android),
+        (None, Some(_)) => Ok(Layout::Ios),
+        (None, None) => {
+            let in_ios = dir
+                .canonicalize()
+                .ok()
+                .and_then(|d| d.parent().and_then(|p| p.file_name()).map(|n| n == "ios"))
+                .unwrap_or(false);
+            Ok(if in_ios { Layout::Ios } else { Layout::Android })
+        }
+    }
 }
 
 /// One mocap frame where the body was tracked.
@@ -217,10 +350,11 @@ pub fn motion_of(name: &str) -> Option<&'static str> {
 /// The run folders of a Tyrex root, as [`list_sequences`] finds them.
 #[derive(Debug, Clone, Default, PartialEq, Eq)]
 pub struct TyrexRuns {
-    /// Runs with a Qualisys file, sorted by name: the ones to convert, train and evaluate on.
+    /// Runs with a Qualisys file, sorted by path (the Android runs, then the iOS runs, each by
+    /// name): the ones to convert, train and evaluate on.
     pub runs: Vec<PathBuf>,
     /// Runs without one (the source keeps an earlier take, `Jakob_Nexus5_Dist_Swinging_old`,
-    /// without motion capture), sorted by name.
+    /// without motion capture), sorted by path.
     pub without_mocap: Vec<PathBuf>,
 }
 
@@ -243,21 +377,31 @@ impl TyrexRuns {
     }
 }
 
+/// The folders of run folders under a Tyrex root: `datasets/android/` and `datasets/ios/` (those
+/// that exist), else `android/` and `ios/`, else `root` itself.
+fn run_folders(root: &Path) -> Option<Vec<PathBuf>> {
+    for base in [root.join("datasets"), root.to_path_buf()] {
+        let found: Vec<PathBuf> = ["android", "ios"]
+            .iter()
+            .map(|l| base.join(l))
+            .filter(|p| p.is_dir())
+            .collect();
+        if !found.is_empty() {
+            return Some(found);
+        }
+    }
+    root.is_dir().then(|| vec![root.to_path_buf()])
+}
+
 /// The run folders under a Tyrex root. `root` may be the dataset root (with
-/// `datasets/android/`), its `datasets/` folder, or the `android/` folder itself; a run folder
-/// is one that holds `accelerometer.txt`. Runs without a Qualisys file are listed apart
+/// `datasets/android/` and `datasets/ios/`, side by side or one of them), its `datasets/` folder,
+/// or an `android/` or `ios/` folder itself; a run folder is one that holds `accelerometer.txt`
+/// (both layouts have it). Runs without a Qualisys file are listed apart
 /// ([`TyrexRuns::without_mocap`]): a root is converted for its ground truth, and one such
 /// folder must not fail it. Read one alone with [`read`] (without ground truth).
 pub fn list_sequences(root: impl AsRef<Path>) -> Result<TyrexRuns> {
     let root = root.as_ref();
-    let base = [
-        root.join("datasets").join("android"),
-        root.join("android"),
-        root.to_path_buf(),
-    ]
-    .into_iter()
-    .find(|p| p.is_dir())
-    .ok_or_else(|| {
+    let bases = run_folders(root).ok_or_else(|| {
         DataError::format(
             Location::file(root),
             format!(
@@ -271,25 +415,33 @@ pub fn list_sequences(root: impl AsRef<Path>) -> Result<TyrexRuns> {
             ),
         )
     })?;
-    let entries = std::fs::read_dir(&base).map_err(|e| DataError::io(&base, e))?;
     let mut out = TyrexRuns::default();
-    for entry in entries {
-        let path = entry.map_err(|e| DataError::io(&base, e))?.path();
-        if !path.join("accelerometer.txt").is_file() {
-            continue;
-        }
-        // `exists`, not `is_file`: a Qualisys path that is no regular file is the reader's
-        // error to report, not a reason to skip the run.
-        if mat_path(&path).is_some_and(|m| m.exists()) {
-            out.runs.push(path);
-        } else {
-            out.without_mocap.push(path);
+    for base in &bases {
+        let entries = std::fs::read_dir(base).map_err(|e| DataError::io(base, e))?;
+        for entry in entries {
+            let path = entry.map_err(|e| DataError::io(base, e))?.path();
+            if !path.join("accelerometer.txt").is_file() {
+                continue;
+            }
+            // `exists`, not `is_file`: a Qualisys path that is no regular file (or two files whose
+            // names differ only in case) is the reader's error to report, not a reason to skip
+            // the run.
+            if mat_candidates(&path).is_some_and(|m| !m.is_empty()) {
+                out.runs.push(path);
+            } else {
+                out.without_mocap.push(path);
+            }
         }
     }
     if out.runs.is_empty() && out.without_mocap.is_empty() {
+        let shown: Vec<String> = bases.iter().map(|b| b.display().to_string()).collect();
         return Err(DataError::format(
-            Location::file(&base),
-            "no Tyrex sequence folder (with accelerometer.txt) here or in datasets/android/",
+            Location::file(&bases[0]),
+            format!(
+                "no Tyrex sequence folder (with accelerometer.txt) here or in datasets/android/ \
+                 or datasets/ios/ (looked in {})",
+                shown.join(", ")
+            ),
         ));
     }
     out.runs.sort();
@@ -297,13 +449,78 @@ pub fn list_sequences(root: impl AsRef<Path>) -> Result<TyrexRuns> {
     Ok(out)
 }
 
-/// Where the ground truth of the sequence folder `dir` is: `../../qualisys/<name>.mat`.
-pub fn mat_path(dir: &Path) -> Option<PathBuf> {
+/// The Qualisys files of the run folder `dir` in `../../qualisys/`: `<name>.mat` when it exists,
+/// else every file whose name is `<name>.mat` but for ASCII case (the source spells one run
+/// `Jakob_iPhone4S_NoDist_Backpocket` and its file `Jakob_iPhone4S_NoDist_BackPocket.mat`).
+/// `None` when `dir` has no name or parent folders to look in.
+fn mat_candidates(dir: &Path) -> Option<Vec<PathBuf>> {
+    let exact = exact_mat_path(dir)?;
+    if exact.exists() {
+        return Some(vec![exact]);
+    }
+    let want = exact.file_name()?.to_str()?.to_owned();
+    let folder = exact.parent()?;
+    let Ok(entries) = std::fs::read_dir(folder) else {
+        return Some(Vec::new());
+    };
+    let mut found: Vec<PathBuf> = entries
+        .filter_map(|e| e.ok())
+        .filter(|e| {
+            e.file_name()
+                .to_str()
+                .is_some_and(|n| n.eq_ignore_ascii_case(&want))
+        })
+        .map(|e| e.path())
+        .collect();
+    found.sort();
+    Some(found)
+}
+
+/// `../../qualisys/<name>.mat` of the run folder `dir`, spelled as the folder is.
+fn exact_mat_path(dir: &Path) -> Option<PathBuf> {
     let name = dir.file_name()?;
     let datasets = dir.parent()?.parent()?;
     let mut file = datasets.join("qualisys").join(name);
-    file.set_extension("mat");
+    file.as_mut_os_string().push(".mat");
     Some(file)
+}
+
+/// Where the ground truth of the sequence folder `dir` is: `../../qualisys/<name>.mat` beside
+/// the `android/` or `ios/` folder, matched regardless of ASCII case when no file has the exact
+/// name (one shared run is `..._Backpocket`, its file `..._BackPocket.mat`). When no file or
+/// several match, the exact name (which does not exist).
+pub fn mat_path(dir: &Path) -> Option<PathBuf> {
+    match mat_candidates(dir)?.as_slice() {
+        [one] => Some(one.clone()),
+        _ => exact_mat_path(dir),
+    }
+}
+
+/// The Qualisys file [`read`] takes for `dir`: `None` when there is none.
+///
+/// # Errors
+/// Several files match but for case; or the one that matches is not a regular file (a folder, a
+/// device).
+fn ground_truth_file(dir: &Path) -> Result<Option<PathBuf>> {
+    let found = mat_candidates(dir).unwrap_or_default();
+    match found.as_slice() {
+        [] => Ok(None),
+        [one] if one.is_file() => Ok(Some(one.clone())),
+        [one] => Err(DataError::format(
+            Location::file(one),
+            "the run's Qualisys file is not a regular file",
+        )),
+        [first, second, ..] => Err(DataError::format(
+            Location::file(first),
+            format!(
+                "{} Qualisys files match the run `{}` but for case ({} and {}): keep one",
+                found.len(),
+                dir.file_name().unwrap_or_default().to_string_lossy(),
+                first.display(),
+                second.display()
+            ),
+        )),
+    }
 }
 
 /// Reads the ground truth of a QTM `.mat` export at the mocap rate.
@@ -481,16 +698,40 @@ impl<T> Stream<T> {
     }
 }
 
+/// What [`read_stream`] does with a last record that has no line break after it (a file cut
+/// off while being written, whose last value may be cut short yet still parse).
+enum CutOff<'a> {
+    /// Refuse the file, naming that line (the Android layout, as every other data reader).
+    Refuse,
+    /// Leave that record out, with a warning naming it (the iOS layout: one shared file,
+    /// `Thibaud_iPhone4S_NoDist_RunningHand/attitude.txt`, is cut off so).
+    Drop(&'a mut Vec<String>),
+}
+
 /// Reads a whitespace-separated table whose rows have one of the `widths` (time included),
 /// converting each row with `row`.
 fn read_stream<T>(
     path: &Path,
     names: &[&str],
     widths: &[usize],
+    cut_off: CutOff<'_>,
     mut row: impl FnMut(&[f64], usize) -> Result<T>,
 ) -> Result<Stream<T>> {
     let bytes = text::read_file(path)?;
-    let content = text::as_text(&bytes, path)?;
+    let mut content = text::as_text(&bytes, path)?;
+    if let CutOff::Drop(warnings) = cut_off
+        && !content.trim_end_matches([' ', '\t', '\r']).ends_with('\n')
+        && let Some((line, last)) = text::lines(content).last()
+    {
+        // `last` is a slice of `content`: keep what comes before it.
+        let at = last.as_ptr() as usize - content.as_ptr() as usize;
+        content = &content[..at];
+        warnings.push(format!(
+            "{}:{line}: the file ends inside this record, without a line break (cut off while \
+             being written): the record is left out",
+            path.display()
+        ));
+    }
     // About 45 bytes per row in these files: reserving avoids regrowing the vectors.
     let guess = content.len() / 40;
     let (mut time, mut values, mut lines) = (
@@ -542,14 +783,14 @@ fn read_stream<T>(
 }
 
 fn read_vec_stream(path: &Path, names: &[&str]) -> Result<Stream<DeviceVec>> {
-    read_stream(path, names, &[4], |c, _| {
+    read_stream(path, names, &[4], CutOff::Refuse, |c, _| {
         Ok(DeviceVec::new(c[1], c[2], c[3]))
     })
 }
 
 fn read_rotation_vector(path: &Path) -> Result<Stream<WorldFromDevice>> {
     let names = ["t", "qx", "qy", "qz", "qw", "heading_accuracy"];
-    read_stream(path, &names, &[4, 5, 6], |c, line| {
+    read_stream(path, &names, &[4, 5, 6], CutOff::Refuse, |c, line| {
         // Old Android versions give only x, y, z.
         android::rotation_vector([c[1], c[2], c[3]], c.get(4).copied()).map_err(|message| {
             DataError::format(Location::line(path, line).with_field("qw"), message)
@@ -578,17 +819,79 @@ fn read_time_diff(path: &Path) -> Result<f64> {
     Ok(value)
 }
 
-/// `Model = ...` of `record.properties`, when the file is there.
-fn read_model(path: &Path) -> Result<Option<String>> {
+/// The value of `key` in the ini-style file `path` (`[Section]` lines, `key = value` lines):
+/// the first in `section` (any section when `None`), with its line. `None` when the file is not
+/// there (`record.properties` is optional) or has no such key. A small hand-written file: its
+/// last line needs no line break.
+fn ini_value(path: &Path, section: Option<&str>, key: &str) -> Result<Option<(usize, String)>> {
     if !path.is_file() {
         return Ok(None);
     }
     let bytes = text::read_file(path)?;
     let content = text::as_text(&bytes, path)?;
-    Ok(text::lines(content).find_map(|(_, l)| {
-        let (key, value) = l.split_once('=')?;
-        (key.trim() == "Model").then(|| value.trim().to_owned())
-    }))
+    let mut current: Option<&str> = None;
+    for (line, l) in text::lines(content) {
+        let l = l.trim();
+        if let Some(name) = l.strip_prefix('[').and_then(|r| r.strip_suffix(']')) {
+            current = Some(name.trim());
+            continue;
+        }
+        let Some((k, value)) = l.split_once('=') else {
+            continue;
+        };
+        if k.trim() == key && (section.is_none() || current == section) {
+            return Ok(Some((line, value.trim().to_owned())));
+        }
+    }
+    Ok(None)
+}
+
+/// The phone of a run named `<Person>_<Phone>_<Dist>_<Motion>`, as a model name: the known
+/// Tyrex phones spelled as their makers do (`Nexus5` is `Nexus 5`, `iPhone4S` `iPhone 4S`,
+/// `iPhone5` `iPhone 5`), any other as it is written.
+pub fn phone_of(name: &str) -> Option<String> {
+    let mut parts = name.split('_');
+    let phone = parts.nth(1)?;
+    if parts.count() < 2 || phone.is_empty() {
+        return None;
+    }
+    Some(
+        match phone {
+            "Nexus5" => "Nexus 5",
+            "iPhone4S" => "iPhone 4S",
+            "iPhone5" => "iPhone 5",
+            other => other,
+        }
+        .to_owned(),
+    )
+}
+
+/// The run's device: `Model` in `file` (`section` of it) when given and usable, else the phone
+/// of the run's name, with the IMU rate of the accelerometer and gyroscope streams. An unusable
+/// `Model` (see [`DeviceInfo::new`]) is a warning, not an error: the device is a label.
+fn device_of(
+    file: &Path,
+    section: Option<&str>,
+    name: &str,
+    acce: &Stream<DeviceVec>,
+    gyro: &Stream<DeviceVec>,
+    warnings: &mut Vec<String>,
+) -> Result<Option<DeviceInfo>> {
+    let given = match ini_value(file, section, "Model")? {
+        Some((line, model)) => match DeviceInfo::new(&model) {
+            Ok(d) => Some(d),
+            Err(e) => {
+                warnings.push(format!(
+                    "{}:{line}: field `Model`: {e}: the device is taken from the run's name",
+                    file.display()
+                ));
+                None
+            }
+        },
+        None => None,
+    };
+    let device = given.or_else(|| DeviceInfo::new(&phone_of(name)?).ok());
+    Ok(device.map(|d| crate::device::with_imu_rate(d, &acce.time, &gyro.time)))
 }
 
 /// A warning when many accelerometer readings sit exactly at the largest magnitude seen: the
@@ -666,9 +969,49 @@ fn stream_intervals<T>(s: &Stream<T>, max_gap: f64, warnings: &mut Vec<String>) 
     })
 }
 
-/// Reads one sequence folder `datasets/android/<name>/` and, when
-/// [`TyrexOptions::ground_truth`] is set and `datasets/qualisys/<name>.mat` exists, its ground
-/// truth. See the module documentation for frames, time alignment and gap handling.
+/// The phone streams of a run, in the Android sensor conventions (device frame, m/s^2, rad/s,
+/// world-from-device orientation), on the phone clock: what each layout's reader gives the
+/// shared checks, gap handling, time alignment and resampling of [`read`].
+struct PhoneStreams {
+    acce: Stream<DeviceVec>,
+    gyro: Stream<DeviceVec>,
+    orientation: Stream<WorldFromDevice>,
+    source: OrientationSource,
+    device: Option<DeviceInfo>,
+    /// The clipping warning of the layout's accelerometer, if any.
+    clipping: Option<String>,
+}
+
+/// Reads the streams of an Android run folder.
+fn read_android(dir: &Path, name: &str, warnings: &mut Vec<String>) -> Result<PhoneStreams> {
+    let acce = read_vec_stream(&dir.join("accelerometer.txt"), &["t", "ax", "ay", "az"])?;
+    let gyro = read_vec_stream(
+        &dir.join("gyroscope-calibrated.txt"),
+        &["t", "wx", "wy", "wz"],
+    )?;
+    let orientation = read_rotation_vector(&dir.join("rotation-vector.txt"))?;
+    let device = device_of(
+        &dir.join("record.properties"),
+        None,
+        name,
+        &acce,
+        &gyro,
+        warnings,
+    )?;
+    Ok(PhoneStreams {
+        clipping: clipping(&acce),
+        acce,
+        gyro,
+        orientation,
+        source: OrientationSource::RotationVector,
+        device,
+    })
+}
+
+/// Reads one run folder, `datasets/android/<name>/` or `datasets/ios/<name>/` (see
+/// [`layout_of`]) and, when [`TyrexOptions::ground_truth`] is set and `datasets/qualisys/` holds
+/// its `.mat` (see [`mat_path`]), its ground truth. See the module documentation for the
+/// layouts, frames, time alignment and gap handling.
 pub fn read(dir: impl AsRef<Path>, options: &TyrexOptions) -> Result<TyrexRead> {
     let dir = dir.as_ref();
     if !(options.rate_hz.is_finite() && options.rate_hz > 0.0) {
@@ -695,27 +1038,34 @@ pub fn read(dir: impl AsRef<Path>, options: &TyrexOptions) -> Result<TyrexRead> 
         ));
     }
 
-    let acce = read_vec_stream(&dir.join("accelerometer.txt"), &["t", "ax", "ay", "az"])?;
-    let gyro = read_vec_stream(
-        &dir.join("gyroscope-calibrated.txt"),
-        &["t", "wx", "wy", "wz"],
-    )?;
-    let rv = read_rotation_vector(&dir.join("rotation-vector.txt"))?;
-    let device_model = read_model(&dir.join("record.properties"))?;
+    let layout = layout_of(dir)?;
+    let PhoneStreams {
+        acce,
+        gyro,
+        orientation: rv,
+        source,
+        device,
+        clipping,
+    } = match layout {
+        Layout::Android => read_android(dir, &name, &mut warnings)?,
+        Layout::Ios => ios::read(dir, &name, &mut warnings)?,
+    };
 
     let limits = &options.validation;
     acce.check(limits, Some(Channel::Acce), |v| v.to_array())?;
     gyro.check(limits, Some(Channel::Gyro), |v| v.to_array())?;
     rv.check(limits, None, |_| [0.0; 3])?;
-    if let Some(w) = clipping(&acce) {
-        warnings.push(w);
-    }
+    warnings.extend(clipping);
     let gap = options.max_sensor_gap_s;
     let mut spans = stream_intervals(&acce, gap, &mut warnings);
     spans = intersect(&spans, &stream_intervals(&gyro, gap, &mut warnings));
     spans = intersect(&spans, &stream_intervals(&rv, gap, &mut warnings));
 
-    let mat = mat_path(dir).filter(|p| options.ground_truth && p.exists());
+    let mat = if options.ground_truth {
+        ground_truth_file(dir)?
+    } else {
+        None
+    };
     let mut time_diff_s = None;
     // Valid mocap frames on the phone clock.
     let mut truth: Option<(Vec<f64>, Vec<WorldVec>, Vec<WorldFromDevice>)> = None;
@@ -800,9 +1150,10 @@ pub fn read(dir: impl AsRef<Path>, options: &TyrexOptions) -> Result<TyrexRead> 
             gravity,
             magnet: None,
             orientation,
-            orientation_source: Some(OrientationSource::RotationVector),
+            orientation_source: Some(source),
             ground_truth,
             steps: None,
+            device: device.clone(),
             time,
         };
         let seq = Sequence::with_validation(parts, limits).map_err(|e| {
@@ -825,7 +1176,8 @@ pub fn read(dir: impl AsRef<Path>, options: &TyrexOptions) -> Result<TyrexRead> 
         sequences,
         warnings,
         time_diff_s,
-        device_model,
+        device_model: device.map(|d| d.model().to_owned()),
+        layout,
     })
 }
 

@@ -5,7 +5,10 @@
 //! same float) and time as integer nanoseconds, so reading a written file gives the same sequence back bit for bit, except that
 //! time is rounded to whole nanoseconds, and that what the layout cannot hold is lost: the
 //! name (taken from the path when read), placement, steps and the orientation source (read back
-//! as the game rotation vector).
+//! as the game rotation vector). The device, which RIDI's layout has no column for either, is
+//! kept in a sidecar beside the data file ([`sidecar_path`](crate::sidecar_path): `data.csv`
+//! gets `data.csv.meta`), which the readers of this crate read back and RIDI's own ignore; a
+//! sequence without a device gets none (and an old one at that path is removed).
 //!
 //! What a sequence lacks is written so that the readers take it as absent again:
 //! - no magnetometer: `magnet_*` are zeros (a real magnetometer never reads exactly zero on
@@ -15,7 +18,10 @@
 //!   readers of this crate.
 //!
 //! Files are written atomically: to a temporary file in the target folder, then renamed, so a
-//! crash never leaves a half-written file under the final name.
+//! crash never leaves a half-written file under the final name. The sidecar goes with its data
+//! file: the old one is removed first, then the data file is written, then the new sidecar, so
+//! that an interrupted write leaves at worst a data file without its device, never one beside
+//! another file's sidecar.
 
 use std::fmt::{self, Write as _};
 use std::io::Write;
@@ -24,6 +30,7 @@ use std::path::Path;
 use crate::Sequence;
 use crate::error::{DataError, Result};
 use crate::processed::COLUMNS;
+use crate::sidecar;
 
 /// The 27 values of frame `i` in [`COLUMNS`] order, time excluded (slot 0 is unused).
 fn row(seq: &Sequence, i: usize) -> [f64; 27] {
@@ -54,33 +61,80 @@ fn time_ns(seq: &Sequence, i: usize) -> i64 {
 
 /// Writes `content` to `path` through a temporary file in the same folder, renamed into place
 /// once complete: readers never see a partial file, and a failed write leaves any previous file
-/// untouched. The one way ridi-rs writes output files.
+/// untouched.
+///
+/// The one way ridi-rs writes its output files: recordings and list files, reports, plots,
+/// trajectories, the models the `ridi` library and command write, and every file of a staged
+/// output folder. [`write_pending`] is the same write in two steps, for a file that is to be
+/// renamed into place only once another is written too. (`ridi_regress::Cascade::save`, for
+/// users of that crate alone, which cannot depend on this one, writes its own temporary file.)
+///
+/// # Permissions
+///
+/// On Unix the file is created with mode `0644` less the process umask, as `open(2)` applies
+/// it: `0644` (read for everyone, write for the owner) under the usual umask `022`, `0600`
+/// under `077`. A file it replaces keeps nothing of its own mode.
 pub fn write_atomically(
     path: &Path,
     content: impl FnOnce(&mut dyn Write) -> std::io::Result<()>,
 ) -> Result<()> {
+    write_pending(path, content)?.commit()
+}
+
+/// [`write_atomically`] up to the rename: `content` is written in full (and synced) to a
+/// temporary file in `path`'s folder, which [`PendingFile::commit`] renames to `path`. Dropped
+/// without a commit, the temporary file is removed and `path` left as it was. For outputs that
+/// are to replace their files together, or not at all.
+pub fn write_pending(
+    path: &Path,
+    content: impl FnOnce(&mut dyn Write) -> std::io::Result<()>,
+) -> Result<PendingFile> {
     let dir = match path.parent() {
         Some(d) if !d.as_os_str().is_empty() => d,
         _ => Path::new("."),
     };
     let io = |e| DataError::io(path, e);
-    let mut tmp = tempfile::NamedTempFile::new_in(dir).map_err(io)?;
-    // Temporary files are created private (0600); an output file is for others to read too.
+    let mut builder = tempfile::Builder::new();
+    // Temporary files are private (0600) by default; an output file is for others to read too.
     #[cfg(unix)]
     {
         use std::os::unix::fs::PermissionsExt;
-        tmp.as_file()
-            .set_permissions(std::fs::Permissions::from_mode(0o644))
-            .map_err(io)?;
+        builder.permissions(std::fs::Permissions::from_mode(0o644));
     }
+    let mut tmp = builder.tempfile_in(dir).map_err(io)?;
     {
         let mut w = std::io::BufWriter::with_capacity(1 << 16, tmp.as_file_mut());
         content(&mut w).map_err(io)?;
         w.flush().map_err(io)?;
     }
     tmp.as_file().sync_all().map_err(io)?;
-    tmp.persist(path).map_err(|e| io(e.error))?;
-    Ok(())
+    Ok(PendingFile {
+        tmp,
+        path: path.to_path_buf(),
+    })
+}
+
+/// A file [`write_pending`] wrote in full under a temporary name beside its path.
+#[derive(Debug)]
+pub struct PendingFile {
+    tmp: tempfile::NamedTempFile,
+    path: std::path::PathBuf,
+}
+
+impl PendingFile {
+    /// The path the file goes to.
+    pub fn path(&self) -> &Path {
+        &self.path
+    }
+
+    /// Renames the file into place, replacing any file of that name.
+    pub fn commit(self) -> Result<()> {
+        let path = self.path;
+        self.tmp
+            .persist(&path)
+            .map_err(|e| DataError::io(&path, e.error))?;
+        Ok(())
+    }
 }
 
 /// How numbers are written.
@@ -135,6 +189,18 @@ fn push_value(line: &mut String, v: f64, precision: Precision) {
     };
 }
 
+/// Writes a processed data file of `seq` through [`write_text`], with its sidecar: the old
+/// sidecar removed before, the new one (when `seq` has a device) written after.
+fn write_data(
+    seq: &Sequence,
+    path: &Path,
+    content: impl FnOnce(&mut dyn Write) -> std::io::Result<()>,
+) -> Result<()> {
+    sidecar::remove(path)?;
+    write_text(path, content)?;
+    sidecar::write(seq, path)
+}
+
 /// Writes text through [`write_atomically`], gzip-compressed when `path` ends in `.gz`.
 fn write_text(
     path: &Path,
@@ -156,7 +222,8 @@ fn write_text(
 
 /// Writes `seq` as a RIDI processed `data.csv`: a header with an empty first name (the pandas
 /// index), then one row per frame `index,time_ns,gyro_x,...,rv_z`. A path ending in `.gz` is
-/// gzip-compressed (the readers decompress transparently).
+/// gzip-compressed (the readers decompress transparently). The device, if any, goes to the
+/// sidecar ([`sidecar_path`](crate::sidecar_path)).
 pub fn write_ridi_csv(seq: &Sequence, path: impl AsRef<Path>) -> Result<()> {
     write_ridi_csv_with(seq, path, Precision::F64)
 }
@@ -167,7 +234,7 @@ pub fn write_ridi_csv_with(
     path: impl AsRef<Path>,
     precision: Precision,
 ) -> Result<()> {
-    write_text(path.as_ref(), |w| {
+    write_data(seq, path.as_ref(), |w| {
         writeln!(w, ",{}", COLUMNS.join(","))?;
         let mut line = String::with_capacity(512);
         for i in 0..seq.len() {
@@ -187,7 +254,7 @@ pub fn write_ridi_csv_with(
 /// Writes `seq` as a RIDI `data_plain.txt`: `N 27`, then N tab-separated rows without index
 /// (gzip-compressed when the path ends in `.gz`).
 pub fn write_ridi_plain(seq: &Sequence, path: impl AsRef<Path>) -> Result<()> {
-    write_text(path.as_ref(), |w| {
+    write_data(seq, path.as_ref(), |w| {
         writeln!(w, "{} {}", seq.len(), COLUMNS.len())?;
         let mut line = String::with_capacity(512);
         for i in 0..seq.len() {

@@ -5,7 +5,8 @@ use std::path::{Path, PathBuf};
 
 use rayon::prelude::*;
 use ridi_data::{
-    DataError, Format, Location, ReadOptions, detect, write_atomically, write_ridi_csv,
+    DataError, DeviceInfo, Format, Location, ReadOptions, detect, sidecar_path, write_atomically,
+    write_ridi_csv,
 };
 use ridi_data::{ilc, tyrex};
 
@@ -23,6 +24,9 @@ pub struct Converted {
     pub path: PathBuf,
     /// Number of frames.
     pub frames: usize,
+    /// The phone it was recorded with, when the source says; kept in the sidecar beside the
+    /// `data.csv` ([`ridi_data::sidecar_path`]).
+    pub device: Option<DeviceInfo>,
 }
 
 /// What [`convert`] wrote.
@@ -74,20 +78,25 @@ impl From<Vec<PathBuf>> for Sources {
     }
 }
 
-/// The runs with motion capture of a Tyrex root, and a warning naming those without.
+/// The runs with motion capture of a Tyrex root, and a warning naming those without (skipped);
+/// when no run has motion capture, every run, without ground truth, and a warning saying so.
 fn tyrex_sources(source: &Path) -> Result<Sources, DataError> {
     let runs = tyrex::list_sequences(source)?;
-    let skipped = runs.warning();
     if runs.runs.is_empty() {
-        return Err(DataError::format(
-            Location::file(source),
-            "no Tyrex run here has a Qualisys file in ../../qualisys/: convert a run folder \
-             itself to read it without ground truth",
-        ));
+        // Recordings in the Tyrex layout without any motion capture (one's own, say): what
+        // there is to convert is the phone data.
+        return Ok(Sources {
+            skipped: Some(format!(
+                "no run has a Qualisys file in ../../qualisys/: the {} run(s) are converted \
+                 without ground truth",
+                runs.without_mocap.len()
+            )),
+            paths: runs.without_mocap,
+        });
     }
     Ok(Sources {
+        skipped: runs.warning(),
         paths: runs.runs,
-        skipped,
     })
 }
 
@@ -280,15 +289,50 @@ fn tyrex_subject(name: &str) -> Option<&str> {
     (parts.count() >= 3).then_some(person).flatten()
 }
 
-/// Converts every sequence under `source` into `<out>/<name>/processed/data.csv` and writes
-/// list files (`name,placement` per line, relative to `out`): `list_all.txt`, and for Tyrex
-/// sources one `list_<person>.txt` per person. The placement of a Tyrex run is its motion name,
-/// that of an Indoor Location Competition path `hand`, that of a RIDI sequence the label list
-/// files directly in `source` give it (none otherwise).
+/// The list of each device, keyed by [`DeviceInfo::key`] (`nexus5`, `iphone4s`), for the
+/// sequences that name their device; `taken` are the lists already there (`all`, the people). A
+/// device whose key is one of those (ignoring case, as some file systems do) gets no list, with a
+/// warning; models with the same key (`Nexus 5`, `NEXUS-5`) share one.
+fn device_lists<'a>(
+    sequences: &'a [Converted],
+    taken: &BTreeMap<String, Vec<&'a Converted>>,
+) -> (BTreeMap<String, Vec<&'a Converted>>, Vec<String>) {
+    let mut lists: BTreeMap<String, Vec<&Converted>> = BTreeMap::new();
+    for c in sequences {
+        if let Some(d) = &c.device {
+            lists.entry(d.key()).or_default().push(c);
+        }
+    }
+    let mut warnings = Vec::new();
+    lists.retain(|key, entries| {
+        let clash = taken.keys().find(|t| t.eq_ignore_ascii_case(key));
+        if let Some(clash) = clash {
+            let model = entries[0].device.as_ref().map_or("", |d| d.model());
+            warnings.push(format!(
+                "{} sequence(s) of the device `{model}` get no list_{key}.txt: list_{clash}.txt \
+                 is another list",
+                entries.len()
+            ));
+        }
+        clash.is_none()
+    });
+    (lists, warnings)
+}
+
+/// Converts every sequence under `source` into `<out>/<name>/processed/data.csv` (with the
+/// sidecar `data.csv.meta` when the sequence names its device, see
+/// [`ridi_data::sidecar_path`]) and writes list files (`name,placement` per line, relative to
+/// `out`): `list_all.txt`, for Tyrex sources one `list_<person>.txt` per person, and one
+/// `list_<device>.txt` per device the sequences name ([`DeviceInfo::key`]: `list_nexus5.txt`,
+/// `list_iphone4s.txt`). The placement of a Tyrex run is its motion name, that of an Indoor
+/// Location Competition path `hand`, that of a RIDI sequence the label list files directly in
+/// `source` give it (none otherwise).
 ///
 /// All or nothing: every source is read and validated, and its files written to a staging
 /// folder in `out`, before any is moved into place; on an error `out` is left as it was (a
-/// folder `out` or its parents created for the conversion is removed again).
+/// folder `out` or its parents created for the conversion is removed again). A `data.csv` and
+/// its sidecar are replaced together: a sequence without a device removes an old sidecar at its
+/// place in the same commit.
 pub fn convert(
     source: &Path,
     out: &Path,
@@ -301,7 +345,7 @@ pub fn convert(
     } = sources(source, from)?;
     let listed = labels_from_lists(source);
     let labels = &listed.labels;
-    let staging = Staging::new(out)?;
+    let mut staging = Staging::new(out)?;
     let results: Vec<Result<Written, DataError>> = dirs
         .par_iter()
         .map(|dir| {
@@ -330,6 +374,7 @@ pub fn convert(
                         .map(str::to_string),
                     path: out.join(rel),
                     frames: seq.len(),
+                    device: seq.device().cloned(),
                 });
             }
             let warnings = loaded
@@ -349,6 +394,11 @@ pub fn convert(
         summary.warnings.extend(warnings);
     }
     summary.sequences.sort_by(|a, b| a.name.cmp(&b.name));
+    for c in summary.sequences.iter().filter(|c| c.device.is_none()) {
+        // A sequence without a device replaces one that had it: its old sidecar must go too.
+        let rel = Path::new(&c.name).join("processed").join("data.csv");
+        staging.remove(&sidecar_path(&rel));
+    }
 
     let mut lists: BTreeMap<String, Vec<&Converted>> = BTreeMap::new();
     for c in &summary.sequences {
@@ -357,6 +407,9 @@ pub fn convert(
             lists.entry(subject.to_string()).or_default().push(c);
         }
     }
+    let (by_device, warnings) = device_lists(&summary.sequences, &lists);
+    summary.warnings.extend(warnings);
+    lists.extend(by_device);
     let mut written_lists = Vec::new();
     for (key, entries) in &lists {
         let name = format!("list_{key}.txt");

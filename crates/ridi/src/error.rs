@@ -4,7 +4,10 @@
 use std::path::PathBuf;
 
 /// An error of the end-to-end pipeline.
+///
+/// Non-exhaustive: features add variants (`Plot` with the `plot` feature).
 #[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
 pub enum PipelineError {
     /// Reading or writing data.
     #[error(transparent)]
@@ -48,6 +51,19 @@ pub enum PipelineError {
     /// A stage was given no sequence at all.
     #[error("no sequences to {0}")]
     NoSequences(&'static str),
+    /// An output that cannot be written, or would replace an input ([`crate::OutputError`]).
+    #[error(transparent)]
+    Output(#[from] crate::output::OutputError),
+    /// An error about one sequence of a list file, at the list file and line
+    /// ([`crate::lists::Listed::locate`]); it chains the error itself.
+    #[error("{at}")]
+    Listed {
+        /// The list file and line of the sequence.
+        at: ridi_data::Location,
+        /// The error about the sequence.
+        #[source]
+        source: Box<PipelineError>,
+    },
     /// A file the pipeline writes or reads itself (models, reports, placement maps).
     #[error("{}: {message}", path.display())]
     File {

@@ -6,7 +6,9 @@
 //! metric keys of [`ridi_eval::TrajectoryMetrics`] (`mpe_m`, `mpe_pct`, `ate_m`, `rte_m`,
 //! `ate_ronin_m`, `rte_ronin_m`, `rte_5s_m`, `path_length_ratio`); `summary.<key>` holds the
 //! means over sequences; `warnings` what the numbers do not say (see [`placement_warnings`]).
-//! Method keys are those of [`Method::key`].
+//! Method keys are those of [`Method::key`]. [`Report::read`] reads a `report.json` back
+//! (`null`, which JSON has for a `NaN`, as `NaN`); [`crate::EvalFolder`] writes an evaluation's
+//! folder.
 
 use std::collections::{BTreeMap, BTreeSet};
 use std::fmt::Write as _;
@@ -20,7 +22,7 @@ use ridi_eval::{
 };
 use ridi_features::{FeatureConfig, compute_targets};
 use ridi_regress::Cascade;
-use serde::Serialize;
+use serde::{Deserialize, Deserializer, Serialize};
 
 use crate::baselines::{Method, trajectory};
 use crate::error::{PipelineError, Result};
@@ -50,7 +52,7 @@ impl Default for EvalOptions {
 }
 
 /// Results of one sequence.
-#[derive(Debug, Clone, PartialEq, Serialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct SequenceResult {
     /// Sequence name.
     pub name: String,
@@ -65,7 +67,9 @@ pub struct SequenceResult {
     pub alignment_extent_m: f64,
     /// Fraction of regressions whose predicted placement is the sequence's label.
     pub placement_accuracy: Option<f64>,
-    /// Velocity regression MSE `[S-x, S-z]`, (m/s)^2, against the smoothed ground truth.
+    /// Velocity regression MSE `[S-x, S-z]`, (m/s)^2, against the smoothed ground truth
+    /// (`NaN` without regressions, `null` in JSON).
+    #[serde(deserialize_with = "nan_if_null")]
     pub velocity_mse: [f64; 2],
     /// Metrics per method key.
     pub methods: BTreeMap<String, TrajectoryMetrics>,
@@ -90,14 +94,16 @@ pub struct Traces {
     pub placements: Vec<String>,
 }
 
-/// The whole evaluation.
-#[derive(Debug, Clone, PartialEq, Serialize)]
+/// The whole evaluation: what `report.json` holds ([`Report::write`], [`Report::read`]).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Report {
     /// Per-sequence results.
     pub sequences: Vec<SequenceResult>,
     /// Mean of each metric over sequences, per method key.
     pub summary: BTreeMap<String, TrajectoryMetrics>,
-    /// Velocity MSE over all regressions of all sequences, (m/s)^2.
+    /// Velocity MSE over all regressions of all sequences, (m/s)^2 (`NaN` without
+    /// regressions, `null` in JSON).
+    #[serde(deserialize_with = "nan_if_null")]
     pub velocity_mse: [f64; 2],
     /// Placement accuracy over all regressions.
     pub placement_accuracy: Option<f64>,
@@ -110,6 +116,13 @@ pub struct Report {
     /// Things to know before reading the numbers, one sentence each ([`placement_warnings`]);
     /// also in `report.md`.
     pub warnings: Vec<String>,
+}
+
+/// Reads a pair of floats that JSON holds as `null` where they are `NaN` (serde_json writes
+/// a non-finite float as `null`).
+fn nan_if_null<'de, D: Deserializer<'de>>(d: D) -> std::result::Result<[f64; 2], D::Error> {
+    let pair = <[Option<f64>; 2]>::deserialize(d)?;
+    Ok(pair.map(|v| v.unwrap_or(f64::NAN)))
 }
 
 struct Evaluated {
@@ -483,6 +496,16 @@ impl Report {
             out.push_str(&markdown_confusion(cm));
         }
         out
+    }
+
+    /// Reads a `report.json` that [`Report::write`] wrote.
+    pub fn read(path: &Path) -> Result<Report> {
+        let file = |message: String| PipelineError::File {
+            path: path.to_path_buf(),
+            message,
+        };
+        let text = std::fs::read_to_string(path).map_err(|e| file(e.to_string()))?;
+        serde_json::from_str(&text).map_err(|e| file(e.to_string()))
     }
 
     /// Writes `report.json` and `report.md` into `dir` (created if needed), atomically.

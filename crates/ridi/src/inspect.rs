@@ -58,6 +58,11 @@ pub struct Inspection {
     pub format: String,
     /// Sequence name.
     pub name: String,
+    /// The phone's model (`iPhone 4S`), when the source says.
+    pub device: Option<String>,
+    /// The rate the phone's IMU sampled at before any resampling, Hz, when known
+    /// ([`ridi_data::DeviceInfo::imu_rate_hz`]); `rate_hz` is the sequence's.
+    pub device_imu_rate_hz: Option<f64>,
     /// Placement label, if known.
     pub placement: Option<String>,
     /// Number of frames.
@@ -163,6 +168,8 @@ pub fn inspect(seq: &Sequence, format: Format) -> Inspection {
     Inspection {
         format: format.to_string(),
         name: seq.name().to_string(),
+        device: seq.device().map(|d| d.model().to_string()),
+        device_imu_rate_hz: seq.device().and_then(|d| d.imu_rate_hz()),
         placement: seq.placement().map(str::to_string),
         frames: seq.len(),
         duration_s: seq.duration(),
@@ -189,6 +196,15 @@ impl std::fmt::Display for Inspection {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         writeln!(f, "name:         {}", self.name)?;
         writeln!(f, "format:       {}", self.format)?;
+        match (&self.device, self.device_imu_rate_hz) {
+            (Some(d), Some(r)) => writeln!(
+                f,
+                "device:       {d}, IMU at {r:.1} Hz (this sequence: {:.0} Hz)",
+                self.rate_hz
+            )?,
+            (Some(d), None) => writeln!(f, "device:       {d}")?,
+            (None, _) => writeln!(f, "device:       (unknown)")?,
+        }
         writeln!(
             f,
             "placement:    {}",

@@ -12,10 +12,11 @@
 //! | [`eval`] | `ridi-eval` | alignment, MPE/ATE/RTE, reports |
 //!
 //! Pipeline modules: [`source`] reads any supported layout, [`convert`] writes the RIDI
-//! layout with list files (all or nothing, through [`staging`]), [`lists`] reads list files
+//! layout with list files (all or nothing, through [`Staging`]), [`lists`] reads list files
 //! for training and evaluation with the labels they need, [`inspect`] summarizes a recording or a model,
 //! [`orientation`] swaps in an orientation estimated from gyro and accelerometer, [`live`]
-//! tracks a stream sample by sample.
+//! tracks a stream sample by sample, [`Demo`] is `ridi demo` (train on a sample, evaluate on
+//! its held-out runs, write both).
 //!
 //! # Design decisions
 //!
@@ -27,6 +28,13 @@
 //! - **Batch and live tracking are one code path.** `ridi track --online` and [`track()`] with
 //!   [`TrackOptions::online`] feed a recording through [`LiveTracker`] sample by sample, so the
 //!   streaming poses a program gets are the ones the command line tests.
+//! - **Outputs are checked first and written all or nothing, here.** An output is refused
+//!   before any work when it cannot be written or would replace an input
+//!   ([`check_output_file`], [`check_output_folder`], [`check_not_input`]); a command's files
+//!   replace the old ones together or not at all ([`TrackOutput`], [`EvalFolder`] through
+//!   [`Staging`]); every file goes through [`data::write_atomically`], with one permission
+//!   mode. This is library policy, so that the `ridi` command line holds only its arguments,
+//!   progress and exit codes, and a program using the library writes as it does.
 //! - **Plots are optional.** The `plot` feature (on by default) brings plotters and an embedded
 //!   font; an embedded tracker leaves it out with `default-features = false`.
 //!
@@ -65,28 +73,36 @@ pub use ridi_regress as regress;
 
 pub mod baselines;
 pub mod convert;
+mod demo;
 mod error;
 pub mod evaluate;
 pub mod inspect;
 pub mod lists;
 pub mod live;
 pub mod orientation;
+mod output;
 pub mod placement;
 #[cfg(feature = "plot")]
 pub mod plot;
 pub mod source;
-pub mod staging;
+mod staging;
 pub mod track;
 pub mod train;
 
 pub use baselines::Method;
+pub use demo::Demo;
 pub use error::{PipelineError, Result};
 pub use evaluate::{EvalOptions, Report, evaluate};
 pub use lists::{Purpose, load_lists};
 pub use live::{LiveTracker, Recorded, SensorReading};
 pub use orientation::{Orientation, apply_orientation, oriented};
+pub use output::{
+    EvalFolder, EvalPlots, EvalWritten, OutputError, TrackOutput, check_not_input,
+    check_output_file, check_output_folder, save_model,
+};
 pub use placement::PlacementMap;
 pub use source::{Loaded, read_any};
+pub use staging::Staging;
 pub use track::{Track, TrackOptions, track};
 pub use train::{GridChoice, TrainOptions, train};
 

@@ -5,8 +5,61 @@ use std::path::Path;
 
 use ridi_data::{DataError, ListEntry, ReadOptions, Sequence, load_entries, read_list};
 
-use crate::error::Result;
+use crate::error::{PipelineError, Result};
 use crate::placement::PlacementMap;
+
+/// Sequences read from list files, each with the list entry (file and line) it was read from,
+/// so that an error found later about one of them (a recording too short to track, say) can
+/// name its list line too.
+#[derive(Debug, Clone)]
+pub struct Listed {
+    sequences: Vec<Sequence>,
+    entries: Vec<ListEntry>,
+}
+
+impl Listed {
+    /// [`load_listed`], keeping the entries.
+    pub fn load(
+        entries: Vec<ListEntry>,
+        map: Option<&PlacementMap>,
+        purpose: Purpose,
+        opts: &ReadOptions,
+    ) -> Result<Self> {
+        let sequences = load_listed(&entries, map, purpose, opts)?;
+        Ok(Self { sequences, entries })
+    }
+
+    /// The sequences, in list order.
+    pub fn sequences(&self) -> &[Sequence] {
+        &self.sequences
+    }
+
+    /// The list entry of each sequence.
+    pub fn entries(&self) -> &[ListEntry] {
+        &self.entries
+    }
+
+    /// `e` at the list file and line of the sequence it is about ([`PipelineError::Listed`]),
+    /// when it is a [`PipelineError::Sequence`] error and that sequence's name is one listed
+    /// sequence's alone (training takes recordings of one name); otherwise `e` as it is.
+    pub fn locate(&self, e: PipelineError) -> PipelineError {
+        let PipelineError::Sequence { sequence, .. } = &e else {
+            return e;
+        };
+        let mut named = self
+            .sequences
+            .iter()
+            .enumerate()
+            .filter(|(_, s)| s.name() == sequence);
+        match (named.next(), named.next()) {
+            (Some((i, _)), None) => PipelineError::Listed {
+                at: self.entries[i].location(),
+                source: Box::new(e),
+            },
+            _ => e,
+        }
+    }
+}
 
 /// What the listed sequences are for, and so what each must have.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

@@ -1,12 +1,16 @@
-//! All-or-nothing output folders: files are written into a hidden staging folder inside the
-//! output folder, then moved into place together once every one of them was written.
+//! All-or-nothing output folders, the one staging mechanism of ridi-rs (`ridi convert`,
+//! evaluations and the demo): files are written into a hidden staging folder inside the output
+//! folder, each through [`ridi_data::write_atomically`], then moved into place together once
+//! every one of them was written.
 
 use std::path::{Path, PathBuf};
 
-use ridi_data::DataError;
+use ridi_data::{DataError, write_atomically};
 
-/// An output folder being written. [`Staging::file`] gives where to write each output file;
-/// [`Staging::commit`] moves them all into the output folder. Dropped without a commit (an
+/// An output folder being written. [`Staging::write`] writes an output file (or
+/// [`Staging::file`] gives where a writer of ridi-rs, which goes through
+/// [`ridi_data::write_atomically`], is to write it); [`Staging::commit`] moves them all into
+/// the output folder. Dropped without a commit (an
 /// error on the way), it removes what it wrote and the folders it created, so the output
 /// folder is left as it was.
 #[derive(Debug)]
@@ -16,6 +20,8 @@ pub struct Staging {
     /// Dropped before `created`, which may hold it.
     temp: tempfile::TempDir,
     created: CreatedDirs,
+    /// Output files to remove at the commit (relative to the output folder).
+    removals: Vec<PathBuf>,
 }
 
 /// Folders created for the output, removed when dropped if they are empty.
@@ -60,7 +66,16 @@ impl Staging {
             out: out.to_path_buf(),
             temp,
             created,
+            removals: Vec::new(),
         })
+    }
+
+    /// Removes the output file `rel` (relative to the output folder) at the commit, if it is
+    /// there and no staged file replaces it; a failed commit puts it back. For a file that must
+    /// not outlive the ones written beside it (the sidecar of a `data.csv` rewritten without
+    /// one).
+    pub fn remove(&mut self, rel: &Path) {
+        self.removals.push(rel.to_path_buf());
     }
 
     /// Where to write the output file `rel` (relative to the output folder) until the commit;
@@ -73,6 +88,18 @@ impl Staging {
         Ok(path)
     }
 
+    /// Writes the output file `rel` (relative to the output folder) through
+    /// [`write_atomically`] until the commit, and returns where it is staged.
+    pub fn write(
+        &self,
+        rel: &Path,
+        content: impl FnOnce(&mut dyn std::io::Write) -> std::io::Result<()>,
+    ) -> Result<PathBuf, DataError> {
+        let path = self.file(rel)?;
+        write_atomically(&path, content)?;
+        Ok(path)
+    }
+
     /// The staged folder `rel` (relative to the output folder, `""` for the output folder
     /// itself), created: where to write output files whose names another function chooses.
     pub fn dir(&self, rel: &Path) -> Result<PathBuf, DataError> {
@@ -81,8 +108,9 @@ impl Staging {
         Ok(dir)
     }
 
-    /// Moves every staged file into the output folder, replacing files of the same name. If a
-    /// move fails, those done are undone (replaced files come back) and the error returned.
+    /// Moves every staged file into the output folder, replacing files of the same name, and
+    /// removes the files [`Staging::remove`] named. If a move fails, those done are undone
+    /// (replaced and removed files come back) and the error returned.
     pub fn commit(mut self) -> Result<(), DataError> {
         let new = self.temp.path().join("new");
         let old = self.temp.path().join("old");
@@ -90,25 +118,42 @@ impl Staging {
         staged_files(&new, Path::new(""), &mut files)?;
         // (destination, where the file it replaced went)
         let mut moved: Vec<(PathBuf, Option<PathBuf>)> = Vec::new();
-        let result = files.iter().try_for_each(|rel| {
+        let removals: Vec<&PathBuf> = self
+            .removals
+            .iter()
+            .filter(|rel| !files.contains(rel) && self.out.join(rel).is_file())
+            .collect();
+        let removed = removals.iter().try_for_each(|rel| {
             let dest = self.out.join(rel);
-            if let Some(dir) = dest.parent() {
-                self.created.create(dir)?;
+            let b = old.join(rel);
+            if let Some(dir) = b.parent() {
+                std::fs::create_dir_all(dir).map_err(|e| DataError::io(dir, e))?;
             }
-            let backup = if dest.is_file() {
-                let b = old.join(rel);
-                if let Some(dir) = b.parent() {
-                    std::fs::create_dir_all(dir).map_err(|e| DataError::io(dir, e))?;
+            std::fs::rename(&dest, &b).map_err(|e| DataError::io(&dest, e))?;
+            moved.push((dest, Some(b)));
+            Ok(())
+        });
+        let result = removed.and_then(|()| {
+            files.iter().try_for_each(|rel| {
+                let dest = self.out.join(rel);
+                if let Some(dir) = dest.parent() {
+                    self.created.create(dir)?;
                 }
-                std::fs::rename(&dest, &b).map_err(|e| DataError::io(&dest, e))?;
-                Some(b)
-            } else {
-                None
-            };
-            let renamed =
-                std::fs::rename(new.join(rel), &dest).map_err(|e| DataError::io(&dest, e));
-            moved.push((dest, backup));
-            renamed
+                let backup = if dest.is_file() {
+                    let b = old.join(rel);
+                    if let Some(dir) = b.parent() {
+                        std::fs::create_dir_all(dir).map_err(|e| DataError::io(dir, e))?;
+                    }
+                    std::fs::rename(&dest, &b).map_err(|e| DataError::io(&dest, e))?;
+                    Some(b)
+                } else {
+                    None
+                };
+                let renamed =
+                    std::fs::rename(new.join(rel), &dest).map_err(|e| DataError::io(&dest, e));
+                moved.push((dest, backup));
+                renamed
+            })
         });
         if result.is_err() {
             for (dest, backup) in moved.iter().rev() {
@@ -188,6 +233,37 @@ mod tests {
         std::fs::write(staging.file(Path::new("x/data.txt")).unwrap(), "new").unwrap();
         drop(staging);
         assert!(out.is_dir() && tree(&out).is_empty());
+    }
+
+    #[test]
+    fn removals_happen_at_the_commit_and_are_undone_with_it() {
+        let dir = tempfile::tempdir().unwrap();
+        let out = dir.path().join("out");
+        std::fs::create_dir_all(out.join("a")).unwrap();
+        std::fs::write(out.join("a/data.csv"), "old").unwrap();
+        std::fs::write(out.join("a/data.csv.meta"), "old").unwrap();
+        let mut staging = Staging::new(&out).unwrap();
+        std::fs::write(staging.file(Path::new("a/data.csv")).unwrap(), "new").unwrap();
+        staging.remove(Path::new("a/data.csv.meta"));
+        staging.remove(Path::new("a/never.txt"));
+        assert!(
+            out.join("a/data.csv.meta").is_file(),
+            "not before the commit"
+        );
+        staging.commit().unwrap();
+        assert_eq!(tree(&out), ["a/data.csv"]);
+
+        // A failed commit brings the removed file back.
+        std::fs::write(out.join("a/data.csv.meta"), "old").unwrap();
+        std::fs::create_dir_all(out.join("b/data.csv")).unwrap();
+        let mut staging = Staging::new(&out).unwrap();
+        staging.remove(Path::new("a/data.csv.meta"));
+        std::fs::write(staging.file(Path::new("b/data.csv")).unwrap(), "new").unwrap();
+        assert!(staging.commit().is_err());
+        assert_eq!(
+            std::fs::read_to_string(out.join("a/data.csv.meta")).unwrap(),
+            "old"
+        );
     }
 
     #[test]

@@ -90,44 +90,78 @@ impl Track {
 
     /// Writes the trajectory CSV: `time,pos_x,pos_y,pos_z,vel_x,vel_y,vel_z,placement,
     /// bias_x,bias_y,bias_z`, one row per frame (`placement` is the latest regression's, empty
-    /// before the first). Written atomically.
+    /// before the first). Written atomically ([`write_atomically`]); [`crate::TrackOutput`]
+    /// writes it together with a plot.
     pub fn write_csv(&self, path: impl AsRef<Path>) -> Result<()> {
-        let path = path.as_ref();
+        write_atomically(path.as_ref(), |w| self.csv(w))?;
+        Ok(())
+    }
+
+    /// The rows of [`Track::write_csv`], header first.
+    pub(crate) fn csv(&self, w: &mut dyn std::io::Write) -> std::io::Result<()> {
         let mut next = 0;
         let mut current: Option<&str> = None;
-        write_atomically(path, |w| {
+        writeln!(
+            w,
+            "time,pos_x,pos_y,pos_z,vel_x,vel_y,vel_z,placement,bias_x,bias_y,bias_z"
+        )?;
+        for i in 0..self.time.len() {
+            while next < self.regressions.len() && self.regressions[next].frame <= i {
+                current = self
+                    .placement_names
+                    .get(self.regressions[next].placement)
+                    .map(String::as_str);
+                next += 1;
+            }
+            let (p, v, b) = (self.position[i], self.velocity[i], self.bias[i]);
+            let r = RoundTrip;
             writeln!(
                 w,
-                "time,pos_x,pos_y,pos_z,vel_x,vel_y,vel_z,placement,bias_x,bias_y,bias_z"
+                "{},{},{},{},{},{},{},{},{},{},{}",
+                r(self.time[i]),
+                r(p.x()),
+                r(p.y()),
+                r(p.z()),
+                r(v.x()),
+                r(v.y()),
+                r(v.z()),
+                current.unwrap_or(""),
+                r(b.x()),
+                r(b.y()),
+                r(b.z())
             )?;
-            for i in 0..self.time.len() {
-                while next < self.regressions.len() && self.regressions[next].frame <= i {
-                    current = self
-                        .placement_names
-                        .get(self.regressions[next].placement)
-                        .map(String::as_str);
-                    next += 1;
-                }
-                let (p, v, b) = (self.position[i], self.velocity[i], self.bias[i]);
-                let r = RoundTrip;
-                writeln!(
-                    w,
-                    "{},{},{},{},{},{},{},{},{},{},{}",
-                    r(self.time[i]),
-                    r(p.x()),
-                    r(p.y()),
-                    r(p.z()),
-                    r(v.x()),
-                    r(v.y()),
-                    r(v.z()),
-                    current.unwrap_or(""),
-                    r(b.x()),
-                    r(b.y()),
-                    r(b.z())
-                )?;
-            }
-            Ok(())
-        })?;
+        }
+        Ok(())
+    }
+
+    /// Draws the horizontal trajectory of `seq` (tracked into `self`) to `path` (`.svg` or
+    /// `.png`), with its ground truth if it has one, the trajectory then aligned to it on the
+    /// first 10 s as evaluations do.
+    #[cfg(feature = "plot")]
+    pub fn plot(&self, seq: &Sequence, path: &Path) -> Result<()> {
+        use crate::plot::{Trajectory, TrajectoryOptions, TrajectoryPlot, plot_trajectories};
+        let est = self.horizontal();
+        let gt = seq.ground_truth().map(|gt| gt.horizontal());
+        let shown = match &gt {
+            Some(gt) => ridi_eval::align_trajectory(seq.time(), &est, gt, Default::default())?.1,
+            None => est,
+        };
+        let estimates = [Trajectory {
+            name: "ridi",
+            points: &shown,
+        }];
+        plot_trajectories(
+            path,
+            &TrajectoryPlot {
+                title: seq.name(),
+                ground_truth: gt.as_deref().map(|points| Trajectory {
+                    name: "ground truth",
+                    points,
+                }),
+                estimates: &estimates,
+            },
+            &TrajectoryOptions::default(),
+        )?;
         Ok(())
     }
 }

@@ -353,3 +353,155 @@ fn rate_resamples_every_sequence_and_refuses_to_fill_gaps() {
         Err(SequenceError::InvalidRate { .. })
     ));
 }
+
+/// The device of a sequence survives `ridi convert` in the sidecar beside its `data.csv`, each
+/// device gets its list, and a sequence converted again without one loses the old sidecar.
+#[test]
+fn devices_are_kept_with_one_list_per_device() {
+    use ridi::data::{DeviceInfo, sidecar_path};
+    let dir = tempfile::tempdir().unwrap();
+    let opts = ReadOptions::default();
+    let walk = read_sequence(seq("Thibaud_Nexus5_NoDist_Texting"), &opts).unwrap();
+    let src = dir.path().join("src");
+    let device =
+        |model: &str, rate: f64| Some(DeviceInfo::new(model).unwrap().with_imu_rate(rate).unwrap());
+    let write = |name: &str, d: Option<DeviceInfo>| {
+        let mut s = walk.clone();
+        s.set_device(d);
+        let folder = src.join(name).join("processed");
+        std::fs::create_dir_all(&folder).unwrap();
+        write_ridi_csv(&s, folder.join("data.csv")).unwrap();
+    };
+    write("Ann_Nexus5_NoDist_Texting", device("Nexus 5", 198.6));
+    write("Ann_iPhone4S_NoDist_AR", device("iPhone 4S", 90.2));
+    write("Bo_iPhone4S_NoDist_Texting", device("iPhone 4S", 90.2));
+    write("plain", None);
+    let out = dir.path().join("out");
+    let summary = convert(&src, &out, &ConvertOptions::default()).unwrap();
+    assert!(summary.warnings.is_empty(), "{:?}", summary.warnings);
+    let lists: Vec<String> = summary
+        .lists
+        .iter()
+        .map(|l| l.file_name().unwrap().to_string_lossy().into_owned())
+        .collect();
+    assert_eq!(
+        lists,
+        [
+            "list_Ann.txt",
+            "list_Bo.txt",
+            "list_all.txt",
+            "list_iphone4s.txt",
+            "list_nexus5.txt"
+        ]
+    );
+    let names = |list: &str| -> Vec<String> {
+        ridi::data::read_list(out.join(list))
+            .unwrap()
+            .iter()
+            .map(|e| e.path.file_name().unwrap().to_string_lossy().into_owned())
+            .collect()
+    };
+    assert_eq!(
+        names("list_iphone4s.txt"),
+        ["Ann_iPhone4S_NoDist_AR", "Bo_iPhone4S_NoDist_Texting"]
+    );
+    assert_eq!(names("list_nexus5.txt"), ["Ann_Nexus5_NoDist_Texting"]);
+    assert_eq!(names("list_all.txt").len(), 4);
+    // Read back from the converted layout, with the device; `plain` has no sidecar.
+    let back = read_sequence(out.join("Ann_iPhone4S_NoDist_AR"), &opts).unwrap();
+    assert_eq!(back.device(), device("iPhone 4S", 90.2).as_ref());
+    assert!(!sidecar_path(&out.join("plain/processed/data.csv")).exists());
+    let c = summary
+        .sequences
+        .iter()
+        .find(|c| c.name == "Ann_Nexus5_NoDist_Texting")
+        .unwrap();
+    assert_eq!(c.device.as_ref().unwrap().model(), "Nexus 5");
+
+    // `ridi inspect` names the device and its rate.
+    let report = ridi::inspect::inspect(&back, Format::RidiCsv);
+    assert_eq!(report.device.as_deref(), Some("iPhone 4S"));
+    assert_eq!(report.device_imu_rate_hz, Some(90.2));
+    let text = report.to_string();
+    assert!(
+        text.contains("device:       iPhone 4S, IMU at 90.2 Hz (this sequence: 200 Hz)\n"),
+        "{text}"
+    );
+    let text = ridi::inspect::inspect(&walk, Format::RidiCsv).to_string();
+    assert!(text.contains("device:       (unknown)\n"), "{text}");
+
+    // Converted again without its device, a sequence loses the old sidecar with its old data.
+    write("Ann_Nexus5_NoDist_Texting", None);
+    let sidecar = sidecar_path(&out.join("Ann_Nexus5_NoDist_Texting/processed/data.csv"));
+    assert!(sidecar.is_file());
+    let summary = convert(&src, &out, &ConvertOptions::default()).unwrap();
+    assert!(!sidecar.exists());
+    let back = read_sequence(out.join("Ann_Nexus5_NoDist_Texting"), &opts).unwrap();
+    assert_eq!(back.device(), None);
+    assert!(!summary.lists.contains(&out.join("list_nexus5.txt")));
+
+    // A device whose list would be another list's gets none, with a warning.
+    write("Ann_Nexus5_NoDist_Texting", device("ANN", 100.0));
+    let summary = convert(&src, &dir.path().join("out2"), &ConvertOptions::default()).unwrap();
+    assert_eq!(
+        summary.warnings,
+        ["1 sequence(s) of the device `ANN` get no list_ann.txt: list_Ann.txt is another list"]
+    );
+}
+
+/// A Tyrex-layout run of `seconds` at 200 Hz (a flat phone turning slowly), without ground truth.
+fn tyrex_run(dir: &Path, seconds: f64) {
+    std::fs::create_dir_all(dir).unwrap();
+    let rows = |f: &dyn Fn(f64) -> String| -> String {
+        (0..(seconds * 200.0) as usize)
+            .map(|k| f(0.003 + k as f64 * 0.005) + "\n")
+            .collect()
+    };
+    let w = 0.3;
+    std::fs::write(
+        dir.join("accelerometer.txt"),
+        rows(&|t| format!("{t:.9} {} 0.0 9.80665", 0.1 * t.sin())),
+    )
+    .unwrap();
+    std::fs::write(
+        dir.join("gyroscope-calibrated.txt"),
+        rows(&|t| format!("{t:.9} 0.0 0.0 {w}")),
+    )
+    .unwrap();
+    std::fs::write(
+        dir.join("rotation-vector.txt"),
+        rows(&|t| {
+            let h = w * t / 2.0;
+            format!("{t:.9} 0 0 {} {} 0.17", h.sin(), h.cos())
+        }),
+    )
+    .unwrap();
+    std::fs::write(dir.join("timeAlignment.txt"), "-2.0\n").unwrap();
+}
+
+/// Runs without motion capture: skipped beside runs that have it, converted without ground
+/// truth when no run has it, the same with and without `--from tyrex`.
+#[test]
+fn tyrex_runs_without_motion_capture_are_skipped_or_converted_with_a_warning() {
+    let tmp = tempfile::tempdir().unwrap();
+    let android = tmp.path().join("tyrex/datasets/android");
+    tyrex_run(&android.join("Ann_Nexus5_NoDist_Texting"), 12.0);
+    tyrex_run(&android.join("Ann_Nexus5_NoDist_AR"), 12.0);
+    for from in [None, Some(ridi::data::Format::Tyrex)] {
+        let out = tmp.path().join(format!("out-{}", from.is_some()));
+        let opts = ridi::convert::ConvertOptions {
+            from,
+            ..Default::default()
+        };
+        let summary = ridi::convert::convert(&tmp.path().join("tyrex"), &out, &opts).unwrap();
+        assert_eq!(summary.sequences.len(), 2, "{from:?}");
+        assert!(
+            summary
+                .warnings
+                .iter()
+                .any(|w| w.contains("no run has a Qualisys file") && w.contains("the 2 run(s)")),
+            "{from:?}: {:?}",
+            summary.warnings
+        );
+    }
+}

@@ -5,23 +5,36 @@
 use ridi::data::{ReadOptions, read_list};
 use ridi_test_support::shared_dataset;
 
-/// Every Android run with motion capture in the shared root (the 24 Nexus 5 runs and the 18
-/// near magnetic disturbance); the one run folder without it is skipped with one warning.
+/// Every run with motion capture in the shared root: the 42 Android runs (24 Nexus 5 runs and 18
+/// near magnetic disturbance) and the 24 iOS runs (iPhone 4S) side by side; the one run folder
+/// without it is skipped with one warning. Lists per person, per device and of all.
 #[test]
 #[ignore = "needs ../shared beside the checkout: `cargo test --workspace --tests -- --ignored` (.ci/run)"]
-fn the_whole_tyrex_root_converts_with_one_list_per_person() {
-    let root = shared_dataset("tyrex-attitude-smartphones", "datasets/android");
+fn the_whole_tyrex_root_converts_with_one_list_per_person_and_device() {
+    let root = shared_dataset("tyrex-attitude-smartphones", "datasets/ios");
     let out = tempfile::tempdir().unwrap();
-    let summary = ridi::convert::convert(&root, out.path(), &Default::default()).unwrap();
-    // 42 runs, some split at long mocap or sensor gaps into parts, each named and listed.
+    let started = std::time::Instant::now();
+    // As `ridi convert --from tyrex <root>`.
+    let opts = ridi::convert::ConvertOptions {
+        from: Some(ridi::data::Format::Tyrex),
+        ..Default::default()
+    };
+    let summary = ridi::convert::convert(&root, out.path(), &opts).unwrap();
+    eprintln!(
+        "{} sequences converted in {:.1?}",
+        summary.sequences.len(),
+        started.elapsed()
+    );
+    // 66 runs, some split at long mocap or sensor gaps into parts, each named and listed.
     let mut runs: Vec<&str> = summary
         .sequences
         .iter()
         .map(|c| c.name.split("_part").next().unwrap())
         .collect();
     runs.dedup();
-    assert_eq!(runs.len(), 42, "{runs:?}");
+    assert_eq!(runs.len(), 66, "{runs:?}");
     assert_eq!(runs.iter().filter(|r| r.contains("_Dist_")).count(), 18);
+    assert_eq!(runs.iter().filter(|r| r.contains("_iPhone4S_")).count(), 24);
     let skipped: Vec<&String> = summary
         .warnings
         .iter()
@@ -59,9 +72,46 @@ fn the_whole_tyrex_root_converts_with_one_list_per_person() {
         per_person += list.len();
     }
     assert_eq!(per_person, all.len(), "every part is in its person's list");
+    let mut per_device = 0;
+    for (key, phone) in [("nexus5", "_Nexus5_"), ("iphone4s", "_iPhone4S_")] {
+        let list = read_list(out.path().join(format!("list_{key}.txt"))).unwrap();
+        assert!(
+            list.iter()
+                .all(|e| e.path.to_string_lossy().contains(phone))
+        );
+        per_device += list.len();
+    }
+    assert_eq!(per_device, all.len(), "every part is in its device's list");
+    assert_eq!(summary.lists.len(), 6, "{:?}", summary.lists);
     for c in &summary.sequences {
         assert!(c.path.is_file(), "{}", c.path.display());
+        let phone = if c.name.contains("_iPhone4S_") {
+            "iPhone 4S"
+        } else {
+            "Nexus 5"
+        };
+        assert_eq!(
+            c.device.as_ref().map(|d| d.model()),
+            Some(phone),
+            "{}",
+            c.name
+        );
     }
+    // The converted files read back with their device, through the sidecar; the run whose
+    // Qualisys file is spelled in another case has its ground truth and its placement.
+    let opts = ReadOptions::default();
+    let back =
+        ridi::data::read_sequence(out.path().join("Jakob_iPhone4S_NoDist_Backpocket"), &opts)
+            .unwrap();
+    assert!(back.ground_truth().is_some());
+    let device = back.device().unwrap();
+    assert_eq!(device.model(), "iPhone 4S");
+    assert!((89.0..91.0).contains(&device.imu_rate_hz().unwrap()));
+    let listed = all
+        .iter()
+        .find(|e| e.path.ends_with("Jakob_iPhone4S_NoDist_Backpocket"))
+        .unwrap();
+    assert_eq!(listed.placement.as_deref(), Some("BackPocket"));
 }
 
 #[test]

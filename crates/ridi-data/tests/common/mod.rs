@@ -61,6 +61,7 @@ pub fn sample_sequence(name: &str, n: usize, ground_truth: bool, magnet: bool) -
         orientation,
         orientation_source: Some(OrientationSource::GameRotationVector),
         steps: None,
+        device: None,
         time,
     })
     .expect("fixture sequence is valid")

@@ -27,7 +27,11 @@ pub(crate) fn thread_cpu_s() -> f64 {
 
 /// Times `predict_one` over `rows` (in that order) on the calling thread: (wall, CPU) seconds
 /// per query.
-pub(crate) fn time_one(model: &Cascade, q: MatrixRef<'_>, rows: &[usize]) -> Result<(f64, f64), String> {
+pub(crate) fn time_one(
+    model: &Cascade,
+    q: MatrixRef<'_>,
+    rows: &[usize],
+) -> Result<(f64, f64), String> {
     let (t, c) = (Instant::now(), thread_cpu_s());
     for &i in rows {
         std::hint::black_box(model.predict_one(q.row(i)).map_err(|e| e.to_string())?);

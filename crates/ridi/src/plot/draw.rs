@@ -1,5 +1,8 @@
 //! Drawing shared by the figures: the embedded font, colours, the figure trait and the
-//! atomic write of a finished figure.
+//! write of a finished figure (rendered in memory, then written through
+//! [`ridi_data::write_atomically`]).
+
+use image::ImageEncoder as _;
 
 use super::*;
 
@@ -122,6 +125,9 @@ pub(super) fn msg<E: std::fmt::Display>(error: E) -> String {
     error.to_string()
 }
 
+/// Renders `figure` in memory and writes it to `path` through
+/// [`ridi_data::write_atomically`], the one writer of ridi-rs: all of it or
+/// nothing, with the same permissions as every other output file.
 pub(super) fn write_figure<F: Figure>(
     path: &Path,
     format: PlotFormat,
@@ -129,54 +135,61 @@ pub(super) fn write_figure<F: Figure>(
     figure: &F,
 ) -> Result<F::Output, PlotError> {
     ensure_font()?;
-    let io_error = |source| PlotError::Io {
-        path: path.to_path_buf(),
-        source,
-    };
     let render_error = |message| PlotError::Render {
         path: path.to_path_buf(),
         message,
     };
-    // Same folder as the target, so the final rename stays on one file
-    // system and is atomic.
-    let dir = match path.parent() {
-        Some(dir) if !dir.as_os_str().is_empty() => dir,
-        _ => Path::new("."),
-    };
-    let mut builder = tempfile::Builder::new();
-    builder.prefix(".ridi-plot-").suffix(format.suffix());
-    // Temporary files are private (0600) by default; a plot is an ordinary
-    // output file, so ask for what `File::create` gives (0666 less umask).
-    #[cfg(unix)]
-    {
-        use std::os::unix::fs::PermissionsExt;
-        builder.permissions(std::fs::Permissions::from_mode(0o666));
-    }
-    let mut file = builder.tempfile_in(dir).map_err(io_error)?;
-    let output = match format {
+    let (rendered, output) = match format {
         PlotFormat::Svg => {
             let mut svg = String::new();
-            let output = {
-                let root = SVGBackend::with_string(&mut svg, size).into_drawing_area();
-                let output = figure.draw(&root, false).map_err(render_error)?;
-                root.present().map_err(|e| render_error(msg(e)))?;
-                output
-            };
-            file.write_all(svg.as_bytes()).map_err(io_error)?;
-            output
+            let backend = SVGBackend::with_string(&mut svg, size);
+            let output = draw_on(backend, figure, false).map_err(render_error)?;
+            (Rendered::Svg(svg), output)
         }
         PlotFormat::Png => {
-            // The image encoder writes the file itself, by path; the suffix
-            // tells it the format.
-            let root = BitMapBackend::new(file.path(), size).into_drawing_area();
-            let output = figure.draw(&root, true).map_err(render_error)?;
-            root.present().map_err(|e| render_error(msg(e)))?;
-            output
+            // RGB, 3 bytes a pixel: the layout `BitMapBackend::with_buffer` draws into.
+            let mut rgb = vec![0; 3 * size.0 as usize * size.1 as usize];
+            let backend = BitMapBackend::with_buffer(&mut rgb, size);
+            let output = draw_on(backend, figure, true).map_err(render_error)?;
+            (Rendered::Png(rgb), output)
         }
     };
-    file.as_file().sync_all().map_err(io_error)?;
-    file.persist(path).map_err(|e| io_error(e.error))?;
+    ridi_data::write_atomically(path, |w| match &rendered {
+        Rendered::Svg(svg) => w.write_all(svg.as_bytes()),
+        // The encoder (and settings) plotters' own PNG files are written with.
+        Rendered::Png(rgb) => image::codecs::png::PngEncoder::new(w)
+            .write_image(rgb, size.0, size.1, image::ColorType::Rgb8)
+            .map_err(|e| match e {
+                image::ImageError::IoError(e) => e,
+                e => std::io::Error::other(e),
+            }),
+    })
+    .map_err(|e| PlotError::Io {
+        path: path.to_path_buf(),
+        source: match e {
+            ridi_data::DataError::Io { source, .. } => source,
+            e => std::io::Error::other(e.to_string()),
+        },
+    })?;
     Ok(output)
+}
+
+/// Draws `figure` on `backend` and finishes the drawing.
+fn draw_on<DB: DrawingBackend, F: Figure>(
+    backend: DB,
+    figure: &F,
+    raster: bool,
+) -> Result<F::Output, String> {
+    let root = backend.into_drawing_area();
+    let output = figure.draw(&root, raster)?;
+    root.present().map_err(msg)?;
+    Ok(output)
+}
+
+/// A figure rendered in memory, before it is written.
+enum Rendered {
+    Svg(String),
+    Png(Vec<u8>),
 }
 
 pub(super) fn estimate_width<DB: DrawingBackend>(

@@ -15,10 +15,10 @@
 //!
 //! The format follows the extension of the output path (`.svg` or `.png`,
 //! see [`PlotFormat`]). Text in PNG files is rendered with DejaVu Sans,
-//! embedded in the binary, so no system font is needed. Files are written
-//! atomically: the plot is rendered to a temporary file in the target folder
-//! and renamed over the target, so a failed or interrupted plot never leaves
-//! a partial file behind.
+//! embedded in the binary, so no system font is needed. A plot is rendered in
+//! memory and written through [`ridi_data::write_atomically`], as every output
+//! file of ridi-rs is: a failed or interrupted plot never leaves a partial file
+//! behind.
 //!
 //! # Example
 //!
@@ -75,7 +75,6 @@ use geometry::*;
 use trajectory::*;
 use velocity::*;
 
-use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::sync::OnceLock;
 
@@ -198,13 +197,6 @@ impl PlotFormat {
             _ => Err(PlotError::UnsupportedFormat {
                 path: path.to_path_buf(),
             }),
-        }
-    }
-
-    fn suffix(self) -> &'static str {
-        match self {
-            Self::Svg => ".svg",
-            Self::Png => ".png",
         }
     }
 }

@@ -1,0 +1,62 @@
+//! `ridi demo`: train on the bundled sample and evaluate on its held-out person
+//! ([`ridi::Demo`] does the work; this prints it).
+
+use std::path::{Path, PathBuf};
+
+use anyhow::{Result, bail};
+
+use crate::{Grid, Plots, eval, train};
+
+#[derive(clap::Args)]
+pub(crate) struct Args {
+    /// Output folder.
+    #[arg(long, default_value = "demo-out")]
+    out: PathBuf,
+    /// The bundled sample folder (default: datasets/sample of this checkout).
+    #[arg(long)]
+    data: Option<PathBuf>,
+    /// Regressor hyper-parameter search.
+    #[arg(long, value_enum, default_value = "none")]
+    grid: Grid,
+    /// Plot format, or `none`.
+    #[arg(long, value_enum, default_value = "png")]
+    plots: Plots,
+}
+
+pub(crate) fn run(args: Args) -> Result<()> {
+    let data = args.data.unwrap_or_else(bundled_sample);
+    if !data.join("list_train.txt").is_file() {
+        bail!(
+            "no bundled sample at {} (give its folder with --data)",
+            data.display()
+        );
+    }
+    let demo = ridi::Demo::prepare(&data, &args.out, args.grid.into(), args.plots.into())?;
+    let train = demo.train_sequences();
+    outln!(
+        "demo: training on {} sequences ({:.0} s), testing on {} held-out sequences",
+        train.len(),
+        train.iter().map(|s| s.duration()).sum::<f64>(),
+        demo.test_sequences().len()
+    );
+    let started = std::time::Instant::now();
+    let model = train::with_progress(|progress| demo.train(progress))?;
+    outln!("trained in {:.1} s", started.elapsed().as_secs_f64());
+    train::print_training(&model);
+    let (report, traces) =
+        eval::with_spinner(demo.test_sequences().len(), || demo.evaluate(&model))?;
+    let written = demo.write(&model, &report, &traces)?;
+    eval::print_written(&report, &written, demo.folder());
+    Ok(())
+}
+
+/// `datasets/sample` of the working folder when it holds the sample, else that of the
+/// checkout this binary was built from.
+fn bundled_sample() -> PathBuf {
+    let here = PathBuf::from("datasets/sample");
+    if here.join("list_train.txt").is_file() {
+        here
+    } else {
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("../../datasets/sample")
+    }
+}

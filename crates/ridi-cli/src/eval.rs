@@ -1,0 +1,175 @@
+//! `ridi eval`: RIDI and the baselines on labelled recordings, into a report folder; and the
+//! printing of an evaluation, which `ridi demo` shares.
+
+use std::path::PathBuf;
+
+use anyhow::Result;
+use indicatif::ProgressBar;
+
+use ridi::eval::{AlignWindow, EvalConfig};
+use ridi::lists::read_lists;
+use ridi::{
+    EvalFolder, EvalOptions, EvalPlots, EvalWritten, Method, Purpose, Report, TrackOptions,
+};
+
+use crate::{Plots, count, non_negative, parse_align, placement_smoothing};
+
+#[derive(clap::Args)]
+pub(crate) struct Args {
+    /// List files of the sequences to evaluate (ground truth required).
+    #[arg(long, required = true, num_args = 1..)]
+    list: Vec<PathBuf>,
+    /// Model file from `ridi train`.
+    #[arg(long)]
+    model: PathBuf,
+    /// Output folder.
+    #[arg(long)]
+    out: PathBuf,
+    /// Methods to compare (comma-separated).
+    #[arg(
+        long,
+        value_delimiter = ',',
+        default_value = "ridi,raw,pdr,ridi_mag,ridi_ori,velocity,still"
+    )]
+    methods: Vec<String>,
+    /// Group placement labels as at training (`tyrex4` or a `label,class` file).
+    #[arg(long)]
+    placement_map: Option<String>,
+    /// Plot format, or `none`.
+    #[arg(long, value_enum, default_value = "png")]
+    plots: Plots,
+    /// Worker threads (default: all cores).
+    #[arg(long, value_parser = |s: &str| count(s, 1, 4096))]
+    jobs: Option<usize>,
+    /// Placement majority window, seconds: each regression takes the most frequent placement
+    /// label within it, centred on it; 0 keeps each window's own label, as in the paper.
+    #[arg(long, value_name = "SECONDS", default_value_t = 10.0, value_parser = non_negative)]
+    placement_window: f64,
+    /// Stretch every trajectory is aligned to the ground truth on (2D rigid, no scale):
+    /// its first SECONDS, as in the paper, or `all` for the whole run (a best case that
+    /// hides initial-heading errors).
+    #[arg(long, value_name = "SECONDS|all", default_value = "10", value_parser = parse_align)]
+    align: AlignWindow,
+}
+
+pub(crate) fn run(args: Args) -> Result<()> {
+    crate::set_jobs(args.jobs)?;
+    let folder = EvalFolder::new(&args.out, args.plots.into())?;
+    let mut methods: Vec<Method> = Vec::new();
+    for m in &args.methods {
+        let m = m.parse::<Method>().map_err(anyhow::Error::msg)?;
+        if !methods.contains(&m) {
+            methods.push(m);
+        }
+    }
+    let model = crate::load_model(&args.model)?;
+    let listed = crate::load_listed(
+        read_lists(&args.list)?,
+        args.placement_map.as_deref(),
+        Purpose::Evaluation,
+    )?;
+    let opts = EvalOptions {
+        methods,
+        track: TrackOptions {
+            placement_smoothing: placement_smoothing(args.placement_window),
+            ..TrackOptions::default()
+        },
+        metrics: EvalConfig {
+            align: args.align,
+            ..EvalConfig::default()
+        },
+    };
+    let seqs = listed.sequences();
+    let (report, traces) = with_spinner(seqs.len(), || ridi::evaluate(seqs, &model, &opts))
+        .map_err(|e| listed.locate(e))?;
+    let written = folder
+        .write(&report, &traces, None)
+        .map_err(|e| listed.locate(e))?;
+    print_written(&report, &written, &folder);
+    Ok(())
+}
+
+/// Runs `evaluate` (of `n` sequences) with a spinner on stderr.
+pub(crate) fn with_spinner<T>(n: usize, evaluate: impl FnOnce() -> T) -> T {
+    let spinner = ProgressBar::new_spinner();
+    spinner.set_message(format!("evaluating {n} sequences"));
+    spinner.enable_steady_tick(std::time::Duration::from_millis(200));
+    let result = evaluate();
+    spinner.finish_and_clear();
+    result
+}
+
+/// Prints what an evaluation found and wrote: warnings on stderr, the summary table and the
+/// files written on stdout.
+pub(crate) fn print_written(report: &Report, written: &EvalWritten, folder: &EvalFolder) {
+    for w in &written.warnings {
+        eprintln!("warning: {w}");
+    }
+    print_summary(report);
+    let stale = written.stale_plots;
+    outln!(
+        "wrote {} files into {} (report.md, report.json{}){}",
+        written.plots.len() + written.reports.len(),
+        folder.dir().display(),
+        if folder.plots() != EvalPlots::None {
+            ", plots/"
+        } else {
+            ""
+        },
+        if stale > 0 {
+            format!("; removed {stale} plots of an earlier evaluation from plots/")
+        } else {
+            String::new()
+        }
+    );
+}
+
+fn print_summary(report: &Report) {
+    for w in &report.warnings {
+        eprintln!("warning: {w}");
+    }
+    let weak = report
+        .sequences
+        .iter()
+        .filter(|s| s.alignment_extent_m < ridi::eval::WEAK_ALIGNMENT_EXTENT_M)
+        .count();
+    if weak > 0 {
+        eprintln!(
+            "warning: in {weak} of {} sequences the ground truth moves less than {} m within the \
+             alignment window, so their fitted heading is weakly determined (listed in report.md)",
+            report.sequences.len(),
+            ridi::eval::WEAK_ALIGNMENT_EXTENT_M
+        );
+    }
+    outln!(
+        "\n{} sequences; velocity MSE S-x {:.3} S-z {:.3} (m/s)^2; placement accuracy {}",
+        report.sequences.len(),
+        report.velocity_mse[0],
+        report.velocity_mse[1],
+        report
+            .placement_accuracy
+            .map_or("-".into(), |a| format!("{a:.3}"))
+    );
+    outln!(
+        "{:<10} {:>9} {:>9} {:>9} {:>9} {:>11}",
+        "method",
+        "RTE 5s m",
+        "ATE m",
+        "RTE m",
+        "MPE m",
+        "path ratio"
+    );
+    let opt = |v: Option<f64>| v.map_or("-".to_string(), |v| format!("{v:.3}"));
+    for key in &report.methods {
+        if let Some(m) = report.summary.get(key) {
+            outln!(
+                "{key:<10} {:>9.3} {:>9.3} {:>9.3} {:>9.3} {:>11}",
+                m.rte_5s_m,
+                m.ate_m,
+                m.rte_m,
+                m.mpe_m,
+                opt(m.path_length_ratio)
+            );
+        }
+    }
+}

@@ -1,0 +1,93 @@
+//! `ridi track`: one recording with a trained model, one pose per frame.
+
+use std::path::PathBuf;
+
+use anyhow::{Context, Result, bail};
+
+use ridi::data::ReadOptions;
+use ridi::source::ReadFiles;
+use ridi::{TrackOptions, TrackOutput, apply_orientation};
+
+use crate::{MAX_FRAMES_APART, count, non_negative, placement_smoothing, positive};
+
+#[derive(clap::Args)]
+pub(crate) struct Args {
+    /// A RIDI data.csv, data_plain.txt, raw folder, Tyrex run, or Indoor Location
+    /// Competition path file.
+    sequence: PathBuf,
+    /// Model file from `ridi train`.
+    #[arg(long)]
+    model: PathBuf,
+    /// Trajectory CSV to write.
+    #[arg(long)]
+    out: PathBuf,
+    /// Streaming mode: correction every 200 frames over the latest 1000.
+    #[arg(long)]
+    online: bool,
+    /// Also draw the trajectory (and ground truth if any) to a .png or .svg file.
+    #[arg(long)]
+    plot: Option<PathBuf>,
+    /// Frames between regressions.
+    #[arg(long, default_value_t = 50, value_parser = |s: &str| count(s, 1, MAX_FRAMES_APART))]
+    regress_every: usize,
+    /// Weight of the bias prior (paper: 0.1).
+    #[arg(long, default_value_t = 0.1, value_parser = positive)]
+    lambda: f64,
+    /// Estimate the initial velocity instead of assuming the walk starts at rest.
+    #[arg(long)]
+    estimate_initial_velocity: bool,
+    /// Placement majority window, seconds: each regression takes the most frequent placement
+    /// label within it (centred in batch, the seconds before it with --online); 0 keeps each
+    /// window's own label, as in the paper.
+    #[arg(long, value_name = "SECONDS", default_value_t = 10.0, value_parser = non_negative)]
+    placement_window: f64,
+}
+
+pub(crate) fn run(args: Args) -> Result<()> {
+    // Every output is checked before any work, so that a bad --plot cannot leave the
+    // trajectory written and the command failed.
+    let inputs = ReadFiles::of([&args.sequence, &args.model]);
+    let mut output = TrackOutput::new(&args.out, &inputs)?;
+    if let Some(plot) = &args.plot {
+        output = output.with_plot(plot, &inputs)?;
+    }
+    let model = crate::load_model(&args.model)?;
+    let mut loaded = ridi::read_any(&args.sequence, None, &ReadOptions::default())?;
+    for w in &loaded.warnings {
+        eprintln!("warning: {w}");
+    }
+    // The model's orientation, once, so that the plot shows what was tracked.
+    apply_orientation(model.feature_config().orientation, &mut loaded.sequences)?;
+    let [seq] = &loaded.sequences[..] else {
+        bail!(
+            "{} holds {} sequences; convert it with `ridi convert` and track each",
+            args.sequence.display(),
+            loaded.sequences.len()
+        );
+    };
+    let mut opts = TrackOptions {
+        regress_every: args.regress_every,
+        online: args.online,
+        placement_smoothing: placement_smoothing(args.placement_window),
+        ..TrackOptions::default()
+    };
+    opts.correction.lambda = args.lambda;
+    if args.estimate_initial_velocity {
+        opts.correction.initial_velocity = ridi::correct::InitialVelocity::Estimate;
+    }
+    let track = ridi::track(seq, &model, &opts)
+        .with_context(|| format!("cannot track {}", args.sequence.display()))?;
+    output.write(seq, &track)?;
+    let n = track.regressions.len();
+    outln!(
+        "{}: {} frames, {n} regression{} -> {}",
+        seq.name(),
+        track.time.len(),
+        if n == 1 { "" } else { "s" },
+        args.out.display()
+    );
+    if let Some(plot) = &args.plot {
+        outln!("plot: {}", plot.display());
+    }
+    Ok(())
+}

@@ -1,0 +1,224 @@
+//! `ridi train`: the placement classifier and velocity regressors, from labelled recordings.
+
+use std::path::PathBuf;
+
+use anyhow::{Context, Result};
+use clap::ValueEnum;
+use indicatif::{ProgressBar, ProgressStyle};
+
+use ridi::features::FeatureConfig;
+use ridi::frames::UpAxis;
+use ridi::lists::read_lists;
+use ridi::regress::{Cascade, ProgressEvent, RegressError, Stage, Storage};
+use ridi::source::ReadFiles;
+use ridi::{
+    GridChoice, Orientation, PipelineError, Purpose, TrainOptions, check_not_input,
+    check_output_file,
+};
+
+use crate::{Grid, MAX_FRAMES_APART, count, positive};
+
+#[derive(clap::Args)]
+pub(crate) struct Args {
+    /// List files (`path,placement` per line); several are concatenated.
+    #[arg(long, required = true, num_args = 1..)]
+    list: Vec<PathBuf>,
+    /// Model file to write.
+    #[arg(long)]
+    out: PathBuf,
+    /// Regressor hyper-parameter search.
+    #[arg(long, value_enum, default_value = "paper")]
+    grid: Grid,
+    /// Group placement labels: `tyrex4` (hand, swing, pocket, running) or a file of
+    /// `label,class` lines.
+    #[arg(long)]
+    placement_map: Option<String>,
+    /// Train on raw features (the original RIDI) instead of standardized ones.
+    #[arg(long)]
+    no_standardize: bool,
+    /// Classifier C (paper: 10).
+    #[arg(long, default_value_t = 10.0, value_parser = positive)]
+    classifier_c: f64,
+    /// Orientation to train and track with: as recorded, or estimated from gyro +
+    /// accelerometer (straighter tracks where the recorded one uses the magnetometer
+    /// indoors). The model records it: `ridi track` and `ridi eval` use the same.
+    #[arg(long, value_enum, default_value = "recorded")]
+    orientation: OrientationArg,
+    /// How the model stores its samples for prediction.
+    #[arg(long, value_enum, default_value = "projected")]
+    storage: StorageArg,
+    /// Also train on N copies of each window turned about the vertical (features and
+    /// velocity together), for phones carried at other headings than in the training
+    /// recordings; 0 for the paper, at most 32.
+    #[arg(long, default_value_t = 1, value_name = "N", value_parser = |s: &str| count(s, 0, MAX_TURNED_COPIES))]
+    turned_copies: usize,
+    /// Frames between training windows [default: 10 x (N + 1), N turned copies: the
+    /// paper's 10 without copies, and the paper's number of rows with them].
+    #[arg(long, value_name = "FRAMES", value_parser = |s: &str| count(s, 1, MAX_FRAMES_APART))]
+    step: Option<usize>,
+    /// Frames per feature window [default: the paper's 200, 1 s at 200 Hz]. The model
+    /// records it; recordings must then be longer than one window to track. 100 gave a
+    /// lower RTE 5 s and shorter paths on the Tyrex protocol (docs/benchmarks.md).
+    #[arg(long, value_name = "FRAMES", value_parser = |s: &str| count(s, MIN_WINDOW, MAX_WINDOW))]
+    window: Option<usize>,
+    /// No speed regressor (the paper): by default each placement also regresses the speed
+    /// and each regressed velocity is scaled to it, since turned training windows make the
+    /// velocity's direction less certain than its size.
+    #[arg(long)]
+    no_speed: bool,
+    /// The device axis the stabilized frame S is built on: `plus-y` always (the paper),
+    /// or `plus-or-minus-y`, which builds it on -y while the phone is upside down (top
+    /// down in a hanging hand, say), where the paper's S turns erratically.
+    #[arg(long, value_enum, default_value = "plus-or-minus-y")]
+    up_axis: UpAxisArg,
+    /// Worker threads (default: all cores).
+    #[arg(long, value_parser = |s: &str| count(s, 1, 4096))]
+    jobs: Option<usize>,
+}
+
+/// Largest `--turned-copies`: copy `j` of a window is turned by `j / N` of a full turn, so a few
+/// dozen copies already cover the circle every few degrees, while each copy costs a full set of
+/// training rows (memory and time grow without limit).
+const MAX_TURNED_COPIES: usize = 32;
+
+/// Smallest `--window`: 0.1 s at 200 Hz, about the feature smoothing's kernel (17 taps at sigma 2).
+const MIN_WINDOW: usize = 20;
+
+/// Largest `--window`: 3 s at 200 Hz. Features grow with the window (3,600 values here, 1,200
+/// for the paper's 1 s), and so do their memory and the projected storage's covariance and
+/// eigendecomposition (quadratic and cubic in it); 400 frames were measured, and were worse.
+const MAX_WINDOW: usize = 600;
+
+#[derive(Clone, Copy, PartialEq, ValueEnum)]
+enum OrientationArg {
+    /// As recorded in the file.
+    Recorded,
+    /// Estimated from gyro + accelerometer.
+    Estimated,
+}
+
+impl From<OrientationArg> for Orientation {
+    fn from(o: OrientationArg) -> Self {
+        match o {
+            OrientationArg::Recorded => Orientation::Recorded,
+            OrientationArg::Estimated => Orientation::Estimated,
+        }
+    }
+}
+
+#[derive(Clone, Copy, PartialEq, ValueEnum)]
+enum StorageArg {
+    /// Coordinates on the principal directions holding 99.99 % of the feature variance (several
+    /// times faster queries; velocities move by about as much as half precision moves them).
+    Projected,
+    /// Every feature value in half precision.
+    Half,
+}
+
+impl From<StorageArg> for Storage {
+    fn from(s: StorageArg) -> Self {
+        match s {
+            StorageArg::Projected => Storage::DEFAULT,
+            StorageArg::Half => Storage::Half,
+        }
+    }
+}
+
+#[derive(Clone, Copy, PartialEq, ValueEnum)]
+enum UpAxisArg {
+    /// Device +y at every attitude (the paper's S).
+    PlusY,
+    /// Device -y while the phone is upside down, +y otherwise.
+    PlusOrMinusY,
+}
+
+impl From<UpAxisArg> for UpAxis {
+    fn from(a: UpAxisArg) -> Self {
+        match a {
+            UpAxisArg::PlusY => UpAxis::PlusY,
+            UpAxisArg::PlusOrMinusY => UpAxis::PlusOrMinusY,
+        }
+    }
+}
+
+pub(crate) fn run(args: Args) -> Result<()> {
+    crate::set_jobs(args.jobs)?;
+    let out = &args.out;
+    check_output_file(out)?;
+    let entries = read_lists(&args.list)?;
+    let mut read = args.list.clone();
+    read.extend(entries.iter().map(|e| e.path.clone()));
+    check_not_input(out, &ReadFiles::of(&read), &[])?;
+    let listed = crate::load_listed(entries, args.placement_map.as_deref(), Purpose::Training)?;
+    let defaults = TrainOptions::default();
+    let mut opts = TrainOptions {
+        standardize: !args.no_standardize,
+        turned_copies: args.turned_copies,
+        features: FeatureConfig {
+            step: args
+                .step
+                .unwrap_or(ridi::train::default_step(args.turned_copies)),
+            window: args.window.unwrap_or(defaults.features.window),
+            up_axis: args.up_axis.into(),
+            orientation: args.orientation.into(),
+            ..defaults.features.clone()
+        },
+        ..defaults
+    };
+    opts.cascade.classifier_c = args.classifier_c;
+    opts.cascade.regressors = GridChoice::from(args.grid).regressors();
+    opts.cascade.storage = args.storage.into();
+    opts.cascade.speed = !args.no_speed;
+    let model = with_progress(|progress| ridi::train(listed.sequences(), &opts, progress))
+        .map_err(|e| {
+            let e = listed.locate(e);
+            let folds = matches!(
+                e,
+                PipelineError::Regress(RegressError::TooFewSequences { .. })
+            );
+            let e = anyhow::Error::from(e);
+            if folds {
+                e.context(
+                    "the grid search cross-validates over each placement's sequences \
+                     (`--grid none` trains without it)",
+                )
+            } else {
+                e
+            }
+        })?;
+    print_training(&model);
+    ridi::save_model(&model, out).with_context(|| format!("cannot write {}", out.display()))?;
+    outln!("model: {}", out.display());
+    Ok(())
+}
+
+/// Runs `train` with a progress bar (on stderr) that follows its stages.
+pub(crate) fn with_progress(
+    train: impl FnOnce(&mut dyn ridi::regress::Progress) -> ridi::Result<Cascade>,
+) -> ridi::Result<Cascade> {
+    let bar = ProgressBar::new(0);
+    bar.set_style(
+        ProgressStyle::with_template("{prefix:>24} [{bar:30}] {pos}/{len} {elapsed}")
+            .unwrap_or_else(|_| ProgressStyle::default_bar())
+            .progress_chars("=> "),
+    );
+    let mut progress = |e: &ProgressEvent<'_>| {
+        let stage = match e.stage {
+            Stage::Classifier => "placement classifier".to_string(),
+            Stage::Grid { placement } => format!("grid {placement}"),
+            Stage::Regressors { placement } => format!("regressors {placement}"),
+        };
+        bar.set_prefix(stage);
+        bar.set_length(e.total as u64);
+        bar.set_position(e.done as u64);
+        true
+    };
+    let model = train(&mut progress)?;
+    bar.finish_and_clear();
+    Ok(model)
+}
+
+/// What the trained model is, as `ridi inspect` says it.
+pub(crate) fn print_training(model: &Cascade) {
+    out!("{}", ridi::inspect::inspect_model(model));
+}

@@ -1,0 +1,212 @@
+//! The sidecar of a processed data file: what RIDI's layout has no column for (the device), in a
+//! small text file beside it.
+//!
+//! `data.csv` (or `data_plain.txt`, `walk.csv.gz`, ...) gets `data.csv.meta`:
+//!
+//! ```text
+//! # ridi-rs: what data.csv has no column for (RIDI's own readers do not open this file)
+//! device = iPhone 4S
+//! device_imu_rate_hz = 90.09009029909154
+//! ```
+//!
+//! `#` comments and blank lines are skipped; every other line is `key = value`. Keys:
+//! `device` (the model, [`DeviceInfo::new`]) and `device_imu_rate_hz` (only with `device`,
+//! [`DeviceInfo::with_imu_rate`]). Other keys are skipped, so that files of a later version with
+//! more keys still read. A malformed line, a key given twice or a value that is not valid is an
+//! error naming the sidecar, the line and the key.
+//!
+//! The sidecar is optional: a data file without one (RIDI's own, one written by another tool)
+//! reads with no device. The writers replace it together with the data file: the old sidecar is
+//! removed first, then the data file and the new sidecar are each written atomically, so an
+//! interrupted write leaves at worst a data file without a sidecar (device unknown), never a data
+//! file beside the sidecar of another.
+
+use std::path::{Path, PathBuf};
+
+use crate::device::DeviceInfo;
+use crate::error::{DataError, Location, Result};
+use crate::text::{self, Nan};
+use crate::write::RoundTrip;
+use crate::{Sequence, write_atomically};
+
+/// What a sidecar's name adds to its data file's.
+pub const SIDECAR_SUFFIX: &str = ".meta";
+
+/// A sidecar larger than this is no sidecar of ours (it holds two short lines).
+const MAX_BYTES: u64 = 64 * 1024;
+
+const DEVICE: &str = "device";
+const RATE: &str = "device_imu_rate_hz";
+
+/// The sidecar of the processed data file `data`: `data.csv` gives `data.csv.meta`, beside it.
+pub fn sidecar_path(data: &Path) -> PathBuf {
+    let mut name = data.file_name().unwrap_or_default().to_os_string();
+    name.push(SIDECAR_SUFFIX);
+    data.with_file_name(name)
+}
+
+/// The device the sidecar of `data` names; `None` without a sidecar.
+pub(crate) fn read(data: &Path) -> Result<Option<DeviceInfo>> {
+    let path = sidecar_path(data);
+    let meta = match std::fs::metadata(&path) {
+        Ok(m) => m,
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(None),
+        Err(e) => return Err(DataError::io(&path, e)),
+    };
+    if !meta.is_file() {
+        return Err(DataError::format(
+            Location::file(&path),
+            "the sidecar of the data file is not a regular file",
+        ));
+    }
+    if meta.len() > MAX_BYTES {
+        return Err(DataError::format(
+            Location::file(&path),
+            format!(
+                "{} bytes: not a ridi-rs sidecar (a few lines, at most {MAX_BYTES} bytes)",
+                meta.len()
+            ),
+        ));
+    }
+    let bytes = text::read_file(&path)?;
+    parse(text::as_text(&bytes, &path)?, &path)
+}
+
+/// Parses the content of the sidecar `path`.
+fn parse(content: &str, path: &Path) -> Result<Option<DeviceInfo>> {
+    let mut device: Option<(usize, DeviceInfo)> = None;
+    let mut rate: Option<(usize, f64)> = None;
+    for (line, l) in text::lines(content) {
+        let l = l.trim();
+        if l.starts_with('#') {
+            continue;
+        }
+        let Some((key, value)) = l.split_once('=') else {
+            return Err(DataError::format(
+                Location::line(path, line),
+                format!("expected `key = value`, found `{}`", text::snippet(l)),
+            ));
+        };
+        let (key, value) = (key.trim(), value.trim());
+        let at = || Location::line(path, line).with_field(key);
+        let first = match key {
+            DEVICE => device.as_ref().map(|(l, _)| *l),
+            RATE => rate.as_ref().map(|(l, _)| *l),
+            // A key of a later version.
+            _ => continue,
+        };
+        if let Some(first) = first {
+            return Err(DataError::format(
+                at(),
+                format!("given twice (first on line {first})"),
+            ));
+        }
+        if key == DEVICE {
+            let d = DeviceInfo::new(value).map_err(|e| DataError::format(at(), e.to_string()))?;
+            device = Some((line, d));
+        } else {
+            rate = Some((line, text::number(value, path, line, RATE, Nan::Reject)?));
+        }
+    }
+    match (device, rate) {
+        (None, None) => Ok(None),
+        (None, Some((line, _))) => Err(DataError::format(
+            Location::line(path, line).with_field(RATE),
+            format!("a device rate without `{DEVICE} = <model>`"),
+        )),
+        (Some((_, d)), None) => Ok(Some(d)),
+        (Some((_, d)), Some((line, r))) => d.with_imu_rate(r).map(Some).map_err(|e| {
+            DataError::format(Location::line(path, line).with_field(RATE), e.to_string())
+        }),
+    }
+}
+
+/// Removes the sidecar of `data`, if there is one: before a data file is replaced, so that the
+/// new one is never read with the old one's metadata.
+pub(crate) fn remove(data: &Path) -> Result<()> {
+    let path = sidecar_path(data);
+    match std::fs::remove_file(&path) {
+        Err(e) if e.kind() != std::io::ErrorKind::NotFound => Err(DataError::io(&path, e)),
+        _ => Ok(()),
+    }
+}
+
+/// Writes the sidecar of `data` for `seq` when it has metadata to keep (atomically); without,
+/// writes nothing.
+pub(crate) fn write(seq: &Sequence, data: &Path) -> Result<()> {
+    let Some(device) = seq.device() else {
+        return Ok(());
+    };
+    let name = data.file_name().unwrap_or_default().to_string_lossy();
+    write_atomically(&sidecar_path(data), |w| {
+        writeln!(
+            w,
+            "# ridi-rs: what {name} has no column for (RIDI's own readers do not open this file)"
+        )?;
+        writeln!(w, "{DEVICE} = {}", device.model())?;
+        if let Some(r) = device.imu_rate_hz() {
+            writeln!(w, "{RATE} = {}", RoundTrip(r))?;
+        }
+        Ok(())
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn p() -> &'static Path {
+        Path::new("data.csv.meta")
+    }
+
+    #[test]
+    fn names_and_values_parse() {
+        assert_eq!(
+            sidecar_path(Path::new("a/processed/data.csv")),
+            Path::new("a/processed/data.csv.meta")
+        );
+        let d = parse(
+            "# c\n\ndevice = iPhone 4S\ndevice_imu_rate_hz=90.5\nlater = x\n",
+            p(),
+        )
+        .unwrap()
+        .unwrap();
+        assert_eq!((d.model(), d.imu_rate_hz()), ("iPhone 4S", Some(90.5)));
+        assert_eq!(parse("# nothing\n", p()).unwrap(), None);
+        // No final line break: a hand-written file.
+        assert!(parse("device = x", p()).unwrap().is_some());
+    }
+
+    #[test]
+    fn errors_name_line_and_key() {
+        for (text, expect) in [
+            (
+                "device\n",
+                "data.csv.meta:1: expected `key = value`, found `device`",
+            ),
+            (
+                "device = a\n\ndevice = b\n",
+                "data.csv.meta:3: field `device`: given twice (first on line 1)",
+            ),
+            (
+                "device = \n",
+                "data.csv.meta:1: field `device`: empty device model",
+            ),
+            (
+                "device = x\ndevice_imu_rate_hz = fast\n",
+                "data.csv.meta:2: field `device_imu_rate_hz`: `fast` is not a number",
+            ),
+            (
+                "device = x\ndevice_imu_rate_hz = -3\n",
+                "data.csv.meta:2: field `device_imu_rate_hz`: device IMU rate -3 Hz",
+            ),
+            (
+                "device_imu_rate_hz = 100\n",
+                "data.csv.meta:1: field `device_imu_rate_hz`: a device rate without `device",
+            ),
+        ] {
+            let e = parse(text, p()).unwrap_err().to_string();
+            assert!(e.starts_with(expect), "{text:?}: {e}");
+        }
+    }
+}

@@ -1,0 +1,191 @@
+//! The device of a sequence: kept through the RIDI processed layout in a sidecar beside the data
+//! file, which RIDI's own readers never open, and read back by this crate's readers.
+
+mod common;
+
+use common::sample_sequence;
+use ridi_data::{
+    DeviceInfo, ReadOptions, Sequence, read_sequence, ridi_csv, ridi_plain, sidecar_path,
+    source_files, write_ridi_csv, write_ridi_plain,
+};
+use ridi_test_support::assert_names_file;
+
+fn iphone() -> DeviceInfo {
+    // A rate with many digits: it must come back bit for bit.
+    DeviceInfo::new("iPhone 4S")
+        .unwrap()
+        .with_imu_rate(90.187_342_118_3)
+        .unwrap()
+}
+
+fn with_device(name: &str) -> Sequence {
+    let mut seq = sample_sequence(name, 300, true, false);
+    seq.set_device(Some(iphone()));
+    seq
+}
+
+#[test]
+fn the_device_goes_to_a_sidecar_and_comes_back() {
+    let dir = tempfile::tempdir().unwrap();
+    let opts = ReadOptions::default();
+    let seq = with_device("walk");
+    for file in [
+        "walk/processed/data.csv",
+        "csvgz/data.csv.gz",
+        "plain/data_plain.txt",
+    ] {
+        let path = dir.path().join(file);
+        std::fs::create_dir_all(path.parent().unwrap()).unwrap();
+        if file.ends_with(".txt") {
+            write_ridi_plain(&seq, &path).unwrap();
+        } else {
+            write_ridi_csv(&seq, &path).unwrap();
+        }
+        let sidecar = sidecar_path(&path);
+        assert_eq!(
+            sidecar.file_name().unwrap().to_string_lossy(),
+            format!("{}.meta", path.file_name().unwrap().to_string_lossy())
+        );
+        let text = std::fs::read_to_string(&sidecar).unwrap();
+        assert!(
+            text.starts_with("# ridi-rs: what ") && text.contains("\ndevice = iPhone 4S\n"),
+            "{text}"
+        );
+        let back = if file.ends_with(".txt") {
+            ridi_plain::read(&path, &opts).unwrap()
+        } else {
+            ridi_csv::read(&path, &opts).unwrap()
+        };
+        assert_eq!(back.device(), Some(&iphone()), "{file}");
+        assert!(source_files(&path).unwrap().contains(&sidecar));
+    }
+    // Through the folder, as `ridi convert`'s output is read.
+    let back = read_sequence(dir.path().join("walk"), &opts).unwrap();
+    assert_eq!(back, seq);
+    // The sidecar is optional: without it, no device.
+    std::fs::remove_file(sidecar_path(&dir.path().join("walk/processed/data.csv"))).unwrap();
+    let back = read_sequence(dir.path().join("walk"), &opts).unwrap();
+    assert_eq!(back.device(), None);
+    // `parse` reads the bytes alone.
+    let path = dir.path().join("walk/processed/data.csv");
+    write_ridi_csv(&seq, &path).unwrap();
+    let bytes = std::fs::read(&path).unwrap();
+    assert_eq!(
+        ridi_csv::parse(&bytes, &path, &opts).unwrap().device(),
+        None
+    );
+}
+
+#[test]
+fn the_data_file_is_what_ridi_reads_whatever_the_device() {
+    let dir = tempfile::tempdir().unwrap();
+    let plain = sample_sequence("walk", 300, true, false);
+    let a = dir.path().join("a.csv");
+    let b = dir.path().join("b.csv");
+    write_ridi_csv(&plain, &a).unwrap();
+    write_ridi_csv(&with_device("walk"), &b).unwrap();
+    assert_eq!(std::fs::read(&a).unwrap(), std::fs::read(&b).unwrap());
+    assert!(!sidecar_path(&a).exists() && sidecar_path(&b).exists());
+}
+
+#[test]
+fn a_sequence_without_a_device_replaces_the_old_sidecar_too() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("data.csv");
+    write_ridi_csv(&with_device("walk"), &path).unwrap();
+    assert!(sidecar_path(&path).is_file());
+    write_ridi_csv(&sample_sequence("walk", 300, true, false), &path).unwrap();
+    assert!(!sidecar_path(&path).exists());
+    let back = ridi_csv::read(&path, &ReadOptions::default()).unwrap();
+    assert_eq!(back.device(), None);
+}
+
+#[test]
+fn slices_and_resampling_keep_the_device() {
+    let seq = with_device("walk");
+    assert_eq!(seq.slice(10..200).device(), Some(&iphone()));
+    assert_eq!(
+        seq.resampled(100.0, 0.05).unwrap().device(),
+        Some(&iphone())
+    );
+}
+
+#[test]
+fn a_bad_sidecar_names_its_file_line_and_key() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("data.csv");
+    write_ridi_csv(&with_device("walk"), &path).unwrap();
+    let sidecar = sidecar_path(&path);
+    let opts = ReadOptions::default();
+    for (text, line, field, words) in [
+        (
+            "# c\ndevice iPhone\n",
+            Some(2),
+            None,
+            "expected `key = value`",
+        ),
+        (
+            "device =  \n",
+            Some(1),
+            Some("device"),
+            "empty device model",
+        ),
+        (
+            "device = a\ndevice = b\n",
+            Some(2),
+            Some("device"),
+            "given twice (first on line 1)",
+        ),
+        (
+            "device = a\ndevice_imu_rate_hz = 0\n",
+            Some(2),
+            Some("device_imu_rate_hz"),
+            "must be a finite number above 0",
+        ),
+        (
+            "device = a\ndevice_imu_rate_hz = NaN\n",
+            Some(2),
+            Some("device_imu_rate_hz"),
+            "`NaN` is not a finite number",
+        ),
+        (
+            "device_imu_rate_hz = 100\n",
+            Some(1),
+            Some("device_imu_rate_hz"),
+            "a device rate without `device = <model>`",
+        ),
+    ] {
+        std::fs::write(&sidecar, text).unwrap();
+        let e = ridi_csv::read(&path, &opts).unwrap_err();
+        let blame = assert_names_file(&e, &sidecar);
+        assert_eq!(
+            (blame.line, blame.field.as_deref()),
+            (line, field),
+            "{text:?}: {e}"
+        );
+        assert!(e.to_string().contains(words), "{text:?}: {e}");
+        blame.assert_line_in(text.as_bytes());
+    }
+    std::fs::write(&sidecar, b"device = a\n\xff\n").unwrap();
+    let e = ridi_csv::read(&path, &opts).unwrap_err();
+    assert_eq!(assert_names_file(&e, &sidecar).line, Some(2), "{e}");
+    assert!(e.to_string().ends_with("is not UTF-8 text"), "{e}");
+    // Keys of a later version are skipped.
+    std::fs::write(
+        &sidecar,
+        "device = Pixel 8\norientation = rotation vector\n",
+    )
+    .unwrap();
+    let seq = ridi_csv::read(&path, &opts).unwrap();
+    assert_eq!(seq.device().unwrap().model(), "Pixel 8");
+    // Not a file, or far too large for one of ours.
+    std::fs::remove_file(&sidecar).unwrap();
+    std::fs::create_dir(&sidecar).unwrap();
+    let e = ridi_csv::read(&path, &opts).unwrap_err();
+    assert_names_file(&e, &sidecar);
+    assert!(e.to_string().ends_with("is not a regular file"), "{e}");
+    std::fs::remove_dir(&sidecar).unwrap();
+    std::fs::write(&sidecar, "#".repeat(100_000)).unwrap();
+    let e = ridi_csv::read(&path, &opts).unwrap_err();
+    assert_names_file(&e, &sidecar);
+}

@@ -1,0 +1,631 @@
+//! What the pipeline's commands write, and how: an output is checked before any work, and
+//! written all or nothing.
+//!
+//! - [`check_output_file`], [`check_output_folder`] and [`check_not_input`] refuse, in a
+//!   second, an output that could not be written after minutes of training or tracking, or
+//!   that would replace what the command reads. They make and remove an empty temporary folder
+//!   to see that the folder takes new entries, as the write will need.
+//! - [`TrackOutput`]: a trajectory CSV and, optionally, its plot, both written in full before
+//!   either replaces a file.
+//! - [`EvalFolder`]: an evaluation's folder (`report.json`, `report.md`, `plots/`, and the
+//!   model for the demo), written through [`Staging`] all or nothing, then cleared of the
+//!   plots an earlier evaluation left there that this one did not write, so that the folder
+//!   matches its report.
+//! - [`save_model`]: a model file.
+//!
+//! Every file goes through [`ridi_data::write_atomically`] (or [`ridi_data::write_pending`],
+//! its first half), the one writer of ridi-rs, with its one permission mode.
+
+use std::path::{Path, PathBuf};
+
+use ridi_data::{Sequence, write_pending};
+use ridi_regress::Cascade;
+
+use crate::error::{PipelineError, Result};
+use crate::evaluate::{Report, Traces};
+use crate::source::{ReadFiles, folder_of, resolved};
+use crate::staging::Staging;
+use crate::track::Track;
+
+/// An output that cannot be written, or must not be. Each message names the output as the
+/// user gave it.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum OutputError {
+    /// The folder of an output file does not exist.
+    #[error("cannot write {}: the folder {} does not exist", path.display(), folder.display())]
+    NoFolder {
+        /// The output file.
+        path: PathBuf,
+        /// Its folder.
+        folder: PathBuf,
+    },
+    /// An output file's path is a folder.
+    #[error("cannot write {}: it is a folder", path.display())]
+    IsFolder {
+        /// The output file.
+        path: PathBuf,
+    },
+    /// The folder of an output file takes no new files.
+    #[error(
+        "cannot write {}: cannot create files in {} ({kind})",
+        path.display(),
+        folder.display()
+    )]
+    FolderNotWritable {
+        /// The output file.
+        path: PathBuf,
+        /// Its folder.
+        folder: PathBuf,
+        /// Why, as the system said it.
+        kind: std::io::ErrorKind,
+    },
+    /// An output folder is a file.
+    #[error("cannot write into {}: it is a file, not a folder", dir.display())]
+    IsFile {
+        /// The output folder.
+        dir: PathBuf,
+    },
+    /// An output folder would have to be made inside a file.
+    #[error("cannot write into {}: {} is a file, not a folder", dir.display(), file.display())]
+    InsideFile {
+        /// The output folder.
+        dir: PathBuf,
+        /// The nearest existing path on the way to it, a file.
+        file: PathBuf,
+    },
+    /// An output folder could not be made, or takes no new entries.
+    #[error(
+        "cannot write into {}: cannot create folders in {} ({kind})",
+        dir.display(),
+        existing.display()
+    )]
+    ParentNotWritable {
+        /// The output folder.
+        dir: PathBuf,
+        /// The output folder, or the nearest existing folder it would be made in.
+        existing: PathBuf,
+        /// Why, as the system said it.
+        kind: std::io::ErrorKind,
+    },
+    /// An output would replace a file the command reads.
+    #[error(
+        "cannot write {}: the command reads it ({}); choose another output",
+        path.display(),
+        input.display()
+    )]
+    Input {
+        /// The output.
+        path: PathBuf,
+        /// The input, as given.
+        input: PathBuf,
+    },
+    /// One file is given as two outputs, which would overwrite each other.
+    #[error("cannot write {}: it is given as two outputs", path.display())]
+    TwoOutputs {
+        /// The output.
+        path: PathBuf,
+    },
+    /// A plot's path does not name a plot format (`.svg`, `.png`).
+    #[cfg(feature = "plot")]
+    #[error(transparent)]
+    PlotFormat(crate::plot::PlotError),
+    /// Writing an output file failed.
+    #[error("cannot write {}", path.display())]
+    Write {
+        /// The output file.
+        path: PathBuf,
+        /// What failed.
+        #[source]
+        source: Box<PipelineError>,
+    },
+    /// Writing into an output folder failed.
+    #[error("cannot write into {}", dir.display())]
+    WriteInto {
+        /// The output folder.
+        dir: PathBuf,
+        /// What failed.
+        #[source]
+        source: Box<PipelineError>,
+    },
+}
+
+impl OutputError {
+    fn write(path: &Path, source: impl Into<PipelineError>) -> Self {
+        OutputError::Write {
+            path: path.to_path_buf(),
+            source: Box::new(source.into()),
+        }
+    }
+}
+
+/// Refuses an output file that cannot be written: its folder missing, not a folder or taking
+/// no new files, or the path itself a folder. For a check before long work (training,
+/// tracking) rather than a failure after it.
+pub fn check_output_file(path: &Path) -> Result<(), OutputError> {
+    let folder = folder_of(path);
+    if !folder.is_dir() {
+        return Err(OutputError::NoFolder {
+            path: path.to_path_buf(),
+            folder: folder.to_path_buf(),
+        });
+    }
+    if path.is_dir() {
+        return Err(OutputError::IsFolder {
+            path: path.to_path_buf(),
+        });
+    }
+    // Outputs are written through a temporary file beside them.
+    probe(folder).map_err(|kind| OutputError::FolderNotWritable {
+        path: path.to_path_buf(),
+        folder: folder.to_path_buf(),
+        kind,
+    })
+}
+
+/// Refuses an output folder that exists as something else (a file) or could not be written
+/// (nor made), before any work.
+pub fn check_output_folder(dir: &Path) -> Result<(), OutputError> {
+    if dir.exists() && !dir.is_dir() {
+        return Err(OutputError::IsFile {
+            dir: dir.to_path_buf(),
+        });
+    }
+    // The folder, or the nearest existing one it would be made in, must take new entries.
+    let Some(existing) = dir
+        .ancestors()
+        .map(|d| {
+            if d.as_os_str().is_empty() {
+                Path::new(".")
+            } else {
+                d
+            }
+        })
+        .find(|d| d.exists())
+    else {
+        return Ok(());
+    };
+    if !existing.is_dir() {
+        return Err(OutputError::InsideFile {
+            dir: dir.to_path_buf(),
+            file: existing.to_path_buf(),
+        });
+    }
+    probe(existing).map_err(|kind| OutputError::ParentNotWritable {
+        dir: dir.to_path_buf(),
+        existing: existing.to_path_buf(),
+        kind,
+    })
+}
+
+/// Whether new entries can be made in the folder `dir`: makes and removes an empty temporary
+/// folder there. The error is its kind alone, since the error's own text names the temporary
+/// entry, not the output.
+fn probe(dir: &Path) -> std::result::Result<(), std::io::ErrorKind> {
+    tempfile::tempdir_in(dir).map(drop).map_err(|e| e.kind())
+}
+
+/// Refuses an output that would replace what the command reads (`inputs`) or another of its
+/// outputs (`others`).
+pub fn check_not_input(
+    out: &Path,
+    inputs: &ReadFiles,
+    others: &[&Path],
+) -> Result<(), OutputError> {
+    if let Some(input) = inputs.overwritten_by(out) {
+        return Err(OutputError::Input {
+            path: out.to_path_buf(),
+            input: input.to_path_buf(),
+        });
+    }
+    let target = resolved(out);
+    if target.is_some() && others.iter().any(|o| resolved(o) == target) {
+        return Err(OutputError::TwoOutputs {
+            path: out.to_path_buf(),
+        });
+    }
+    Ok(())
+}
+
+/// Writes `model`'s file ([`Cascade::to_bytes`]) to `path` through
+/// [`ridi_data::write_atomically`], as every output of ridi-rs is written.
+pub fn save_model(model: &Cascade, path: &Path) -> Result<()> {
+    let bytes = model.to_bytes()?;
+    ridi_data::write_atomically(path, |w| w.write_all(&bytes))?;
+    Ok(())
+}
+
+/// The outputs of tracking one recording: the trajectory CSV ([`Track::write_csv`]) and,
+/// optionally, its plot ([`Track::plot`]). Both are checked when made, before the tracking;
+/// [`TrackOutput::write`] writes both in full before either replaces a file.
+#[derive(Debug, Clone)]
+pub struct TrackOutput {
+    csv: PathBuf,
+    #[cfg(feature = "plot")]
+    plot: Option<PathBuf>,
+}
+
+impl TrackOutput {
+    /// The trajectory CSV `csv`, refused when it cannot be written ([`check_output_file`]) or
+    /// would replace one of `inputs` ([`check_not_input`]).
+    pub fn new(csv: &Path, inputs: &ReadFiles) -> Result<Self> {
+        check_output_file(csv)?;
+        check_not_input(csv, inputs, &[])?;
+        Ok(Self {
+            csv: csv.to_path_buf(),
+            #[cfg(feature = "plot")]
+            plot: None,
+        })
+    }
+
+    /// Also the plot `plot` (`.svg` or `.png`), refused as the CSV is, and when it is the CSV
+    /// or no plot format.
+    #[cfg(feature = "plot")]
+    pub fn with_plot(self, plot: &Path, inputs: &ReadFiles) -> Result<Self> {
+        check_output_file(plot)?;
+        check_not_input(plot, inputs, &[&self.csv])?;
+        crate::plot::PlotFormat::from_path(plot).map_err(OutputError::PlotFormat)?;
+        Ok(Self {
+            plot: Some(plot.to_path_buf()),
+            ..self
+        })
+    }
+
+    /// Writes the trajectory `track` of `seq`: the CSV in full under a temporary name beside
+    /// it, then the plot (itself written through a temporary file), then the CSV renamed into
+    /// place. A failed write leaves both files as they were; only a failed rename, after the
+    /// plot's, would not.
+    pub fn write(&self, seq: &Sequence, track: &Track) -> Result<()> {
+        let csv = write_pending(&self.csv, |w| track.csv(w))
+            .map_err(|e| OutputError::write(&self.csv, e))?;
+        #[cfg(feature = "plot")]
+        if let Some(plot) = &self.plot {
+            track.plot(seq, plot)?;
+        }
+        #[cfg(not(feature = "plot"))]
+        let _ = seq;
+        csv.commit().map_err(|e| OutputError::write(&self.csv, e))?;
+        Ok(())
+    }
+}
+
+/// Which plots an evaluation draws beside its report.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum EvalPlots {
+    /// None.
+    #[default]
+    None,
+    /// PNG images.
+    #[cfg(feature = "plot")]
+    Png,
+    /// SVG drawings.
+    #[cfg(feature = "plot")]
+    Svg,
+}
+
+impl EvalPlots {
+    /// The plot files' extension, `None` for no plots.
+    #[cfg(feature = "plot")]
+    fn extension(self) -> Option<&'static str> {
+        match self {
+            EvalPlots::None => None,
+            #[cfg(feature = "plot")]
+            EvalPlots::Png => Some("png"),
+            #[cfg(feature = "plot")]
+            EvalPlots::Svg => Some("svg"),
+        }
+    }
+}
+
+/// An evaluation's output folder: `report.json` and `report.md` ([`Report::write`]), the plots
+/// of each sequence in `plots/` ([`Traces::plot`]) and, for the demo, the model evaluated.
+#[derive(Debug, Clone)]
+pub struct EvalFolder {
+    dir: PathBuf,
+    plots: EvalPlots,
+}
+
+/// What [`EvalFolder::write`] wrote.
+#[derive(Debug, Clone, Default, PartialEq)]
+#[non_exhaustive]
+pub struct EvalWritten {
+    /// `report.json` and `report.md`.
+    pub reports: Vec<PathBuf>,
+    /// The plot files, in sequence order.
+    pub plots: Vec<PathBuf>,
+    /// The model file, when one was asked for.
+    pub model: Option<PathBuf>,
+    /// How many plots of an earlier evaluation were removed from `plots/`.
+    pub stale_plots: usize,
+    /// What went wrong after the new files were in place (an old plot that could not be
+    /// removed), one sentence each: worth a warning, not a failure.
+    pub warnings: Vec<String>,
+}
+
+impl EvalFolder {
+    /// The folder `dir` with `plots`, refused before any work when it (or its `plots/`, if
+    /// plots are drawn) exists as a file or cannot be written ([`check_output_folder`]).
+    pub fn new(dir: &Path, plots: EvalPlots) -> Result<Self, OutputError> {
+        check_output_folder(dir)?;
+        if plots != EvalPlots::None {
+            check_output_folder(&dir.join("plots"))?;
+        }
+        Ok(Self {
+            dir: dir.to_path_buf(),
+            plots,
+        })
+    }
+
+    /// The folder, as given.
+    pub fn dir(&self) -> &Path {
+        &self.dir
+    }
+
+    /// The plots it gets.
+    pub fn plots(&self) -> EvalPlots {
+        self.plots
+    }
+
+    /// Writes `report`, the plots of `traces` and, when given, `model` under the file name
+    /// `model.0`, all or nothing ([`Staging`]): a failure on the way leaves the folder as it
+    /// was. (The staging folder exists only while the files are written, so a killed write
+    /// leaves nothing behind.) Then removes the plots of the sequences of the `report.json`
+    /// it replaced, and of `report`, that it did not write (other sequences, the other format,
+    /// or no plots), so that `plots/` matches the report; other files there stay, and `plots/`
+    /// goes if that empties it.
+    pub fn write(
+        &self,
+        report: &Report,
+        traces: &[Traces],
+        model: Option<(&str, &Cascade)>,
+    ) -> Result<EvalWritten> {
+        let out = &self.dir;
+        let plot_dir = out.join("plots");
+        // Read before report.json is replaced: whose plots an earlier evaluation wrote.
+        let mut plotted = earlier_sequences(out);
+        plotted.extend(report.sequences.iter().map(|s| s.name.clone()));
+        let staging = Staging::new(out).map_err(|e| OutputError::WriteInto {
+            dir: out.clone(),
+            source: Box::new(e.into()),
+        })?;
+        let mut written = EvalWritten::default();
+        if let Some((name, model)) = model {
+            let path = out.join(name);
+            let bytes = model.to_bytes().map_err(|e| OutputError::write(&path, e))?;
+            staging
+                .write(Path::new(name), |w| w.write_all(&bytes))
+                .map_err(|e| OutputError::write(&path, e))?;
+            written.model = Some(path);
+        }
+        #[cfg(feature = "plot")]
+        if let Some(ext) = self.plots.extension() {
+            let staged = staging.dir(Path::new("plots"))?;
+            for t in traces {
+                for file in t.plot(&staged, ext)? {
+                    written
+                        .plots
+                        .extend(file.file_name().map(|name| plot_dir.join(name)));
+                }
+            }
+        }
+        #[cfg(not(feature = "plot"))]
+        let _ = traces;
+        for file in report.write(&staging.dir(Path::new(""))?)? {
+            written
+                .reports
+                .extend(file.file_name().map(|name| out.join(name)));
+        }
+        staging.commit()?;
+        // The new report is in place: an old plot that cannot go is worth a warning only.
+        match remove_stale_plots(&plot_dir, &plotted, &written.plots) {
+            Ok(n) => written.stale_plots = n,
+            Err(warning) => written.warnings.push(warning),
+        }
+        Ok(written)
+    }
+}
+
+/// The sequences of the `report.json` an earlier evaluation left in `dir` (none when there is
+/// none, or it cannot be read as a [`Report`]: it only decides which old plots may go).
+fn earlier_sequences(dir: &Path) -> Vec<String> {
+    Report::read(&dir.join("report.json"))
+        .map(|r| r.sequences.into_iter().map(|s| s.name).collect())
+        .unwrap_or_default()
+}
+
+/// Removes the plots an earlier evaluation left in `dir` that this one did not write
+/// (`written`). Only the plot files of `sequences` (those of the earlier report and of this
+/// evaluation) are touched, so other files in `dir` stay; `dir` goes if that empties it. The
+/// error is a sentence for a warning.
+fn remove_stale_plots(
+    dir: &Path,
+    sequences: &[String],
+    written: &[PathBuf],
+) -> std::result::Result<usize, String> {
+    let mut removed = 0;
+    // A name that is not a plain file name (an edited report.json) must not reach outside.
+    let plain = |name: &&String| Path::new(name.as_str()).file_name() == Some(name.as_ref());
+    for name in sequences.iter().filter(plain) {
+        for kind in ["trajectory", "velocity"] {
+            for ext in ["png", "svg"] {
+                let path = dir.join(format!("{name}.{kind}.{ext}"));
+                if path.is_file() && !written.contains(&path) {
+                    std::fs::remove_file(&path)
+                        .map_err(|e| format!("cannot remove {}: {e}", path.display()))?;
+                    removed += 1;
+                }
+            }
+        }
+    }
+    // Only succeeds when nothing else is in the folder.
+    let _ = std::fs::remove_dir(dir);
+    Ok(removed)
+}
+
+#[cfg(test)]
+mod tests {
+    use std::collections::BTreeMap;
+
+    use super::*;
+    use crate::evaluate::SequenceResult;
+
+    /// A report of sequences of these names, with what JSON cannot hold as a number (`NaN`,
+    /// written as `null`), as an evaluation without regressions has.
+    fn report(names: &[&str]) -> Report {
+        Report {
+            sequences: names
+                .iter()
+                .map(|name| SequenceResult {
+                    name: name.to_string(),
+                    placement: None,
+                    path_length_m: 12.5,
+                    alignment_extent_m: 3.0,
+                    placement_accuracy: None,
+                    velocity_mse: [f64::NAN; 2],
+                    methods: BTreeMap::new(),
+                })
+                .collect(),
+            summary: BTreeMap::new(),
+            velocity_mse: [f64::NAN; 2],
+            placement_accuracy: None,
+            placement_confusion: None,
+            config: ridi_eval::EvalConfig::default(),
+            methods: Vec::new(),
+            warnings: vec!["a warning".into()],
+        }
+    }
+
+    #[test]
+    fn a_written_report_reads_back_nan_and_all() {
+        let dir = tempfile::tempdir().unwrap();
+        let written = report(&["a", "b"]);
+        written.write(dir.path()).unwrap();
+        let read = Report::read(&dir.path().join("report.json")).unwrap();
+        assert!(read.velocity_mse.iter().all(|v| v.is_nan()));
+        assert!(read.sequences[1].velocity_mse.iter().all(|v| v.is_nan()));
+        // Equal but for NaN, which equals nothing.
+        let finite = |mut r: Report| {
+            r.velocity_mse = [0.0; 2];
+            for s in &mut r.sequences {
+                s.velocity_mse = [0.0; 2];
+            }
+            r
+        };
+        assert_eq!(finite(read), finite(written));
+        let err = Report::read(&dir.path().join("none.json")).unwrap_err();
+        assert!(err.to_string().contains("none.json"), "{err}");
+    }
+
+    /// Only the plots of the named sequences go, and only inside the folder, whatever an
+    /// edited report.json names; a report.json that is no report names nothing.
+    #[test]
+    fn stale_plots_are_those_of_named_sequences_inside_the_folder() {
+        let dir = tempfile::tempdir().unwrap();
+        let plots = dir.path().join("plots");
+        std::fs::create_dir_all(&plots).unwrap();
+        let file = |p: &Path| {
+            std::fs::write(p, "x").unwrap();
+            p.to_path_buf()
+        };
+        let outside = file(&dir.path().join("x.trajectory.png"));
+        let old = file(&plots.join("a.velocity.svg"));
+        let kept = file(&plots.join("a.trajectory.png"));
+        let mine = file(&plots.join("b.trajectory.png"));
+        report(&["a", "../x", ""]).write(dir.path()).unwrap();
+        let names = earlier_sequences(dir.path());
+        assert_eq!(names, ["a", "../x", ""]);
+        assert_eq!(
+            remove_stale_plots(&plots, &names, std::slice::from_ref(&kept)).unwrap(),
+            1
+        );
+        assert!(!old.exists() && kept.exists() && mine.exists() && outside.exists());
+        for text in ["{ cut", r#"{"sequences":[{"name":"a"}]}"#] {
+            std::fs::write(dir.path().join("report.json"), text).unwrap();
+            assert!(earlier_sequences(dir.path()).is_empty(), "{text}");
+        }
+        assert!(earlier_sequences(&plots).is_empty());
+    }
+
+    #[test]
+    fn outputs_that_cannot_be_written_are_refused_before_any_work() {
+        let dir = tempfile::tempdir().unwrap();
+        let file = dir.path().join("file.txt");
+        std::fs::write(&file, "mine").unwrap();
+        let message = |e: OutputError| e.to_string();
+        assert!(check_output_file(&dir.path().join("new.csv")).is_ok());
+        let e = message(check_output_file(&dir.path().join("no/new.csv")).unwrap_err());
+        assert!(e.ends_with("no does not exist"), "{e}");
+        let e = message(check_output_file(dir.path()).unwrap_err());
+        assert!(e.ends_with("it is a folder"), "{e}");
+        assert!(check_output_folder(&dir.path().join("a/b/c")).is_ok());
+        let e = message(check_output_folder(&file).unwrap_err());
+        assert!(e.ends_with("it is a file, not a folder"), "{e}");
+        let e = message(check_output_folder(&file.join("a/b")).unwrap_err());
+        assert!(e.ends_with("file.txt is a file, not a folder"), "{e}");
+        let e = message(EvalFolder::new(&file, EvalPlots::None).unwrap_err());
+        assert!(e.ends_with("it is a file, not a folder"), "{e}");
+        #[cfg(feature = "plot")]
+        {
+            std::fs::write(dir.path().join("plots"), "mine").unwrap();
+            let e = message(EvalFolder::new(dir.path(), EvalPlots::Png).unwrap_err());
+            assert!(e.ends_with("plots: it is a file, not a folder"), "{e}");
+        }
+
+        let inputs = ReadFiles::of([&file]);
+        let e = message(check_not_input(&file, &inputs, &[]).unwrap_err());
+        assert!(e.contains("the command reads it"), "{e}");
+        let out = dir.path().join("out.csv");
+        assert!(check_not_input(&out, &inputs, &[]).is_ok());
+        let e =
+            message(check_not_input(&out, &inputs, &[&dir.path().join("./out.csv")]).unwrap_err());
+        assert!(e.ends_with("it is given as two outputs"), "{e}");
+        assert_eq!(std::fs::read(&file).unwrap(), b"mine");
+    }
+
+    /// An evaluation folder takes its reports and plots together, and a later evaluation
+    /// without plots takes the earlier one's away, and `plots/` with them.
+    #[cfg(feature = "plot")]
+    #[test]
+    fn an_evaluation_folder_matches_its_latest_report() {
+        let dir = tempfile::tempdir().unwrap();
+        let out = dir.path().join("eval");
+        let points: Vec<[f64; 2]> = (0..50).map(|i| [f64::from(i) * 0.1, 0.0]).collect();
+        let traces = Traces {
+            name: "a".into(),
+            ground_truth: points.clone(),
+            methods: vec![(crate::Method::Raw, points)],
+            regression_time: Vec::new(),
+            regressed: Vec::new(),
+            true_velocity: Vec::new(),
+            placements: Vec::new(),
+        };
+        let folder = EvalFolder::new(&out, EvalPlots::Svg).unwrap();
+        let written = folder
+            .write(&report(&["a"]), std::slice::from_ref(&traces), None)
+            .unwrap();
+        assert_eq!(written.plots, [out.join("plots/a.trajectory.svg")]);
+        assert_eq!(
+            written.reports,
+            [out.join("report.json"), out.join("report.md")]
+        );
+        assert!(written.plots[0].is_file() && written.warnings.is_empty());
+        #[cfg(unix)]
+        {
+            // One writer, one permission mode: readable by all, written by the owner alone.
+            use std::os::unix::fs::PermissionsExt;
+            let mode = |p: &Path| std::fs::metadata(p).unwrap().permissions().mode() & 0o777;
+            let report_mode = mode(&written.reports[0]);
+            assert_eq!(mode(&written.plots[0]), report_mode);
+            assert_eq!(report_mode & 0o622, 0o600, "{report_mode:o}");
+        }
+
+        let again = EvalFolder::new(&out, EvalPlots::None).unwrap();
+        let written = again.write(&report(&["b"]), &[traces], None).unwrap();
+        assert!(written.plots.is_empty());
+        assert_eq!(written.stale_plots, 1);
+        assert_eq!(
+            ridi_test_support::file_names(&out),
+            ["report.json", "report.md"]
+        );
+    }
+}
