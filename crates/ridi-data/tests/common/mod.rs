@@ -15,11 +15,11 @@ use ridi_data::{GroundTruth, OrientationSource, ReadOptions, Sequence, SequenceP
 use ridi_test_support::write_files;
 
 /// First timestamp of the fixtures, ns (a plausible boot-clock value).
-pub const T0_NS: i64 = 172_364_832_413_231;
+pub(crate) const T0_NS: i64 = 172_364_832_413_231;
 
 /// A valid sequence at 200 Hz whose values have many significant digits, so that round trips
 /// test float formatting for real. Times are whole nanoseconds, as files store them.
-pub fn sample_sequence(name: &str, n: usize, ground_truth: bool, magnet: bool) -> Sequence {
+pub(crate) fn sample_sequence(name: &str, n: usize, ground_truth: bool, magnet: bool) -> Sequence {
     let time: Vec<f64> = (0..n)
         .map(|i| (T0_NS + 5_000_000 * i as i64 + (i as i64 * 7919) % 1000) as f64 / 1e9)
         .collect();
@@ -68,7 +68,7 @@ pub fn sample_sequence(name: &str, n: usize, ground_truth: bool, magnet: bool) -
 }
 
 /// The bytes of a valid RIDI `data.csv` with ground truth and magnet.
-pub fn valid_csv(n: usize) -> Vec<u8> {
+pub(crate) fn valid_csv(n: usize) -> Vec<u8> {
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("data.csv");
     ridi_data::write_ridi_csv(&sample_sequence("s", n, true, true), &path).unwrap();
@@ -76,7 +76,7 @@ pub fn valid_csv(n: usize) -> Vec<u8> {
 }
 
 /// The bytes of a valid `data_plain.txt`.
-pub fn valid_plain(n: usize) -> Vec<u8> {
+pub(crate) fn valid_plain(n: usize) -> Vec<u8> {
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("data_plain.txt");
     ridi_data::write_ridi_plain(&sample_sequence("s", n, true, true), &path).unwrap();
@@ -84,7 +84,7 @@ pub fn valid_plain(n: usize) -> Vec<u8> {
 }
 
 /// Options for the small raw fixtures: fewer pose records trimmed than the original's 800.
-pub fn raw_options() -> ReadOptions {
+pub(crate) fn raw_options() -> ReadOptions {
     ReadOptions {
         pose_trim: 5,
         ..ReadOptions::default()
@@ -94,7 +94,7 @@ pub fn raw_options() -> ReadOptions {
 /// The files of a valid raw folder: sensors at 200 Hz starting slightly before the pose, pose
 /// at 200 Hz with a 1 ms offset, each file with a `#` header. Channels are linear in time
 /// (value = seconds since start times a per-channel factor) so interpolation is checkable.
-pub fn raw_files(n: usize, with_pose: bool) -> Vec<(&'static str, String)> {
+pub(crate) fn raw_files(n: usize, with_pose: bool) -> Vec<(&'static str, String)> {
     let sensor = |name: &'static str, factor: f64, base: [f64; 3]| {
         let mut s = String::from("# t_ns x y z\n");
         for i in 0..n + 20 {
@@ -142,7 +142,7 @@ pub fn raw_files(n: usize, with_pose: bool) -> Vec<(&'static str, String)> {
 }
 
 /// Reads a raw folder of `raw_files(60, true)` after `edit`.
-pub fn raw_with(
+pub(crate) fn raw_with(
     edit: impl FnOnce(&mut Vec<(&'static str, String)>),
 ) -> (tempfile::TempDir, ridi_data::Result<Sequence>) {
     let dir = tempfile::tempdir().unwrap();

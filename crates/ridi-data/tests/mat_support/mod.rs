@@ -9,27 +9,27 @@ use std::io::Write;
 use flate2::Compression;
 use flate2::write::ZlibEncoder;
 
-pub const MI_INT8: u32 = 1;
-pub const MI_UINT8: u32 = 2;
-pub const MI_INT16: u32 = 3;
-pub const MI_INT32: u32 = 5;
-pub const MI_UINT32: u32 = 6;
-pub const MI_SINGLE: u32 = 7;
-pub const MI_DOUBLE: u32 = 9;
-pub const MI_MATRIX: u32 = 14;
-pub const MI_COMPRESSED: u32 = 15;
-pub const MI_UTF16: u32 = 17;
+pub(crate) const MI_INT8: u32 = 1;
+pub(crate) const MI_UINT8: u32 = 2;
+pub(crate) const MI_INT16: u32 = 3;
+pub(crate) const MI_INT32: u32 = 5;
+pub(crate) const MI_UINT32: u32 = 6;
+pub(crate) const MI_SINGLE: u32 = 7;
+pub(crate) const MI_DOUBLE: u32 = 9;
+pub(crate) const MI_MATRIX: u32 = 14;
+pub(crate) const MI_COMPRESSED: u32 = 15;
+pub(crate) const MI_UTF16: u32 = 17;
 
-pub const CLASS_CELL: u8 = 1;
-pub const CLASS_STRUCT: u8 = 2;
-pub const CLASS_CHAR: u8 = 4;
-pub const CLASS_DOUBLE: u8 = 6;
-pub const CLASS_SINGLE: u8 = 7;
-pub const CLASS_INT16: u8 = 10;
+pub(crate) const CLASS_CELL: u8 = 1;
+pub(crate) const CLASS_STRUCT: u8 = 2;
+pub(crate) const CLASS_CHAR: u8 = 4;
+pub(crate) const CLASS_DOUBLE: u8 = 6;
+pub(crate) const CLASS_SINGLE: u8 = 7;
+pub(crate) const CLASS_INT16: u8 = 10;
 
 /// A value to write.
 #[derive(Clone, Debug)]
-pub enum V {
+pub(crate) enum V {
     /// Double array, column-major.
     Num(Vec<usize>, Vec<f64>),
     /// Array of `class` whose data are stored as `mi_type` with the given raw bytes (file
@@ -50,7 +50,7 @@ pub enum V {
     Cell(Vec<V>),
 }
 
-pub struct W {
+pub(crate) struct W {
     pub big_endian: bool,
 }
 
@@ -72,7 +72,7 @@ impl W {
     }
 
     /// One data element; up to 4 bytes use the small element form, as MATLAB does.
-    pub fn elem(&self, ty: u32, data: &[u8]) -> Vec<u8> {
+    pub(crate) fn elem(&self, ty: u32, data: &[u8]) -> Vec<u8> {
         let mut out = Vec::new();
         if !data.is_empty() && data.len() <= 4 {
             out.extend(self.u32(((data.len() as u32) << 16) | ty));
@@ -102,7 +102,7 @@ impl W {
     }
 
     /// The payload of a miMATRIX element (without its tag).
-    pub fn matrix_body(&self, name: &str, v: &V) -> Vec<u8> {
+    pub(crate) fn matrix_body(&self, name: &str, v: &V) -> Vec<u8> {
         match v {
             V::Num(dims, data) => {
                 let mut out = self.header_parts(CLASS_DOUBLE, 0, dims, name);
@@ -171,7 +171,7 @@ impl W {
     }
 
     /// A whole miMATRIX element.
-    pub fn matrix(&self, name: &str, v: &V) -> Vec<u8> {
+    pub(crate) fn matrix(&self, name: &str, v: &V) -> Vec<u8> {
         let body = self.matrix_body(name, v);
         let mut out = Vec::new();
         out.extend(self.u32(MI_MATRIX));
@@ -180,7 +180,7 @@ impl W {
         out
     }
 
-    pub fn header(&self, text: &str) -> Vec<u8> {
+    pub(crate) fn header(&self, text: &str) -> Vec<u8> {
         let mut h = text.as_bytes().to_vec();
         h.resize(116, b' ');
         h.extend([0u8; 8]);
@@ -195,7 +195,7 @@ impl W {
     }
 
     /// A file with `vars`, each in its own miCOMPRESSED element when `compress`.
-    pub fn file(&self, vars: &[(&str, V)], compress: bool) -> Vec<u8> {
+    pub(crate) fn file(&self, vars: &[(&str, V)], compress: bool) -> Vec<u8> {
         let mut out = self.header("MATLAB 5.0 MAT-file, written by the ridi-data tests");
         for (name, v) in vars {
             let m = self.matrix(name, v);
@@ -214,13 +214,13 @@ impl W {
     }
 }
 
-pub fn le() -> W {
+pub(crate) fn le() -> W {
     W { big_endian: false }
 }
 
 /// A QTM-like export: a struct named `take` with `FrameRate` and a `RigidBodies` struct whose
 /// `Positions` (mm) and `Rotations` (column-major 3x3) are 1x3xN and 1x9xN.
-pub fn qtm_like(
+pub(crate) fn qtm_like(
     take: &str,
     rate: f64,
     positions_mm: &[[f64; 3]],
