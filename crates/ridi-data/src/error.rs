@@ -56,17 +56,17 @@ impl fmt::Display for Location {
 }
 
 /// An error of a reader or writer. Every variant names the file; parse errors name the line and
-/// field too.
+/// field too. A cause is printed in the message, not also chained as `source()` (a reporter
+/// walking the chain would print it twice).
 #[derive(Debug, thiserror::Error)]
 pub enum DataError {
     /// The file could not be opened, read or written.
-    #[error("{}: {source}", path.display())]
+    #[error("{}: {error}", path.display())]
     Io {
         /// The file.
         path: PathBuf,
         /// The cause.
-        #[source]
-        source: std::io::Error,
+        error: std::io::Error,
     },
     /// The content is not what the format says.
     #[error("{at}: {message}")]
@@ -77,22 +77,21 @@ pub enum DataError {
         message: String,
     },
     /// The data parsed but do not make a valid sequence.
-    #[error("{}: {source}", path.display())]
+    #[error("{}: {error}", path.display())]
     Sequence {
         /// The file or folder the sequence came from.
         path: PathBuf,
         /// The cause.
-        #[source]
-        source: SequenceError,
+        error: SequenceError,
     },
 }
 
 impl DataError {
     /// An I/O error on `path`.
-    pub fn io(path: impl AsRef<Path>, source: std::io::Error) -> Self {
+    pub fn io(path: impl AsRef<Path>, error: std::io::Error) -> Self {
         DataError::Io {
             path: path.as_ref().to_path_buf(),
-            source,
+            error,
         }
     }
 
@@ -105,10 +104,10 @@ impl DataError {
     }
 
     /// An invalid sequence read from `path`.
-    pub fn sequence(path: impl AsRef<Path>, source: SequenceError) -> Self {
+    pub fn sequence(path: impl AsRef<Path>, error: SequenceError) -> Self {
         DataError::Sequence {
             path: path.as_ref().to_path_buf(),
-            source,
+            error,
         }
     }
 }

@@ -70,11 +70,11 @@ pub enum RegressError {
     #[error("model encoding failed: {0}")]
     Encode(String),
     /// Filesystem error.
-    #[error("i/o error on {path}: {source}")]
+    #[error("i/o error on {path}: {error}")]
     Io {
         /// File concerned.
         path: std::path::PathBuf,
-        /// Underlying error.
-        source: std::io::Error,
+        /// Underlying error (printed, not chained).
+        error: std::io::Error,
     },
 }

@@ -151,9 +151,9 @@ fn decode(bytes: &[u8]) -> Result<Cascade, RegressError> {
 }
 
 fn io_err(path: &Path) -> impl FnOnce(std::io::Error) -> RegressError + '_ {
-    move |source| RegressError::Io {
+    move |error| RegressError::Io {
         path: path.to_path_buf(),
-        source,
+        error,
     }
 }
 

@@ -166,8 +166,8 @@ pub(super) fn write_figure<F: Figure>(
     })
     .map_err(|e| PlotError::Io {
         path: path.to_path_buf(),
-        source: match e {
-            ridi_data::DataError::Io { source, .. } => source,
+        error: match e {
+            ridi_data::DataError::Io { error, .. } => error,
             e => std::io::Error::other(e.to_string()),
         },
     })?;

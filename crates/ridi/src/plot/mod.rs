@@ -145,13 +145,12 @@ pub enum PlotError {
     #[error("invalid plot options: {0}")]
     InvalidOptions(String),
     /// Creating, writing or renaming the output file failed.
-    #[error("cannot write plot {}: {source}", path.display())]
+    #[error("cannot write plot {}: {error}", path.display())]
     Io {
         /// The output path.
         path: PathBuf,
-        /// The underlying error.
-        #[source]
-        source: std::io::Error,
+        /// The underlying error (printed, not chained).
+        error: std::io::Error,
     },
     /// The drawing library failed.
     #[error("cannot render plot {}: {message}", path.display())]
