@@ -90,18 +90,18 @@ impl FrameRing {
         let a = self.len().saturating_sub(n);
         FrameWindow {
             first_frame: self.first + a as u64,
-            imu: self.frames(a..self.len()),
+            imu: self.imu().slice(a..self.len()),
         }
     }
 
-    /// Frames `range` (local indices).
-    pub(crate) fn frames(&self, range: std::ops::Range<usize>) -> ImuFrames<'_> {
+    /// Every frame held (local indices).
+    pub(crate) fn imu(&self) -> ImuFrames<'_> {
         ImuFrames {
-            time: &self.time[range.clone()],
-            gyro: &self.gyro[range.clone()],
-            linacce: &self.linacce[range.clone()],
-            gravity: &self.gravity[range.clone()],
-            orientation: &self.orientation[range],
+            time: &self.time,
+            gyro: &self.gyro,
+            linacce: &self.linacce,
+            gravity: &self.gravity,
+            orientation: &self.orientation,
         }
     }
 }

@@ -761,7 +761,7 @@ impl<R: VelocityRegressor> Tracker<R> {
         };
         match &mut self.solver {
             Solver::Inline(corrector) => {
-                let imu = self.ring.frames(a..b + 1);
+                let imu = self.ring.imu().slice(a..b + 1);
                 let initial = job.initial.unwrap_or_default();
                 pending.result = Some(corrector.solve_validated(&imu, &job.targets, initial));
                 self.spare = Some(job);
