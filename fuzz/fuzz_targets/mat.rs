@@ -2,7 +2,7 @@
 #![no_main]
 
 use libfuzzer_sys::fuzz_target;
-use ridi_data::mat::MatFile;
+use ridi_data::MatFile;
 
 fuzz_target!(|data: &[u8]| {
     if let Ok(file) = MatFile::from_bytes(data, "fuzz.mat") {

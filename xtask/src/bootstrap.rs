@@ -52,25 +52,77 @@ pub fn mean_interval(values: &[f64], cluster: &[&str]) -> Option<Interval> {
         sums[k].0 += v;
         sums[k].1 += 1;
     }
+    let mean = values.iter().sum::<f64>() / values.len() as f64;
+    percentile_interval(mean, sums.len(), |draw| {
+        let (mut s, mut n) = (0.0, 0usize);
+        for &k in draw {
+            s += sums[k].0;
+            n += sums[k].1;
+        }
+        s / n as f64
+    })
+}
+
+/// The mean of one value per run and its 95 % interval over [`DRAWS`] resamples of the runs.
+/// `None` without values or with a non-finite one.
+pub fn runs_interval(values: &[f64]) -> Option<Interval> {
+    if values.is_empty() || !values.iter().all(|v| v.is_finite()) {
+        return None;
+    }
+    let mean = values.iter().sum::<f64>() / values.len() as f64;
+    percentile_interval(mean, values.len(), |draw| {
+        draw.iter().map(|&k| values[k]).sum::<f64>() / draw.len() as f64
+    })
+}
+
+/// The ratio of the means of paired per-run values, `mean(num) / mean(den)`, and its 95 %
+/// interval over resamples of the runs (a drawn run brings both its values). `None` without
+/// values, with slices of different lengths, a non-finite value or a mean of `den` that is not
+/// positive.
+pub fn ratio_interval(num: &[f64], den: &[f64]) -> Option<Interval> {
+    let finite = |v: &[f64]| v.iter().all(|x| x.is_finite());
+    if num.is_empty() || num.len() != den.len() || !finite(num) || !finite(den) {
+        return None;
+    }
+    let ratio = |draw: &mut dyn Iterator<Item = usize>| {
+        let (mut a, mut b) = (0.0, 0.0);
+        for k in draw {
+            a += num[k];
+            b += den[k];
+        }
+        a / b
+    };
+    if den.iter().sum::<f64>() <= 0.0 {
+        return None;
+    }
+    let point = ratio(&mut (0..num.len()));
+    // A draw whose denominators sum to 0 has no ratio: +inf sorts it into the upper tail.
+    percentile_interval(point, num.len(), |draw| {
+        let r = ratio(&mut draw.iter().copied());
+        if r.is_finite() { r } else { f64::INFINITY }
+    })
+}
+
+/// `point` and the 2.5 % and 97.5 % percentiles of `stat` over [`DRAWS`] draws of `n` cluster
+/// indices with replacement (fixed seed).
+fn percentile_interval(point: f64, n: usize, stat: impl Fn(&[usize]) -> f64) -> Option<Interval> {
     let mut rng = ChaCha8Rng::seed_from_u64(SEED);
-    let mut means: Vec<f64> = (0..DRAWS)
+    let mut draw = vec![0; n];
+    let mut stats: Vec<f64> = (0..DRAWS)
         .map(|_| {
-            let (mut s, mut n) = (0.0, 0usize);
-            for _ in 0..sums.len() {
-                let (cs, cn) = sums[rng.random_range(0..sums.len())];
-                s += cs;
-                n += cn;
+            for k in draw.iter_mut() {
+                *k = rng.random_range(0..n);
             }
-            s / n as f64
+            stat(&draw)
         })
         .collect();
-    means.sort_unstable_by(f64::total_cmp);
+    stats.sort_unstable_by(f64::total_cmp);
     // The 250th draw from each end, so that both tails leave out the same number.
     let tail = (0.025 * DRAWS as f64).round() as usize;
     Some(Interval {
-        mean: values.iter().sum::<f64>() / values.len() as f64,
-        low: means[tail - 1],
-        high: means[DRAWS - tail],
+        mean: point,
+        low: stats[tail - 1],
+        high: stats[DRAWS - tail],
     })
 }
 
@@ -129,6 +181,33 @@ mod tests {
         let seqs = mean_interval(&values, &independent).unwrap();
         assert_eq!(runs.mean, 0.5);
         assert!(runs.high - runs.low > 1.5 * (seqs.high - seqs.low));
+    }
+
+    #[test]
+    fn one_value_per_run_is_one_cluster_per_value() {
+        let values = [0.2, 0.9, 0.4, 1.3, 0.7];
+        let names = ["a", "b", "c", "d", "e"];
+        assert_eq!(runs_interval(&values), mean_interval(&values, &names));
+        assert_eq!(runs_interval(&[]), None);
+        assert_eq!(runs_interval(&[1.0, f64::INFINITY]), None);
+    }
+
+    #[test]
+    fn ratio_of_paired_means() {
+        // A constant ratio has no spread, whatever the runs drawn.
+        let den = [1.0, 2.0, 4.0, 0.5];
+        let num = den.map(|d| 1.2 * d);
+        let i = ratio_interval(&num, &den).unwrap();
+        for x in [i.mean, i.low, i.high] {
+            assert!((x - 1.2).abs() < 1e-12, "{i:?}");
+        }
+        // The ratio of the means, not the mean of the ratios: (1 + 3) / (1 + 1) = 2.
+        let i = ratio_interval(&[1.0, 3.0], &[1.0, 1.0]).unwrap();
+        assert_eq!(i.mean, 2.0);
+        assert!(i.low >= 1.0 && i.high <= 3.0 && i.low < i.high, "{i:?}");
+        assert_eq!(ratio_interval(&[1.0], &[0.0]), None);
+        assert_eq!(ratio_interval(&[1.0], &[1.0, 2.0]), None);
+        assert_eq!(ratio_interval(&[], &[]), None);
     }
 
     #[test]

@@ -1,4 +1,5 @@
-//! `cargo xtask eval tyrex`: the accuracy protocol of ridi-rs on the 24 Tyrex Nexus 5 runs.
+//! `cargo xtask eval tyrex --variants`: one variant per open choice of the paper, on the 24
+//! Tyrex Nexus 5 runs without magnetic disturbance.
 //!
 //! Leave one subject out: train on two people, test on the third, three folds, so every run
 //! is tested once by a model that never saw its person. Runs split at long mocap or sensor gaps
@@ -17,7 +18,7 @@ use std::time::Instant;
 use crate::bootstrap::{self, Interval};
 use anyhow::{Context, Result};
 use ridi::baselines::{Method, trajectory};
-use ridi::correct::{CorrectionConfig, InitialVelocity, PlacementSmoother};
+use ridi::correct::{CorrectionConfig, FrameVelocity, InitialVelocity, PlacementSmoother};
 use ridi::data::tyrex::{self, TyrexOptions};
 use ridi::data::{Sequence, write_atomically};
 use ridi::eval::{AlignWindow, EvalConfig, evaluate_trajectory};
@@ -25,14 +26,13 @@ use ridi::evaluate::{SequenceResult, Traces};
 use ridi::features::{SampleSchedule, compute_targets};
 use ridi::frames::UpAxis;
 use ridi::regress::{Cascade, Gamma, NoProgress};
-use ridi::track::Regressed;
 use ridi::train::ground_truth_view;
 use ridi::{
     EvalOptions, GridChoice, Orientation, PlacementMap, TrackOptions, TrainOptions,
     apply_orientation,
 };
 
-const PEOPLE: [&str; 3] = ["Guillaume", "Jakob", "Thibaud"];
+pub(crate) const PEOPLE: [&str; 3] = ["Guillaume", "Jakob", "Thibaud"];
 
 /// One configuration of the protocol.
 #[derive(Debug, Clone)]
@@ -280,7 +280,7 @@ fn swapped_rte(
     correction: CorrectionConfig,
     truth_of: Truth,
 ) -> Result<f64> {
-    let regs: Vec<Regressed> = traces
+    let regs: Vec<FrameVelocity> = traces
         .regression_time
         .iter()
         .zip(traces.regressed.iter().zip(&traces.true_velocity))
@@ -292,9 +292,8 @@ fn swapped_rte(
             let n = direction[0].hypot(direction[1]);
             let speed = size[0].hypot(size[1]);
             let scale = if n > 1e-9 { speed / n } else { 0.0 };
-            Regressed {
+            FrameVelocity {
                 frame: seq.time().partition_point(|&x| x < t),
-                placement: 0,
                 velocity: ridi::frames::StabHorizontal::from_array(direction) * scale,
             }
         })
@@ -350,12 +349,11 @@ fn oracle_rte(seq: &Sequence, window: usize, opts: &EvalOptions) -> Result<f64> 
     };
     let frames = SampleSchedule::every(&config, opts.track.regress_every)?.frames(seq.len());
     let targets = compute_targets(&ground_truth_view(seq)?, &config, &frames)?;
-    let regs: Vec<Regressed> = frames
+    let regs: Vec<FrameVelocity> = frames
         .iter()
         .zip(&targets.values)
-        .map(|(&frame, v)| Regressed {
+        .map(|(&frame, v)| FrameVelocity {
             frame,
-            placement: 0,
             velocity: *v,
         })
         .collect();
@@ -519,7 +517,7 @@ fn run_of(name: &str) -> &str {
 
 /// `mean [low, high]`, or a dash without an interval; a difference (`signed`) whose interval
 /// leaves out 0 is bold.
-fn interval_cell(i: Option<Interval>, signed: bool) -> String {
+pub(crate) fn interval_cell(i: Option<Interval>, signed: bool) -> String {
     match (i, signed) {
         (Some(i), false) => format!("{:.3} [{:.2}, {:.2}]", i.mean, i.low, i.high),
         (Some(i), true) if i.contains(0.0) => {
@@ -726,7 +724,7 @@ pub fn run(
     );
     let _ = writeln!(
         md,
-        "Command: `cargo xtask eval tyrex{}{}` ({:.0} s in all on a 2-core machine shared with other work). \
+        "Command: `cargo xtask eval tyrex --variants{}{}` ({:.0} s in all on a 2-core machine shared with other work). \
          {} test sequences (24 runs; runs split at long mocap or sensor gaps count once per part). \
          Train on two people, test on the third, three folds; C = 10, epsilon = 0.01 without grid \
          search unless a variant searches; \

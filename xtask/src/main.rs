@@ -6,6 +6,7 @@ use clap::{Args, Parser, Subcommand};
 
 mod bench;
 mod bootstrap;
+mod eval_devices;
 mod eval_orientation;
 mod eval_tyrex;
 mod sample;
@@ -91,8 +92,11 @@ enum Task {
 
 #[derive(Subcommand)]
 enum Eval {
-    /// The accuracy protocol: leave-one-subject-out on the 24 Tyrex Nexus 5 runs, every method,
-    /// and one variant per open choice of the paper; writes docs/bench-accuracy.md.
+    /// The accuracy protocols on every Tyrex run of datasets/protocols/tyrex-runs.txt: leave
+    /// one person out over both phones, across phones (Nexus 5 -> iPhone 4S and the reverse,
+    /// beside the same-phone models) and on the 24 undisturbed Nexus 5 runs; writes
+    /// docs/bench-devices.md. With --variants: one variant per open choice of the paper on the
+    /// 24 Nexus 5 runs; writes docs/bench-accuracy.md.
     Tyrex(TyrexArgs),
     /// Compare the gyro + accelerometer orientation estimator (default gains and a kp/ki
     /// sweep) and the Android rotation vector with the Tyrex motion capture, and write a
@@ -106,15 +110,28 @@ struct TyrexArgs {
     /// <workspace>/datasets/tyrex from `cargo xtask fetch tyrex`].
     #[arg(long, value_name = "DIR")]
     data: Option<PathBuf>,
-    /// Report to write [default: <workspace>/docs/bench-accuracy.md].
+    /// Report to write [default: <workspace>/docs/bench-devices.md, with --variants
+    /// docs/bench-accuracy.md].
     #[arg(long, value_name = "FILE")]
     out: Option<PathBuf>,
-    /// Only the reference variant.
+    /// The variant sweep on the 24 Nexus 5 runs instead of the device protocols.
     #[arg(long)]
+    variants: bool,
+    /// With --variants: only the reference variants.
+    #[arg(long, requires = "variants")]
     quick: bool,
-    /// Only the variants whose name contains this text (e.g. "turned").
+    /// Only the protocols (with --variants: the variants) whose name contains this text (e.g.
+    /// "iPhone", "turned").
     #[arg(long, value_name = "TEXT")]
     only: Option<String>,
+    /// Training sample step in frames [default: ridi train's, 20]; a coarser step trains
+    /// faster on fewer windows (the report says so).
+    #[arg(long, value_name = "FRAMES", conflicts_with = "variants", value_parser = clap::value_parser!(u64).range(1..))]
+    step: Option<u64>,
+    /// Device orientation the models see: as recorded, or estimated from gyro and
+    /// accelerometer.
+    #[arg(long, value_name = "SOURCE", default_value = "recorded", value_parser = ["recorded", "estimated"], conflicts_with = "variants")]
+    orientation: String,
 }
 
 #[derive(Args)]
@@ -191,7 +208,20 @@ fn run(cli: Cli) -> Result<()> {
             print!("{}", checksum::format_list(&list));
         }
         Task::Eval(Eval::Tyrex(args)) | Task::EvalTyrex(args) => {
-            let out = eval_tyrex::run(args.data, args.out, args.quick, args.only)?;
+            let out = if args.variants {
+                eval_tyrex::run(args.data, args.out, args.quick, args.only)?
+            } else {
+                eval_devices::run(eval_devices::Options {
+                    data: args.data,
+                    out: args.out,
+                    only: args.only,
+                    step: args.step.map(|s| s as usize),
+                    orientation: match args.orientation.as_str() {
+                        "estimated" => ridi::features::Orientation::Estimated,
+                        _ => ridi::features::Orientation::Recorded,
+                    },
+                })?
+            };
             println!("wrote {}", out.display());
         }
         Task::Eval(Eval::Orientation(args)) | Task::EvalOrientation(args) => {

@@ -3,11 +3,12 @@
 //! - Every workspace crate's dependencies on other workspace crates are exactly the row of the
 //!   layer table in `docs/ARCHITECTURE.md` (normal and build dependencies; dev-dependencies
 //!   may only name crates of that row, `ridi-test-support`, or the crate itself).
-//! - No error enum uses a retired spelling: `NotFinite`, and `LengthMismatch` / `NonFinite`
-//!   variants with other fields than `what`, `expected`, `found`, `index` (and a plot's
-//!   `series`).
-//! - No crate declares a public module outside [`PUBLIC_MODULES`]: new items are re-exported at
-//!   the crate root from private modules, as ripgrep's crates do.
+//! - No error enum uses a retired spelling: `NotFinite`, `DimensionMismatch`, a `Shape(..)`
+//!   variant, `LengthMismatch` / `NonFinite` as unit or tuple variants, or with other fields
+//!   than `what`, `expected`, `found`, `index` (and a plot's `series`).
+//! - No crate declares a public module outside [`PUBLIC_MODULES`], and the list names no module
+//!   that is not public: new items are re-exported at the crate root from private modules, as
+//!   ripgrep's crates do.
 //!
 //! It reads files only (no build), so it takes well under a second.
 
@@ -17,21 +18,13 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result, bail};
 
-/// The public modules each crate still has. The list may only shrink: a new public item goes
+/// The public modules each crate still has, exactly (a module made private leaves the list, so
+/// that making it public again is caught). The list may only shrink: a new public item goes
 /// into a private module and is re-exported at the crate root.
 pub const PUBLIC_MODULES: &[(&str, &[&str])] = &[
     (
         "ridi-data",
-        &[
-            "ilc",
-            "mat",
-            "processed",
-            "resample",
-            "ridi_csv",
-            "ridi_plain",
-            "ridi_raw",
-            "tyrex",
-        ],
+        &["ilc", "ridi_csv", "ridi_plain", "ridi_raw", "tyrex"],
     ),
     (
         "ridi",
@@ -40,7 +33,6 @@ pub const PUBLIC_MODULES: &[(&str, &[&str])] = &[
             "convert",
             "evaluate",
             "inspect",
-            "lists",
             "live",
             "orientation",
             "placement",
@@ -49,6 +41,15 @@ pub const PUBLIC_MODULES: &[(&str, &[&str])] = &[
             "track",
             "train",
         ],
+    ),
+];
+
+/// Retired variant names, wherever they appear in code, and what replaced them.
+const RETIRED_NAMES: &[(&str, &str)] = &[
+    ("NotFinite", "the variant is `NonFinite`"),
+    (
+        "DimensionMismatch",
+        "the variant is `LengthMismatch { what, expected, found }`",
     ),
 ];
 
@@ -251,13 +252,27 @@ pub fn check_error_spellings(file: &str, text: &str, problems: &mut Vec<String>)
     let lines: Vec<&str> = text.lines().collect();
     for (i, line) in lines.iter().enumerate() {
         let code = line.split("//").next().unwrap_or("");
-        if contains_word(code, "NotFinite") {
+        for (name, instead) in RETIRED_NAMES {
+            if contains_word(code, name) {
+                problems.push(format!("{file}:{}: `{name}` is retired: {instead}", i + 1));
+            }
+        }
+        let t = line.trim();
+        // A unit or tuple variant definition (`NonFinite,`, `Shape(String),`): the workspace's
+        // are struct variants that name the input.
+        let shapeless = ["LengthMismatch", "NonFinite", "Shape"]
+            .into_iter()
+            .find(|v| {
+                t.strip_prefix(v)
+                    .is_some_and(|r| r == "," || r.starts_with('('))
+            });
+        if let Some(v) = shapeless {
             problems.push(format!(
-                "{file}:{}: `NotFinite` is retired: the variant is `NonFinite`",
+                "{file}:{}: a unit or tuple `{v}` variant is retired: the variants are \
+                 `LengthMismatch {{ what, expected, found }}` and `NonFinite {{ what, index }}`",
                 i + 1
             ));
         }
-        let t = line.trim();
         // A variant definition, not a use (`Error::LengthMismatch {` or a pattern).
         let variant = ["LengthMismatch {", "NonFinite {"]
             .into_iter()
@@ -318,8 +333,10 @@ fn check_public_modules(root: &Path, krate: &Crate, problems: &mut Vec<String>) 
     Ok(())
 }
 
-/// Problems for the `pub mod` declarations of the crate root `text` outside `allowed`.
+/// Problems for the `pub mod` declarations of the crate root `text` outside `allowed`, and for
+/// the modules of `allowed` it does not declare public.
 fn public_modules_outside(shown: &str, text: &str, allowed: &[&str], problems: &mut Vec<String>) {
+    let mut public = Vec::new();
     for (i, line) in text.lines().enumerate() {
         // `#[cfg(..)] pub mod x;` on one line too.
         let mut code = line.trim();
@@ -332,6 +349,7 @@ fn public_modules_outside(shown: &str, text: &str, allowed: &[&str], problems: &
             continue;
         };
         let module = module.trim_end_matches(';').trim_end_matches('{').trim();
+        public.push(module);
         if !allowed.contains(&module) {
             problems.push(format!(
                 "{shown}:{}: `pub mod {module}`: make the module private and re-export its \
@@ -339,6 +357,12 @@ fn public_modules_outside(shown: &str, text: &str, allowed: &[&str], problems: &
                 i + 1
             ));
         }
+    }
+    for stale in allowed.iter().filter(|m| !public.contains(m)) {
+        problems.push(format!(
+            "{shown}: `{stale}` is no public module: remove it from PUBLIC_MODULES \
+             (xtask/src/tidy.rs), so that making it public again is caught"
+        ));
     }
 }
 
@@ -369,7 +393,7 @@ mod tests {
 
     #[test]
     fn retired_error_spellings_are_named_with_file_and_line() {
-        let text = "pub enum E {\n    LengthMismatch {\n        /// Which.\n        what: &'static str,\n        left: usize,\n    },\n    NotFinite,\n}\nfn f() { E::LengthMismatch {\n left: 1 }; }\n";
+        let text = "pub enum E {\n    LengthMismatch {\n        /// Which.\n        what: &'static str,\n        left: usize,\n    },\n    NotFinite,\n    Shape(String),\n    NonFinite,\n    DimensionMismatch { expected: usize },\n}\nfn f() { E::LengthMismatch {\n left: 1 }; }\n";
         let mut problems = Vec::new();
         check_error_spellings("x.rs", text, &mut problems);
         assert_eq!(
@@ -378,12 +402,18 @@ mod tests {
                 "x.rs:5: field `left` of `LengthMismatch`: the fields are spelled what, \
                  expected, found, index, series",
                 "x.rs:7: `NotFinite` is retired: the variant is `NonFinite`",
+                "x.rs:8: a unit or tuple `Shape` variant is retired: the variants are \
+                 `LengthMismatch { what, expected, found }` and `NonFinite { what, index }`",
+                "x.rs:9: a unit or tuple `NonFinite` variant is retired: the variants are \
+                 `LengthMismatch { what, expected, found }` and `NonFinite { what, index }`",
+                "x.rs:10: `DimensionMismatch` is retired: the variant is `LengthMismatch { what, \
+                 expected, found }`",
             ]
         );
         let mut none = Vec::new();
         check_error_spellings(
             "y.rs",
-            "enum E { NonFiniteTarget }\n// NotFinite\n",
+            "enum E { NonFiniteTarget }\n// NotFinite\nErr(E::NonFinite(_)),\n    ShapeOf(usize),\n",
             &mut none,
         );
         assert!(none.is_empty(), "{none:?}");
@@ -423,6 +453,34 @@ mod tests {
         assert_eq!(problems.len(), 2, "{problems:#?}");
         assert!(problems[0].starts_with("lib.rs:3: `pub mod gated`"));
         assert!(problems[1].starts_with("lib.rs:4: `pub mod new`"));
+    }
+
+    #[test]
+    fn a_listed_module_that_is_private_is_named_and_public_again_is_caught() {
+        let mut problems = Vec::new();
+        public_modules_outside(
+            "lib.rs",
+            "mod mat;\npub mod kept;\n",
+            &["kept", "mat"],
+            &mut problems,
+        );
+        assert_eq!(problems.len(), 1, "{problems:#?}");
+        assert!(problems[0].starts_with("lib.rs: `mat` is no public module"));
+        // ridi-data's MAT reader, resampling and processed layout are internal.
+        let (_, data) = PUBLIC_MODULES
+            .iter()
+            .find(|(c, _)| *c == "ridi-data")
+            .unwrap();
+        let mut problems = Vec::new();
+        let text = "pub mod mat;\npub mod resample;\npub mod processed;\n";
+        public_modules_outside("lib.rs", text, data, &mut problems);
+        for (i, module) in ["mat", "resample", "processed"].iter().enumerate() {
+            let named = format!("lib.rs:{}: `pub mod {module}`", i + 1);
+            assert!(
+                problems.iter().any(|p| p.starts_with(&named)),
+                "{problems:#?}"
+            );
+        }
     }
 
     #[test]

@@ -36,23 +36,30 @@ fn missing_data_folder_fails_with_a_clear_message_and_writes_nothing() {
 }
 
 #[test]
-fn a_variant_filter_that_matches_nothing_fails_before_reading_data() {
+fn a_filter_that_matches_nothing_fails_before_reading_data() {
     let tmp = tempfile::tempdir().unwrap();
     let out = tmp.path().join("report.md");
-    let o = Command::new(env!("CARGO_BIN_EXE_xtask"))
-        .args(["eval", "tyrex", "--only", "no such variant", "--data"])
-        .arg(tmp.path().join("absent"))
-        .arg("--out")
-        .arg(&out)
-        .output()
-        .unwrap();
-    assert!(!o.status.success());
-    let stderr = String::from_utf8_lossy(&o.stderr);
-    assert!(
-        stderr.starts_with("error: no variant's name contains \"no such variant\"; the variants: ")
-            && stderr.contains("(ridi's defaults)"),
-        "{stderr}"
-    );
-    assert_eq!(stderr.lines().count(), 1, "{stderr}");
-    assert!(!out.exists());
+    for (variants, expect, listed) in [
+        (true, "no variant's name contains", "(ridi's defaults)"),
+        (false, "no protocol's name contains", "Nexus 5 -> iPhone 4S"),
+    ] {
+        let mut cmd = Command::new(env!("CARGO_BIN_EXE_xtask"));
+        cmd.args(["eval", "tyrex", "--only", "no such thing", "--data"])
+            .arg(tmp.path().join("absent"))
+            .arg("--out")
+            .arg(&out);
+        if variants {
+            cmd.arg("--variants");
+        }
+        let o = cmd.output().unwrap();
+        assert!(!o.status.success());
+        let stderr = String::from_utf8_lossy(&o.stderr);
+        assert!(
+            stderr.starts_with(&format!("error: {expect} \"no such thing\"; the "))
+                && stderr.contains(listed),
+            "{stderr}"
+        );
+        assert_eq!(stderr.lines().count(), 1, "{stderr}");
+        assert!(!out.exists());
+    }
 }

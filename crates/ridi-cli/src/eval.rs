@@ -6,8 +6,8 @@ use std::path::PathBuf;
 use anyhow::Result;
 use indicatif::ProgressBar;
 
+use ridi::data::ListEntry;
 use ridi::eval::{AlignWindow, EvalConfig};
-use ridi::lists::read_lists;
 use ridi::{
     EvalFolder, EvalOptions, EvalPlots, EvalWritten, Method, Purpose, Report, TrackOptions,
 };
@@ -64,7 +64,7 @@ pub(crate) fn run(args: Args) -> Result<()> {
     }
     let model = crate::load_model(&args.model)?;
     let listed = crate::load_listed(
-        read_lists(&args.list)?,
+        ListEntry::read(&args.list)?,
         args.placement_map.as_deref(),
         Purpose::Evaluation,
     )?;
@@ -81,10 +81,10 @@ pub(crate) fn run(args: Args) -> Result<()> {
     };
     let seqs = listed.sequences();
     let (report, traces) = with_spinner(seqs.len(), || ridi::evaluate(seqs, &model, &opts))
-        .map_err(|e| listed.locate(e))?;
+        .map_err(|e| e.locate_in(&listed))?;
     let written = folder
         .write(&report, &traces, None)
-        .map_err(|e| listed.locate(e))?;
+        .map_err(|e| e.locate_in(&listed))?;
     print_written(&report, &written, &folder);
     Ok(())
 }

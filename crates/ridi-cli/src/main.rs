@@ -9,9 +9,8 @@ use anyhow::{Context, Result};
 use clap::{Parser, Subcommand, ValueEnum};
 
 use ridi::correct::PlacementSmoother;
-use ridi::data::{ListEntry, ReadOptions};
+use ridi::data::{ListEntry, Listed, ReadOptions};
 use ridi::eval::AlignWindow;
-use ridi::lists::Listed;
 use ridi::regress::Cascade;
 use ridi::{EvalPlots, GridChoice, PlacementMap, Purpose};
 
@@ -203,7 +202,7 @@ fn set_jobs(jobs: Option<usize>) -> Result<()> {
 /// `--placement-map` when given.
 fn load_listed(entries: Vec<ListEntry>, map: Option<&str>, purpose: Purpose) -> Result<Listed> {
     let map = map.map(PlacementMap::from_arg).transpose()?;
-    Ok(Listed::load(
+    Ok(ridi::load_listed(
         entries,
         map.as_ref(),
         purpose,

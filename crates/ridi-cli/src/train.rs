@@ -6,9 +6,9 @@ use anyhow::{Context, Result};
 use clap::ValueEnum;
 use indicatif::{ProgressBar, ProgressStyle};
 
+use ridi::data::ListEntry;
 use ridi::features::FeatureConfig;
 use ridi::frames::UpAxis;
-use ridi::lists::read_lists;
 use ridi::regress::{Cascade, ProgressEvent, RegressError, Stage, Storage};
 use ridi::source::ReadFiles;
 use ridi::{
@@ -145,7 +145,7 @@ pub(crate) fn run(args: Args) -> Result<()> {
     crate::set_jobs(args.jobs)?;
     let out = &args.out;
     check_output_file(out)?;
-    let entries = read_lists(&args.list)?;
+    let entries = ListEntry::read(&args.list)?;
     let mut read = args.list.clone();
     read.extend(entries.iter().map(|e| e.path.clone()));
     check_not_input(out, &ReadFiles::of(&read), &[])?;
@@ -171,7 +171,7 @@ pub(crate) fn run(args: Args) -> Result<()> {
     opts.cascade.speed = !args.no_speed;
     let model = with_progress(|progress| ridi::train(listed.sequences(), &opts, progress))
         .map_err(|e| {
-            let e = listed.locate(e);
+            let e = e.locate_in(&listed);
             let folds = matches!(
                 e,
                 PipelineError::Regress(RegressError::TooFewSequences { .. })

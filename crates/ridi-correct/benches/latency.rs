@@ -9,7 +9,7 @@ mod common;
 use std::time::Instant;
 
 use ridi_correct::{
-    CorrectionConfig, CorrectionOutcome, Corrector, FrameWindow, Regression, RegressorError,
+    CorrectionConfig, CorrectionOutcome, Corrector, FrameWindow, RegressorError, RegressorOutput,
     Tracker, TrackerConfig, VelocityRegressor, solve_dense,
 };
 use ridi_frames::{ImuSample, WorldVec};
@@ -24,9 +24,12 @@ impl VelocityRegressor for Replay {
     fn window_len(&self) -> usize {
         200
     }
-    fn regress(&mut self, frames: &FrameWindow<'_>) -> Result<Option<Regression>, RegressorError> {
+    fn regress(
+        &mut self,
+        frames: &FrameWindow<'_>,
+    ) -> Result<Option<RegressorOutput>, RegressorError> {
         let f = frames.last_frame() as usize % self.velocity.len();
-        Ok(Some(Regression {
+        Ok(Some(RegressorOutput {
             velocity: self.velocity[f],
             placement: None,
         }))

@@ -10,7 +10,7 @@ use ridi_frames::{DeviceVec, WorldVec};
 
 use crate::config::{CorrectionConfig, InitialVelocity};
 use crate::error::CorrectError;
-use crate::input::{VelocityTarget, validate_imu, validate_targets};
+use crate::input::{FrameVelocity, validate_imu, validate_targets};
 use crate::integrate::{corrected_acceleration_unchecked, integrate_unchecked};
 use crate::knots::{BiasCurve, Knots};
 use crate::solve::Correction;
@@ -21,7 +21,7 @@ use ridi_frames::ImuFrames;
 pub fn objective(
     config: &CorrectionConfig,
     imu: &ImuFrames<'_>,
-    targets: &[VelocityTarget],
+    targets: &[FrameVelocity],
     correction: &Correction,
 ) -> Result<f64, CorrectError> {
     config.validate()?;
@@ -56,7 +56,7 @@ pub fn objective(
 pub fn solve_dense(
     config: &CorrectionConfig,
     imu: &ImuFrames<'_>,
-    targets: &[VelocityTarget],
+    targets: &[FrameVelocity],
 ) -> Result<Correction, CorrectError> {
     config.validate()?;
     validate_imu(imu, config.max_dt)?;

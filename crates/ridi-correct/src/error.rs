@@ -100,6 +100,8 @@ pub enum CorrectError {
     OutOfMemory,
 }
 
+/// An [`ImuFrames`](ridi_frames::ImuFrames) length error is this crate's `LengthMismatch`, so
+/// that a caller matches one spelling for every input of the crate, whichever check found it.
 impl From<ridi_frames::ImuError> for CorrectError {
     fn from(e: ridi_frames::ImuError) -> Self {
         let ridi_frames::ImuError::LengthMismatch {

@@ -1,4 +1,4 @@
-//! Inputs of a correction: checks of its frames, and regressed velocity targets.
+//! Inputs of a correction: checks of its frames, and of the velocities at frames it follows.
 
 use ridi_frames::{ImuFrames, ImuStream, StabHorizontal};
 use serde::{Deserialize, Serialize};
@@ -96,9 +96,11 @@ pub(crate) fn validate_time(time: &[f64], max_dt: f64) -> Result<(), CorrectErro
     Ok(())
 }
 
-/// A regressed velocity: the horizontal velocity in the stabilized frame S at one frame.
+/// A velocity at a frame: the horizontal velocity in the stabilized frame S that the
+/// correction makes the integrated velocity follow there (a regressed one, or a ground-truth
+/// one for an oracle). Not a training target (ridi-features' targets are those).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-pub struct VelocityTarget {
+pub struct FrameVelocity {
     /// Frame index (into the slices of the correction).
     pub frame: usize,
     /// `[S-x, S-z]` velocity, m/s (forward is -z).
@@ -106,7 +108,7 @@ pub struct VelocityTarget {
 }
 
 /// Checks that targets are finite, strictly increasing and inside `0..len`.
-pub(crate) fn validate_targets(targets: &[VelocityTarget], len: usize) -> Result<(), CorrectError> {
+pub(crate) fn validate_targets(targets: &[FrameVelocity], len: usize) -> Result<(), CorrectError> {
     for (i, t) in targets.iter().enumerate() {
         if t.frame >= len {
             return Err(CorrectError::TargetOutOfRange {

@@ -34,7 +34,7 @@
 //! # Example
 //!
 //! ```
-//! use ridi_correct::{CorrectionConfig, Corrector, VelocityTarget};
+//! use ridi_correct::{CorrectionConfig, Corrector, FrameVelocity};
 //! use ridi_frames::{DeviceVec, ImuFrames, StabHorizontal, WorldFromDevice};
 //!
 //! // Two seconds at 200 Hz of a phone lying flat, its accelerometer biased by 0.05 m/s² along
@@ -46,8 +46,8 @@
 //! let gravity = vec![DeviceVec::new(0.0, 0.0, 9.81); n];
 //! let gyro = vec![DeviceVec::ZERO; n];
 //! let imu = ImuFrames::new(&time, &gyro, &linacce, &gravity, &orientation)?;
-//! let targets: Vec<VelocityTarget> =
-//!     (10..n).step_by(10).map(|frame| VelocityTarget { frame, velocity: StabHorizontal::ZERO }).collect();
+//! let targets: Vec<FrameVelocity> =
+//!     (10..n).step_by(10).map(|frame| FrameVelocity { frame, velocity: StabHorizontal::ZERO }).collect();
 //!
 //! let config = CorrectionConfig { lambda: 1e-6, ..CorrectionConfig::default() };
 //! let trajectory = Corrector::new(config)?.correct(&imu, &targets)?;
@@ -77,11 +77,11 @@ mod tracker;
 pub use config::{CorrectionConfig, InitialVelocity};
 pub use dense::{objective, solve_dense};
 pub use error::CorrectError;
-pub use input::VelocityTarget;
+pub use input::FrameVelocity;
 pub use integrate::{Integrator, Pose, corrected_acceleration, integrate, world_acceleration};
 pub use knots::{BiasCurve, Knots};
 pub use placement::{PlacementFilter, PlacementSmoother, TrailingMajority};
-pub use regressor::{FrameWindow, Regression, RegressorError, VelocityRegressor};
+pub use regressor::{FrameWindow, RegressorError, RegressorOutput, VelocityRegressor};
 /// The frame types the inputs are built from.
 pub use ridi_frames;
 pub use solve::{Correction, Corrector, Trajectory, correct};

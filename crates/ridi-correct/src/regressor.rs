@@ -29,9 +29,15 @@ impl FrameWindow<'_> {
     }
 }
 
-/// A regressed velocity with the placement it was regressed for.
+/// What a [`VelocityRegressor`] gives for one window: the velocity at its last frame, and the
+/// placement it was regressed for if the regressor classifies one.
+///
+/// The same meaning as ridi-regress's `Prediction` (the cascade's output for one window), which
+/// always has a placement; this crate does not depend on ridi-regress, and a regressor that
+/// does not classify has none, hence `Option`. The tracker stores the velocity as a
+/// [`FrameVelocity`](crate::FrameVelocity) at the window's frame.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Regression {
+pub struct RegressorOutput {
     /// Horizontal velocity in the stabilized frame S, `[S-x, S-z]`, m/s.
     pub velocity: StabHorizontal,
     /// The placement it was regressed for, as an index into the regressor's placement names
@@ -64,7 +70,10 @@ pub trait VelocityRegressor {
     /// The velocity at the last frame of `frames`. `Ok(None)` means "no estimate here" (the
     /// frame is skipped silently); an error is reported in the tracker's update and the frame
     /// is skipped too.
-    fn regress(&mut self, frames: &FrameWindow<'_>) -> Result<Option<Regression>, RegressorError>;
+    fn regress(
+        &mut self,
+        frames: &FrameWindow<'_>,
+    ) -> Result<Option<RegressorOutput>, RegressorError>;
 }
 
 impl<R: VelocityRegressor + ?Sized> VelocityRegressor for Box<R> {
@@ -74,7 +83,10 @@ impl<R: VelocityRegressor + ?Sized> VelocityRegressor for Box<R> {
     fn up_axis(&self) -> Option<UpAxis> {
         (**self).up_axis()
     }
-    fn regress(&mut self, frames: &FrameWindow<'_>) -> Result<Option<Regression>, RegressorError> {
+    fn regress(
+        &mut self,
+        frames: &FrameWindow<'_>,
+    ) -> Result<Option<RegressorOutput>, RegressorError> {
         (**self).regress(frames)
     }
 }
@@ -86,7 +98,10 @@ impl<R: VelocityRegressor + ?Sized> VelocityRegressor for &mut R {
     fn up_axis(&self) -> Option<UpAxis> {
         (**self).up_axis()
     }
-    fn regress(&mut self, frames: &FrameWindow<'_>) -> Result<Option<Regression>, RegressorError> {
+    fn regress(
+        &mut self,
+        frames: &FrameWindow<'_>,
+    ) -> Result<Option<RegressorOutput>, RegressorError> {
         (**self).regress(frames)
     }
 }

@@ -14,7 +14,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::config::{CorrectionConfig, InitialVelocity};
 use crate::error::CorrectError;
-use crate::input::{VelocityTarget, validate_imu, validate_targets};
+use crate::input::{FrameVelocity, validate_imu, validate_targets};
 use crate::integrate::{Pose, corrected_acceleration_unchecked, integrate_unchecked};
 use crate::knots::{BiasCurve, Knots};
 use ridi_frames::ImuFrames;
@@ -203,7 +203,7 @@ impl Corrector {
     pub fn solve(
         &mut self,
         imu: &ImuFrames<'_>,
-        targets: &[VelocityTarget],
+        targets: &[FrameVelocity],
     ) -> Result<Correction, CorrectError> {
         let initial = self.config.initial_velocity;
         self.solve_from(imu, targets, initial)
@@ -214,7 +214,7 @@ impl Corrector {
     pub fn solve_from(
         &mut self,
         imu: &ImuFrames<'_>,
-        targets: &[VelocityTarget],
+        targets: &[FrameVelocity],
         initial: InitialVelocity,
     ) -> Result<Correction, CorrectError> {
         validate_imu(imu, self.config.max_dt)?;
@@ -237,7 +237,7 @@ impl Corrector {
     pub fn correct(
         &mut self,
         imu: &ImuFrames<'_>,
-        targets: &[VelocityTarget],
+        targets: &[FrameVelocity],
     ) -> Result<Trajectory, CorrectError> {
         let correction = self.solve(imu, targets)?;
         let acc = corrected_acceleration_unchecked(imu, &correction.bias);
@@ -249,7 +249,7 @@ impl Corrector {
     pub(crate) fn solve_validated(
         &mut self,
         imu: &ImuFrames<'_>,
-        targets: &[VelocityTarget],
+        targets: &[FrameVelocity],
         initial: InitialVelocity,
     ) -> Result<Correction, CorrectError> {
         let knots = Knots::new(imu.time, self.config.knot_spacing);
@@ -324,12 +324,7 @@ impl Corrector {
     }
 
     /// Segment integrals: `d_j` (uncorrected world acceleration) and the blocks `G_j`.
-    fn assemble_segments(
-        &mut self,
-        imu: &ImuFrames<'_>,
-        targets: &[VelocityTarget],
-        knots: &Knots,
-    ) {
+    fn assemble_segments(&mut self, imu: &ImuFrames<'_>, targets: &[FrameVelocity], knots: &Knots) {
         let s = &mut self.scratch;
         let r = targets.len();
         s.seg_lo.clear();
@@ -402,7 +397,7 @@ impl Corrector {
     fn target_blocks(
         &mut self,
         imu: &ImuFrames<'_>,
-        targets: &[VelocityTarget],
+        targets: &[FrameVelocity],
     ) -> Result<(), CorrectError> {
         let (wh, wv) = (self.config.horizontal_weight, self.config.vertical_weight);
         let up_axis = self.config.up_axis;
@@ -576,7 +571,7 @@ impl Corrector {
 pub fn correct(
     config: CorrectionConfig,
     imu: &ImuFrames<'_>,
-    targets: &[VelocityTarget],
+    targets: &[FrameVelocity],
 ) -> Result<Trajectory, CorrectError> {
     Corrector::new(config)?.correct(imu, targets)
 }

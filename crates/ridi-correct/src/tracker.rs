@@ -11,11 +11,11 @@ use thiserror::Error;
 
 use crate::config::{CorrectionConfig, InitialVelocity};
 use crate::error::CorrectError;
-use crate::input::VelocityTarget;
+use crate::input::FrameVelocity;
 use crate::integrate::{Integrator, Pose};
 use crate::knots::BiasCurve;
 use crate::placement::PlacementFilter;
-use crate::regressor::{Regression, VelocityRegressor};
+use crate::regressor::{RegressorOutput, VelocityRegressor};
 use crate::ring::FrameRing;
 use crate::solve::{Correction, Corrector, Trajectory};
 
@@ -145,7 +145,7 @@ pub enum TrackError {
 #[derive(Debug, Clone, PartialEq)]
 pub enum RegressionOutcome {
     /// A velocity was regressed and stored as a target.
-    Velocity(Regression),
+    Velocity(RegressorOutput),
     /// The regressor had no estimate for this frame.
     NoEstimate,
     /// The regressor failed (or returned a non-finite velocity): the frame gets no target,
@@ -237,7 +237,7 @@ struct Job {
     linacce: Vec<DeviceVec>,
     orientation: Vec<WorldFromDevice>,
     gravity: Vec<DeviceVec>,
-    targets: Vec<VelocityTarget>,
+    targets: Vec<FrameVelocity>,
     initial: Option<InitialVelocity>,
 }
 
@@ -644,10 +644,10 @@ impl<R: VelocityRegressor> Tracker<R> {
                 .collect();
             let labels: Vec<Option<usize>> = stored.iter().map(|t| t.placement).collect();
             let zero = self.filter_flags(&labels);
-            let targets: Vec<VelocityTarget> = stored
+            let targets: Vec<FrameVelocity> = stored
                 .iter()
                 .zip(&zero)
-                .map(|(t, &z)| VelocityTarget {
+                .map(|(t, &z)| FrameVelocity {
                     frame: (t.frame - first_frame) as usize,
                     velocity: if z { StabHorizontal::ZERO } else { t.velocity },
                 })
@@ -737,7 +737,7 @@ impl<R: VelocityRegressor> Tracker<R> {
                 if z {
                     self.stats.zeroed_targets += 1;
                 }
-                job.targets.push(VelocityTarget {
+                job.targets.push(FrameVelocity {
                     frame: (t.frame - first) as usize,
                     velocity: if z { StabHorizontal::ZERO } else { t.velocity },
                 });

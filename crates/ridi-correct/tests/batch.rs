@@ -6,7 +6,7 @@ mod common;
 use common::{max_position_error, walk};
 use proptest::prelude::*;
 use ridi_correct::{
-    BiasCurve, CorrectError, CorrectionConfig, Corrector, InitialVelocity, VelocityTarget,
+    BiasCurve, CorrectError, CorrectionConfig, Corrector, FrameVelocity, InitialVelocity,
     integrate, objective, solve_dense, world_acceleration,
 };
 use ridi_frames::{
@@ -25,7 +25,7 @@ fn max_bias_diff(a: &[DeviceVec], b: &[DeviceVec]) -> f64 {
 fn banded_solve_matches_dense_reference() {
     let w = walk(1237, 50, WorldVec::new(0.3, -0.2, 0.0), true);
     let imu = w.imu();
-    let cases: Vec<(CorrectionConfig, Vec<VelocityTarget>)> = vec![
+    let cases: Vec<(CorrectionConfig, Vec<FrameVelocity>)> = vec![
         (CorrectionConfig::default(), w.targets(50, 50)),
         (CorrectionConfig::original_cpp(), w.targets(0, 30)),
         (
@@ -232,9 +232,9 @@ fn tiny_lambda_follows_the_targets() {
     // Targets that no real walk would produce (a step in speed): with lambda -> 0 the
     // corrected velocity still passes through every one of them, and stays level.
     let w = walk(2001, 50, WorldVec::ZERO, false);
-    let targets: Vec<VelocityTarget> = (50..2001)
+    let targets: Vec<FrameVelocity> = (50..2001)
         .step_by(50)
-        .map(|f| VelocityTarget {
+        .map(|f| FrameVelocity {
             frame: f,
             velocity: StabHorizontal::new(
                 if f < 1000 { 0.2 } else { -0.5 },
@@ -353,7 +353,7 @@ fn bad_input_is_a_clear_error() {
         })
     ));
 
-    let out_of_range = [VelocityTarget {
+    let out_of_range = [FrameVelocity {
         frame: 400,
         velocity: StabHorizontal::ZERO,
     }];
@@ -366,7 +366,7 @@ fn bad_input_is_a_clear_error() {
         c.solve(&w.imu(), &unsorted),
         Err(CorrectError::TargetsNotIncreasing { index: 1 })
     );
-    let nan_target = [VelocityTarget {
+    let nan_target = [FrameVelocity {
         frame: 10,
         velocity: StabHorizontal::new(f64::NAN, 0.0),
     }];
@@ -461,7 +461,7 @@ fn single_frame_and_target_at_start() {
     let ori = [WorldFromDevice::identity()];
     let grav = [DeviceVec::new(0.0, 0.0, 9.8)];
     let imu = ImuFrames::new(&time, &[DeviceVec::ZERO], &lin, &grav, &ori).unwrap();
-    let targets = [VelocityTarget {
+    let targets = [FrameVelocity {
         frame: 0,
         velocity: StabHorizontal::new(1.0, 0.0),
     }];
@@ -489,7 +489,7 @@ struct Problem {
     lin: Vec<DeviceVec>,
     ori: Vec<WorldFromDevice>,
     grav: Vec<DeviceVec>,
-    targets: Vec<VelocityTarget>,
+    targets: Vec<FrameVelocity>,
 }
 
 impl Problem {
@@ -537,7 +537,7 @@ fn random_problem(seed: u64, n: usize, every: usize, first: usize) -> Problem {
         .collect();
     let targets = (first..n)
         .step_by(every)
-        .map(|f| VelocityTarget {
+        .map(|f| FrameVelocity {
             frame: f,
             velocity: StabHorizontal::new(rng.random_range(-2.0..2.0), rng.random_range(-2.0..2.0)),
         })

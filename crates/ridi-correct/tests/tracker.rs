@@ -5,9 +5,9 @@ mod common;
 
 use common::{Walk, max_position_error, walk};
 use ridi_correct::{
-    CorrectionConfig, CorrectionOutcome, Corrector, FrameWindow, GapPolicy, InitialVelocity,
-    PlacementFilter, Regression, RegressionOutcome, RegressorError, TrackError, Tracker,
-    TrackerConfig, VelocityRegressor, VelocityTarget, corrected_acceleration, integrate,
+    CorrectionConfig, CorrectionOutcome, Corrector, FrameVelocity, FrameWindow, GapPolicy,
+    InitialVelocity, PlacementFilter, RegressionOutcome, RegressorError, RegressorOutput,
+    TrackError, Tracker, TrackerConfig, VelocityRegressor, corrected_acceleration, integrate,
     world_acceleration,
 };
 use ridi_frames::{DeviceVec, ImuSample, StabHorizontal, WorldVec};
@@ -36,7 +36,10 @@ impl VelocityRegressor for Truth {
     fn window_len(&self) -> usize {
         self.window
     }
-    fn regress(&mut self, frames: &FrameWindow<'_>) -> Result<Option<Regression>, RegressorError> {
+    fn regress(
+        &mut self,
+        frames: &FrameWindow<'_>,
+    ) -> Result<Option<RegressorOutput>, RegressorError> {
         assert_eq!(frames.len(), self.window);
         let f = frames.last_frame();
         if self.fail_every.is_some_and(|k| f.is_multiple_of(k)) {
@@ -46,10 +49,13 @@ impl VelocityRegressor for Truth {
             Some((a, b)) if f >= a && f <= b => Some(((f / 50) % 2) as usize),
             _ => Some(0),
         };
-        Ok(self.velocity.get(f as usize).map(|&velocity| Regression {
-            velocity,
-            placement,
-        }))
+        Ok(self
+            .velocity
+            .get(f as usize)
+            .map(|&velocity| RegressorOutput {
+                velocity,
+                placement,
+            }))
     }
 }
 
@@ -114,10 +120,10 @@ fn each_window_starts_from_raw_data_and_the_earlier_output() {
         // the tracker had output for the window's first frame.
         let start_pose = before.expect("the window start was pushed earlier");
         let imu = w.imu().slice(start..f + 1);
-        let targets: Vec<VelocityTarget> = (200..=f)
+        let targets: Vec<FrameVelocity> = (200..=f)
             .step_by(50)
             .filter(|&g| g >= start)
-            .map(|g| VelocityTarget {
+            .map(|g| FrameVelocity {
                 frame: g - start,
                 velocity: w.target(g).velocity,
             })
@@ -294,7 +300,7 @@ fn gap_policy_restart_starts_a_new_segment() {
     assert!(u[700].restarted);
     assert_eq!(u[700].pose.position, u[699].pose.position);
     assert_eq!(u[700].pose.velocity, WorldVec::ZERO);
-    // Regression waits for a full window in the new segment: the first is at 700 + 200.
+    // RegressorOutput waits for a full window in the new segment: the first is at 700 + 200.
     assert!(u[900].regression.is_some() && u[850].regression.is_none());
     let segments = tracker.global_pass().unwrap();
     assert_eq!(segments.len(), 2);
@@ -329,8 +335,11 @@ fn failing_regressions_are_reported_and_skipped() {
         fn window_len(&self) -> usize {
             10
         }
-        fn regress(&mut self, _: &FrameWindow<'_>) -> Result<Option<Regression>, RegressorError> {
-            Ok(Some(Regression {
+        fn regress(
+            &mut self,
+            _: &FrameWindow<'_>,
+        ) -> Result<Option<RegressorOutput>, RegressorError> {
+            Ok(Some(RegressorOutput {
                 velocity: StabHorizontal::new(f64::NAN, 0.0),
                 placement: None,
             }))
@@ -356,7 +365,7 @@ fn global_pass_is_the_batch_solve() {
     let mut tracker = Tracker::new(config, Truth::new(&w, 200)).unwrap();
     tracker.push_all(&samples(&w));
     let global = tracker.global_pass().unwrap();
-    let targets: Vec<VelocityTarget> = (200..3000).step_by(50).map(|f| w.target(f)).collect();
+    let targets: Vec<FrameVelocity> = (200..3000).step_by(50).map(|f| w.target(f)).collect();
     let batch = Corrector::new(CorrectionConfig::default())
         .unwrap()
         .correct(&w.imu(), &targets)

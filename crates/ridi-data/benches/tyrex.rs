@@ -8,7 +8,7 @@ use std::hint::black_box;
 use std::path::{Path, PathBuf};
 
 use criterion::{Criterion, criterion_group, criterion_main};
-use ridi_data::mat::MatFile;
+use ridi_data::MatFile;
 use ridi_data::tyrex::{self, TyrexOptions};
 
 fn root() -> Option<PathBuf> {

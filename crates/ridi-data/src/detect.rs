@@ -205,8 +205,8 @@ pub fn detect(path: impl AsRef<Path>) -> Result<Format> {
 /// [`tyrex::read`](crate::tyrex::read) with `TyrexOptions::from(opts)` (the options this
 /// function uses, see [`TyrexOptions`](crate::tyrex::TyrexOptions)), or, from the `ridi`
 /// facade crate, `ridi::read_any`, which returns the sequences of any format together with
-/// their warnings. [`load_list`](crate::load_list) and [`load_entries`](crate::load_entries)
-/// read every listed path through this function, so they drop the warnings too.
+/// their warnings. [`Listed`](crate::Listed) reads every listed path through this function, so
+/// it drops the warnings too.
 pub fn read_sequence(path: impl AsRef<Path>, opts: &ReadOptions) -> Result<Sequence> {
     let (format, file) = locate(path.as_ref())?;
     match format {

@@ -13,12 +13,12 @@
 //!
 //! | format | reader | writer |
 //! | --- | --- | --- |
-//! | RIDI processed `data.csv`: pandas index, then the 27 [`processed::COLUMNS`], time in ns | [`ridi_csv::read`] | [`write_ridi_csv`] |
+//! | RIDI processed `data.csv`: pandas index, then the 27 [`PROCESSED_COLUMNS`], time in ns | [`ridi_csv::read`] | [`write_ridi_csv`] |
 //! | RIDI `data_plain.txt`: `N 27`, then N tab-separated rows | [`ridi_plain::read`] | [`write_ridi_plain`] |
 //! | RIDI raw recorder folder (`gyro.txt`, `acce.txt`, ..., `pose.txt`) | [`ridi_raw::read`] | |
 //! | Tyrex smartphone benchmark run folder (Android or iOS text files, Qualisys `.mat` ground truth) | [`tyrex::read`] | |
 //! | Indoor Location Competition 2.0 path file (`unix_ms<TAB>TYPE_...` records, waypoints) | [`ilc::read`] | |
-//! | dataset list file (`path,placement` per line) | [`read_list`], [`load_list`], [`load_entries`] | |
+//! | dataset list file (`path,placement` per line) | [`ListEntry::read`], [`Listed`] | |
 //!
 //! [`detect`] tells the format of a file or folder and [`read_sequence`] reads any of them
 //! (a Tyrex run only when it is not split into parts; it drops the reader's warnings, which
@@ -31,6 +31,12 @@
 //! missing ground truth as `NaN` on every row, and both read back as absent. The device a
 //! sequence was recorded with ([`DeviceInfo`]) has no column there: it goes to a sidecar beside
 //! the data file ([`sidecar_path`]), optional on read.
+//!
+//! # Features
+//!
+//! - `internals` (off): the MAT-file reader, the list parser on bytes and the interpolation
+//!   that the fuzz targets (`fuzz/`), this crate's tests and its benches use; not a supported
+//!   API.
 //!
 //! # Example
 //!
@@ -70,11 +76,13 @@ mod detect;
 mod device;
 mod error;
 pub mod ilc;
+#[cfg(feature = "internals")]
+mod internals;
 mod list;
-pub mod mat;
+mod mat;
 mod options;
-pub mod processed;
-pub mod resample;
+mod processed;
+mod resample;
 pub mod ridi_csv;
 pub mod ridi_plain;
 pub mod ridi_raw;
@@ -89,17 +97,22 @@ mod write;
 pub use detect::{Format, detect, read_sequence, source_files};
 pub use device::{DeviceError, DeviceInfo};
 pub use error::{DataError, Location, Result};
-pub use list::{
-    ListEntry, check_distinct, check_entries, load_entries, load_list, parse_list, read_list,
+#[cfg(feature = "internals")]
+#[doc(hidden)]
+pub use internals::{
+    CellArray, CharArray, MAX_DEPTH, MatClass, MatFile, MatValue, Numeric, StructArray,
+    interpolate_vec3, parse_list,
 };
+pub use list::{ListEntry, Listed};
 pub use options::ReadOptions;
+pub use processed::PROCESSED_COLUMNS;
 pub use ridi_frames;
 pub use sequence::{Channel, GroundTruth, OrientationSource, Sequence, SequenceParts};
 pub use sequence_error::SequenceError;
 pub use sidecar::{SIDECAR_SUFFIX, sidecar_path};
 pub use validation::{
     GYRO_SCALE_MIN_RATE, LINACCE_SCALE_MIN_RMS, MAX_JUMP_SHARE, ORIENTATION_JUMP_RATE,
-    OrientationJump, Validation, orientation_jumps,
+    OrientationJump, Validation, bridge_orientation_jumps, orientation_jumps,
 };
 pub use write::{
     PendingFile, Precision, RoundTrip, write_atomically, write_pending, write_ridi_csv,

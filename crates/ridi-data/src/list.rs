@@ -4,6 +4,9 @@
 //! folder, the placement (e.g. `body`, `handheld`, `bag`, `leg`) is optional (`path` alone or
 //! `path,`). Blank lines and lines starting with `#` are skipped. Surrounding spaces are
 //! trimmed. A list that lists no sequence is an error.
+//!
+//! [`ListEntry::read`] parses list files (syntax only); [`Listed`] holds the sequences read
+//! from them, with the checks that make them a dataset split.
 
 use std::path::{Path, PathBuf};
 
@@ -31,19 +34,23 @@ impl ListEntry {
     pub fn location(&self) -> Location {
         Location::line(&self.list, self.line)
     }
-}
 
-/// Reads a list file. Only the syntax is checked; [`load_list`] checks that the sequences
-/// exist.
-pub fn read_list(path: impl AsRef<Path>) -> Result<Vec<ListEntry>> {
-    let path = path.as_ref();
-    parse_list(&text::read_file(path)?, path)
+    /// The entries of the list files `lists`, in order. Only the syntax is checked (errors name
+    /// the list file and line); [`Listed::load`] reads the sequences.
+    pub fn read(lists: &[impl AsRef<Path>]) -> Result<Vec<ListEntry>> {
+        let mut entries = Vec::new();
+        for list in lists {
+            let path = list.as_ref();
+            entries.extend(parse_list(&text::read_file(path)?, path)?);
+        }
+        Ok(entries)
+    }
 }
 
 /// Parses the content of a list file; `path` is the list file itself (relative entries are
 /// resolved against its folder, errors name it). A list without any entry (empty, or only
 /// comments and blank lines) is an error: "no sequences listed".
-pub fn parse_list(bytes: &[u8], path: &Path) -> Result<Vec<ListEntry>> {
+pub(crate) fn parse_list(bytes: &[u8], path: &Path) -> Result<Vec<ListEntry>> {
     let base = path.parent().unwrap_or(Path::new(""));
     let mut entries = Vec::new();
     for (line, content) in text::lines(text::as_text(bytes, path)?) {
@@ -88,70 +95,141 @@ pub fn parse_list(bytes: &[u8], path: &Path) -> Result<Vec<ListEntry>> {
     Ok(entries)
 }
 
-/// Reads every sequence of a list file, detecting each one's format (see
-/// [`detect`](crate::detect())) and setting its placement from the list when the list gives one.
+/// Sequences read from list files, each with the list entry (file and line) it was read from,
+/// so that an error found later about one of them (a recording too short to track, say) can
+/// name its list line too.
 ///
-/// Every entry is checked to exist before any is read, so a typo fails fast with the list file
-/// and line; errors while reading a sequence name that sequence's file.
-pub fn load_list(path: impl AsRef<Path>, opts: &ReadOptions) -> Result<Vec<Sequence>> {
-    load_entries(&read_list(path)?, opts)
+/// No recording is in it twice, also not through two paths (a folder and its
+/// `processed/data.csv`, a symbolic link) nor as two files of the same data (a copy in another
+/// folder, the same recording converted to another format): it would count twice in every
+/// mean, and sit on both sides of a cross-validation split. [`Listed::check_distinct`] makes
+/// the same check between two of them, such as a training and a test split.
+#[derive(Debug, Clone)]
+pub struct Listed {
+    sequences: Vec<Sequence>,
+    entries: Vec<ListEntry>,
 }
 
-/// Reads the sequences of `entries` (from [`read_list`], of one or several list files), in
-/// order, as [`load_list`] does: every path is checked to exist before any is read, and the
-/// placement is the entry's when it gives one.
-///
-/// A recording listed twice is refused, also through two paths (a folder and its
-/// `processed/data.csv`, a symbolic link) and, once read, as two files of the same data (a
-/// copy in another folder, the same recording converted to another format): it would count
-/// twice in every mean, and sit on both sides of a cross-validation split.
-pub fn load_entries(entries: &[ListEntry], opts: &ReadOptions) -> Result<Vec<Sequence>> {
-    check_entries(entries)?;
-    let seqs: Vec<Sequence> = entries
-        .iter()
-        .map(|e| {
-            let mut seq = read_sequence(&e.path, opts)?;
-            if e.placement.is_some() {
-                seq.set_placement(e.placement.clone());
+impl Listed {
+    /// Reads every sequence of the list files `lists` ([`ListEntry::read`], then
+    /// [`Listed::load`]).
+    pub fn read(lists: &[impl AsRef<Path>], opts: &ReadOptions) -> Result<Self> {
+        Self::load(ListEntry::read(lists)?, opts)
+    }
+
+    /// Reads the sequence of each of `entries`, in order, detecting each one's format (see
+    /// [`detect`](crate::detect())) and setting its placement from the entry when it gives one.
+    ///
+    /// Every entry is checked to exist, and no recording to be listed twice by path, before
+    /// any is read, so a typo fails fast with the list file and line; errors while reading a
+    /// sequence name that sequence's file. Once read, two entries of the same data are refused.
+    pub fn load(entries: Vec<ListEntry>, opts: &ReadOptions) -> Result<Self> {
+        let mut seen: Vec<(Vec<PathBuf>, &ListEntry)> = Vec::new();
+        for e in &entries {
+            if !e.path.exists() {
+                return Err(DataError::format(
+                    e.location().with_field("path"),
+                    format!("sequence `{}` does not exist", e.path.display()),
+                ));
             }
-            Ok(seq)
-        })
-        .collect::<Result<_>>()?;
-    for (i, (seq, e)) in seqs.iter().zip(entries).enumerate() {
-        if let Some(j) = seqs[..i].iter().position(|s| same_data(s, seq)) {
-            return Err(copy_error(e, &entries[j]));
+            // An unknown format is reported by the read below.
+            let Some(files) = recording_files(e) else {
+                continue;
+            };
+            if let Some((_, first)) = seen.iter().find(|(f, _)| *f == files) {
+                return Err(listed_twice(e, first));
+            }
+            seen.push((files, e));
         }
-    }
-    Ok(seqs)
-}
-
-/// Refuses a sequence of `later` that holds the same recording as one of `earlier` (each a
-/// list's sequences with their entries, as [`load_entries`] returns them for its entries): the
-/// check [`load_entries`] makes within its entries, across two lists loaded apart, such as a
-/// training and a test list, where a copy in another folder or format passes
-/// [`check_entries`]. The error names the later entry's list line and the earlier one's.
-///
-/// Each pair holds as many sequences as entries (debug builds assert it).
-pub fn check_distinct(
-    earlier: (&[Sequence], &[ListEntry]),
-    later: (&[Sequence], &[ListEntry]),
-) -> Result<()> {
-    debug_assert_eq!(earlier.0.len(), earlier.1.len(), "one entry per sequence");
-    debug_assert_eq!(later.0.len(), later.1.len(), "one entry per sequence");
-    for (seq, e) in later.0.iter().zip(later.1) {
-        if let Some((_, first)) = earlier
-            .0
+        let sequences: Vec<Sequence> = entries
             .iter()
-            .zip(earlier.1)
-            .find(|(s, _)| same_data(s, seq))
-        {
-            return Err(copy_error(e, first));
+            .map(|e| {
+                let mut seq = read_sequence(&e.path, opts)?;
+                if e.placement.is_some() {
+                    seq.set_placement(e.placement.clone());
+                }
+                Ok(seq)
+            })
+            .collect::<Result<_>>()?;
+        for (i, (seq, e)) in sequences.iter().zip(&entries).enumerate() {
+            if let Some(j) = sequences[..i].iter().position(|s| same_data(s, seq)) {
+                return Err(copy_error(e, &entries[j]));
+            }
         }
+        Ok(Self { sequences, entries })
     }
-    Ok(())
+
+    /// The sequences, in list order.
+    pub fn sequences(&self) -> &[Sequence] {
+        &self.sequences
+    }
+
+    /// The sequences, to relabel (a placement map) or rename; their data is what the checks
+    /// compared.
+    pub fn sequences_mut(&mut self) -> &mut [Sequence] {
+        &mut self.sequences
+    }
+
+    /// The list entry of each sequence.
+    pub fn entries(&self) -> &[ListEntry] {
+        &self.entries
+    }
+
+    /// The sequences, without their entries.
+    pub fn into_sequences(self) -> Vec<Sequence> {
+        self.sequences
+    }
+
+    /// Refuses a sequence of `later` that is a recording of `self`: the checks [`Listed::load`]
+    /// makes within its entries (the same files, then the same data), across two splits read
+    /// apart, such as a training and a test list (a recording in both would be tested on after
+    /// training on it). The error names the later entry's list line and the earlier one's.
+    pub fn check_distinct(&self, later: &Listed) -> Result<()> {
+        let earlier: Vec<_> = self.entries.iter().map(recording_files).collect();
+        for e in &later.entries {
+            let Some(files) = recording_files(e) else {
+                continue;
+            };
+            if let Some(i) = earlier.iter().position(|f| f.as_ref() == Some(&files)) {
+                return Err(listed_twice(e, &self.entries[i]));
+            }
+        }
+        for (seq, e) in later.sequences.iter().zip(&later.entries) {
+            if let Some(i) = self.sequences.iter().position(|s| same_data(s, seq)) {
+                return Err(copy_error(e, &self.entries[i]));
+            }
+        }
+        Ok(())
+    }
 }
 
-/// `e` lists the recording that `first` listed already.
+/// The files a read of `e` takes data from, resolved and sorted: two entries with the same
+/// are one recording. `None` when the format is unknown (the read reports it).
+fn recording_files(e: &ListEntry) -> Option<Vec<PathBuf>> {
+    let mut files: Vec<PathBuf> = source_files(&e.path)
+        .ok()?
+        .iter()
+        .map(|f| f.canonicalize().unwrap_or_else(|_| f.clone()))
+        .collect();
+    files.sort();
+    Some(files)
+}
+
+/// `e` lists, by another path or the same, the files `first` listed already.
+fn listed_twice(e: &ListEntry, first: &ListEntry) -> DataError {
+    DataError::format(
+        e.location().with_field("path"),
+        format!(
+            "sequence `{}` is the recording already listed at {}:{}; a recording listed \
+             twice would count twice, or be tested on after training on it",
+            e.path.display(),
+            first.list.display(),
+            first.line
+        ),
+    )
+}
+
+/// `e` lists the recording that `first` listed already, in other files.
 fn copy_error(e: &ListEntry, first: &ListEntry) -> DataError {
     DataError::format(
         e.location().with_field("path"),
@@ -172,42 +250,4 @@ fn copy_error(e: &ListEntry, first: &ListEntry) -> DataError {
 /// recordings cost a length and a timestamp compare (phone clocks count nanoseconds from boot).
 fn same_data(a: &Sequence, b: &Sequence) -> bool {
     a.time() == b.time() && a.gyro() == b.gyro() && a.acce() == b.acce()
-}
-
-/// The checks [`load_entries`] makes before reading anything: every listed path exists and no
-/// recording is listed twice. Useful on its own over entries that are loaded apart, such as a
-/// training and a test list (a recording in both would be tested on after training on it).
-pub fn check_entries(entries: &[ListEntry]) -> Result<()> {
-    let mut seen: Vec<(Vec<PathBuf>, &ListEntry)> = Vec::new();
-    for e in entries {
-        if !e.path.exists() {
-            return Err(DataError::format(
-                e.location().with_field("path"),
-                format!("sequence `{}` does not exist", e.path.display()),
-            ));
-        }
-        // What the read takes data from, resolved; an unknown format is reported by the read.
-        let Ok(files) = source_files(&e.path) else {
-            continue;
-        };
-        let mut files: Vec<PathBuf> = files
-            .iter()
-            .map(|f| f.canonicalize().unwrap_or_else(|_| f.clone()))
-            .collect();
-        files.sort();
-        if let Some((_, first)) = seen.iter().find(|(f, _)| *f == files) {
-            return Err(DataError::format(
-                e.location().with_field("path"),
-                format!(
-                    "sequence `{}` is the recording already listed at {}:{}; a recording listed \
-                     twice would count twice, or be tested on after training on it",
-                    e.path.display(),
-                    first.list.display(),
-                    first.line
-                ),
-            ));
-        }
-        seen.push((files, e));
-    }
-    Ok(())
 }

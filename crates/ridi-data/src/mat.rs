@@ -32,6 +32,13 @@
 //! are bounded by the size the compressed element declares. Truncated or corrupt input gives a
 //! [`DataError`] that names the file, the variable path (e.g. `Take1.RigidBodies.Positions`) and
 //! the byte offset.
+//!
+//! Internal to the crate (the Tyrex reader's): its items are `pub` only so that the
+//! `internals` feature can hand them to the fuzz targets, tests and benches; not a supported API.
+
+// Without `internals` nothing re-exports the `pub` items (crate-private in effect), and the
+// Tyrex reader uses part of the value API that the tests check whole.
+#![cfg_attr(not(feature = "internals"), allow(unreachable_pub, dead_code))]
 
 use std::fmt;
 use std::io::Read;
@@ -533,7 +540,7 @@ impl MatFile {
 }
 
 /// Dimensions as MATLAB prints them, e.g. `1x3x7200`.
-pub fn dims_text(dims: &[usize]) -> String {
+pub(crate) fn dims_text(dims: &[usize]) -> String {
     dims.iter()
         .map(|d| d.to_string())
         .collect::<Vec<_>>()

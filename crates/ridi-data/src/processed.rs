@@ -14,7 +14,7 @@ use crate::{Channel, GroundTruth, OrientationSource, Sequence, SequenceParts};
 /// The 27 columns of the RIDI processed layout, in the order the original writes them. `time`
 /// is in nanoseconds; `ori_*` is the Tango ground-truth orientation and `rv_*` the game
 /// rotation vector, both world-from-device in `w, x, y, z` order.
-pub const COLUMNS: [&str; 27] = [
+pub const PROCESSED_COLUMNS: [&str; 27] = [
     "time",
     "gyro_x",
     "gyro_y",
@@ -60,7 +60,7 @@ pub(crate) struct ProcessedFields;
 impl text::Fields for ProcessedFields {
     fn field(&self, channel: Channel, axis: Option<usize>) -> String {
         let first = match channel {
-            Channel::Time => return COLUMNS[TIME].to_owned(),
+            Channel::Time => return PROCESSED_COLUMNS[TIME].to_owned(),
             Channel::Gyro => GYRO,
             Channel::Acce => ACCE,
             Channel::Linacce => LINACCE,
@@ -68,7 +68,7 @@ impl text::Fields for ProcessedFields {
             Channel::Magnet => MAGNET,
             Channel::Position => POS,
         };
-        text::axis_field([0, 1, 2].map(|a| COLUMNS[first + a]), axis)
+        text::axis_field([0, 1, 2].map(|a| PROCESSED_COLUMNS[first + a]), axis)
     }
     fn time_unit(&self) -> &str {
         "nanoseconds"
@@ -85,7 +85,7 @@ pub(crate) fn nan_policy(column: usize) -> text::Nan {
     }
 }
 
-/// Parsed rows in [`COLUMNS`] order, each with its line number.
+/// Parsed rows in [`PROCESSED_COLUMNS`] order, each with its line number.
 pub(crate) struct Table {
     pub rows: Vec<[f64; 27]>,
     pub lines: Vec<usize>,
@@ -96,10 +96,10 @@ pub(crate) struct Table {
 }
 
 /// Parses one data line of the processed layout: `cells()` yields its cells, `column_of(c)`
-/// says which of the [`COLUMNS`] cell `c` holds (`None`: not read), `width` is how many cells a
-/// line must have and `width_error(n)` the error for a line with `n`. Columns no cell fills stay
-/// NaN. A cut line often ends in a partial cell, so a bad number on a line of the wrong width
-/// is reported as the wrong width.
+/// says which of the [`PROCESSED_COLUMNS`] cell `c` holds (`None`: not read), `width` is how
+/// many cells a line must have and `width_error(n)` the error for a line with `n`. Columns no
+/// cell fills stay NaN. A cut line often ends in a partial cell, so a bad number on a line of
+/// the wrong width is reported as the wrong width.
 pub(crate) fn parse_row<'a, I: Iterator<Item = &'a str>>(
     cells: impl Fn() -> I,
     column_of: impl Fn(usize) -> Option<usize>,
@@ -112,13 +112,12 @@ pub(crate) fn parse_row<'a, I: Iterator<Item = &'a str>>(
     let mut fields = 0;
     for (c, cell) in cells().enumerate() {
         if let Some(k) = column_of(c) {
-            row[k] =
-                text::number(cell, path, line, COLUMNS[k], nan_policy(k)).map_err(
-                    |e| match cells().count() {
-                        n if n != width => width_error(n),
-                        _ => e,
-                    },
-                )?;
+            row[k] = text::number(cell, path, line, PROCESSED_COLUMNS[k], nan_policy(k)).map_err(
+                |e| match cells().count() {
+                    n if n != width => width_error(n),
+                    _ => e,
+                },
+            )?;
         }
         fields = c + 1;
     }
@@ -182,11 +181,11 @@ fn rotations(table: &Table, at: usize, path: &Path) -> Result<Vec<WorldFromDevic
         .map(|(r, &line)| {
             rotation_wxyz([r[at], r[at + 1], r[at + 2], r[at + 3]]).map_err(|e| {
                 DataError::format(
-                    Location::line(path, line).with_field(COLUMNS[at]),
+                    Location::line(path, line).with_field(PROCESSED_COLUMNS[at]),
                     format!(
                         "`{}..{}` is not a rotation: {e}",
-                        COLUMNS[at],
-                        COLUMNS[at + 3]
+                        PROCESSED_COLUMNS[at],
+                        PROCESSED_COLUMNS[at + 3]
                     ),
                 )
             })
@@ -214,7 +213,7 @@ fn ground_truth(table: &Table, path: &Path) -> Result<Option<GroundTruth>> {
         let (nan, given): (Vec<usize>, Vec<usize>) =
             (0..gt(r).len()).partition(|&j| gt(r)[j].is_nan());
         let names = |js: &[usize]| -> String {
-            let names: Vec<&str> = js.iter().map(|&j| COLUMNS[POS + j]).collect();
+            let names: Vec<&str> = js.iter().map(|&j| PROCESSED_COLUMNS[POS + j]).collect();
             names.join(", ")
         };
         let message = if given.is_empty() {
@@ -228,7 +227,7 @@ fn ground_truth(table: &Table, path: &Path) -> Result<Option<GroundTruth>> {
             )
         };
         return Err(DataError::format(
-            Location::line(path, line).with_field(COLUMNS[POS + k]),
+            Location::line(path, line).with_field(PROCESSED_COLUMNS[POS + k]),
             message,
         ));
     }
@@ -246,7 +245,7 @@ pub(crate) fn assemble(table: Table, path: &Path, opts: &ReadOptions) -> Result<
         &time,
         &table.lines,
         path,
-        COLUMNS[TIME],
+        PROCESSED_COLUMNS[TIME],
         opts.validation.max_gap_s,
     )?;
     let magnet = table

@@ -8,7 +8,7 @@ use ridi_frames::{Frame, Rot, Vec3};
 ///
 /// # Panics
 /// When `src` is empty or its length differs from `src_t`'s.
-pub fn interpolate_with<T: Clone>(
+pub(crate) fn interpolate_with<T: Clone>(
     src_t: &[f64],
     src: &[T],
     dst_t: &[f64],
@@ -37,17 +37,21 @@ pub fn interpolate_with<T: Clone>(
 }
 
 /// Linear interpolation of scalars.
-pub fn interpolate_scalar(src_t: &[f64], src: &[f64], dst_t: &[f64]) -> Vec<f64> {
+pub(crate) fn interpolate_scalar(src_t: &[f64], src: &[f64], dst_t: &[f64]) -> Vec<f64> {
     interpolate_with(src_t, src, dst_t, |a, b, t| a + (b - a) * t)
 }
 
 /// Linear interpolation of vectors.
-pub fn interpolate_vec3<F: Frame>(src_t: &[f64], src: &[Vec3<F>], dst_t: &[f64]) -> Vec<Vec3<F>> {
+pub(crate) fn interpolate_vec3<F: Frame>(
+    src_t: &[f64],
+    src: &[Vec3<F>],
+    dst_t: &[f64],
+) -> Vec<Vec3<F>> {
     interpolate_with(src_t, src, dst_t, |a, b, t| a.lerp(*b, t))
 }
 
 /// Spherical linear interpolation of rotations (shortest path).
-pub fn interpolate_rot<A: Frame, B: Frame>(
+pub(crate) fn interpolate_rot<A: Frame, B: Frame>(
     src_t: &[f64],
     src: &[Rot<A, B>],
     dst_t: &[f64],
@@ -56,7 +60,7 @@ pub fn interpolate_rot<A: Frame, B: Frame>(
 }
 
 /// A uniform timeline from `start` to at most `end` at `rate_hz`.
-pub fn uniform_timeline(start: f64, end: f64, rate_hz: f64) -> Vec<f64> {
+pub(crate) fn uniform_timeline(start: f64, end: f64, rate_hz: f64) -> Vec<f64> {
     if !(end >= start && rate_hz > 0.0 && start.is_finite() && end.is_finite()) {
         return Vec::new();
     }

@@ -6,25 +6,25 @@
 //! recorded"), and `pos_*` with `ori_*` together (NaN on every row also means "no ground
 //! truth"). Time is in nanoseconds and becomes absolute seconds. A last row without a line break
 //! after it is refused: the file was cut off while being written, maybe inside a value. The
-//! device, which the layout has no column for, comes from the optional sidecar ridi-rs writes
-//! beside the file ([`sidecar_path`](crate::sidecar_path)).
+//! device and the orientation source, which the layout has no column for, come from the
+//! optional sidecar ridi-rs writes beside the file ([`sidecar_path`](crate::sidecar_path)).
 
 use std::path::Path;
 
 use crate::Sequence;
 use crate::error::{DataError, Location, Result};
 use crate::options::ReadOptions;
-use crate::processed::{self, COLUMNS, MAGNET, POS, RV, Table};
+use crate::processed::{self, MAGNET, POS, PROCESSED_COLUMNS, RV, Table};
 use crate::{sidecar, text};
 
 /// Reads a RIDI processed `data.csv`. The sequence is named after its capture folder (see
-/// [`read_sequence`](crate::read_sequence)), its orientation source is the game rotation vector,
-/// and its device is the one the optional sidecar beside the file names
-/// ([`sidecar_path`](crate::sidecar_path)).
+/// [`read_sequence`](crate::read_sequence)); its device and orientation source are those the
+/// optional sidecar beside the file names ([`sidecar_path`](crate::sidecar_path)), else none and
+/// RIDI's game rotation vector.
 pub fn read(path: impl AsRef<Path>, opts: &ReadOptions) -> Result<Sequence> {
     let path = path.as_ref();
     let mut seq = parse(&text::read_file(path)?, path, opts)?;
-    seq.set_device(sidecar::read(path)?);
+    sidecar::read(path)?.apply(&mut seq);
     Ok(seq)
 }
 
@@ -44,7 +44,8 @@ fn header_name(cell: &str) -> &str {
         .trim()
 }
 
-/// The [`COLUMNS`] index fed by each file column (`None` for the index and unknown columns).
+/// The [`PROCESSED_COLUMNS`] index fed by each file column (`None` for the index and unknown
+/// columns).
 struct Header {
     line: usize,
     slots: Vec<Option<usize>>,
@@ -58,7 +59,7 @@ fn parse_header(line: usize, content: &str, path: &Path) -> Result<Header> {
     let mut found = [false; 27];
     for cell in text::cells(content, b',') {
         let name = header_name(cell);
-        let slot = COLUMNS.iter().position(|&c| c == name);
+        let slot = PROCESSED_COLUMNS.iter().position(|&c| c == name);
         if let Some(k) = slot {
             if found[k] {
                 return Err(DataError::format(at(name), "column appears twice"));
@@ -74,8 +75,8 @@ fn parse_header(line: usize, content: &str, path: &Path) -> Result<Header> {
         }
         match range.clone().find(|&k| !found[k]) {
             Some(k) => Err(DataError::format(
-                at(COLUMNS[k]),
-                format!("missing column `{}` ({what})", COLUMNS[k]),
+                at(PROCESSED_COLUMNS[k]),
+                format!("missing column `{}` ({what})", PROCESSED_COLUMNS[k]),
             )),
             None => Ok(true),
         }
@@ -154,19 +155,23 @@ mod tests {
     #[test]
     fn header_groups_are_all_or_nothing() {
         let p = Path::new("h.csv");
-        let full = format!(",{}", COLUMNS.join(","));
+        let full = format!(",{}", PROCESSED_COLUMNS.join(","));
         let h = parse_header(1, &full, p).unwrap();
         assert!(h.has_magnet && h.has_ground_truth);
         assert_eq!(h.slots[0], None);
         assert_eq!(h.slots[1], Some(0));
-        let no_gt: Vec<_> = COLUMNS
+        let no_gt: Vec<_> = PROCESSED_COLUMNS
             .iter()
             .filter(|c| !c.starts_with("pos") && !c.starts_with("ori"))
             .copied()
             .collect();
         let h = parse_header(1, &no_gt.join(","), p).unwrap();
         assert!(h.has_magnet && !h.has_ground_truth);
-        let partial: Vec<_> = COLUMNS.iter().filter(|&&c| c != "ori_z").copied().collect();
+        let partial: Vec<_> = PROCESSED_COLUMNS
+            .iter()
+            .filter(|&&c| c != "ori_z")
+            .copied()
+            .collect();
         let e = parse_header(1, &partial.join(","), p).err().unwrap();
         assert!(
             e.to_string()

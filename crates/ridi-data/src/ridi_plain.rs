@@ -1,5 +1,5 @@
 //! Reader of RIDI `data_plain.txt`, the input of the original C++ tools: a first line `N 27`,
-//! then `N` rows of the 27 processed [`COLUMNS`], tab-separated, without an index column. Any
+//! then `N` rows of the 27 [`PROCESSED_COLUMNS`], tab-separated, without an index column. Any
 //! run of spaces or tabs is accepted as a separator.
 //! Magnet and ground truth follow the `data.csv` conventions (all zeros and all NaN mean absent).
 //! A last row without a line break after it is refused, as a file cut off while being written.
@@ -9,15 +9,15 @@ use std::path::Path;
 use crate::Sequence;
 use crate::error::{DataError, Location, Result};
 use crate::options::ReadOptions;
-use crate::processed::{self, COLUMNS, Table};
+use crate::processed::{self, PROCESSED_COLUMNS, Table};
 use crate::{sidecar, text};
 
-/// Reads a `data_plain.txt`, and its device from the optional sidecar beside it
-/// ([`sidecar_path`](crate::sidecar_path)).
+/// Reads a `data_plain.txt`, and its device and orientation source from the optional sidecar
+/// beside it ([`sidecar_path`](crate::sidecar_path)).
 pub fn read(path: impl AsRef<Path>, opts: &ReadOptions) -> Result<Sequence> {
     let path = path.as_ref();
     let mut seq = parse(&text::read_file(path)?, path, opts)?;
-    seq.set_device(sidecar::read(path)?);
+    sidecar::read(path)?.apply(&mut seq);
     Ok(seq)
 }
 
@@ -48,7 +48,7 @@ fn parse_table(text: &str, path: &Path) -> Result<Table> {
     };
     let n = text::count(n, path, header_line, "rows")?;
     let width = text::count(width, path, header_line, "columns")?;
-    if width != COLUMNS.len() {
+    if width != PROCESSED_COLUMNS.len() {
         return Err(DataError::format(
             Location::line(path, header_line).with_field("columns"),
             format!("{width} columns announced, the RIDI layout has 27"),
@@ -86,7 +86,7 @@ fn parse_table(text: &str, path: &Path) -> Result<Table> {
         };
         let row = processed::parse_row(
             || content.split_ascii_whitespace(),
-            |k| (k < COLUMNS.len()).then_some(k),
+            |k| (k < PROCESSED_COLUMNS.len()).then_some(k),
             width,
             width_error,
             path,

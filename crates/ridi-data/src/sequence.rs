@@ -28,6 +28,28 @@ pub enum OrientationSource {
     GroundTruth,
 }
 
+impl OrientationSource {
+    /// Every source, in declaration order.
+    pub const ALL: [OrientationSource; 5] = [
+        OrientationSource::GameRotationVector,
+        OrientationSource::RotationVector,
+        OrientationSource::CoreMotionAttitude,
+        OrientationSource::Estimated,
+        OrientationSource::GroundTruth,
+    ];
+
+    /// The name in files (`game-rotation-vector`, ...; serde's name too).
+    pub fn key(self) -> &'static str {
+        match self {
+            OrientationSource::GameRotationVector => "game-rotation-vector",
+            OrientationSource::RotationVector => "rotation-vector",
+            OrientationSource::CoreMotionAttitude => "core-motion-attitude",
+            OrientationSource::Estimated => "estimated",
+            OrientationSource::GroundTruth => "ground-truth",
+        }
+    }
+}
+
 impl fmt::Display for OrientationSource {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         f.write_str(match self {
@@ -401,6 +423,11 @@ impl Sequence {
     /// Sets the phone it was recorded with.
     pub fn set_device(&mut self, device: Option<DeviceInfo>) {
         self.parts.device = device;
+    }
+
+    /// Sets where the orientation comes from (a reader's sidecar knows better than its layout).
+    pub(crate) fn set_orientation_source(&mut self, source: Option<OrientationSource>) {
+        self.parts.orientation_source = source;
     }
 
     /// Duration from first to last frame, seconds.

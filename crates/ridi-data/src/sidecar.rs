@@ -1,5 +1,5 @@
-//! The sidecar of a processed data file: what RIDI's layout has no column for (the device), in a
-//! small text file beside it.
+//! The sidecar of a processed data file: what RIDI's layout has no column for (the device, where
+//! the orientation comes from), in a small text file beside it.
 //!
 //! `data.csv` (or `data_plain.txt`, `walk.csv.gz`, ...) gets `data.csv.meta`:
 //!
@@ -7,11 +7,13 @@
 //! # ridi-rs: what data.csv has no column for (RIDI's own readers do not open this file)
 //! device = iPhone 4S
 //! device_imu_rate_hz = 90.09009029909154
+//! orientation_source = core-motion-attitude
 //! ```
 //!
 //! `#` comments and blank lines are skipped; every other line is `key = value`. Keys:
-//! `device` (the model, [`DeviceInfo::new`]) and `device_imu_rate_hz` (only with `device`,
-//! [`DeviceInfo::with_imu_rate`]). Other keys are skipped, so that files of a later version with
+//! `device` (the model, [`DeviceInfo::new`]), `device_imu_rate_hz` (only with `device`,
+//! [`DeviceInfo::with_imu_rate`]) and `orientation_source` ([`OrientationSource::key`]; without
+//! it, the layout's own: RIDI's game rotation vector). Other keys are skipped, so that files of a later version with
 //! more keys still read. A malformed line, a key given twice or a value that is not valid is an
 //! error naming the sidecar, the line and the key.
 //!
@@ -23,6 +25,7 @@
 
 use std::path::{Path, PathBuf};
 
+use crate::OrientationSource;
 use crate::device::DeviceInfo;
 use crate::error::{DataError, Location, Result};
 use crate::text::{self, Nan};
@@ -37,6 +40,24 @@ const MAX_BYTES: u64 = 64 * 1024;
 
 const DEVICE: &str = "device";
 const RATE: &str = "device_imu_rate_hz";
+const SOURCE: &str = "orientation_source";
+
+/// What a sidecar holds.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub(crate) struct Sidecar {
+    pub(crate) device: Option<DeviceInfo>,
+    pub(crate) orientation_source: Option<OrientationSource>,
+}
+
+impl Sidecar {
+    /// Gives `seq` the sidecar's device and, when it names one, its orientation source.
+    pub(crate) fn apply(self, seq: &mut Sequence) {
+        seq.set_device(self.device);
+        if self.orientation_source.is_some() {
+            seq.set_orientation_source(self.orientation_source);
+        }
+    }
+}
 
 /// The sidecar of the processed data file `data`: `data.csv` gives `data.csv.meta`, beside it.
 pub fn sidecar_path(data: &Path) -> PathBuf {
@@ -45,12 +66,12 @@ pub fn sidecar_path(data: &Path) -> PathBuf {
     data.with_file_name(name)
 }
 
-/// The device the sidecar of `data` names; `None` without a sidecar.
-pub(crate) fn read(data: &Path) -> Result<Option<DeviceInfo>> {
+/// What the sidecar of `data` holds; nothing without a sidecar.
+pub(crate) fn read(data: &Path) -> Result<Sidecar> {
     let path = sidecar_path(data);
     let meta = match std::fs::metadata(&path) {
         Ok(m) => m,
-        Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(None),
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(Sidecar::default()),
         Err(e) => return Err(DataError::io(&path, e)),
     };
     if !meta.is_file() {
@@ -73,9 +94,10 @@ pub(crate) fn read(data: &Path) -> Result<Option<DeviceInfo>> {
 }
 
 /// Parses the content of the sidecar `path`.
-fn parse(content: &str, path: &Path) -> Result<Option<DeviceInfo>> {
+fn parse(content: &str, path: &Path) -> Result<Sidecar> {
     let mut device: Option<(usize, DeviceInfo)> = None;
     let mut rate: Option<(usize, f64)> = None;
+    let mut source: Option<(usize, OrientationSource)> = None;
     for (line, l) in text::lines(content) {
         let l = l.trim();
         if l.starts_with('#') {
@@ -92,6 +114,7 @@ fn parse(content: &str, path: &Path) -> Result<Option<DeviceInfo>> {
         let first = match key {
             DEVICE => device.as_ref().map(|(l, _)| *l),
             RATE => rate.as_ref().map(|(l, _)| *l),
+            SOURCE => source.as_ref().map(|(l, _)| *l),
             // A key of a later version.
             _ => continue,
         };
@@ -104,21 +127,44 @@ fn parse(content: &str, path: &Path) -> Result<Option<DeviceInfo>> {
         if key == DEVICE {
             let d = DeviceInfo::new(value).map_err(|e| DataError::format(at(), e.to_string()))?;
             device = Some((line, d));
+        } else if key == SOURCE {
+            let s = OrientationSource::ALL
+                .into_iter()
+                .find(|s| s.key() == value)
+                .ok_or_else(|| {
+                    let keys: Vec<&str> = OrientationSource::ALL.iter().map(|s| s.key()).collect();
+                    DataError::format(
+                        at(),
+                        format!(
+                            "unknown orientation source `{}` (one of {})",
+                            text::snippet(value),
+                            keys.join(", ")
+                        ),
+                    )
+                })?;
+            source = Some((line, s));
         } else {
             rate = Some((line, text::number(value, path, line, RATE, Nan::Reject)?));
         }
     }
-    match (device, rate) {
-        (None, None) => Ok(None),
-        (None, Some((line, _))) => Err(DataError::format(
-            Location::line(path, line).with_field(RATE),
-            format!("a device rate without `{DEVICE} = <model>`"),
-        )),
-        (Some((_, d)), None) => Ok(Some(d)),
-        (Some((_, d)), Some((line, r))) => d.with_imu_rate(r).map(Some).map_err(|e| {
+    let orientation_source = source.map(|(_, s)| s);
+    let device = match (device, rate) {
+        (None, None) => None,
+        (None, Some((line, _))) => {
+            return Err(DataError::format(
+                Location::line(path, line).with_field(RATE),
+                format!("a device rate without `{DEVICE} = <model>`"),
+            ));
+        }
+        (Some((_, d)), None) => Some(d),
+        (Some((_, d)), Some((line, r))) => Some(d.with_imu_rate(r).map_err(|e| {
             DataError::format(Location::line(path, line).with_field(RATE), e.to_string())
-        }),
-    }
+        })?),
+    };
+    Ok(Sidecar {
+        device,
+        orientation_source,
+    })
 }
 
 /// Removes the sidecar of `data`, if there is one: before a data file is replaced, so that the
@@ -131,21 +177,30 @@ pub(crate) fn remove(data: &Path) -> Result<()> {
     }
 }
 
-/// Writes the sidecar of `data` for `seq` when it has metadata to keep (atomically); without,
-/// writes nothing.
+/// Writes the sidecar of `data` for `seq` when it has metadata to keep (atomically): a device, or
+/// an orientation source other than the layout's game rotation vector. Without, writes nothing.
 pub(crate) fn write(seq: &Sequence, data: &Path) -> Result<()> {
-    let Some(device) = seq.device() else {
+    let device = seq.device();
+    let source = seq
+        .orientation_source()
+        .filter(|&s| s != OrientationSource::GameRotationVector);
+    if device.is_none() && source.is_none() {
         return Ok(());
-    };
+    }
     let name = data.file_name().unwrap_or_default().to_string_lossy();
     write_atomically(&sidecar_path(data), |w| {
         writeln!(
             w,
             "# ridi-rs: what {name} has no column for (RIDI's own readers do not open this file)"
         )?;
-        writeln!(w, "{DEVICE} = {}", device.model())?;
-        if let Some(r) = device.imu_rate_hz() {
-            writeln!(w, "{RATE} = {}", RoundTrip(r))?;
+        if let Some(device) = device {
+            writeln!(w, "{DEVICE} = {}", device.model())?;
+            if let Some(r) = device.imu_rate_hz() {
+                writeln!(w, "{RATE} = {}", RoundTrip(r))?;
+            }
+        }
+        if let Some(s) = source {
+            writeln!(w, "{SOURCE} = {}", s.key())?;
         }
         Ok(())
     })
@@ -165,16 +220,32 @@ mod tests {
             sidecar_path(Path::new("a/processed/data.csv")),
             Path::new("a/processed/data.csv.meta")
         );
-        let d = parse(
-            "# c\n\ndevice = iPhone 4S\ndevice_imu_rate_hz=90.5\nlater = x\n",
+        let s = parse(
+            "# c\n\ndevice = iPhone 4S\ndevice_imu_rate_hz=90.5\nlater = x\n\
+             orientation_source = core-motion-attitude\n",
             p(),
         )
-        .unwrap()
         .unwrap();
+        let d = s.device.unwrap();
         assert_eq!((d.model(), d.imu_rate_hz()), ("iPhone 4S", Some(90.5)));
-        assert_eq!(parse("# nothing\n", p()).unwrap(), None);
+        assert_eq!(
+            s.orientation_source,
+            Some(OrientationSource::CoreMotionAttitude)
+        );
+        assert_eq!(parse("# nothing\n", p()).unwrap(), Sidecar::default());
         // No final line break: a hand-written file.
-        assert!(parse("device = x", p()).unwrap().is_some());
+        assert!(parse("device = x", p()).unwrap().device.is_some());
+        // A source without a device.
+        let s = parse("orientation_source = rotation-vector\n", p()).unwrap();
+        assert_eq!(
+            (s.device, s.orientation_source),
+            (None, Some(OrientationSource::RotationVector))
+        );
+        // Every source's key parses back to it.
+        for source in OrientationSource::ALL {
+            let s = parse(&format!("orientation_source = {}", source.key()), p()).unwrap();
+            assert_eq!(s.orientation_source, Some(source));
+        }
     }
 
     #[test]
@@ -203,6 +274,14 @@ mod tests {
             (
                 "device_imu_rate_hz = 100\n",
                 "data.csv.meta:1: field `device_imu_rate_hz`: a device rate without `device",
+            ),
+            (
+                "\norientation_source = compass\n",
+                "data.csv.meta:2: field `orientation_source`: unknown orientation source `compass` (one of game-rotation-vector,",
+            ),
+            (
+                "orientation_source = estimated\norientation_source = estimated\n",
+                "data.csv.meta:2: field `orientation_source`: given twice (first on line 1)",
             ),
         ] {
             let e = parse(text, p()).unwrap_err().to_string();

@@ -153,8 +153,8 @@ use crate::resample::{interpolate_rot, interpolate_vec3, uniform_timeline};
 use crate::text::{self, Nan};
 use crate::validation::orientation_jump_warning;
 use crate::{
-    Channel, DeviceInfo, GroundTruth, OrientationSource, Sequence, SequenceError, SequenceParts,
-    Validation,
+    Channel, DeviceInfo, GroundTruth, OrientationJump, OrientationSource, Sequence, SequenceError,
+    SequenceParts, Validation, bridge_orientation_jumps,
 };
 
 mod ios;
@@ -198,6 +198,14 @@ pub struct TyrexOptions {
     /// NoDist runs, all within -0.010..-0.030 s). The rotation vector is a filtered output, so
     /// part of that may be its own latency rather than a clock offset of the raw sensors.
     pub extra_time_diff_s: f64,
+    /// Where the mocap's up axis (in the device frame) is further than this from the phone
+    /// orientation's, degrees, for a second, the accelerometer decides which is wrong: mocap
+    /// frames it discredits are treated as mocap losses, a phone orientation it discredits is
+    /// a warning ([`MAX_MOCAP_TILT_DEG`]). Infinity trusts both.
+    pub max_mocap_tilt_deg: f64,
+    /// Bridge the OS orientation's jumps by the gyro, keeping the heading continuous across them
+    /// ([`bridge_orientation_jumps`]); on by default: a jump turns a track by up to 160 degrees.
+    pub bridge_orientation_jumps: bool,
     /// Limits every output sequence is checked against.
     pub validation: Validation,
 }
@@ -212,6 +220,8 @@ impl Default for TyrexOptions {
             min_part_s: 10.0,
             ground_truth: true,
             extra_time_diff_s: 0.0,
+            max_mocap_tilt_deg: MAX_MOCAP_TILT_DEG,
+            bridge_orientation_jumps: true,
             validation: Validation::default(),
         }
     }
@@ -938,6 +948,134 @@ fn intervals(time: &[f64], max_gap: f64, mut on_gap: impl FnMut(usize)) -> Vec<(
     out
 }
 
+/// `seq` with its orientation's `jumps` bridged by the gyro ([`bridge_orientation_jumps`]), and
+/// gravity and linear acceleration derived from the bridged orientation.
+fn bridged(
+    seq: Sequence,
+    jumps: &[OrientationJump],
+    gravity: f64,
+    limits: &Validation,
+) -> std::result::Result<Sequence, SequenceError> {
+    let mut p = seq.into_parts();
+    p.orientation = bridge_orientation_jumps(&p.time, &p.gyro, &p.orientation, jumps);
+    (p.gravity, p.linacce) = android::gravity_and_linacce(&p.orientation, &p.acce, gravity);
+    Sequence::with_validation(p, limits)
+}
+
+/// Largest angle between the mocap's and the phone's up axis in the device frame at which the
+/// two are taken to agree, degrees. Both come from orientations, not from the accelerometer, so
+/// walking does not move them apart: clean runs agree within a few degrees (medians 1-3).
+pub const MAX_MOCAP_TILT_DEG: f64 = 20.0;
+
+/// Blocks judged as a whole, seconds: long enough for the mean accelerometer to point along
+/// gravity, short enough to cut little around a fault.
+const TILT_BLOCK_S: f64 = 1.0;
+
+/// Largest angle between a block's mean accelerometer and the phone orientation's up axis at
+/// which the accelerometer discredits the mocap, degrees: 1.5-2.5 where the mocap mis-solves,
+/// 17-80 in running blocks where both the mocap and the attitude may be off.
+const ACCE_SIDES_DEG: f64 = 10.0;
+
+/// Which of the mocap and the phone's own orientation a block of disagreement discredits.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum TiltVerdict {
+    Agree,
+    /// The accelerometer sides with the phone: the mocap mis-solved the rigid body.
+    MocapWrong,
+    /// The accelerometer sides with the mocap: the phone's orientation filter lost its tilt
+    /// (Core Motion does while running with a clipped accelerometer).
+    PhoneWrong,
+}
+
+/// Judges each mocap frame (`time` on the phone clock, orientations `mocap`) in blocks of
+/// [`TILT_BLOCK_S`]: where the median angle between the mocap's and the phone orientation's up
+/// axis exceeds `max_deg`, the block's mean accelerometer (nearly gravity over a second) decides
+/// which of the two is wrong: the mocap only when the accelerometer is within
+/// [`ACCE_SIDES_DEG`] of the phone, the phone whenever it is closer to the mocap. Frames outside `spans` (where every phone stream has data) are
+/// not judged: they are cut later.
+fn judge_tilt(
+    time: &[f64],
+    mocap: &[WorldFromDevice],
+    phone: &Stream<WorldFromDevice>,
+    acce: &Stream<DeviceVec>,
+    spans: &[(f64, f64)],
+    max_deg: f64,
+) -> Vec<TiltVerdict> {
+    let mut verdicts = vec![TiltVerdict::Agree; time.len()];
+    if max_deg == f64::INFINITY {
+        return verdicts;
+    }
+    let up = WorldVec::new(0.0, 0.0, 1.0);
+    let angle = |a: DeviceVec, b: DeviceVec| {
+        let cos = a.dot(b) / (a.norm() * b.norm());
+        cos.clamp(-1.0, 1.0).acos().to_degrees()
+    };
+    for &(start, end) in spans {
+        let first = time.partition_point(|&t| t < start);
+        let last = time.partition_point(|&t| t <= end);
+        let mut i = first;
+        while i < last {
+            let j = (time[i..last].partition_point(|&t| t < time[i] + TILT_BLOCK_S) + i).max(i + 1);
+            let block = &time[i..j];
+            let phone_at = interpolate_rot(&phone.time, &phone.values, block);
+            let acce_at = interpolate_vec3(&acce.time, &acce.values, block);
+            let (mut m_sum, mut p_sum, mut a_sum) =
+                (DeviceVec::ZERO, DeviceVec::ZERO, DeviceVec::ZERO);
+            let mut diffs = Vec::with_capacity(block.len());
+            for ((m, p), a) in mocap[i..j].iter().zip(&phone_at).zip(&acce_at) {
+                let (m_up, p_up) = (m.inverse() * up, p.inverse() * up);
+                diffs.push(angle(m_up, p_up));
+                m_sum += m_up;
+                p_sum += p_up;
+                a_sum += *a;
+            }
+            diffs.sort_unstable_by(f64::total_cmp);
+            if diffs[diffs.len() / 2] > max_deg {
+                let (to_phone, to_mocap) = (angle(a_sum, p_sum), angle(a_sum, m_sum));
+                // The mocap is dropped only on clear evidence: a running phone's clipped
+                // accelerometer can side with a wrong orientation by chance.
+                let verdict = if to_phone < ACCE_SIDES_DEG && to_phone < to_mocap {
+                    TiltVerdict::MocapWrong
+                } else if to_mocap < to_phone {
+                    TiltVerdict::PhoneWrong
+                } else {
+                    TiltVerdict::Agree
+                };
+                verdicts[i..j].fill(verdict);
+            }
+            i = j;
+        }
+    }
+    verdicts
+}
+
+/// The stretches of frames judged `which`, `a-b s` (phone clock), the first few, and their
+/// number of frames.
+fn verdict_spans(time: &[f64], verdicts: &[TiltVerdict], which: TiltVerdict) -> (usize, String) {
+    const SHOWN: usize = 5;
+    let mut spans: Vec<(f64, f64)> = Vec::new();
+    let mut frames = 0;
+    for (i, (&t, &v)) in time.iter().zip(verdicts).enumerate() {
+        if v != which {
+            continue;
+        }
+        frames += 1;
+        match spans.last_mut() {
+            Some(s) if i > 0 && verdicts[i - 1] == which => s.1 = t,
+            _ => spans.push((t, t)),
+        }
+    }
+    let mut text: Vec<String> = spans
+        .iter()
+        .take(SHOWN)
+        .map(|(a, b)| format!("{a:.2}-{b:.2} s"))
+        .collect();
+    if spans.len() > SHOWN {
+        text.push(format!("and {} more", spans.len() - SHOWN));
+    }
+    (frames, text.join(", "))
+}
+
 /// Intersection of two sorted lists of disjoint closed intervals.
 fn intersect(a: &[(f64, f64)], b: &[(f64, f64)]) -> Vec<(f64, f64)> {
     let (mut i, mut j) = (0, 0);
@@ -1081,6 +1219,41 @@ pub fn read(dir: impl AsRef<Path>, options: &TyrexOptions) -> Result<TyrexRead> 
                 q.push(pose.orientation);
             }
         }
+        let verdicts = judge_tilt(&t, &q, &rv, &acce, &spans, options.max_mocap_tilt_deg);
+        let (wrong, at) = verdict_spans(&t, &verdicts, TiltVerdict::PhoneWrong);
+        if wrong > 0 {
+            warnings.push(format!(
+                "{}: the phone's orientation tilts more than {} degrees from the mocap's, and \
+                 the accelerometer sides with the mocap, for {wrong} of {} mocap frames ({at}): \
+                 gravity and linear acceleration derived from it are wrong there (tracking with \
+                 the orientation estimated from gyro and accelerometer avoids them)",
+                rv.path.display(),
+                options.max_mocap_tilt_deg,
+                t.len()
+            ));
+        }
+        let (dropped, at) = verdict_spans(&t, &verdicts, TiltVerdict::MocapWrong);
+        if dropped > 0 {
+            warnings.push(format!(
+                "{}: {dropped} of {} mocap frames tilted more than {} degrees from the phone's \
+                 orientation, the accelerometer siding with the phone ({at}): the mocap \
+                 mis-solved the body there; treated as mocap losses",
+                mat.display(),
+                t.len(),
+                options.max_mocap_tilt_deg,
+            ));
+            let mut kept = (Vec::new(), Vec::new(), Vec::new());
+            for (i, _) in verdicts
+                .iter()
+                .enumerate()
+                .filter(|(_, v)| **v != TiltVerdict::MocapWrong)
+            {
+                kept.0.push(t[i]);
+                kept.1.push(p[i]);
+                kept.2.push(q[i]);
+            }
+            (t, p, q) = kept;
+        }
         if t.is_empty() {
             return Err(DataError::format(
                 Location::file(mat).with_field("RigidBodies.Positions"),
@@ -1166,10 +1339,21 @@ pub fn read(dir: impl AsRef<Path>, options: &TyrexOptions) -> Result<TyrexRead> 
             text::sequence_error(path, None, &TyrexFields, e)
         })?;
         let jumps = seq.orientation_jumps();
-        warnings.extend(orientation_jump_warning(
-            &rv.path.display().to_string(),
-            &jumps,
-        ));
+        warnings.extend(
+            orientation_jump_warning(&rv.path.display().to_string(), &jumps).map(|w| {
+                if options.bridge_orientation_jumps {
+                    format!("{w}; bridged by the gyro, the heading kept across them")
+                } else {
+                    w
+                }
+            }),
+        );
+        let seq = if options.bridge_orientation_jumps && !jumps.is_empty() {
+            bridged(seq, &jumps, options.gravity, limits)
+                .map_err(|e| text::sequence_error(&rv.path, None, &TyrexFields, e))?
+        } else {
+            seq
+        };
         sequences.push(seq);
     }
     Ok(TyrexRead {
@@ -1184,6 +1368,91 @@ pub fn read(dir: impl AsRef<Path>, options: &TyrexOptions) -> Result<TyrexRead> 
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Two minutes of one-second judgements at 100 Hz: the phone flat, the accelerometer on
+    /// gravity, the mocap and phone tilted by `mocap_tilt(t)` and `phone_tilt(t)` degrees about x.
+    fn judge(
+        mocap_tilt: impl Fn(f64) -> f64,
+        phone_tilt: impl Fn(f64) -> f64,
+        acce_tilt: impl Fn(f64) -> f64,
+        spans: &[(f64, f64)],
+        max_deg: f64,
+    ) -> Vec<TiltVerdict> {
+        let time: Vec<f64> = (0..12_000).map(|i| i as f64 / 100.0).collect();
+        let x = ridi_frames::nalgebra::Vector3::x_axis();
+        let rot = |deg: f64| WorldFromDevice::from_axis_angle(&x, deg.to_radians());
+        fn stream<T>(time: &[f64], values: Vec<T>) -> Stream<T> {
+            Stream {
+                path: PathBuf::new(),
+                time: time.to_vec(),
+                values,
+                lines: vec![0; time.len()],
+            }
+        }
+        let phone = stream(&time, time.iter().map(|&t| rot(phone_tilt(t))).collect());
+        let acce = stream(
+            &time,
+            time.iter()
+                .map(|&t| rot(acce_tilt(t)).inverse() * WorldVec::new(0.0, 0.0, 9.8))
+                .collect(),
+        );
+        let mocap: Vec<_> = time.iter().map(|&t| rot(mocap_tilt(t))).collect();
+        judge_tilt(&time, &mocap, &phone, &acce, spans, max_deg)
+    }
+
+    #[test]
+    fn tilt_disagreement_discredits_whichever_the_accelerometer_contradicts() {
+        let whole = [(0.0, 120.0)];
+        let fault = |t: f64| if (30.0..40.0).contains(&t) { 45.0 } else { 0.0 };
+        let at = |v: &[TiltVerdict], t: f64| v[(t * 100.0) as usize];
+        // The mocap tilts alone: it is wrong for those ten seconds, nowhere else.
+        let v = judge(fault, |_| 0.0, |_| 0.0, &whole, MAX_MOCAP_TILT_DEG);
+        assert_eq!(at(&v, 35.0), TiltVerdict::MocapWrong);
+        assert_eq!(at(&v, 29.0), TiltVerdict::Agree);
+        assert_eq!(at(&v, 41.0), TiltVerdict::Agree);
+        let wrong = v.iter().filter(|&&x| x == TiltVerdict::MocapWrong).count();
+        assert_eq!(wrong, 1000);
+        // The phone's orientation tilts while the accelerometer follows the mocap.
+        let v = judge(|_| 0.0, fault, |_| 0.0, &whole, MAX_MOCAP_TILT_DEG);
+        assert_eq!(at(&v, 35.0), TiltVerdict::PhoneWrong);
+        assert!(!v.contains(&TiltVerdict::MocapWrong));
+        // Under the limit, and a single glitching frame, are agreement.
+        let glitch = |t: f64| {
+            if (50.0..50.01).contains(&t) {
+                90.0
+            } else {
+                15.0
+            }
+        };
+        let v = judge(glitch, |_| 0.0, |_| 0.0, &whole, MAX_MOCAP_TILT_DEG);
+        assert!(v.iter().all(|&x| x == TiltVerdict::Agree));
+        // Outside the spans nothing is judged (the phone streams have a gap there), and an
+        // infinite limit judges nothing.
+        let v = judge(
+            fault,
+            |_| 0.0,
+            |_| 0.0,
+            &[(0.0, 25.0), (45.0, 120.0)],
+            MAX_MOCAP_TILT_DEG,
+        );
+        assert!(v.iter().all(|&x| x == TiltVerdict::Agree));
+        let v = judge(fault, |_| 0.0, |_| 0.0, &whole, f64::INFINITY);
+        assert!(v.iter().all(|&x| x == TiltVerdict::Agree));
+    }
+
+    #[test]
+    fn verdict_spans_name_the_stretches() {
+        use TiltVerdict::*;
+        let time: Vec<f64> = (0..10).map(f64::from).collect();
+        let v = [
+            Agree, MocapWrong, MocapWrong, Agree, MocapWrong, Agree, Agree, Agree, Agree, Agree,
+        ];
+        assert_eq!(
+            verdict_spans(&time, &v, MocapWrong),
+            (3, "1.00-2.00 s, 4.00-4.00 s".to_string())
+        );
+        assert_eq!(verdict_spans(&time, &v, PhoneWrong), (0, String::new()));
+    }
 
     #[test]
     fn intervals_split_only_at_long_gaps() {

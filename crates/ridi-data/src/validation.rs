@@ -1,7 +1,11 @@
 //! Limits every sequence and stream is checked against, and the orientation jumps those checks
 //! leave out.
 
-use ridi_frames::{DeviceVec, WorldFromDevice, WorldVec};
+use ridi_frames::nalgebra::Vector3;
+use ridi_frames::{Device, DeviceVec, World, WorldFromDevice, WorldVec};
+
+/// A turn of the world frame.
+type WorldFromWorld = ridi_frames::Rot<World, World>;
 
 use crate::sequence::{Channel, norm};
 use crate::sequence_error::{SequenceError, short};
@@ -417,6 +421,67 @@ pub fn orientation_jumps(
     out
 }
 
+/// `orientation` with each of `jumps` ([`orientation_jumps`]) bridged by the gyro: through a
+/// jump the orientation follows the gyro from the frame before it; from its last frame on, the
+/// recorded orientation is turned about the vertical by the heading the jump added beyond the
+/// gyro. The heading so stays continuous (an OS correction turns a track by up to 160 degrees on
+/// the Tyrex runs), while the tilt after a jump is the recorded one: the accelerometer makes it
+/// observable, and the jumps leave it nearly unchanged. The stretch after the last jump keeps
+/// its recorded heading, the others are turned to join it. `gyro` must be in the orientation's
+/// device frame, rad/s.
+pub fn bridge_orientation_jumps(
+    time: &[f64],
+    gyro: &[DeviceVec],
+    orientation: &[WorldFromDevice],
+    jumps: &[OrientationJump],
+) -> Vec<WorldFromDevice> {
+    let mut out = orientation.to_vec();
+    // World-frame turn about z applied to the recorded orientation from the current frame on.
+    let mut turn = WorldFromWorld::identity();
+    let mut next = 0;
+    for jump in jumps {
+        let (a, b) = jump.frames;
+        if a < next || b >= orientation.len() || b <= a {
+            continue; // overlapping or outside the slices: nothing sound to do
+        }
+        for k in next..=a {
+            out[k] = turn * orientation[k];
+        }
+        let mut q = out[a];
+        for k in a + 1..b {
+            q = q * gyro_step(time[k] - time[k - 1], gyro[k - 1], gyro[k]);
+            out[k] = q;
+        }
+        let bridged = q * gyro_step(time[b] - time[b - 1], gyro[b - 1], gyro[b]);
+        turn = yaw_between(bridged, turn * orientation[b]) * turn;
+        next = b;
+    }
+    for k in next..orientation.len() {
+        out[k] = turn * orientation[k];
+    }
+    // Turns about z commute: re-based on the last stretch, whose heading, the OS's most settled
+    // (a filter converging after its start jumps too), is kept as recorded.
+    let last = turn.inverse();
+    for q in &mut out {
+        *q = last * *q;
+    }
+    out
+}
+
+/// The device's rotation over one step of the gyro (the mean of its two readings).
+fn gyro_step(dt: f64, g0: DeviceVec, g1: DeviceVec) -> ridi_frames::Rot<Device, Device> {
+    let w = ((g0 + g1) * (0.5 * dt)).to_array();
+    ridi_frames::Rot::from_scaled_axis(Vector3::new(w[0], w[1], w[2]))
+}
+
+/// The turn about the world's z axis that takes the heading of `from` to that of `to`: the twist
+/// about z of `to * from^-1`.
+fn yaw_between(to: WorldFromDevice, from: WorldFromDevice) -> WorldFromWorld {
+    let [w, _, _, z] = (to * from.inverse()).to_wxyz();
+    let angle = 2.0 * z.atan2(w);
+    WorldFromWorld::from_axis_angle(&Vector3::z_axis(), angle)
+}
+
 /// One line for a reader's warnings about `jumps` in the orientation read from `file`:
 /// how many, where (the first few), how fast; `None` without jumps.
 pub(crate) fn orientation_jump_warning(file: &str, jumps: &[OrientationJump]) -> Option<String> {
@@ -456,6 +521,82 @@ pub const LINACCE_SCALE_MIN_RMS: f64 = 0.5;
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A phone turning at 0.5 rad/s about its own z (lying flat), 200 Hz, whose OS orientation
+    /// jumps by `jump` (a world turn, applied from frame 400 on, reached over 3 frames).
+    fn jumping(
+        jump: WorldFromWorld,
+    ) -> (
+        Vec<f64>,
+        Vec<DeviceVec>,
+        Vec<WorldFromDevice>,
+        Vec<WorldFromDevice>,
+    ) {
+        let n = 1000;
+        let time: Vec<f64> = (0..n).map(|i| i as f64 / 200.0).collect();
+        let gyro = vec![DeviceVec::new(0.0, 0.0, 0.5); n];
+        let truth: Vec<WorldFromDevice> = time
+            .iter()
+            .map(|&t| WorldFromDevice::from_axis_angle(&Vector3::z_axis(), 0.5 * t))
+            .collect();
+        let recorded = truth
+            .iter()
+            .enumerate()
+            .map(|(k, &q)| match k {
+                0..400 => q,
+                400..403 => WorldFromWorld::identity().slerp(&jump, (k - 399) as f64 / 4.0) * q,
+                _ => jump * q,
+            })
+            .collect();
+        (time, gyro, truth, recorded)
+    }
+
+    #[test]
+    fn a_heading_jump_is_bridged_and_the_heading_kept() {
+        let jump = WorldFromWorld::from_axis_angle(&Vector3::z_axis(), 2.0);
+        let (time, gyro, truth, recorded) = jumping(jump);
+        let jumps = orientation_jumps(&time, &gyro, &recorded);
+        assert_eq!(jumps.len(), 1, "{jumps:?}");
+        let bridged = bridge_orientation_jumps(&time, &gyro, &recorded, &jumps);
+        // The heading after the jump, as recorded, everywhere.
+        let worst = bridged
+            .iter()
+            .zip(&truth)
+            .map(|(a, b)| a.angle_to(&(jump * *b)))
+            .fold(0.0, f64::max);
+        assert!(worst < 1e-9, "{worst} rad from the truth");
+        assert!(bridged[999].angle_to(&recorded[999]) < 1e-12);
+        assert!(orientation_jumps(&time, &gyro, &bridged).is_empty());
+        // Without jumps, the orientation as recorded.
+        assert_eq!(bridge_orientation_jumps(&time, &gyro, &truth, &[]), truth);
+    }
+
+    #[test]
+    fn after_a_jump_the_tilt_is_the_recorded_one() {
+        // A reset that turns the heading by 1 rad and tilts by 0.1 rad about world x.
+        let tilt = WorldFromWorld::from_axis_angle(&Vector3::x_axis(), 0.1);
+        let jump = tilt * WorldFromWorld::from_axis_angle(&Vector3::z_axis(), 1.0);
+        let (time, gyro, truth, recorded) = jumping(jump);
+        let jumps = orientation_jumps(&time, &gyro, &recorded);
+        let bridged = bridge_orientation_jumps(&time, &gyro, &recorded, &jumps);
+        let up = WorldVec::new(0.0, 0.0, 1.0);
+        for k in [500, 999] {
+            // Gravity in the device frame as recorded; the heading close to the truth's.
+            let (b, r) = (bridged[k].inverse() * up, recorded[k].inverse() * up);
+            assert!((b - r).norm() < 1e-9, "frame {k}");
+            assert!(bridged[k].angle_to(&recorded[k]) < 1e-9, "frame {k}");
+        }
+        // Before it, the gyro's heading joined to the recorded one after: the truth turned by
+        // the jump's heading, within the tilt it added.
+        let heading = WorldFromWorld::from_axis_angle(&Vector3::z_axis(), 1.0);
+        for k in [0, 200, 399] {
+            assert!(
+                bridged[k].angle_to(&(heading * truth[k])) < 0.11,
+                "frame {k}"
+            );
+            assert!(recorded[k].angle_to(&(heading * truth[k])) > 0.9);
+        }
+    }
 
     #[test]
     fn a_gyro_in_deg_per_s_is_named_as_such_before_any_single_value() {

@@ -29,10 +29,10 @@ use std::path::Path;
 
 use crate::Sequence;
 use crate::error::{DataError, Result};
-use crate::processed::COLUMNS;
+use crate::processed::PROCESSED_COLUMNS;
 use crate::sidecar;
 
-/// The 27 values of frame `i` in [`COLUMNS`] order, time excluded (slot 0 is unused).
+/// The 27 values of frame `i` in [`PROCESSED_COLUMNS`] order, time excluded (slot 0 is unused).
 fn row(seq: &Sequence, i: usize) -> [f64; 27] {
     let mut r = [0.0; 27];
     let mut put = |at: usize, v: &[f64]| r[at..at + v.len()].copy_from_slice(v);
@@ -235,7 +235,7 @@ pub fn write_ridi_csv_with(
     precision: Precision,
 ) -> Result<()> {
     write_data(seq, path.as_ref(), |w| {
-        writeln!(w, ",{}", COLUMNS.join(","))?;
+        writeln!(w, ",{}", PROCESSED_COLUMNS.join(","))?;
         let mut line = String::with_capacity(512);
         for i in 0..seq.len() {
             line.clear();
@@ -255,7 +255,7 @@ pub fn write_ridi_csv_with(
 /// (gzip-compressed when the path ends in `.gz`).
 pub fn write_ridi_plain(seq: &Sequence, path: impl AsRef<Path>) -> Result<()> {
     write_data(seq, path.as_ref(), |w| {
-        writeln!(w, "{} {}", seq.len(), COLUMNS.len())?;
+        writeln!(w, "{} {}", seq.len(), PROCESSED_COLUMNS.len())?;
         let mut line = String::with_capacity(512);
         for i in 0..seq.len() {
             line.clear();

@@ -5,8 +5,8 @@ mod common;
 
 use common::sample_sequence;
 use ridi_data::{
-    DeviceInfo, ReadOptions, Sequence, read_sequence, ridi_csv, ridi_plain, sidecar_path,
-    source_files, write_ridi_csv, write_ridi_plain,
+    DeviceInfo, OrientationSource, ReadOptions, Sequence, read_sequence, ridi_csv, ridi_plain,
+    sidecar_path, source_files, write_ridi_csv, write_ridi_plain,
 };
 use ridi_test_support::assert_names_file;
 
@@ -73,6 +73,45 @@ fn the_device_goes_to_a_sidecar_and_comes_back() {
     assert_eq!(
         ridi_csv::parse(&bytes, &path, &opts).unwrap().device(),
         None
+    );
+}
+
+/// Where the orientation comes from goes to the sidecar too, when it is not the layout's own (RIDI's
+/// game rotation vector): a converted Tyrex run's magnetic rotation vector, a phone's Core Motion
+/// attitude, stay what they are.
+#[test]
+fn the_orientation_source_goes_to_the_sidecar_and_comes_back() {
+    let dir = tempfile::tempdir().unwrap();
+    let opts = ReadOptions::default();
+    for (device, source) in [
+        (None, OrientationSource::RotationVector),
+        (Some(iphone()), OrientationSource::CoreMotionAttitude),
+        (None, OrientationSource::Estimated),
+    ] {
+        let mut parts = sample_sequence("walk", 300, true, false).into_parts();
+        parts.orientation_source = Some(source);
+        parts.device = device.clone();
+        let seq = Sequence::new(parts).unwrap();
+        let path = dir.path().join(format!("{}/data.csv", source.key()));
+        std::fs::create_dir_all(path.parent().unwrap()).unwrap();
+        write_ridi_csv(&seq, &path).unwrap();
+        let text = std::fs::read_to_string(sidecar_path(&path)).unwrap();
+        assert!(
+            text.contains(&format!("\norientation_source = {}\n", source.key())),
+            "{text}"
+        );
+        let back = ridi_csv::read(&path, &opts).unwrap();
+        assert_eq!(back.orientation_source(), Some(source));
+        assert_eq!(back.device(), device.as_ref());
+    }
+    // The layout's own source needs no sidecar, and a file without one reads as RIDI's.
+    let path = dir.path().join("grv/data.csv");
+    std::fs::create_dir_all(path.parent().unwrap()).unwrap();
+    write_ridi_csv(&sample_sequence("walk", 300, true, false), &path).unwrap();
+    assert!(!sidecar_path(&path).exists());
+    assert_eq!(
+        ridi_csv::read(&path, &opts).unwrap().orientation_source(),
+        Some(OrientationSource::GameRotationVector)
     );
 }
 

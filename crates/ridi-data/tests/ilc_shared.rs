@@ -6,7 +6,7 @@ use std::f64::consts::PI;
 use std::path::{Path, PathBuf};
 
 use ridi_data::ilc::{self, IlcOptions, IlcPath};
-use ridi_data::resample::interpolate_vec3;
+use ridi_data::interpolate_vec3;
 use ridi_data::ridi_frames::{DeviceVec, WorldVec};
 use ridi_data::{Format, OrientationSource, ReadOptions, detect, read_sequence};
 

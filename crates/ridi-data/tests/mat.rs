@@ -9,7 +9,7 @@ use std::path::Path;
 
 use mat_support::{V, W, le};
 use ridi_data::DataError;
-use ridi_data::mat::{MAX_DEPTH, MatClass, MatFile, MatValue};
+use ridi_data::{MAX_DEPTH, MatClass, MatFile, MatValue};
 use ridi_test_support::assert_names_file;
 
 fn sample() -> Vec<(&'static str, V)> {

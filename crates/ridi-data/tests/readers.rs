@@ -6,8 +6,8 @@ use std::path::Path;
 
 use common::*;
 use ridi_data::{
-    DataError, Format, ReadOptions, Sequence, detect, load_list, parse_list, read_list,
-    read_sequence, ridi_csv, ridi_plain, ridi_raw, write_ridi_csv, write_ridi_plain,
+    DataError, Format, ListEntry, Listed, ReadOptions, Sequence, detect, parse_list, read_sequence,
+    ridi_csv, ridi_plain, ridi_raw, write_ridi_csv, write_ridi_plain,
 };
 use ridi_test_support::{assert_err, edit_file, edit_rows, with_cell, write_files};
 
@@ -17,6 +17,11 @@ fn opts() -> ReadOptions {
 
 fn csv_string() -> String {
     String::from_utf8(valid_csv(20)).unwrap()
+}
+
+/// The sequences of the list file `list`.
+fn load_list(list: &Path) -> ridi_data::Result<Vec<Sequence>> {
+    Listed::read(&[list], &opts()).map(Listed::into_sequences)
 }
 
 fn parse_csv(text: &str) -> ridi_data::Result<Sequence> {
@@ -505,7 +510,7 @@ fn dataset() -> tempfile::TempDir {
     .unwrap();
     std::fs::create_dir_all(root.join("plain_seq")).unwrap();
     write_ridi_plain(
-        // Another length: the same samples would be the same recording (`load_entries`).
+        // Another length: the same samples would be the same recording (`Listed::load`).
         &sample_sequence("plain_seq", 60, true, false),
         root.join("plain_seq/data_plain.txt"),
     )
@@ -581,7 +586,10 @@ fn list_files_parse_comments_paths_and_placements() {
         parse_list(b"a,hand held\n", list),
         &["train.txt:1: field `placement`"],
     );
-    assert_err(read_list("/definitely/not/here.txt"), &["here.txt"]);
+    assert_err(
+        ListEntry::read(&["/definitely/not/here.txt"]),
+        &["here.txt"],
+    );
 }
 
 #[test]
@@ -598,7 +606,7 @@ fn lists_without_sequences_are_errors() {
     let list = dir.path().join("empty.txt");
     for text in ["", "\n\n", "# only a comment\n\n# another\n"] {
         std::fs::write(&list, text).unwrap();
-        let e = assert_err(read_list(&list), &[]);
+        let e = assert_err(ListEntry::read(&[&list]), &[]);
         assert_eq!(
             e.to_string(),
             format!(
@@ -606,10 +614,7 @@ fn lists_without_sequences_are_errors() {
                 list.display()
             )
         );
-        assert_err(
-            load_list(&list, &opts()),
-            &["empty.txt", "no sequences listed"],
-        );
+        assert_err(load_list(&list), &["empty.txt", "no sequences listed"]);
     }
 }
 
@@ -626,7 +631,7 @@ fn lists_load_every_format_and_set_placements() {
         ),
     )
     .unwrap();
-    let seqs = load_list(&list, &opts()).unwrap();
+    let seqs = load_list(&list).unwrap();
     let got: Vec<(&str, Option<&str>)> = seqs.iter().map(|s| (s.name(), s.placement())).collect();
     assert_eq!(
         got,
@@ -640,14 +645,11 @@ fn lists_load_every_format_and_set_placements() {
 
     std::fs::write(&list, "csv_seq,body\n\nmissing_seq,bag\n").unwrap();
     assert_err(
-        load_list(&list, &opts()),
+        load_list(&list),
         &["list.txt:3: field `path`", "missing_seq", "does not exist"],
     );
     std::fs::write(&list, "nothing\n").unwrap();
-    assert_err(
-        load_list(&list, &opts()),
-        &["nothing", "not a known dataset folder"],
-    );
+    assert_err(load_list(&list), &["nothing", "not a known dataset folder"]);
 }
 
 #[test]
@@ -657,7 +659,7 @@ fn lists_refuse_a_recording_listed_twice_also_through_another_path() {
     let list = root.join("list.txt");
     std::fs::write(&list, "csv_seq,handheld\nraw_seq\ncsv_seq,body\n").unwrap();
     assert_err(
-        load_list(&list, &opts()),
+        load_list(&list),
         &[
             "list.txt:3: field `path`",
             "csv_seq",
@@ -668,12 +670,12 @@ fn lists_refuse_a_recording_listed_twice_also_through_another_path() {
     // The folder and the file it is read from are one recording.
     let other = root.join("other.txt");
     std::fs::write(&other, "csv_seq/processed/data.csv\n").unwrap();
-    let entries: Vec<_> = [&list, &other]
-        .iter()
-        .flat_map(|l| ridi_data::read_list(l).unwrap())
+    let entries: Vec<_> = ListEntry::read(&[&list, &other])
+        .unwrap()
+        .into_iter()
         .filter(|e| e.line != 3)
         .collect();
-    let e = ridi_data::load_entries(&entries, &opts()).unwrap_err();
+    let e = Listed::load(entries, &opts()).unwrap_err();
     assert!(
         e.to_string().contains("other.txt:1: field `path`") && e.to_string().contains("list.txt:1"),
         "{e}"
@@ -701,7 +703,7 @@ plain_seq,bag
         )
         .unwrap();
         assert_err(
-            load_list(&list, &opts()),
+            load_list(&list),
             &[
                 &format!(
                     "list.txt:3: field `path`: sequence `{}",
@@ -719,41 +721,37 @@ plain_seq,bag
 ",
     )
     .unwrap();
-    assert_eq!(load_list(&list, &opts()).unwrap().len(), 2);
+    assert_eq!(load_list(&list).unwrap().len(), 2);
 
-    // Across two lists loaded apart (training and test): a copy on the second is named at its
-    // line with the first list's line; distinct recordings pass.
+    // Across two lists loaded apart (training and test): a recording on the second, by path or
+    // as a copy, is named at its line with the first list's line; distinct recordings pass.
     let test = root.join("test.txt");
     std::fs::write(&test, "plain_seq,bag\nas_plain,body\n").unwrap();
-    let train_entries = ridi_data::read_list(&list).unwrap();
-    let test_entries = ridi_data::read_list(&test).unwrap();
-    let train = ridi_data::load_entries(&train_entries, &opts()).unwrap();
-    let held_out = ridi_data::load_entries(&test_entries, &opts()).unwrap();
-    let e = ridi_data::check_distinct((&train, &train_entries), (&held_out, &test_entries))
-        .unwrap_err()
-        .to_string();
+    let train_entries = ListEntry::read(&[&list]).unwrap();
+    let test_entries = ListEntry::read(&[&test]).unwrap();
+    let load = |entries: &[ListEntry]| Listed::load(entries.to_vec(), &opts()).unwrap();
+    let (train, held_out) = (load(&train_entries), load(&test_entries));
+    let e = train.check_distinct(&held_out).unwrap_err().to_string();
     assert!(
         e.contains("test.txt:1: field `path`")
             && e.contains("plain_seq")
-            && e.contains("holds the same recording as")
+            && e.contains("already listed at")
             && e.contains("list.txt:2"),
         "{e}"
     );
-    let e = ridi_data::check_distinct(
-        (&train, &train_entries),
-        (&held_out[1..], &test_entries[1..]),
-    )
-    .unwrap_err()
-    .to_string();
+    let e = train
+        .check_distinct(&load(&test_entries[1..]))
+        .unwrap_err()
+        .to_string();
     assert!(
-        e.contains("test.txt:2: field `path`") && e.contains("list.txt:1"),
+        e.contains("test.txt:2: field `path`")
+            && e.contains("holds the same recording as")
+            && e.contains("list.txt:1"),
         "{e}"
     );
-    ridi_data::check_distinct(
-        (&train[1..], &train_entries[1..]),
-        (&held_out[1..], &test_entries[1..]),
-    )
-    .unwrap();
+    load(&train_entries[1..])
+        .check_distinct(&load(&test_entries[1..]))
+        .unwrap();
 }
 
 // ---- writer ------------------------------------------------------------------------------

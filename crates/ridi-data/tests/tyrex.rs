@@ -795,7 +795,11 @@ fn os_orientation_jumps_are_a_warning_not_a_gyro_unit_error() {
             })
             .collect()
     });
-    let read = tyrex::read(&fx.dir, &TyrexOptions::default()).unwrap();
+    let as_recorded = TyrexOptions {
+        bridge_orientation_jumps: false,
+        ..TyrexOptions::default()
+    };
+    let read = tyrex::read(&fx.dir, &as_recorded).unwrap();
     let [seq] = read.sequences.as_slice() else {
         panic!("{} parts", read.sequences.len())
     };
@@ -822,8 +826,38 @@ fn os_orientation_jumps_are_a_warning_not_a_gyro_unit_error() {
         "{}",
         warning[0]
     );
-    // A clean run has none.
+    assert!(!warning[0].contains("bridged"), "{}", warning[0]);
+    // By default the reader bridges them by the gyro: the same warning says so, and the
+    // orientation turns with the gyro throughout (here, back to the recorded heading).
+    let bridged = tyrex::read(&fx.dir, &TyrexOptions::default()).unwrap();
+    let warning = bridged
+        .warnings
+        .iter()
+        .find(|w| w.contains("orientation jumps"))
+        .unwrap();
+    assert!(
+        warning.ends_with("; bridged by the gyro, the heading kept across them"),
+        "{warning}"
+    );
+    let b = &bridged.sequences[0];
+    assert!(b.orientation_jumps().is_empty());
+    let in_jump = |t: f64| jumps.iter().any(|j| (j.time.0..=j.time.1).contains(&t));
+    let worst = b
+        .orientation()
+        .iter()
+        .zip(seq.orientation())
+        .zip(b.time())
+        .filter(|(_, t)| !in_jump(**t))
+        .map(|((a, r), _)| a.angle_to(r))
+        .fold(0.0, f64::max);
+    assert!(
+        worst < 1e-6,
+        "{worst} rad from the recorded orientation away from the glitches"
+    );
+    // A clean run has none, and reads the same either way.
     let clean = Fixture::standard();
     let read = tyrex::read(&clean.dir, &TyrexOptions::default()).unwrap();
     assert!(read.sequences[0].orientation_jumps().is_empty());
+    let raw = tyrex::read(&clean.dir, &as_recorded).unwrap();
+    assert_eq!(read.sequences, raw.sequences);
 }

@@ -150,9 +150,13 @@ impl Standardization {
     }
 
     fn validate(&self, dim: usize) -> Result<(), FeatureError> {
-        for len in [self.mean.len(), self.std.len()] {
+        for (what, len) in [
+            ("standardization mean", self.mean.len()),
+            ("standardization std", self.std.len()),
+        ] {
             if len != dim {
-                return Err(FeatureError::DimensionMismatch {
+                return Err(FeatureError::LengthMismatch {
+                    what,
                     expected: dim,
                     found: len,
                 });
@@ -176,7 +180,8 @@ impl Standardization {
     /// Standardizes one feature row in place.
     pub fn apply_row(&self, row: &mut [f32]) -> Result<(), FeatureError> {
         if row.len() != self.dim() || self.std.len() != self.dim() {
-            return Err(FeatureError::DimensionMismatch {
+            return Err(FeatureError::LengthMismatch {
+                what: "feature row",
                 expected: self.dim(),
                 found: row.len(),
             });
@@ -189,7 +194,8 @@ impl Standardization {
     pub fn apply(&self, m: &mut FeatureMatrix) -> Result<(), FeatureError> {
         use rayon::prelude::*;
         if m.cols() != self.dim() || self.std.len() != self.dim() {
-            return Err(FeatureError::DimensionMismatch {
+            return Err(FeatureError::LengthMismatch {
+                what: "feature matrix row",
                 expected: self.dim(),
                 found: m.cols(),
             });
@@ -242,7 +248,8 @@ impl StandardizationFit {
     /// later feature.
     pub fn add_row(&mut self, row: &[f32]) -> Result<(), FeatureError> {
         if row.len() != self.mean.len() {
-            return Err(FeatureError::DimensionMismatch {
+            return Err(FeatureError::LengthMismatch {
+                what: "feature row",
                 expected: self.mean.len(),
                 found: row.len(),
             });
@@ -268,7 +275,8 @@ impl StandardizationFit {
     pub fn add_matrix(&mut self, m: &FeatureMatrix) -> Result<(), FeatureError> {
         use rayon::prelude::*;
         if m.cols() != self.mean.len() {
-            return Err(FeatureError::DimensionMismatch {
+            return Err(FeatureError::LengthMismatch {
+                what: "feature matrix row",
                 expected: self.mean.len(),
                 found: m.cols(),
             });

@@ -4,8 +4,9 @@
 /// input so that a caller can point at the bad recording.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum FeatureError {
-    /// Inputs that must be parallel have different lengths.
-    #[error("{what} has {found} samples, expected {expected}")]
+    /// An input has another length than the others, the configuration or the matrix shape
+    /// imply (streams of one recording, a feature row, targets per row).
+    #[error("length of {what} is {found}, expected {expected}")]
     LengthMismatch {
         /// Which input.
         what: &'static str,
@@ -38,19 +39,13 @@ pub enum FeatureError {
         /// Largest valid frame.
         max: usize,
     },
-    /// A row or vector has the wrong dimension.
-    #[error("dimension {found} where {expected} was expected")]
-    DimensionMismatch {
-        /// Dimension the configuration implies.
-        expected: usize,
-        /// Dimension found.
-        found: usize,
-    },
     /// A configuration value is out of range.
     #[error("invalid feature configuration: {0}")]
     InvalidConfig(String),
 }
 
+/// An [`ImuFrames`](ridi_frames::ImuFrames) length error is this crate's `LengthMismatch`, so
+/// that a caller matches one spelling for every input of the crate, whichever check found it.
 impl From<ridi_frames::ImuError> for FeatureError {
     fn from(e: ridi_frames::ImuError) -> Self {
         let ridi_frames::ImuError::LengthMismatch {

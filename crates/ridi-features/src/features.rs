@@ -201,7 +201,8 @@ impl FeatureExtractor {
     ) -> Result<(), FeatureError> {
         self.check_stab(stab)?;
         if out.len() != self.dim() {
-            return Err(FeatureError::DimensionMismatch {
+            return Err(FeatureError::LengthMismatch {
+                what: "feature row",
                 expected: self.dim(),
                 found: out.len(),
             });
@@ -250,7 +251,8 @@ impl FeatureExtractor {
 
     fn check_stab(&self, stab: &StabilizedChannels) -> Result<(), FeatureError> {
         if stab.width() != self.config.row_width() {
-            return Err(FeatureError::DimensionMismatch {
+            return Err(FeatureError::LengthMismatch {
+                what: "stabilized frame (values per frame)",
                 expected: self.config.row_width(),
                 found: stab.width(),
             });

@@ -15,7 +15,8 @@
 //! into its row of a row-major [`FeatureMatrix`], rows in parallel with rayon and no
 //! allocation per window ([`FeatureExtractor::features_into`] also reuses the matrix, and
 //! [`FeatureExtractor::row_into`] computes one row for streaming use). [`compute_features`]
-//! does both steps. Frames come from a
+//! does both steps. [`FeatureMatrixRef`] is the matrix's borrowed view, checked for whole rows
+//! of finite values: what ridi-regress's solvers take. Frames come from a
 //! [`SampleSchedule`]: every `step` frames from the first full window (training: step 10).
 //!
 //! # Configuration and standardization
@@ -95,7 +96,7 @@ pub use config::{FeatureChannel, FeatureConfig, Orientation, Standardization, St
 pub use error::FeatureError;
 pub use features::{FeatureExtractor, SampleSchedule, StabilizedChannels, compute_features};
 pub use gaussian::{gaussian_filter1d, gaussian_kernel};
-pub use matrix::FeatureMatrix;
+pub use matrix::{FeatureMatrix, FeatureMatrixRef};
 /// The frame types the inputs are built from.
 pub use ridi_frames;
 pub use targets::{GroundTruthView, Targets, compute_targets, stabilized_velocity};

@@ -40,7 +40,8 @@ impl YawTurn {
     /// are vectors in S). Fails when the row is not made of whole 3-vectors.
     pub fn row(&self, row: &mut [f32]) -> Result<(), FeatureError> {
         if !row.len().is_multiple_of(3) {
-            return Err(FeatureError::DimensionMismatch {
+            return Err(FeatureError::LengthMismatch {
+                what: "feature row (whole 3-vectors)",
                 expected: row.len() / 3 * 3,
                 found: row.len(),
             });
@@ -78,7 +79,8 @@ pub fn turned_copies(
     copies: usize,
 ) -> Result<TurnedRows, FeatureError> {
     if targets.len() != features.rows() {
-        return Err(FeatureError::DimensionMismatch {
+        return Err(FeatureError::LengthMismatch {
+            what: "targets (one per feature row)",
             expected: features.rows(),
             found: targets.len(),
         });

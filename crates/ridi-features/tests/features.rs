@@ -334,7 +334,7 @@ fn bad_input_is_an_error_not_a_panic() {
     let mut short = vec![0.0; 10];
     assert!(matches!(
         fx.row_into(&stab, 250, &mut short),
-        Err(FeatureError::DimensionMismatch { .. })
+        Err(FeatureError::LengthMismatch { .. })
     ));
     let gyro_only = FeatureExtractor::new(FeatureConfig {
         channels: vec![FeatureChannel::Gyro],
@@ -343,7 +343,7 @@ fn bad_input_is_an_error_not_a_panic() {
     .unwrap();
     assert!(matches!(
         gyro_only.features(&stab, &[250]),
-        Err(FeatureError::DimensionMismatch { .. })
+        Err(FeatureError::LengthMismatch { .. })
     ));
 }
 

@@ -36,7 +36,12 @@ pub type StabFromWorld = Rot<Stabilized, World>;
 pub enum QuatError {
     /// A component of the quaternion, or an entry of the matrix ([`Rot::from_matrix`]), is NaN
     /// or infinite.
-    NonFinite,
+    NonFinite {
+        /// What holds it: a quaternion component (in the order given) or a matrix entry.
+        what: &'static str,
+        /// Its index: in the components as given, or row-major in the matrix.
+        index: usize,
+    },
     /// The norm is too far from 1 to be a rotation (see [`Rot::NORM_TOLERANCE`]).
     NotUnit {
         /// The norm found.
@@ -56,7 +61,7 @@ pub enum QuatError {
 impl fmt::Display for QuatError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {
-            QuatError::NonFinite => write!(f, "a component is NaN or infinite"),
+            QuatError::NonFinite { what, index } => write!(f, "non-finite {what} {index}"),
             QuatError::NotUnit { norm } => {
                 write!(f, "quaternion norm {norm} is not close to 1")
             }
@@ -77,6 +82,14 @@ impl fmt::Display for QuatError {
 const ORTHONORMALITY_TOLERANCE: f64 = 1e-3;
 
 impl std::error::Error for QuatError {}
+
+/// [`QuatError::NonFinite`] naming the first non-finite of `c`.
+fn finite(c: &[f64; 4], what: &'static str) -> Result<(), QuatError> {
+    match c.iter().position(|v| !v.is_finite()) {
+        Some(index) => Err(QuatError::NonFinite { what, index }),
+        None => Ok(()),
+    }
+}
 
 impl<To: Frame, From: Frame> Rot<To, From> {
     /// Largest accepted deviation of a quaternion's norm from 1 before normalizing. Loose
@@ -137,8 +150,11 @@ impl<To: Frame, From: Frame> Rot<To, From> {
     /// # Ok::<(), QuatError>(())
     /// ```
     pub fn from_matrix(m: &Matrix3<f64>) -> Result<Self, QuatError> {
-        if !m.iter().all(|v| v.is_finite()) {
-            return Err(QuatError::NonFinite);
+        if let Some(index) = (0..9).find(|&i| !m[(i / 3, i % 3)].is_finite()) {
+            return Err(QuatError::NonFinite {
+                what: "matrix entry (row-major)",
+                index,
+            });
         }
         let orthonormality_error = (m.transpose() * m - Matrix3::identity()).abs().max();
         let determinant = m.determinant();
@@ -182,18 +198,18 @@ impl<To: Frame, From: Frame> Rot<To, From> {
 
     /// From Hamilton components in `[w, x, y, z]` order, normalized after checking the norm.
     pub fn from_wxyz(c: [f64; 4]) -> Result<Self, QuatError> {
+        finite(&c, "quaternion component (w, x, y, z)")?;
         Self::checked(Quaternion::new(c[0], c[1], c[2], c[3]))
     }
 
     /// From Hamilton components in `[x, y, z, w]` order (Android, Tango, ROS).
     pub fn from_xyzw(c: [f64; 4]) -> Result<Self, QuatError> {
+        finite(&c, "quaternion component (x, y, z, w)")?;
         Self::checked(Quaternion::new(c[3], c[0], c[1], c[2]))
     }
 
+    /// `q`, finite, normalized after checking the norm.
     fn checked(q: Quaternion<f64>) -> Result<Self, QuatError> {
-        if !q.coords.iter().all(|c| c.is_finite()) {
-            return Err(QuatError::NonFinite);
-        }
         let norm = q.norm();
         if (norm - 1.0).abs() > Self::NORM_TOLERANCE {
             return Err(QuatError::NotUnit { norm });
@@ -373,7 +389,10 @@ mod tests {
             m[(1, 2)] = bad;
             assert_eq!(
                 WorldFromDevice::from_matrix(&m),
-                Err(QuatError::NonFinite),
+                Err(QuatError::NonFinite {
+                    what: "matrix entry (row-major)",
+                    index: 5
+                }),
                 "{bad}"
             );
         }

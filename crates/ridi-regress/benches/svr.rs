@@ -9,14 +9,15 @@ mod synth;
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use ridi_features::FeatureConfig;
+use ridi_features::FeatureMatrixRef;
 use ridi_regress::{
-    Cascade, CascadeParams, MatrixRef, NoProgress, RegressorChoice, Storage, Svc, SvcParams, Svr,
-    SvrParams, TrainingSet,
+    Cascade, CascadeParams, NoProgress, RegressorChoice, Storage, Svc, SvcParams, Svr, SvrParams,
+    TrainingSet,
 };
 
 fn benches(c: &mut Criterion) {
     let data = synth::generate(2000, 4, 150, 42);
-    let x = MatrixRef::new(&data.x, data.dim).unwrap();
+    let x = FeatureMatrixRef::new(&data.x, data.dim).unwrap();
     let gamma = 1.0 / data.dim as f32;
     let mut g = c.benchmark_group("regress");
     g.sample_size(10);

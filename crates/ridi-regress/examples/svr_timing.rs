@@ -24,9 +24,10 @@ use timing::{peak_mb, thread_cpu_s, time_one};
 use std::time::Instant;
 
 use ridi_features::FeatureConfig;
+use ridi_features::FeatureMatrixRef;
 use ridi_regress::{
-    Cascade, CascadeParams, GridSpec, MatrixRef, Precompute, ProgressEvent, RegressorChoice,
-    SolverConfig, Storage, Svc, SvcParams, Svr, SvrParams, TrainingSet,
+    Cascade, CascadeParams, GridSpec, Precompute, ProgressEvent, RegressorChoice, SolverConfig,
+    Storage, Svc, SvcParams, Svr, SvrParams, TrainingSet,
 };
 
 fn arg<T: std::str::FromStr>(args: &[String], name: &str, default: T) -> T {
@@ -59,7 +60,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     }
     let t = Instant::now();
     let data = synth::generate(n, k, 150, 42);
-    let x = MatrixRef::new(&data.x, data.dim)?;
+    let x = FeatureMatrixRef::new(&data.x, data.dim)?;
     eprintln!("generated {n} x {} in {:.2?}", data.dim, t.elapsed());
     let gamma = 1.0 / data.dim as f32;
     let threads = rayon::current_num_threads();
@@ -280,7 +281,7 @@ fn load_query(args: &[String], n: usize, k: usize) -> Result<(), Box<dyn std::er
     drop(all);
     // Peak memory from here on: the model and the queries, not the generator's data.
     std::fs::write("/proc/self/clear_refs", "5")?;
-    let q = MatrixRef::new(&held_x, dim)?;
+    let q = FeatureMatrixRef::new(&held_x, dim)?;
     let stream: Vec<usize> = (0..nq).collect();
     let shuffled = timing::shuffled(nq);
     let one = rayon::ThreadPoolBuilder::new().num_threads(1).build()?;
@@ -320,7 +321,7 @@ fn load_query(args: &[String], n: usize, k: usize) -> Result<(), Box<dyn std::er
     );
     let train = synth::generate(n, k, 150, 42);
     let t = Instant::now();
-    let r = model.rounding_effect(MatrixRef::new(&train.x, dim)?, q)?;
+    let r = model.rounding_effect(FeatureMatrixRef::new(&train.x, dim)?, q)?;
     println!(
         "stored samples vs exact f32 rows ({:.1} s): {r}",
         t.elapsed().as_secs_f64()

@@ -8,7 +8,7 @@ use std::sync::{Arc, Mutex};
 use rayon::prelude::*;
 
 use crate::kernel;
-use crate::matrix::MatrixRef;
+use ridi_features::FeatureMatrixRef;
 
 /// One kernel row: `K(x_i, x_j)` for all `j` of the base sample set.
 pub(crate) enum Row<'a> {
@@ -52,7 +52,7 @@ pub(crate) struct FullKernel {
 }
 
 impl FullKernel {
-    pub(crate) fn new(x: MatrixRef<'_>, norms: &[f32], gamma: f32) -> Self {
+    pub(crate) fn new(x: FeatureMatrixRef<'_>, norms: &[f32], gamma: f32) -> Self {
         Self {
             n: x.rows(),
             data: kernel::gram(x, norms, gamma),
@@ -163,7 +163,7 @@ impl Lru {
 
 /// Rows computed on demand and kept in a bounded LRU cache.
 pub(crate) struct CachedKernel<'x> {
-    x: MatrixRef<'x>,
+    x: FeatureMatrixRef<'x>,
     norms: Vec<f32>,
     gamma: f32,
     lru: Mutex<Lru>,
@@ -175,7 +175,7 @@ pub(crate) struct CachedKernel<'x> {
 impl<'x> CachedKernel<'x> {
     /// `cap_bytes` bounds the cached rows (at least a few rows are always kept so that the
     /// two rows of a working pair coexist).
-    pub(crate) fn new(x: MatrixRef<'x>, gamma: f32, cap_bytes: u64) -> Self {
+    pub(crate) fn new(x: FeatureMatrixRef<'x>, gamma: f32, cap_bytes: u64) -> Self {
         let n = x.rows();
         let row_bytes = (n.max(1) * 4) as u64;
         let capacity = ((cap_bytes / row_bytes) as usize).max(8);
@@ -261,12 +261,12 @@ impl KernelRows for CachedKernel<'_> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::matrix::Matrix;
+    use crate::matrix::{View as _, owned};
 
     #[test]
     fn cached_rows_equal_full_rows_and_eviction_is_bounded() {
         let v: Vec<f32> = (0..40 * 6).map(|k| (k as f32 * 0.7).cos()).collect();
-        let x = Matrix::new(v, 6).unwrap();
+        let x = owned(v, 6);
         let norms = kernel::sq_norms(x.view());
         let full = FullKernel::new(x.view(), &norms, 0.3);
         // Room for 8 rows of 40 floats.
@@ -289,7 +289,7 @@ mod tests {
     #[test]
     fn block_is_the_sub_matrix() {
         let v: Vec<f32> = (0..30 * 4).map(|k| (k as f32 * 0.3).sin()).collect();
-        let x = Matrix::new(v, 4).unwrap();
+        let x = owned(v, 4);
         let full = FullKernel::new(x.view(), &kernel::sq_norms(x.view()), 0.5);
         let idx = [29, 3, 4, 17, 0];
         let block = FullKernel::block(&full, &idx);

@@ -4,8 +4,8 @@ use serde::{Deserialize, Serialize};
 
 use crate::cache::{CachedKernel, FullKernel, KernelRows};
 use crate::kernel;
-use crate::matrix::MatrixRef;
 use crate::smo::SmoSettings;
+use ridi_features::FeatureMatrixRef;
 
 /// When to precompute a full kernel matrix instead of caching rows on demand.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
@@ -44,7 +44,7 @@ impl Default for SolverConfig {
 
 /// Builds the kernel row provider for `x` under the memory cap.
 pub(crate) fn kernel_rows<'x>(
-    x: MatrixRef<'x>,
+    x: FeatureMatrixRef<'x>,
     gamma: f32,
     memory: u64,
     strategy: Precompute,

@@ -1,16 +1,68 @@
 //! Error type of the crate.
 
+use ridi_features::FeatureError;
 use thiserror::Error;
 
 /// Everything that can go wrong while training, predicting or reading a model.
 #[derive(Debug, Error)]
 pub enum RegressError {
-    /// Inconsistent dimensions between inputs.
-    #[error("shape mismatch: {0}")]
-    Shape(String),
-    /// NaN or infinite input.
-    #[error("non-finite input: {0}")]
-    NonFinite(String),
+    /// A feature matrix refused by its checks (not whole rows, a non-finite value): the view
+    /// belongs to ridi-features, and so do its errors.
+    #[error(transparent)]
+    Features(#[from] FeatureError),
+    /// Inputs that must be parallel, or a row and the model, disagree in length.
+    #[error("length of {what} is {found}, expected {expected}")]
+    LengthMismatch {
+        /// Which input.
+        what: &'static str,
+        /// Length the other inputs or the model imply.
+        expected: usize,
+        /// Length found.
+        found: usize,
+    },
+    /// A NaN or infinite target.
+    #[error("non-finite {what} at sample {index}")]
+    NonFinite {
+        /// Which input.
+        what: &'static str,
+        /// Sample index.
+        index: usize,
+    },
+    /// A value to store is beyond the half-precision range of the model's samples.
+    #[error(
+        "{what} {value} at row {row}, column {column} exceeds the half-precision range of the \
+         model (±{max}); standardize the features",
+        max = crate::f16mat::F16_MAX
+    )]
+    BeyondHalfPrecision {
+        /// Which value: a feature, or a principal coordinate of one.
+        what: &'static str,
+        /// The value.
+        value: f32,
+        /// Its row (training sample).
+        row: usize,
+        /// Its column.
+        column: usize,
+    },
+    /// A training sample's placement is not an index into the placement names.
+    #[error("sample {index} has placement {placement}, only {names} names")]
+    PlacementOutOfRange {
+        /// Sample index.
+        index: usize,
+        /// Its placement.
+        placement: usize,
+        /// Number of placement names.
+        names: usize,
+    },
+    /// [`Cascade::rounding_effect`](crate::Cascade::rounding_effect) was not given the rows
+    /// the model was trained on.
+    #[error("stored sample {index} of placement {placement} is not a training row")]
+    NotTrainingRow {
+        /// Placement index.
+        placement: usize,
+        /// Index of the stored sample in that placement.
+        index: usize,
+    },
     /// A hyper-parameter outside its valid range.
     #[error("invalid parameter: {0}")]
     InvalidParam(String),

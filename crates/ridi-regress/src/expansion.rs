@@ -6,7 +6,8 @@ use serde::{Deserialize, Serialize};
 
 use crate::error::RegressError;
 use crate::kernel;
-use crate::matrix::{Matrix, MatrixRef};
+use crate::matrix::View as _;
+use ridi_features::{FeatureMatrix, FeatureMatrixRef};
 
 /// Queries per kernel block in batched evaluation: bounds the temporary kernel block to
 /// `QUERY_BLOCK × n_sv` floats.
@@ -15,7 +16,8 @@ const QUERY_BLOCK: usize = 512;
 /// Support vectors with `k` coefficient columns.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub(crate) struct Expansion {
-    pub sv: Matrix,
+    #[serde(with = "crate::matrix::stored")]
+    pub sv: FeatureMatrix,
     pub norms: Vec<f32>,
     /// Row-major `n_sv × k`.
     pub coef: Vec<f64>,
@@ -24,7 +26,7 @@ pub(crate) struct Expansion {
 }
 
 impl Expansion {
-    pub(crate) fn new(sv: Matrix, coef: Vec<f64>, k: usize, gamma: f32) -> Self {
+    pub(crate) fn new(sv: FeatureMatrix, coef: Vec<f64>, k: usize, gamma: f32) -> Self {
         let norms = kernel::sq_norms(sv.view());
         Self {
             sv,
@@ -40,13 +42,13 @@ impl Expansion {
     }
 
     /// `m × k` sums (no offsets) for the query rows.
-    pub(crate) fn eval(&self, q: MatrixRef<'_>) -> Result<Vec<f64>, RegressError> {
-        if q.dim() != self.sv.dim() {
-            return Err(RegressError::Shape(format!(
-                "queries have {} features, model expects {}",
-                q.dim(),
-                self.sv.dim()
-            )));
+    pub(crate) fn eval(&self, q: FeatureMatrixRef<'_>) -> Result<Vec<f64>, RegressError> {
+        if q.cols() != self.sv.cols() {
+            return Err(RegressError::LengthMismatch {
+                what: "query row",
+                expected: self.sv.cols(),
+                found: q.cols(),
+            });
         }
         let (m, n, k) = (q.rows(), self.n_sv(), self.k);
         let mut out = vec![0.0f64; m * k];

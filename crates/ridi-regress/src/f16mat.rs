@@ -16,7 +16,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::error::RegressError;
 use crate::kernel;
-use crate::matrix::MatrixRef;
+use ridi_features::FeatureMatrixRef;
 
 /// Largest finite binary16 value: larger feature values cannot be stored.
 pub(crate) const F16_MAX: f32 = 65504.0;
@@ -30,8 +30,8 @@ pub(crate) struct F16Matrix {
 
 impl F16Matrix {
     /// Rounds the rows of `x` listed in `idx` (to nearest, ties to even).
-    pub(crate) fn from_rows(x: MatrixRef<'_>, idx: &[usize]) -> Self {
-        let dim = x.dim();
+    pub(crate) fn from_rows(x: FeatureMatrixRef<'_>, idx: &[usize]) -> Self {
+        let dim = x.cols();
         let mut data = vec![f16::ZERO; idx.len() * dim];
         for (dst, &i) in data.chunks_exact_mut(dim).zip(idx) {
             dst.convert_from_f32_slice(x.row(i));
@@ -187,6 +187,7 @@ impl<'de> Deserialize<'de> for Bytes {
 mod tests {
     use super::*;
     use crate::kernel::tests::data;
+    use crate::matrix::View as _;
 
     #[test]
     fn dots_match_widened_rows_for_any_shape() {

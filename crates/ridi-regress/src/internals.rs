@@ -4,16 +4,16 @@
 //! internals it wraps.
 
 use crate::error::RegressError;
-use crate::matrix::MatrixRef;
+use ridi_features::FeatureMatrixRef;
 
 /// Squared Euclidean norm of every row, as [`gram`] takes them.
-pub fn sq_norms(x: MatrixRef<'_>) -> Vec<f32> {
+pub fn sq_norms(x: FeatureMatrixRef<'_>) -> Vec<f32> {
     crate::kernel::sq_norms(x)
 }
 
 /// The full RBF kernel matrix of `x` (row-major `n × n`) from the squared norms of its rows:
 /// what a precomputed kernel costs.
-pub fn gram(x: MatrixRef<'_>, norms: &[f32], gamma: f32) -> Vec<f32> {
+pub fn gram(x: FeatureMatrixRef<'_>, norms: &[f32], gamma: f32) -> Vec<f32> {
     crate::kernel::gram(x, norms, gamma)
 }
 

@@ -9,14 +9,15 @@ use faer::linalg::matmul::matmul;
 use faer::{Accum, MatMut, MatRef, Par};
 use rayon::prelude::*;
 
-use crate::matrix::MatrixRef;
+use crate::matrix::View as _;
+use ridi_features::FeatureMatrixRef;
 
 /// Tile edge for blocked kernel computation: large enough for GEMM efficiency with
 /// `dim = 1200`, small enough to give both cores work on a few thousand samples.
 const TILE: usize = 256;
 
 /// Squared Euclidean norm of every row.
-pub(crate) fn sq_norms(x: MatrixRef<'_>) -> Vec<f32> {
+pub(crate) fn sq_norms(x: FeatureMatrixRef<'_>) -> Vec<f32> {
     (0..x.rows())
         .into_par_iter()
         .with_min_len(64)
@@ -153,15 +154,15 @@ impl OutPtr {
 /// `out` must be valid for the `ma × mb` tile with row stride `ldo`, and no other thread may
 /// access that region concurrently.
 unsafe fn kernel_tile(
-    a: MatrixRef<'_>,
+    a: FeatureMatrixRef<'_>,
     na: &[f32],
-    b: MatrixRef<'_>,
+    b: FeatureMatrixRef<'_>,
     nb: &[f32],
     gamma: Option<f32>,
     out: *mut f32,
     ldo: usize,
 ) {
-    let (ma, mb, dim) = (a.rows(), b.rows(), a.dim());
+    let (ma, mb, dim) = (a.rows(), b.rows(), a.cols());
     if ma == 0 || mb == 0 {
         return;
     }
@@ -178,15 +179,15 @@ unsafe fn kernel_tile(
     }
 }
 
-fn sub(x: MatrixRef<'_>, r0: usize, r1: usize) -> MatrixRef<'_> {
+fn sub(x: FeatureMatrixRef<'_>, r0: usize, r1: usize) -> FeatureMatrixRef<'_> {
     x.rows_range(r0, r1)
 }
 
 /// Kernel block `out (a.rows() × b.rows(), row-major) = K(a_i, b_j)`, tiled and parallel.
 pub(crate) fn cross_kernel(
-    a: MatrixRef<'_>,
+    a: FeatureMatrixRef<'_>,
     na: &[f32],
-    b: MatrixRef<'_>,
+    b: FeatureMatrixRef<'_>,
     nb: &[f32],
     gamma: f32,
     out: &mut [f32],
@@ -197,9 +198,9 @@ pub(crate) fn cross_kernel(
 /// Squared distances `out (a.rows() × b.rows()) = |a_i - b_j|²`, from which kernels of any
 /// width follow with [`exp_neg_scaled`] (the classifier and the regressors may differ).
 pub(crate) fn cross_sq_dist(
-    a: MatrixRef<'_>,
+    a: FeatureMatrixRef<'_>,
     na: &[f32],
-    b: MatrixRef<'_>,
+    b: FeatureMatrixRef<'_>,
     nb: &[f32],
     out: &mut [f32],
 ) {
@@ -207,16 +208,16 @@ pub(crate) fn cross_sq_dist(
 }
 
 fn cross_block(
-    a: MatrixRef<'_>,
+    a: FeatureMatrixRef<'_>,
     na: &[f32],
-    b: MatrixRef<'_>,
+    b: FeatureMatrixRef<'_>,
     nb: &[f32],
     gamma: Option<f32>,
     out: &mut [f32],
 ) {
     let (ma, mb) = (a.rows(), b.rows());
     assert_eq!(out.len(), ma * mb, "cross_kernel output size");
-    assert_eq!(a.dim(), b.dim(), "cross_kernel dimensions");
+    assert_eq!(a.cols(), b.cols(), "cross_kernel dimensions");
     if ma == 0 || mb == 0 {
         return;
     }
@@ -246,7 +247,7 @@ fn cross_block(
 
 /// Full symmetric kernel matrix of `x` (row-major `n × n`); only the upper tiles go through
 /// GEMM, the lower ones are mirrored.
-pub(crate) fn gram(x: MatrixRef<'_>, norms: &[f32], gamma: f32) -> Vec<f32> {
+pub(crate) fn gram(x: FeatureMatrixRef<'_>, norms: &[f32], gamma: f32) -> Vec<f32> {
     let n = x.rows();
     let mut out = vec![0.0f32; n * n];
     if n == 0 {
@@ -300,7 +301,7 @@ pub(crate) fn gram(x: MatrixRef<'_>, norms: &[f32], gamma: f32) -> Vec<f32> {
 /// Kernel rows `K(x_r, x_j)` for every `r` in `rows` and all `j`, into `out`
 /// (`rows.len() × x.rows()`): one GEMM of the gathered rows against `x`.
 pub(crate) fn kernel_rows(
-    x: MatrixRef<'_>,
+    x: FeatureMatrixRef<'_>,
     norms: &[f32],
     rows: &[usize],
     gamma: f32,
@@ -314,7 +315,8 @@ pub(crate) fn kernel_rows(
 #[cfg(test)]
 pub(crate) mod tests {
     use super::*;
-    use crate::matrix::Matrix;
+    use crate::matrix::owned;
+    use ridi_features::FeatureMatrix;
 
     /// Radial basis function kernel `exp(-gamma |a - b|²)`.
     struct Rbf {
@@ -331,11 +333,11 @@ pub(crate) mod tests {
     }
 
     /// Smooth test rows of magnitude up to about 3 (shared with other modules' tests).
-    pub(crate) fn data(n: usize, d: usize) -> Matrix {
+    pub(crate) fn data(n: usize, d: usize) -> FeatureMatrix {
         let v: Vec<f32> = (0..n * d)
             .map(|k| ((k as f32) * 0.37).sin() * 2.0 + ((k / d) as f32 * 0.1).cos())
             .collect();
-        Matrix::new(v, d).unwrap()
+        owned(v, d)
     }
 
     #[test]

@@ -22,6 +22,13 @@
 //! values, the solver's selection and gradient update, half-precision dot products) take AVX2
 //! code paths when the running CPU has AVX2 and FMA, checked once per process.
 //!
+//! # Inputs
+//!
+//! Samples are the rows of a [`FeatureMatrixRef`](ridi_features::FeatureMatrixRef), the
+//! borrowed view of ridi-features' row-major `f32` matrix; its checked constructors refuse a
+//! NaN or infinite value, which the solver has no answer for
+//! ([`RegressError::Features`]).
+//!
 //! # Reuse
 //!
 //! All fits of a placement index one kernel over its samples: the velocity (and speed)
@@ -58,9 +65,9 @@
 //! # Example
 //!
 //! ```
-//! use ridi_features::FeatureConfig;
 //! use ridi_features::ridi_frames::StabHorizontal;
-//! use ridi_regress::{Cascade, CascadeParams, MatrixRef, NoProgress, RegressorChoice, TrainingSet};
+//! use ridi_features::{FeatureConfig, FeatureMatrixRef};
+//! use ridi_regress::{Cascade, CascadeParams, NoProgress, RegressorChoice, TrainingSet};
 //!
 //! // A tiny feature config: a 2-frame window of one channel gives 6 values per sample.
 //! let config = FeatureConfig { window: 2, channels: vec![ridi_features::FeatureChannel::Gyro], ..FeatureConfig::default() };
@@ -78,7 +85,7 @@
 //! }
 //! let names = vec!["handheld".to_string(), "bag".to_string()];
 //! let data = TrainingSet {
-//!     features: MatrixRef::new(&x, 6)?,
+//!     features: FeatureMatrixRef::new(&x, 6)?,
 //!     targets: &y,
 //!     placements: &placement,
 //!     placement_names: &names,
@@ -144,7 +151,6 @@ pub use crate::grid::{GridRow, GridSpec};
 #[cfg(feature = "bench-internals")]
 #[doc(hidden)]
 pub use crate::internals::{assign_folds, gram, sq_norms};
-pub use crate::matrix::{Matrix, MatrixRef};
 pub use crate::model_file::{MODEL_FORMAT_VERSION, MODEL_MAGIC};
 pub use crate::progress::{NoProgress, Progress, ProgressEvent, Stage};
 pub use crate::smo::SmoSettings;

@@ -11,7 +11,7 @@
 //! let x = Array2::from_shape_fn((40, 3), |(i, j)| (i as f32 * 0.1 + j as f32).sin());
 //! let y = Array1::from_shape_fn(40, |i| (i as f32 * 0.1).cos());
 //! let model: Svr = SvrParams::new(10.0, 0.01, 0.5).fit(&Dataset::new(x.clone(), y.clone()))?;
-//! // `Svr::predict` (inherent, on `MatrixRef`) shadows the trait method; name the trait.
+//! // `Svr::predict` (inherent, on `FeatureMatrixRef`) shadows the trait method; name the trait.
 //! let pred: Array1<f32> = Predict::predict(&model, &x);
 //! assert!(pred.iter().zip(&y).all(|(p, t)| (p - t).abs() < 0.05));
 //! # Ok::<(), ridi_regress::RegressError>(())
@@ -22,9 +22,9 @@ use linfa::traits::{Fit, PredictInplace};
 use ndarray::{Array1, ArrayBase, Data, Ix2};
 
 use crate::error::RegressError;
-use crate::matrix::MatrixRef;
 use crate::svc::{Svc, SvcParams};
 use crate::svr::{Svr, SvrParams};
+use ridi_features::FeatureMatrixRef;
 
 impl From<linfa::Error> for RegressError {
     fn from(e: linfa::Error) -> Self {
@@ -52,7 +52,7 @@ where
             .map(|&v| f64::from(v))
             .collect();
         Svr::fit(
-            MatrixRef::new(&x, dataset.records().ncols().max(1))?,
+            FeatureMatrixRef::new(&x, dataset.records().ncols().max(1))?,
             &y,
             self,
         )
@@ -70,7 +70,7 @@ where
         let x = records(dataset.records());
         let y: Vec<usize> = dataset.as_single_targets().iter().copied().collect();
         Svc::fit(
-            MatrixRef::new(&x, dataset.records().ncols().max(1))?,
+            FeatureMatrixRef::new(&x, dataset.records().ncols().max(1))?,
             &y,
             self,
         )
@@ -82,7 +82,9 @@ where
 impl<D: Data<Elem = f32>> PredictInplace<ArrayBase<D, Ix2>, Array1<f32>> for Svr {
     fn predict_inplace(&self, x: &ArrayBase<D, Ix2>, y: &mut Array1<f32>) {
         let data = records(x);
-        let pred = MatrixRef::new(&data, x.ncols().max(1)).and_then(|m| self.predict(m));
+        let pred = FeatureMatrixRef::new(&data, x.ncols().max(1))
+            .map_err(RegressError::from)
+            .and_then(|m| self.predict(m));
         match pred {
             Ok(p) if p.len() == y.len() => y.iter_mut().zip(p).for_each(|(o, v)| *o = v as f32),
             _ => y.fill(f32::NAN),
@@ -99,7 +101,9 @@ impl<D: Data<Elem = f32>> PredictInplace<ArrayBase<D, Ix2>, Array1<f32>> for Svr
 impl<D: Data<Elem = f32>> PredictInplace<ArrayBase<D, Ix2>, Array1<usize>> for Svc {
     fn predict_inplace(&self, x: &ArrayBase<D, Ix2>, y: &mut Array1<usize>) {
         let data = records(x);
-        let pred = MatrixRef::new(&data, x.ncols().max(1)).and_then(|m| self.predict(m));
+        let pred = FeatureMatrixRef::new(&data, x.ncols().max(1))
+            .map_err(RegressError::from)
+            .and_then(|m| self.predict(m));
         match pred {
             Ok(p) if p.len() == y.len() => y.iter_mut().zip(p).for_each(|(o, v)| *o = v),
             _ => y.fill(usize::MAX),

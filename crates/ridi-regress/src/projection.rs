@@ -28,7 +28,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::error::RegressError;
 use crate::kernel;
-use crate::matrix::{Matrix, MatrixRef};
+use ridi_features::{FeatureMatrix, FeatureMatrixRef};
 
 /// Rows used to estimate the covariance at most (evenly spaced; the directions are settled
 /// long before, and the `n × dim²` product would otherwise dominate small trainings).
@@ -60,7 +60,8 @@ fn stored_bytes(k: usize) -> usize {
 pub(crate) struct Projection {
     mean: Vec<f32>,
     /// `k × dim`, orthonormal rows.
-    basis: Matrix,
+    #[serde(with = "crate::matrix::stored")]
+    basis: FeatureMatrix,
     /// Share of the training variance the kept directions hold.
     energy: f64,
 }
@@ -69,13 +70,13 @@ impl Projection {
     /// Principal directions of `x` holding at least `energy` of its variance, rounded up to a
     /// multiple of 16 and at least 64; `None` when the coordinates would take more than half
     /// the bytes of the `dim` half-precision values they replace.
-    pub(crate) fn fit(x: MatrixRef<'_>, energy: f64) -> Result<Option<Self>, RegressError> {
+    pub(crate) fn fit(x: FeatureMatrixRef<'_>, energy: f64) -> Result<Option<Self>, RegressError> {
         if !(energy > 0.0 && energy <= 1.0) {
             return Err(RegressError::InvalidParam(format!(
                 "projection energy {energy} (must be in (0, 1])"
             )));
         }
-        let d = x.dim();
+        let d = x.cols();
         if stored_bytes(MIN_COMPONENTS) > d || x.rows() < 2 {
             return Ok(None);
         }
@@ -146,7 +147,11 @@ impl Projection {
         }
         Ok(Some(Self {
             mean,
-            basis: Matrix::new(basis, d)?,
+            basis: {
+                // Eigenvectors of a finite covariance are finite: the scan is a guard.
+                FeatureMatrixRef::new(&basis, d)?;
+                crate::matrix::owned(basis, d)
+            },
             energy: values[..k].iter().sum::<f64>() / total,
         }))
     }
@@ -190,13 +195,13 @@ impl Projection {
 
     /// Every row of `x` in stored form (as [`Self::project_one`]) and the exact `|x_i − μ|²`
     /// (one GEMM; the batched query path).
-    pub(crate) fn project(&self, x: MatrixRef<'_>) -> (Matrix, Vec<f32>) {
+    pub(crate) fn project(&self, x: FeatureMatrixRef<'_>) -> (FeatureMatrix, Vec<f32>) {
         let (n, d, k) = (x.rows(), self.input_dim(), self.dim());
         let mut centred = x.as_slice().to_vec();
         for row in centred.chunks_exact_mut(d) {
             row.iter_mut().zip(&self.mean).for_each(|(v, &mu)| *v -= mu);
         }
-        let norms = kernel::sq_norms(MatrixRef::trusted(&centred, d));
+        let norms = kernel::sq_norms(FeatureMatrixRef::trusted(&centred, d));
         let mut data = vec![0.0f32; n * k];
         matmul(
             MatMut::from_row_major_slice_mut(&mut data, n, k),
@@ -212,13 +217,14 @@ impl Projection {
             o[..SPLIT_LEAD].copy_from_slice(&z[..SPLIT_LEAD]);
             o[SPLIT_LEAD..].copy_from_slice(z);
         }
-        (Matrix::from_parts(out, w), norms)
+        (crate::matrix::owned(out, w), norms)
     }
 
     /// Consistency after decoding.
     pub(crate) fn check(&self) -> Result<(), RegressError> {
         let bad = |m: &str| Err(RegressError::Decode(format!("projection: {m}")));
-        if self.basis.dim() != self.mean.len() || self.dim() == 0 || self.dim() > self.input_dim() {
+        if self.basis.cols() != self.mean.len() || self.dim() == 0 || self.dim() > self.input_dim()
+        {
             return bad("sizes");
         }
         if !self
@@ -239,11 +245,12 @@ impl Projection {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::matrix::{View as _, owned};
     use rand::{RngExt, SeedableRng};
     use rand_chacha::ChaCha8Rng;
 
     /// Rows near a 3-dimensional subspace of R^256, plus faint noise.
-    fn low_rank(n: usize, noise: f32) -> Matrix {
+    fn low_rank(n: usize, noise: f32) -> FeatureMatrix {
         let mut rng = ChaCha8Rng::seed_from_u64(7);
         let d = 256;
         let dirs: Vec<Vec<f32>> = (0..3)
@@ -257,7 +264,7 @@ mod tests {
                 data.push(2.0 + v + noise * rng.random_range(-1.0..1.0));
             }
         }
-        Matrix::new(data, d).unwrap()
+        owned(data, d)
     }
 
     #[test]
@@ -300,10 +307,10 @@ mod tests {
         // White noise: every direction matters.
         let mut rng = ChaCha8Rng::seed_from_u64(1);
         let data: Vec<f32> = (0..200 * 48).map(|_| rng.random_range(-1.0..1.0)).collect();
-        let x = Matrix::new(data, 48).unwrap();
+        let x = owned(data, 48);
         assert!(Projection::fit(x.view(), 0.999).unwrap().is_none());
         // Too few values per row to gain from 64 coordinates.
-        let small = Matrix::new(vec![1.0; 60], 6).unwrap();
+        let small = owned(vec![1.0; 60], 6);
         assert!(Projection::fit(small.view(), 0.5).unwrap().is_none());
     }
 

@@ -1028,13 +1028,14 @@ mod tests {
     use super::*;
     use crate::cache::{CachedKernel, FullKernel};
     use crate::kernel;
-    use crate::matrix::Matrix;
+    use crate::matrix::{View as _, owned};
+    use ridi_features::FeatureMatrix;
 
-    fn data(n: usize) -> Matrix {
+    fn data(n: usize) -> FeatureMatrix {
         let v: Vec<f32> = (0..n * 6)
             .map(|k| ((k as f32) * 0.713).sin() + ((k / 6) as f32 * 0.05).cos())
             .collect();
-        Matrix::new(v, 6).unwrap()
+        owned(v, 6)
     }
 
     fn svr_problem(idx: &[usize], c: f64, eps: f64) -> SmoProblem {

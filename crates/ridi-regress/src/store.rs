@@ -8,8 +8,8 @@ use serde::{Deserialize, Serialize};
 use crate::error::RegressError;
 use crate::f16mat::{F16_MAX, F16Matrix};
 use crate::kernel;
-use crate::matrix::MatrixRef;
 use crate::projection::{Projection, SPLIT_LEAD};
+use ridi_features::FeatureMatrixRef;
 
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub(crate) struct SampleRows {
@@ -24,7 +24,7 @@ impl SampleRows {
     /// Rows `idx` of `x`, in the form `projection` calls for. Fails when a value to store
     /// is beyond the half-precision range (the caller checks the features themselves).
     pub(crate) fn from_rows(
-        x: MatrixRef<'_>,
+        x: FeatureMatrixRef<'_>,
         idx: &[usize],
         projection: Option<&Projection>,
     ) -> Result<Self, RegressError> {
@@ -41,11 +41,13 @@ impl SampleRows {
         for (out, &i) in stored.chunks_exact_mut(w).zip(idx) {
             let norm = p.project_one(x.row(i), &mut buf, out);
             let z = &out[SPLIT_LEAD..];
-            if let Some(v) = z.iter().find(|v| v.abs() > F16_MAX) {
-                return Err(RegressError::NonFinite(format!(
-                    "principal coordinate {v} of training row {i} exceeds the half-precision \
-                     range of the model (±{F16_MAX}); standardize the features"
-                )));
+            if let Some(j) = z.iter().position(|v| v.abs() > F16_MAX) {
+                return Err(RegressError::BeyondHalfPrecision {
+                    what: "principal coordinate",
+                    value: z[j],
+                    row: i,
+                    column: SPLIT_LEAD + j,
+                });
             }
             residual.push((norm - kernel::dot(z, z)).max(0.0));
             // `out[..SPLIT_LEAD]` rounds to `hi`; keep what that rounding loses as `lo`.
@@ -55,7 +57,7 @@ impl SampleRows {
         }
         let all: Vec<usize> = (0..idx.len()).collect();
         Ok(Self {
-            rows: F16Matrix::from_rows(MatrixRef::trusted(&stored, w), &all),
+            rows: F16Matrix::from_rows(FeatureMatrixRef::trusted(&stored, w), &all),
             residual: Some(residual),
         })
     }

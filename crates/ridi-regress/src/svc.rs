@@ -8,9 +8,10 @@ use crate::cache::KernelRows;
 use crate::config::{self, Precompute, SolverConfig};
 use crate::error::RegressError;
 use crate::expansion::Expansion;
-use crate::matrix::MatrixRef;
+use crate::matrix::View as _;
 use crate::smo::{self, SmoProblem, SmoSettings};
 use crate::svr::{FitInfo, check_c_gamma, check_smo, check_xy};
+use ridi_features::FeatureMatrixRef;
 
 /// Hyper-parameters of the classifier.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -108,7 +109,7 @@ pub(crate) struct PairDual {
 /// Fits all `k (k-1) / 2` pairs. `class_of[i] < k` is the class of sample `i`.
 /// `on_pair(done, total)` is called after each pair and may cancel by returning `false`.
 pub(crate) fn fit_ovo(
-    x: MatrixRef<'_>,
+    x: FeatureMatrixRef<'_>,
     class_of: &[usize],
     k: usize,
     params: &SvcParams,
@@ -196,7 +197,11 @@ pub struct Svc {
 
 impl Svc {
     /// Trains on rows of `x` with labels `y` (at least two distinct labels).
-    pub fn fit(x: MatrixRef<'_>, y: &[usize], params: &SvcParams) -> Result<Self, RegressError> {
+    pub fn fit(
+        x: FeatureMatrixRef<'_>,
+        y: &[usize],
+        params: &SvcParams,
+    ) -> Result<Self, RegressError> {
         params.validate()?;
         check_xy(x, y.len())?;
         let mut labels = y.to_vec();
@@ -216,7 +221,7 @@ impl Svc {
     }
 
     pub(crate) fn from_pairs(
-        x: MatrixRef<'_>,
+        x: FeatureMatrixRef<'_>,
         labels: Vec<usize>,
         duals: &[PairDual],
         params: SvcParams,
@@ -245,7 +250,7 @@ impl Svc {
 
     /// Decision values, `rows × pairs` row-major, pairs in `(0,1), (0,2), …, (k-2,k-1)` order;
     /// positive favours the first class of the pair.
-    pub fn decision_function(&self, x: MatrixRef<'_>) -> Result<Vec<f64>, RegressError> {
+    pub fn decision_function(&self, x: FeatureMatrixRef<'_>) -> Result<Vec<f64>, RegressError> {
         let mut d = self.exp.eval(x)?;
         let np = self.pairs.len();
         for row in d.chunks_mut(np) {
@@ -257,7 +262,7 @@ impl Svc {
     }
 
     /// Predicted labels.
-    pub fn predict(&self, x: MatrixRef<'_>) -> Result<Vec<usize>, RegressError> {
+    pub fn predict(&self, x: FeatureMatrixRef<'_>) -> Result<Vec<usize>, RegressError> {
         let d = self.decision_function(x)?;
         let k = self.labels.len();
         let mut votes = vec![0u32; k];
@@ -277,7 +282,7 @@ impl Svc {
     }
 
     /// Union of the support vectors of all pairs (row-major).
-    pub fn support_vectors(&self) -> MatrixRef<'_> {
+    pub fn support_vectors(&self) -> FeatureMatrixRef<'_> {
         self.exp.sv.view()
     }
 

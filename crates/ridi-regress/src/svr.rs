@@ -6,8 +6,9 @@ use crate::cache::KernelRows;
 use crate::config::{self, SolverConfig};
 use crate::error::RegressError;
 use crate::expansion::Expansion;
-use crate::matrix::MatrixRef;
+use crate::matrix::View as _;
 use crate::smo::{self, SmoProblem, SmoSettings};
+use ridi_features::FeatureMatrixRef;
 
 /// Hyper-parameters of one epsilon-SVR.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -159,13 +160,13 @@ pub struct Svr {
     pub(crate) info: FitInfo,
 }
 
-pub(crate) fn check_xy(x: MatrixRef<'_>, n_targets: usize) -> Result<(), RegressError> {
+pub(crate) fn check_xy(x: FeatureMatrixRef<'_>, n_targets: usize) -> Result<(), RegressError> {
     if x.rows() != n_targets {
-        return Err(RegressError::Shape(format!(
-            "{} samples but {} targets",
-            x.rows(),
-            n_targets
-        )));
+        return Err(RegressError::LengthMismatch {
+            what: "targets (one per sample row)",
+            expected: x.rows(),
+            found: n_targets,
+        });
     }
     if x.rows() == 0 {
         return Err(RegressError::NotEnoughData("no training samples".into()));
@@ -175,11 +176,18 @@ pub(crate) fn check_xy(x: MatrixRef<'_>, n_targets: usize) -> Result<(), Regress
 
 impl Svr {
     /// Trains on rows of `x` with targets `y`.
-    pub fn fit(x: MatrixRef<'_>, y: &[f64], params: &SvrParams) -> Result<Self, RegressError> {
+    pub fn fit(
+        x: FeatureMatrixRef<'_>,
+        y: &[f64],
+        params: &SvrParams,
+    ) -> Result<Self, RegressError> {
         params.validate()?;
         check_xy(x, y.len())?;
         if let Some(i) = y.iter().position(|v| !v.is_finite()) {
-            return Err(RegressError::NonFinite(format!("target {i}")));
+            return Err(RegressError::NonFinite {
+                what: "target",
+                index: i,
+            });
         }
         let rows = config::kernel_rows(
             x,
@@ -201,7 +209,7 @@ impl Svr {
     }
 
     pub(crate) fn from_dual(
-        x: MatrixRef<'_>,
+        x: FeatureMatrixRef<'_>,
         idx: &[usize],
         dual: &SvrDual,
         params: SvrParams,
@@ -218,7 +226,7 @@ impl Svr {
     }
 
     /// Predictions for every row of `x`.
-    pub fn predict(&self, x: MatrixRef<'_>) -> Result<Vec<f64>, RegressError> {
+    pub fn predict(&self, x: FeatureMatrixRef<'_>) -> Result<Vec<f64>, RegressError> {
         Ok(self
             .exp
             .eval(x)?
@@ -238,7 +246,7 @@ impl Svr {
     }
 
     /// Support vectors (row-major).
-    pub fn support_vectors(&self) -> MatrixRef<'_> {
+    pub fn support_vectors(&self) -> FeatureMatrixRef<'_> {
         self.exp.sv.view()
     }
 
@@ -258,13 +266,13 @@ mod tests {
     use super::*;
     use crate::cache::FullKernel;
     use crate::kernel;
-    use crate::matrix::Matrix;
+    use crate::matrix::owned;
 
     #[test]
     fn fit_warm_started_from_another_epsilon_reaches_the_cold_solution() {
         let n = 120;
         let x: Vec<f32> = (0..n * 5).map(|k| ((k as f32) * 0.61).sin()).collect();
-        let x = Matrix::new(x, 5).unwrap();
+        let x = owned(x, 5);
         let y: Vec<f64> = (0..n).map(|i| (i as f64 * 0.1).cos()).collect();
         let full = FullKernel::new(x.view(), &kernel::sq_norms(x.view()), 0.3);
         let settings = SmoSettings {

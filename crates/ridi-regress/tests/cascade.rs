@@ -1,10 +1,11 @@
 //! Cascade training and prediction, grid search, model file codec.
 
+use ridi_features::FeatureMatrixRef;
 use ridi_features::ridi_frames::StabHorizontal;
-use ridi_features::{FeatureChannel, FeatureConfig};
+use ridi_features::{FeatureChannel, FeatureConfig, FeatureError};
 use ridi_regress::{
-    Cascade, CascadeParams, GridSpec, MatrixRef, NoProgress, ProgressEvent, RegressError,
-    RegressorChoice, Stage, Storage, StoredAs, Svc, SvcParams, TrainingSet,
+    Cascade, CascadeParams, GridSpec, NoProgress, ProgressEvent, RegressError, RegressorChoice,
+    Stage, Storage, StoredAs, Svc, SvcParams, TrainingSet,
 };
 use ridi_test_support::{SplitMix64, assert_names_file};
 
@@ -20,7 +21,7 @@ struct Data {
 impl Data {
     fn set(&self) -> TrainingSet<'_> {
         TrainingSet {
-            features: MatrixRef::new(&self.x, self.config.feature_dim()).unwrap(),
+            features: FeatureMatrixRef::new(&self.x, self.config.feature_dim()).unwrap(),
             targets: &self.y,
             placements: &self.placement,
             placement_names: &self.names,
@@ -127,7 +128,7 @@ fn cascade_classifies_regresses_and_batches_consistently() {
 
     // Held-out data from the same distribution.
     let test = make(3, 1, 20, 99);
-    let xt = MatrixRef::new(&test.x, 24).unwrap();
+    let xt = FeatureMatrixRef::new(&test.x, 24).unwrap();
     let batch = model.predict(xt).unwrap();
     let correct = batch
         .iter()
@@ -137,7 +138,7 @@ fn cascade_classifies_regresses_and_batches_consistently() {
     assert!(correct >= 57, "placement accuracy {correct}/60");
     // The cascade's classifier (each placement keeping the coefficients of its own pairs) is
     // the stand-alone one-vs-one classifier on the same data.
-    let train_x = MatrixRef::new(&data.x, 24).unwrap();
+    let train_x = FeatureMatrixRef::new(&data.x, 24).unwrap();
     let svc = Svc::fit(train_x, &data.placement, &SvcParams::new(10.0, 1.0 / 24.0)).unwrap();
     let labels = svc.predict(xt).unwrap();
     for (b, l) in batch.iter().zip(&labels) {
@@ -165,13 +166,21 @@ fn cascade_classifies_regresses_and_batches_consistently() {
     }
     assert_eq!(
         model.predict_one(&test.x[..23]).unwrap_err().to_string(),
-        RegressError::Shape("query has 23 values, model expects 24".into()).to_string()
+        RegressError::LengthMismatch {
+            what: "query row",
+            expected: 24,
+            found: 23
+        }
+        .to_string()
     );
     let mut nan = test.x[..24].to_vec();
     nan[5] = f32::NAN;
     assert!(matches!(
         model.predict_one(&nan),
-        Err(RegressError::NonFinite(_))
+        Err(RegressError::Features(FeatureError::NonFinite {
+            index: 0,
+            ..
+        }))
     ));
 }
 
@@ -202,7 +211,7 @@ fn speed_regressor_scales_velocities_to_the_regressed_speed() {
         assert_eq!(model.regressor_params(p), plain.regressor_params(p));
     }
     let test = make(2, 1, 20, 98);
-    let xt = MatrixRef::new(&test.x, 24).unwrap();
+    let xt = FeatureMatrixRef::new(&test.x, 24).unwrap();
     let scaled = model.predict(xt).unwrap();
     let unscaled = plain.predict(xt).unwrap();
     let (mut err_scaled, mut moved) = (0.0f64, 0.0f64);
@@ -351,14 +360,17 @@ fn small_or_degenerate_placements_give_clear_errors_or_documented_fallbacks() {
     short.y.pop();
     assert!(matches!(
         Cascade::train(&short.set(), &fixed, &mut NoProgress),
-        Err(RegressError::Shape(_))
+        Err(RegressError::LengthMismatch {
+            what: "targets (one per feature row)",
+            ..
+        })
     ));
     let mut wide = make(2, 3, 10, 3);
     wide.config.window = 5;
     let set = wide.set_unchecked();
     assert!(matches!(
         Cascade::train(&set, &fixed, &mut NoProgress),
-        Err(RegressError::Shape(_))
+        Err(RegressError::LengthMismatch { expected: 30, .. })
     ));
 }
 
@@ -374,7 +386,7 @@ fn half_precision_samples_stay_close_to_the_exact_model() {
     };
     let model = Cascade::train(&data.set(), &params, &mut NoProgress).unwrap();
     let test = make(3, 2, 20, 99);
-    let xt = MatrixRef::new(&test.x, 24).unwrap();
+    let xt = FeatureMatrixRef::new(&test.x, 24).unwrap();
     let r = model.rounding_effect(data.set().features, xt).unwrap();
     assert_eq!(r.queries, 120);
     assert_eq!(r.placement_agreement, 1.0);
@@ -391,7 +403,7 @@ fn half_precision_samples_stay_close_to_the_exact_model() {
     // Rows that are not the training rows cannot be matched.
     assert!(matches!(
         model.rounding_effect(xt, xt),
-        Err(RegressError::Shape(_))
+        Err(RegressError::NotTrainingRow { .. })
     ));
     // The single-query path (half-precision GEMV) agrees with the batched GEMM path up to the
     // summation order of the dot products (the distances cancel |q|² + |s|² - 2 q·s).
@@ -436,7 +448,7 @@ fn projected_samples_stay_close_to_the_exact_model() {
     assert_eq!(half.stored_as(), StoredAs::Half);
 
     let test = make_window(3, 2, 20, 99, 40);
-    let xt = MatrixRef::new(&test.x, d).unwrap();
+    let xt = FeatureMatrixRef::new(&test.x, d).unwrap();
     let r = model.rounding_effect(data.set().features, xt).unwrap();
     assert_eq!(r.queries, 120);
     assert_eq!(r.placement_agreement, 1.0);
@@ -475,8 +487,13 @@ fn projected_samples_stay_close_to_the_exact_model() {
         &params(Storage::Projected { energy: 0.999 }),
         &mut NoProgress,
     ) {
-        Err(RegressError::NonFinite(m)) => assert!(m.contains("standardize"), "{m}"),
-        other => panic!("expected NonFinite, got {other:?}"),
+        Err(
+            e @ RegressError::BeyondHalfPrecision {
+                what: "principal coordinate",
+                ..
+            },
+        ) => assert!(e.to_string().contains("standardize"), "{e}"),
+        other => panic!("expected BeyondHalfPrecision, got {other:?}"),
     }
 }
 
@@ -492,8 +509,14 @@ fn features_beyond_the_half_precision_range_are_refused() {
         ..CascadeParams::default()
     };
     match Cascade::train(&data.set(), &fixed, &mut NoProgress) {
-        Err(RegressError::NonFinite(m)) => assert!(m.contains("row 1, column 6"), "{m}"),
-        other => panic!("expected NonFinite, got {other:?}"),
+        Err(
+            e @ RegressError::BeyondHalfPrecision {
+                row: 1, column: 6, ..
+            },
+        ) => {
+            assert!(e.to_string().contains("row 1, column 6"), "{e}")
+        }
+        other => panic!("expected BeyondHalfPrecision, got {other:?}"),
     }
 }
 
@@ -516,7 +539,7 @@ impl Data {
     /// Like `set` but without building the features view from the config width.
     fn set_unchecked(&self) -> TrainingSet<'_> {
         TrainingSet {
-            features: MatrixRef::new(&self.x, 24).unwrap(),
+            features: FeatureMatrixRef::new(&self.x, 24).unwrap(),
             targets: &self.y,
             placements: &self.placement,
             placement_names: &self.names,

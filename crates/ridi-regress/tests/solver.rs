@@ -6,9 +6,8 @@ use std::collections::HashMap;
 use linfa::prelude::*;
 use linfa_svm::Svm;
 use ndarray::{Array1, Array2};
-use ridi_regress::{
-    MatrixRef, Precompute, SmoSettings, SolverConfig, Svc, SvcParams, Svr, SvrParams,
-};
+use ridi_features::FeatureMatrixRef;
+use ridi_regress::{Precompute, SmoSettings, SolverConfig, Svc, SvcParams, Svr, SvrParams};
 use ridi_test_support::{blob_data, regression_data};
 
 fn tight() -> SolverConfig {
@@ -36,16 +35,18 @@ fn two_point_classifier_matches_closed_form() {
     for c in [0.1, 1.0, 100.0] {
         let mut p = SvcParams::new(c, gamma);
         p.solver = tight();
-        let m = Svc::fit(MatrixRef::new(&x, 3).unwrap(), &[7, 3], &p).unwrap();
+        let m = Svc::fit(FeatureMatrixRef::new(&x, 3).unwrap(), &[7, 3], &p).unwrap();
         assert_eq!(m.labels(), &[3, 7]);
         let alpha = (1.0 / (1.0 - k)).min(c);
-        let d = m.decision_function(MatrixRef::new(&x, 3).unwrap()).unwrap();
+        let d = m
+            .decision_function(FeatureMatrixRef::new(&x, 3).unwrap())
+            .unwrap();
         // Class index 0 is label 3 (second row), positive side of the only pair.
         assert!((d[1] - alpha * (1.0 - k)).abs() < 1e-5, "C={c}: {d:?}");
         assert!((d[0] + alpha * (1.0 - k)).abs() < 1e-5, "C={c}: {d:?}");
         assert!(m.rho()[0].abs() < 1e-6);
         assert_eq!(
-            m.predict(MatrixRef::new(&x, 3).unwrap()).unwrap(),
+            m.predict(FeatureMatrixRef::new(&x, 3).unwrap()).unwrap(),
             vec![7, 3]
         );
     }
@@ -62,9 +63,9 @@ fn two_point_regressor_matches_closed_form() {
     for (c, eps) in [(100.0, 0.1), (0.5, 0.1), (10.0, 0.0)] {
         let mut p = SvrParams::new(c, eps, gamma);
         p.solver = tight();
-        let m = Svr::fit(MatrixRef::new(&x, 2).unwrap(), &[t, -t], &p).unwrap();
+        let m = Svr::fit(FeatureMatrixRef::new(&x, 2).unwrap(), &[t, -t], &p).unwrap();
         let beta = ((t - eps) / (1.0 - k)).min(c);
-        let f = m.predict(MatrixRef::new(&x, 2).unwrap()).unwrap();
+        let f = m.predict(FeatureMatrixRef::new(&x, 2).unwrap()).unwrap();
         assert!((f[0] - beta * (1.0 - k)).abs() < 1e-5, "C={c}: {f:?}");
         assert!((f[1] + beta * (1.0 - k)).abs() < 1e-5);
         assert!(m.rho().abs() < 1e-6);
@@ -74,7 +75,7 @@ fn two_point_regressor_matches_closed_form() {
     }
 }
 
-fn coef_by_row(sv: MatrixRef<'_>, coef: &[f64]) -> HashMap<Vec<u32>, f64> {
+fn coef_by_row(sv: FeatureMatrixRef<'_>, coef: &[f64]) -> HashMap<Vec<u32>, f64> {
     (0..sv.rows())
         .map(|i| (sv.row(i).iter().map(|v| v.to_bits()).collect(), coef[i]))
         .collect()
@@ -83,7 +84,7 @@ fn coef_by_row(sv: MatrixRef<'_>, coef: &[f64]) -> HashMap<Vec<u32>, f64> {
 #[test]
 fn regressor_satisfies_kkt_conditions() {
     let (x, y) = regression_data(120, 10, 11);
-    let xm = MatrixRef::new(&x, 10).unwrap();
+    let xm = FeatureMatrixRef::new(&x, 10).unwrap();
     let (c, eps) = (3.0, 0.05);
     let mut p = SvrParams::new(c, eps, 0.2);
     p.solver = tight();
@@ -129,7 +130,7 @@ fn regressor_satisfies_kkt_conditions() {
 #[test]
 fn classifier_satisfies_kkt_conditions() {
     let (x, y) = blob_data(40, 6, &[0, 1], 1.2, 5);
-    let xm = MatrixRef::new(&x, 6).unwrap();
+    let xm = FeatureMatrixRef::new(&x, 6).unwrap();
     let c = 2.0;
     let mut p = SvcParams::new(c, 0.3);
     p.solver = tight();
@@ -166,7 +167,7 @@ fn classifier_satisfies_kkt_conditions() {
 #[test]
 fn regressor_matches_linfa_svm() {
     let (x, y) = regression_data(80, 8, 3);
-    let xm = MatrixRef::new(&x, 8).unwrap();
+    let xm = FeatureMatrixRef::new(&x, 8).unwrap();
     let (xt, _) = regression_data(30, 8, 4);
     let gamma = 0.25f32;
     for (c, eps) in [(1.0, 0.01), (10.0, 0.1), (0.1, 0.001)] {
@@ -189,7 +190,9 @@ fn regressor_matches_linfa_svm() {
         );
         let test = Array2::from_shape_fn((30, 8), |(i, j)| xt[i * 8 + j] as f64);
         let theirs = oracle.predict(&test);
-        let mine = ours.predict(MatrixRef::new(&xt, 8).unwrap()).unwrap();
+        let mine = ours
+            .predict(FeatureMatrixRef::new(&xt, 8).unwrap())
+            .unwrap();
         for (a, b) in mine.iter().zip(theirs.iter()) {
             assert!((a - b).abs() < 2e-4, "C={c} eps={eps}: {a} vs {b}");
         }
@@ -199,7 +202,7 @@ fn regressor_matches_linfa_svm() {
 #[test]
 fn classifier_matches_linfa_svm() {
     let (x, y) = blob_data(30, 5, &[0, 1], 1.0, 9);
-    let xm = MatrixRef::new(&x, 5).unwrap();
+    let xm = FeatureMatrixRef::new(&x, 5).unwrap();
     let gamma = 0.5f32;
     for c in [0.5, 10.0] {
         let mut p = SvcParams::new(c, gamma);
@@ -230,18 +233,21 @@ fn classifier_matches_linfa_svm() {
 fn multiclass_separates_blobs_with_arbitrary_labels() {
     let labels = [5usize, 2, 9, 4];
     let (x, y) = blob_data(25, 8, &labels, 0.3, 21);
-    let xm = MatrixRef::new(&x, 8).unwrap();
+    let xm = FeatureMatrixRef::new(&x, 8).unwrap();
     let m = Svc::fit(xm, &y, &SvcParams::new(10.0, 0.5)).unwrap();
     assert_eq!(m.labels(), &[2, 4, 5, 9]);
     assert_eq!(m.predict(xm).unwrap(), y);
     let (xt, yt) = blob_data(10, 8, &labels, 0.3, 22);
-    assert_eq!(m.predict(MatrixRef::new(&xt, 8).unwrap()).unwrap(), yt);
+    assert_eq!(
+        m.predict(FeatureMatrixRef::new(&xt, 8).unwrap()).unwrap(),
+        yt
+    );
 }
 
 #[test]
 fn cached_rows_and_full_kernel_give_the_same_model() {
     let (x, y) = regression_data(150, 12, 8);
-    let xm = MatrixRef::new(&x, 12).unwrap();
+    let xm = FeatureMatrixRef::new(&x, 12).unwrap();
     let mut full = SvrParams::new(5.0, 0.01, 0.1);
     full.solver = tight();
     let mut cached = full;
@@ -257,7 +263,7 @@ fn cached_rows_and_full_kernel_give_the_same_model() {
     let mut p = SvcParams::new(1.0, 0.3);
     p.solver = tight();
     let (xc, yc) = blob_data(50, 6, &[1, 2, 3], 1.0, 2);
-    let xcm = MatrixRef::new(&xc, 6).unwrap();
+    let xcm = FeatureMatrixRef::new(&xc, 6).unwrap();
     let a = Svc::fit(xcm, &yc, &p).unwrap();
     p.solver.classifier_kernel = Precompute::Auto;
     let b = Svc::fit(xcm, &yc, &p).unwrap();
@@ -273,9 +279,9 @@ fn cached_rows_and_full_kernel_give_the_same_model() {
 #[test]
 fn invalid_inputs_are_errors_not_panics() {
     let x = [0.0f32, 1.0, 2.0, 3.0];
-    let xm = MatrixRef::new(&x, 2).unwrap();
-    assert!(MatrixRef::new(&x, 3).is_err());
-    assert!(MatrixRef::new(&[f32::NAN, 1.0], 2).is_err());
+    let xm = FeatureMatrixRef::new(&x, 2).unwrap();
+    assert!(FeatureMatrixRef::new(&x, 3).is_err());
+    assert!(FeatureMatrixRef::new(&[f32::NAN, 1.0], 2).is_err());
     assert!(Svr::fit(xm, &[1.0], &SvrParams::new(1.0, 0.1, 0.5)).is_err());
     assert!(Svr::fit(xm, &[1.0, 2.0], &SvrParams::new(-1.0, 0.1, 0.5)).is_err());
     assert!(Svr::fit(xm, &[1.0, 2.0], &SvrParams::new(1.0, -0.1, 0.5)).is_err());
@@ -283,7 +289,7 @@ fn invalid_inputs_are_errors_not_panics() {
     assert!(Svc::fit(xm, &[1, 1], &SvcParams::new(1.0, 0.5)).is_err());
     let m = Svr::fit(xm, &[1.0, 2.0], &SvrParams::new(1.0, 0.1, 0.5)).unwrap();
     assert!(
-        m.predict(MatrixRef::new(&[1.0, 2.0, 3.0], 3).unwrap())
+        m.predict(FeatureMatrixRef::new(&[1.0, 2.0, 3.0], 3).unwrap())
             .is_err()
     );
 }

@@ -15,8 +15,9 @@
 use std::path::PathBuf;
 use std::time::Instant;
 
-use ridi::data::{ReadOptions, load_list};
-use ridi::regress::{Cascade, MatrixRef};
+use ridi::data::{Listed, ReadOptions};
+use ridi::features::FeatureMatrixRef;
+use ridi::regress::Cascade;
 
 #[path = "../../ridi-regress/examples/common/timing.rs"]
 mod timing;
@@ -29,7 +30,7 @@ type Error = Box<dyn std::error::Error>;
 fn features(model: &Cascade, lists: &[PathBuf]) -> Result<Vec<f32>, Error> {
     let mut seqs = Vec::new();
     for l in lists {
-        seqs.extend(load_list(l, &ReadOptions::default())?);
+        seqs.extend(Listed::read(&[l], &ReadOptions::default())?.into_sequences());
     }
     let config = model.feature_config();
     let mut data = ridi::train::training_data(&seqs, config)?;
@@ -65,7 +66,7 @@ fn main() -> Result<(), Error> {
     );
     let dim = model.dim();
     let test = features(&model, &lists[1])?;
-    let q = MatrixRef::new(&test, dim)?;
+    let q = FeatureMatrixRef::new(&test, dim)?;
     let n = q.rows();
     let stream: Vec<usize> = (0..n).collect();
     let shuffled = timing::shuffled(n);
@@ -99,7 +100,7 @@ fn main() -> Result<(), Error> {
     );
     if !lists[0].is_empty() {
         let train = features(&model, &lists[0])?;
-        let r = model.rounding_effect(MatrixRef::new(&train, dim)?, q)?;
+        let r = model.rounding_effect(FeatureMatrixRef::new(&train, dim)?, q)?;
         println!("storage vs exact f32 samples: {r}");
     }
     Ok(())

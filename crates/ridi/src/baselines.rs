@@ -16,14 +16,13 @@
 use std::fmt;
 use std::str::FromStr;
 
-use ridi_correct::{CorrectionConfig, integrate, world_acceleration};
+use ridi_correct::{CorrectionConfig, FrameVelocity, correct, integrate, world_acceleration};
 use ridi_data::Sequence;
 use ridi_eval::{StepDetectorConfig, detect_steps, pdr_trajectory};
 use ridi_frames::{StabHorizontal, StabVec, UpAxis, WorldVec};
 use serde::{Deserialize, Serialize};
 
 use crate::error::{PipelineError, Result};
-use crate::track::{Regressed, correct_with};
 
 /// A trajectory method.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize)]
@@ -123,15 +122,21 @@ fn mean_speed(seq: &Sequence) -> Result<f64> {
 }
 
 /// The horizontal trajectory of `method` on `seq`, starting at the origin. `regressions` are
-/// the cascade's outputs (needed by the model-based methods); `config` is RIDI's correction.
+/// the cascade's velocities at their frames (needed by the model-based methods); `config` is
+/// RIDI's correction.
 pub fn trajectory(
     method: Method,
     seq: &Sequence,
-    regressions: &[Regressed],
+    regressions: &[FrameVelocity],
     config: CorrectionConfig,
 ) -> Result<Vec<[f64; 2]>> {
-    let with = |regs: Vec<Regressed>, config: CorrectionConfig| -> Result<Vec<[f64; 2]>> {
-        Ok(correct_with(seq, &regs, config, &[])?.horizontal())
+    let with = |regs: Vec<FrameVelocity>, config: CorrectionConfig| -> Result<Vec<[f64; 2]>> {
+        let traj = correct(config, &seq.imu(), &regs)?;
+        Ok(traj
+            .poses
+            .iter()
+            .map(|p| [p.position.x(), p.position.y()])
+            .collect())
     };
     match method {
         Method::Ridi => with(regressions.to_vec(), config),
@@ -145,7 +150,7 @@ pub fn trajectory(
         Method::RidiMag => with(
             regressions
                 .iter()
-                .map(|r| Regressed {
+                .map(|r| FrameVelocity {
                     velocity: StabHorizontal::new(0.0, -r.velocity.norm()),
                     ..*r
                 })
@@ -164,7 +169,7 @@ pub fn trajectory(
                         } else {
                             StabHorizontal::ZERO
                         };
-                        Regressed { velocity: v, ..*r }
+                        FrameVelocity { velocity: v, ..*r }
                     })
                     .collect(),
                 config,

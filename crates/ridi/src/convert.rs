@@ -217,7 +217,7 @@ fn labels_from_lists(source: &Path) -> ListLabels {
     lists.sort();
     let (labels, warnings) = (&mut out.labels, &mut out.warnings);
     for list in lists {
-        let Ok(entries) = ridi_data::read_list(&list) else {
+        let Ok(entries) = ridi_data::ListEntry::read(&[&list]) else {
             continue;
         };
         out.lists.push(list.clone());

@@ -8,12 +8,12 @@
 
 use std::path::Path;
 
-use ridi_data::{ReadOptions, Sequence};
+use ridi_data::{ListEntry, Listed, ReadOptions, Sequence};
 use ridi_regress::{Cascade, Progress};
 
 use crate::error::Result;
 use crate::evaluate::{EvalOptions, Report, Traces, check_evaluable};
-use crate::lists::{Listed, Purpose, read_lists};
+use crate::lists::{Purpose, load_listed};
 use crate::output::{EvalFolder, EvalPlots, EvalWritten};
 use crate::placement::PlacementMap;
 use crate::train::{GridChoice, TrainOptions};
@@ -37,22 +37,20 @@ impl Demo {
     /// four Tyrex groups, [`PlacementMap::tyrex_groups`]) to write into `out`, with the
     /// regressor search `grid` and `plots`. Refused: an output folder that cannot be written,
     /// list errors, a recording on both lists or in both as copies, and each sequence's
-    /// problems as [`Listed::load`] finds them.
+    /// problems as [`load_listed`] finds them.
     pub fn prepare(data: &Path, out: &Path, grid: GridChoice, plots: EvalPlots) -> Result<Self> {
         let folder = EvalFolder::new(out, plots)?;
         let map = PlacementMap::tyrex_groups();
-        let train_entries = read_lists(&[data.join("list_train.txt")])?;
-        let test_entries = read_lists(&[data.join("list_test.txt")])?;
-        // Held out means held out: no recording on both lists.
-        ridi_data::check_entries(&[train_entries.as_slice(), &test_entries].concat())?;
         let read = ReadOptions::default();
-        let train = Listed::load(train_entries, Some(&map), Purpose::Training, &read)?;
-        let test = Listed::load(test_entries, Some(&map), Purpose::Evaluation, &read)?;
-        // Also not as a copy in another folder or format (the paths above differ).
-        ridi_data::check_distinct(
-            (train.sequences(), train.entries()),
-            (test.sequences(), test.entries()),
-        )?;
+        let load = |list: &str, purpose| {
+            let entries = ListEntry::read(&[data.join(list)])?;
+            load_listed(entries, Some(&map), purpose, &read)
+        };
+        let train = load("list_train.txt", Purpose::Training)?;
+        let test = load("list_test.txt", Purpose::Evaluation)?;
+        // Held out means held out: no recording on both lists, also not as a copy in another
+        // folder or format.
+        train.check_distinct(&test)?;
         let mut options = TrainOptions::default();
         options.cascade.regressors = grid.regressors();
         Ok(Self {
@@ -84,17 +82,17 @@ impl Demo {
         // A held-out run that cannot be evaluated fails before the training, not after it.
         for seq in self.test.sequences() {
             check_evaluable(seq, &self.options.features, &EvalOptions::default())
-                .map_err(|e| self.test.locate(e))?;
+                .map_err(|e| e.locate_in(&self.test))?;
         }
         crate::train(self.train.sequences(), &self.options, progress)
-            .map_err(|e| self.train.locate(e))
+            .map_err(|e| e.locate_in(&self.train))
     }
 
     /// Evaluates `model` on the held-out sequences with every method ([`crate::evaluate()`]
     /// with the default [`EvalOptions`]).
     pub fn evaluate(&self, model: &Cascade) -> Result<(Report, Vec<Traces>)> {
         crate::evaluate(self.test.sequences(), model, &EvalOptions::default())
-            .map_err(|e| self.test.locate(e))
+            .map_err(|e| e.locate_in(&self.test))
     }
 
     /// Writes `model` (as `model.ridi`), `report` and the plots of `traces` into the output
@@ -107,6 +105,6 @@ impl Demo {
     ) -> Result<EvalWritten> {
         self.folder
             .write(report, traces, Some((MODEL_FILE, model)))
-            .map_err(|e| self.test.locate(e))
+            .map_err(|e| e.locate_in(&self.test))
     }
 }

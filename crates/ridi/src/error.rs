@@ -55,7 +55,7 @@ pub enum PipelineError {
     #[error(transparent)]
     Output(#[from] crate::output::OutputError),
     /// An error about one sequence of a list file, at the list file and line
-    /// ([`crate::lists::Listed::locate`]); it chains the error itself.
+    /// ([`PipelineError::locate_in`]); it chains the error itself.
     #[error("{at}")]
     Listed {
         /// The list file and line of the sequence.

@@ -27,7 +27,7 @@ use serde::{Deserialize, Deserializer, Serialize};
 use crate::baselines::{Method, trajectory};
 use crate::error::{PipelineError, Result};
 use crate::orientation::oriented;
-use crate::track::{Regressed, TrackOptions, check_trackable, regress};
+use crate::track::{TrackOptions, check_trackable, regress};
 use crate::train::ground_truth_view;
 
 /// What to evaluate and how.
@@ -140,10 +140,10 @@ fn evaluate_one(seq: &Sequence, model: &Cascade, opts: &EvalOptions) -> Result<E
         .ground_truth()
         .ok_or_else(|| PipelineError::sequence(seq.name(), "has no ground truth to evaluate"))?;
     let gt2 = gt.horizontal();
-    let regressions: Vec<Regressed> = if opts.methods.iter().any(|m| m.needs_model()) {
+    let (regressions, placements) = if opts.methods.iter().any(|m| m.needs_model()) {
         regress(seq, model, &opts.track)?
     } else {
-        Vec::new()
+        Default::default()
     };
     let frames: Vec<usize> = regressions.iter().map(|r| r.frame).collect();
     let targets = compute_targets(&ground_truth_view(seq)?, model.feature_config(), &frames)?;
@@ -154,15 +154,9 @@ fn evaluate_one(seq: &Sequence, model: &Cascade, opts: &EvalOptions) -> Result<E
     } else {
         velocity_mse(&predicted, &truth)?
     };
-    let names: Vec<String> = regressions
+    let names: Vec<String> = placements
         .iter()
-        .map(|r| {
-            model
-                .placements()
-                .get(r.placement)
-                .cloned()
-                .unwrap_or_default()
-        })
+        .map(|&p| model.placements().get(p).cloned().unwrap_or_default())
         .collect();
     let placement_accuracy = match (seq.placement(), names.is_empty()) {
         (Some(p), false) => {

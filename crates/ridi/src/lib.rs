@@ -12,9 +12,9 @@
 //! | [`eval`] | `ridi-eval` | alignment, MPE/ATE/RTE, reports |
 //!
 //! Pipeline modules: [`source`] reads any supported layout, [`convert`] writes the RIDI
-//! layout with list files (all or nothing, through [`Staging`]), [`lists`] reads list files
-//! for training and evaluation with the labels they need, [`inspect`] summarizes a recording or a model,
-//! [`orientation`] swaps in an orientation estimated from gyro and accelerometer, [`live`]
+//! layout with list files (all or nothing, through [`Staging`]), [`load_listed`] reads the
+//! sequences of list files for training and evaluation with the labels they need, [`inspect`]
+//! summarizes a recording or a model, [`orientation`] swaps in an orientation estimated from gyro and accelerometer, [`live`]
 //! tracks a stream sample by sample, [`Demo`] is `ridi demo` (train on a sample, evaluate on
 //! its held-out runs, write both).
 //!
@@ -43,18 +43,19 @@
 //! Train on one person of the bundled sample, track and evaluate another's run:
 //!
 //! ```
-//! use ridi::data::{ReadOptions, load_list};
+//! use ridi::data::{Listed, ReadOptions};
 //! use ridi::regress::NoProgress;
 //! use ridi::{EvalOptions, GridChoice, PlacementMap, TrackOptions, TrainOptions};
 //!
 //! let sample = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../datasets/sample");
-//! let mut train = load_list(sample.join("list_Guillaume.txt"), &ReadOptions::default())?;
+//! let read = |list: &str| Listed::read(&[sample.join(list)], &ReadOptions::default());
+//! let mut train = read("list_Guillaume.txt")?.into_sequences();
 //! PlacementMap::tyrex_groups().apply(&mut train);
 //! let mut opts = TrainOptions::default();
 //! opts.cascade.regressors = GridChoice::None.regressors(); // fixed C and epsilon: fast
 //! let model = ridi::train(&train, &opts, &mut NoProgress)?;
 //!
-//! let mut test = load_list(sample.join("list_Jakob.txt"), &ReadOptions::default())?;
+//! let mut test = read("list_Jakob.txt")?.into_sequences();
 //! PlacementMap::tyrex_groups().apply(&mut test);
 //! let track = ridi::track(&test[0], &model, &TrackOptions::default())?;
 //! assert_eq!(track.position.len(), test[0].len());
@@ -77,7 +78,7 @@ mod demo;
 mod error;
 pub mod evaluate;
 pub mod inspect;
-pub mod lists;
+mod lists;
 pub mod live;
 pub mod orientation;
 mod output;
@@ -87,13 +88,14 @@ pub mod plot;
 pub mod source;
 mod staging;
 pub mod track;
+mod track_options;
 pub mod train;
 
 pub use baselines::Method;
 pub use demo::Demo;
 pub use error::{PipelineError, Result};
 pub use evaluate::{EvalOptions, Report, evaluate};
-pub use lists::{Purpose, load_lists};
+pub use lists::{Purpose, load_listed};
 pub use live::{LiveTracker, Recorded, SensorReading};
 pub use orientation::{Orientation, apply_orientation, oriented};
 pub use output::{

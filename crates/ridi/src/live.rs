@@ -9,16 +9,16 @@
 use std::collections::VecDeque;
 
 use ridi_correct::{
-    FrameWindow, GapPolicy, PlacementSmoother, Regression, TrackError, Tracker, TrackerConfig,
-    TrailingMajority, Update, VelocityRegressor,
+    FrameVelocity, FrameWindow, GapPolicy, PlacementSmoother, RegressorOutput, TrackError, Tracker,
+    TrackerConfig, TrailingMajority, Update, VelocityRegressor,
 };
 use ridi_data::{Channel, Sequence, Validation};
-use ridi_features::{FeatureExtractor, Orientation};
+use ridi_features::{FeatureExtractor, FeatureMatrixRef, Orientation};
 use ridi_frames::{DeviceVec, FilterConfig, ImuSample, OrientationFilter, WorldFromDevice};
-use ridi_regress::{Cascade, MatrixRef};
+use ridi_regress::Cascade;
 
 use crate::error::{PipelineError, Result};
-use crate::track::{Regressed, TrackOptions};
+use crate::track_options::TrackOptions;
 
 /// The cascade as the streaming tracker's regressor: features of the latest window, one query.
 ///
@@ -31,14 +31,18 @@ pub struct CascadeRegressor<'m> {
     extractor: FeatureExtractor,
     row: Vec<f32>,
     majority: Option<TrailingMajority>,
-    /// Every regression made, for reports.
-    made: Vec<Regressed>,
+    /// Every velocity regressed, at its frame, for reports.
+    made: Vec<FrameVelocity>,
+    /// The placement of each of `made`.
+    placements: Vec<usize>,
 }
 
 impl<'m> CascadeRegressor<'m> {
-    /// Every regression made so far, for reports.
-    pub fn made(&self) -> &[Regressed] {
-        &self.made
+    /// Every regression made so far, for reports: the velocities at their frames and the
+    /// placement of each, as [`Track::regressions`](crate::Track::regressions) and
+    /// [`Track::placements`](crate::Track::placements) hold them.
+    pub fn made(&self) -> (&[FrameVelocity], &[usize]) {
+        (&self.made, &self.placements)
     }
 
     /// A regressor over `model`; with `smoothing`, each placement becomes the majority label of
@@ -52,6 +56,7 @@ impl<'m> CascadeRegressor<'m> {
             row,
             majority: smoothing.map(|s| s.trailing(model.placements().len())),
             made: Vec::new(),
+            placements: Vec::new(),
         })
     }
 }
@@ -70,7 +75,7 @@ impl VelocityRegressor for CascadeRegressor<'_> {
     fn regress(
         &mut self,
         frames: &FrameWindow<'_>,
-    ) -> std::result::Result<Option<Regression>, ridi_correct::RegressorError> {
+    ) -> std::result::Result<Option<RegressorOutput>, ridi_correct::RegressorError> {
         let stab = self.extractor.stabilize(&frames.imu)?;
         let len = frames.len();
         self.extractor.row_into(&stab, len - 1, &mut self.row)?;
@@ -78,19 +83,18 @@ impl VelocityRegressor for CascadeRegressor<'_> {
         if let Some(m) = &mut self.majority {
             let label = m.push(frames.imu.time[len - 1], p.placement);
             if label != p.placement {
-                let row = MatrixRef::new(&self.row, self.row.len())?;
+                let row = FeatureMatrixRef::new(&self.row, self.row.len())?;
                 p.velocity = self.model.predict_with_placement(row, label)?[0];
                 p.placement = label;
             }
         }
-        let velocity = p.velocity;
-        self.made.push(Regressed {
+        self.made.push(FrameVelocity {
             frame: frames.last_frame() as usize,
-            placement: p.placement,
-            velocity,
+            velocity: p.velocity,
         });
-        Ok(Some(Regression {
-            velocity,
+        self.placements.push(p.placement);
+        Ok(Some(RegressorOutput {
+            velocity: p.velocity,
             placement: Some(p.placement),
         }))
     }
@@ -165,19 +169,21 @@ impl SensorReading {
 /// [`restarted`](Update::restarted). (`ridi track` refuses such a gap in a recording instead.)
 ///
 /// ```
-/// use ridi::data::{ReadOptions, load_list};
+/// use ridi::data::{Listed, ReadOptions};
 /// use ridi::regress::NoProgress;
 /// use ridi::{SensorReading, LiveTracker, PlacementMap, TrackOptions, TrainOptions};
 ///
 /// let sample = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../datasets/sample");
-/// let mut train = load_list(sample.join("list_Guillaume.txt"), &ReadOptions::default())?;
+/// let read = |list: &str| Listed::read(&[sample.join(list)], &ReadOptions::default());
+/// let mut train = read("list_Guillaume.txt")?.into_sequences();
 /// PlacementMap::tyrex_groups().apply(&mut train);
 /// let mut opts = TrainOptions::default();
 /// opts.cascade.regressors = ridi::GridChoice::None.regressors();
 /// let model = ridi::train(&train, &opts, &mut NoProgress)?;
 ///
 /// // A recording played back as if it arrived live.
-/// let stream = &load_list(sample.join("list_Jakob.txt"), &ReadOptions::default())?[0];
+/// let test = read("list_Jakob.txt")?;
+/// let stream = &test.sequences()[0];
 /// let mut live = LiveTracker::new(&model, &TrackOptions::default())?;
 /// let mut updates = Vec::new();
 /// for i in 0..stream.len() {
@@ -319,9 +325,10 @@ impl<'m> LiveTracker<'m> {
         self.tracker.stats().frames as usize + waiting
     }
 
-    /// Every regression made so far.
-    pub fn regressions(&self) -> &[Regressed] {
-        &self.tracker.regressor().made
+    /// Every regression made so far: the velocities at their frames and the placement of
+    /// each ([`CascadeRegressor::made`]).
+    pub fn regressions(&self) -> (&[FrameVelocity], &[usize]) {
+        self.tracker.regressor().made()
     }
 
     /// The streaming tracker underneath (statistics, buffered poses, the current bias).

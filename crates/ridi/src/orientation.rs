@@ -79,14 +79,16 @@ pub fn apply_orientation(choice: Orientation, seqs: &mut [Sequence]) -> Result<(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use ridi_data::{ReadOptions, load_list};
+    use ridi_data::{Listed, ReadOptions};
     use ridi_frames::{STANDARD_GRAVITY, gravity_in_device};
 
     #[test]
     fn estimate_replaces_orientation_gravity_and_linear_acceleration_consistently() {
         let list = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
             .join("../../datasets/sample/list_Jakob.txt");
-        let mut seqs = load_list(&list, &ReadOptions::default()).unwrap();
+        let mut seqs = Listed::read(&[list], &ReadOptions::default())
+            .unwrap()
+            .into_sequences();
         seqs.truncate(1);
         let before = seqs[0].clone();
         apply_orientation(Orientation::Recorded, &mut seqs).unwrap();

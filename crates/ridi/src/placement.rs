@@ -123,7 +123,7 @@ impl PlacementMap {
     }
 
     /// Relabels every sequence whose label the map has; others keep theirs (load list files
-    /// with [`crate::lists::load_lists`], which refuses labels the map does not have).
+    /// with [`crate::load_listed`], which refuses labels the map does not have).
     pub fn apply(&self, seqs: &mut [Sequence]) {
         for s in seqs {
             if let Some(class) = s.placement().and_then(|p| self.class_of(p)) {

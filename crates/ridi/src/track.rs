@@ -2,68 +2,19 @@
 
 use std::path::Path;
 
-use ridi_correct::{CorrectionConfig, PlacementSmoother, VelocityTarget, correct};
+use ridi_correct::{CorrectionConfig, FrameVelocity, correct};
 use ridi_data::{RoundTrip, Sequence, write_atomically};
-use ridi_features::{FeatureConfig, FeatureExtractor, Orientation, SampleSchedule};
-use ridi_frames::{DeviceVec, StabHorizontal, WorldVec};
-use ridi_regress::{Cascade, MatrixRef};
-use serde::{Deserialize, Serialize};
+use ridi_features::{
+    FeatureConfig, FeatureExtractor, FeatureMatrixRef, Orientation, SampleSchedule,
+};
+use ridi_frames::{DeviceVec, WorldVec};
+use ridi_regress::Cascade;
 
 use crate::error::{PipelineError, Result};
 use crate::live::{LiveTracker, SensorReading};
 use crate::orientation::oriented;
 
-/// How to track.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-pub struct TrackOptions {
-    /// Frames between regressions (paper: 50, the residual frames of the correction).
-    pub regress_every: usize,
-    /// The correction objective (knots, lambda, weights, initial velocity). Its `up_axis` is
-    /// replaced by the model's: see [`TrackOptions::correction_for`].
-    pub correction: CorrectionConfig,
-    /// Streaming mode (paper's online variant): a 1000-frame window corrected every 200
-    /// frames, each frame's pose as known when it arrived. Otherwise one global correction.
-    pub online: bool,
-    /// Each regression's placement becomes the majority label of a time window, and its
-    /// velocity comes from that placement's regressors: centred on it in batch, the window
-    /// before it when streaming. `None` keeps every window's own label (the paper).
-    pub placement_smoothing: Option<PlacementSmoother>,
-}
-
-impl Default for TrackOptions {
-    fn default() -> Self {
-        Self {
-            regress_every: 50,
-            correction: CorrectionConfig::default(),
-            online: false,
-            placement_smoothing: Some(PlacementSmoother::default()),
-        }
-    }
-}
-
-impl TrackOptions {
-    /// The correction of `model`'s regressions: [`TrackOptions::correction`] with the S its
-    /// velocities are expressed in (the model's [`FeatureConfig::up_axis`]).
-    ///
-    /// [`FeatureConfig::up_axis`]: ridi_features::FeatureConfig::up_axis
-    pub fn correction_for(&self, model: &Cascade) -> CorrectionConfig {
-        CorrectionConfig {
-            up_axis: model.feature_config().up_axis,
-            ..self.correction
-        }
-    }
-}
-
-/// One regression: the cascade's output at a frame.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-pub struct Regressed {
-    /// Frame index.
-    pub frame: usize,
-    /// Placement index into the model's placement names.
-    pub placement: usize,
-    /// Velocity `[S-x, S-z]`, m/s.
-    pub velocity: StabHorizontal,
-}
+pub use crate::track_options::TrackOptions;
 
 /// A tracked sequence: one pose per frame, plus what produced it.
 #[derive(Debug, Clone, PartialEq)]
@@ -76,8 +27,11 @@ pub struct Track {
     pub velocity: Vec<WorldVec>,
     /// Estimated accelerometer bias, device frame, m/s^2.
     pub bias: Vec<DeviceVec>,
-    /// The regressions used.
-    pub regressions: Vec<Regressed>,
+    /// The regressed velocities the correction followed, at their frames.
+    pub regressions: Vec<FrameVelocity>,
+    /// The placement each of `regressions` was regressed for, an index into
+    /// `placement_names`.
+    pub placements: Vec<usize>,
     /// Placement names of the model.
     pub placement_names: Vec<String>,
 }
@@ -109,7 +63,7 @@ impl Track {
             while next < self.regressions.len() && self.regressions[next].frame <= i {
                 current = self
                     .placement_names
-                    .get(self.regressions[next].placement)
+                    .get(self.placements[next])
                     .map(String::as_str);
                 next += 1;
             }
@@ -169,33 +123,41 @@ impl Track {
 /// Regresses placement and velocity every `opts.regress_every` frames from the first full
 /// window, in one batched pass, then smooths the placements if `opts.placement_smoothing` asks.
 /// `seq` is first given the model's orientation ([`oriented`]).
-pub fn regress(seq: &Sequence, model: &Cascade, opts: &TrackOptions) -> Result<Vec<Regressed>> {
+///
+/// Returns the velocities at their frames (what the correction follows) and, one per velocity,
+/// the placement it was regressed for: a cascade [`Prediction`](ridi_regress::Prediction) at a
+/// frame, kept as the two things its users take apart ([`Track::regressions`] and
+/// [`Track::placements`]).
+pub fn regress(
+    seq: &Sequence,
+    model: &Cascade,
+    opts: &TrackOptions,
+) -> Result<(Vec<FrameVelocity>, Vec<usize>)> {
     let seq = oriented(seq, model.feature_config().orientation)?;
     let seq = seq.as_ref();
     let fx = FeatureExtractor::new(model.feature_config().clone())?;
     let frames = SampleSchedule::every(fx.config(), opts.regress_every)?.frames(seq.len());
     if frames.is_empty() {
-        return Ok(Vec::new());
+        return Ok((Vec::new(), Vec::new()));
     }
     let features = fx.features(&fx.stabilize(&seq.imu())?, &frames)?;
-    let predictions = model.predict(MatrixRef::try_from(&features)?)?;
-    let mut out: Vec<Regressed> = frames
+    let predictions = model.predict(FeatureMatrixRef::try_from(&features)?)?;
+    let mut velocities: Vec<FrameVelocity> = frames
         .iter()
-        .zip(predictions)
-        .map(|(&frame, p)| Regressed {
+        .zip(&predictions)
+        .map(|(&frame, p)| FrameVelocity {
             frame,
-            placement: p.placement,
             velocity: p.velocity,
         })
         .collect();
+    let labels: Vec<usize> = predictions.iter().map(|p| p.placement).collect();
     let Some(smoother) = opts.placement_smoothing else {
-        return Ok(out);
+        return Ok((velocities, labels));
     };
     let times: Vec<f64> = frames.iter().map(|&f| seq.time()[f]).collect();
-    let labels: Vec<usize> = out.iter().map(|r| r.placement).collect();
     let smoothed = smoother.smooth(&times, &labels, model.placements().len());
     for p in 0..model.placements().len() {
-        let moved: Vec<usize> = (0..out.len())
+        let moved: Vec<usize> = (0..velocities.len())
             .filter(|&i| smoothed[i] == p && labels[i] != p)
             .collect();
         if moved.is_empty() {
@@ -205,40 +167,34 @@ pub fn regress(seq: &Sequence, model: &Cascade, opts: &TrackOptions) -> Result<V
             .iter()
             .flat_map(|&i| features.row(i).iter().copied())
             .collect();
-        let velocities =
-            model.predict_with_placement(MatrixRef::new(&rows, features.cols())?, p)?;
-        for (&i, v) in moved.iter().zip(velocities) {
-            out[i].placement = p;
-            out[i].velocity = v;
+        let moved_velocities =
+            model.predict_with_placement(FeatureMatrixRef::new(&rows, features.cols())?, p)?;
+        for (&i, v) in moved.iter().zip(moved_velocities) {
+            velocities[i].velocity = v;
         }
     }
-    Ok(out)
+    Ok((velocities, smoothed))
 }
 
 /// Corrects and integrates `seq` so that its velocity follows `regressions` (batch: one
-/// global solve). `seq` must carry the orientation of the model that regressed them
+/// global solve), `placements` their placements. `seq` must carry the orientation of the model that regressed them
 /// ([`oriented`]), `config` the model's S ([`TrackOptions::correction_for`]).
-pub fn correct_with(
+pub(crate) fn correct_with(
     seq: &Sequence,
-    regressions: &[Regressed],
+    regressions: Vec<FrameVelocity>,
+    placements: Vec<usize>,
     config: CorrectionConfig,
     placement_names: &[String],
 ) -> Result<Track> {
-    let targets: Vec<VelocityTarget> = regressions
-        .iter()
-        .map(|r| VelocityTarget {
-            frame: r.frame,
-            velocity: r.velocity,
-        })
-        .collect();
-    let traj = correct(config, &seq.imu(), &targets)?;
+    let traj = correct(config, &seq.imu(), &regressions)?;
     let bias = &traj.correction.bias;
     Ok(Track {
         time: seq.time().to_vec(),
         position: traj.poses.iter().map(|p| p.position).collect(),
         velocity: traj.poses.iter().map(|p| p.velocity).collect(),
         bias: (0..seq.len()).map(|i| bias.at(i, seq.time()[i])).collect(),
-        regressions: regressions.to_vec(),
+        regressions,
+        placements,
         placement_names: placement_names.to_vec(),
     })
 }
@@ -331,10 +287,11 @@ pub fn track(seq: &Sequence, model: &Cascade, opts: &TrackOptions) -> Result<Tra
     }
     let seq = oriented(seq, model.feature_config().orientation)?;
     let seq = seq.as_ref();
-    let regressions = regress(seq, model, opts)?;
+    let (regressions, placements) = regress(seq, model, opts)?;
     correct_with(
         seq,
-        &regressions,
+        regressions,
+        placements,
         opts.correction_for(model),
         model.placements(),
     )
@@ -354,7 +311,8 @@ fn track_online(seq: &Sequence, model: &Cascade, opts: &TrackOptions) -> Result<
         position: updates.iter().map(|u| u.pose.position).collect(),
         velocity: updates.iter().map(|u| u.pose.velocity).collect(),
         bias: updates.iter().map(|u| u.bias).collect(),
-        regressions: live.regressions().to_vec(),
+        regressions: live.regressions().0.to_vec(),
+        placements: live.regressions().1.to_vec(),
         placement_names: model.placements().to_vec(),
     })
 }

@@ -5,13 +5,11 @@ use std::collections::BTreeSet;
 use rayon::prelude::*;
 use ridi_data::Sequence;
 use ridi_features::{
-    FeatureConfig, FeatureExtractor, FeatureMatrix, GroundTruthView, SampleSchedule,
-    Standardization, compute_targets,
+    FeatureConfig, FeatureExtractor, FeatureMatrix, FeatureMatrixRef, GroundTruthView,
+    SampleSchedule, Standardization, compute_targets,
 };
 use ridi_frames::{StabHorizontal, UpAxis};
-use ridi_regress::{
-    Cascade, CascadeParams, GridSpec, MatrixRef, Progress, RegressorChoice, TrainingSet,
-};
+use ridi_regress::{Cascade, CascadeParams, GridSpec, Progress, RegressorChoice, TrainingSet};
 use serde::{Deserialize, Serialize};
 
 use crate::error::{PipelineError, Result};
@@ -229,7 +227,7 @@ pub fn train(
         config.standardization = Some(s);
     }
     let set = TrainingSet {
-        features: MatrixRef::try_from(&data.features)?,
+        features: FeatureMatrixRef::try_from(&data.features)?,
         targets: &data.targets,
         placements: &data.placements,
         placement_names: &data.placement_names,

@@ -395,7 +395,7 @@ fn devices_are_kept_with_one_list_per_device() {
         ]
     );
     let names = |list: &str| -> Vec<String> {
-        ridi::data::read_list(out.join(list))
+        ridi::data::ListEntry::read(&[out.join(list)])
             .unwrap()
             .iter()
             .map(|e| e.path.file_name().unwrap().to_string_lossy().into_owned())

@@ -2,7 +2,7 @@
 //! checkout). The tests are `#[ignore]`d, so that `cargo test` shows them as not run; `.ci/run`
 //! runs them with `--ignored`.
 
-use ridi::data::{ReadOptions, read_list};
+use ridi::data::{ListEntry, Listed, ReadOptions};
 use ridi_test_support::shared_dataset;
 
 /// Every run with motion capture in the shared root: the 42 Android runs (24 Nexus 5 runs and 18
@@ -59,11 +59,11 @@ fn the_whole_tyrex_root_converts_with_one_list_per_person_and_device() {
             .contains("Jakob_Nexus5_Dist_BackPocket/rotation-vector.txt: the orientation jumps")),
         "the run the gyro check refused reads, with its orientation jumps reported"
     );
-    let all = read_list(out.path().join("list_all.txt")).unwrap();
+    let all = ListEntry::read(&[out.path().join("list_all.txt")]).unwrap();
     assert_eq!(all.len(), summary.sequences.len());
     let mut per_person = 0;
     for person in ["Guillaume", "Jakob", "Thibaud"] {
-        let list = read_list(out.path().join(format!("list_{person}.txt"))).unwrap();
+        let list = ListEntry::read(&[out.path().join(format!("list_{person}.txt"))]).unwrap();
         assert!(
             list.iter()
                 .all(|e| e.path.to_string_lossy().contains(person))
@@ -74,7 +74,7 @@ fn the_whole_tyrex_root_converts_with_one_list_per_person_and_device() {
     assert_eq!(per_person, all.len(), "every part is in its person's list");
     let mut per_device = 0;
     for (key, phone) in [("nexus5", "_Nexus5_"), ("iphone4s", "_iPhone4S_")] {
-        let list = read_list(out.path().join(format!("list_{key}.txt"))).unwrap();
+        let list = ListEntry::read(&[out.path().join(format!("list_{key}.txt"))]).unwrap();
         assert!(
             list.iter()
                 .all(|e| e.path.to_string_lossy().contains(phone))
@@ -122,12 +122,13 @@ fn indoor_location_competition_paths_convert_with_the_hand_placement() {
     let summary = ridi::convert::convert(&root, out.path(), &Default::default()).unwrap();
     assert_eq!(summary.sequences.len(), 12);
     assert!(summary.warnings.is_empty(), "{:?}", summary.warnings);
-    let all = read_list(out.path().join("list_all.txt")).unwrap();
+    let all = ListEntry::read(&[out.path().join("list_all.txt")]).unwrap();
     assert_eq!(all.len(), 12);
     assert!(all.iter().all(|e| e.placement.as_deref() == Some("hand")));
     // The converted files read back with their ground truth, at 200 Hz.
-    let seqs =
-        ridi::data::load_list(out.path().join("list_all.txt"), &ReadOptions::default()).unwrap();
+    let seqs = Listed::read(&[out.path().join("list_all.txt")], &ReadOptions::default())
+        .unwrap()
+        .into_sequences();
     for s in &seqs {
         assert!(s.ground_truth().is_some() && s.magnet().is_some());
         assert!((s.rate_hz() - 200.0).abs() < 0.01, "{}", s.rate_hz());

@@ -3,9 +3,9 @@
 
 use std::path::{Path, PathBuf};
 
-use ridi::data::{ReadOptions, Sequence, read_sequence, write_ridi_csv};
+use ridi::data::{ListEntry, Listed, ReadOptions, Sequence, read_sequence, write_ridi_csv};
 use ridi::regress::NoProgress;
-use ridi::{EvalOptions, GridChoice, Method, PlacementMap, Purpose, TrainOptions, load_lists};
+use ridi::{EvalOptions, GridChoice, Method, PlacementMap, Purpose, TrainOptions, load_listed};
 use ridi_test_support::sample_dataset;
 
 fn seq(name: &str) -> PathBuf {
@@ -28,7 +28,8 @@ fn load(
     map: Option<&PlacementMap>,
     purpose: Purpose,
 ) -> ridi::Result<Vec<Sequence>> {
-    load_lists(lists, map, purpose, &ReadOptions::default())
+    let entries = ListEntry::read(lists)?;
+    load_listed(entries, map, purpose, &ReadOptions::default()).map(Listed::into_sequences)
 }
 
 fn err<T: std::fmt::Debug>(r: ridi::Result<T>) -> String {

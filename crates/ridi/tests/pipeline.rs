@@ -1,7 +1,7 @@
 //! End to end on the bundled sample: train, track (batch and online), evaluate.
 
 use ridi::correct::{Tracker, TrackerConfig};
-use ridi::data::{ReadOptions, Sequence, load_list};
+use ridi::data::{Listed, ReadOptions, Sequence};
 use ridi::frames::ImuSample;
 use ridi::frames::nalgebra::Vector3;
 use ridi::frames::{DeviceVec, Rot, UpAxis};
@@ -14,7 +14,9 @@ use ridi::{
 use ridi_test_support::sample_dataset;
 
 fn load(list: &str) -> Vec<Sequence> {
-    let mut seqs = load_list(sample_dataset().join(list), &ReadOptions::default()).unwrap();
+    let mut seqs = Listed::read(&[sample_dataset().join(list)], &ReadOptions::default())
+        .unwrap()
+        .into_sequences();
     PlacementMap::tyrex_groups().apply(&mut seqs);
     seqs
 }
@@ -203,16 +205,16 @@ fn placement_smoothing_takes_the_window_majority_and_its_regressors() {
         };
         let on = TrackOptions::default();
         let smoother = on.placement_smoothing.unwrap();
-        let raw = ridi::track::regress(seq, &model, &off).unwrap();
-        let smoothed = ridi::track::regress(seq, &model, &on).unwrap();
+        let (raw, raw_p) = ridi::track::regress(seq, &model, &off).unwrap();
+        let (smoothed, smoothed_p) = ridi::track::regress(seq, &model, &on).unwrap();
         let times: Vec<f64> = raw.iter().map(|r| seq.time()[r.frame]).collect();
-        let labels: Vec<usize> = raw.iter().map(|r| r.placement).collect();
-        let want = smoother.smooth(&times, &labels, model.placements().len());
+        let want = smoother.smooth(&times, &raw_p, model.placements().len());
         assert_eq!(raw.len(), smoothed.len());
-        for ((a, b), w) in raw.iter().zip(&smoothed).zip(&want) {
+        assert_eq!((raw.len(), smoothed.len()), (raw_p.len(), smoothed_p.len()));
+        assert_eq!(smoothed_p, want);
+        for (i, (a, b)) in raw.iter().zip(&smoothed).enumerate() {
             assert_eq!(a.frame, b.frame);
-            assert_eq!(b.placement, *w);
-            if a.placement == b.placement {
+            if raw_p[i] == smoothed_p[i] {
                 assert_eq!(a.velocity, b.velocity);
             } else {
                 changed += 1;
@@ -220,12 +222,8 @@ fn placement_smoothing_takes_the_window_majority_and_its_regressors() {
             }
         }
         // Fewer label changes than before.
-        let flips = |r: &[ridi::track::Regressed]| {
-            r.windows(2)
-                .filter(|w| w[0].placement != w[1].placement)
-                .count()
-        };
-        assert!(flips(&smoothed) <= flips(&raw), "{}", seq.name());
+        let flips = |p: &[usize]| p.windows(2).filter(|w| w[0] != w[1]).count();
+        assert!(flips(&smoothed_p) <= flips(&raw_p), "{}", seq.name());
     }
     // A model of one person mislabels some windows of another: the test must exercise that.
     assert!(changed > 0);
@@ -246,10 +244,17 @@ fn online_smoothing_takes_the_majority_of_the_labels_before() {
     let mut live = smoother.trailing(model.placements().len());
     let mut changed = 0;
     assert_eq!(raw.regressions.len(), smoothed.regressions.len());
-    for (a, b) in raw.regressions.iter().zip(&smoothed.regressions) {
+    assert_eq!(raw.placements.len(), smoothed.placements.len());
+    for (i, (a, b)) in raw
+        .regressions
+        .iter()
+        .zip(&smoothed.regressions)
+        .enumerate()
+    {
+        let (pa, pb) = (raw.placements[i], smoothed.placements[i]);
         assert_eq!(a.frame, b.frame);
-        assert_eq!(b.placement, live.push(seq.time()[a.frame], a.placement));
-        if a.placement == b.placement {
+        assert_eq!(pb, live.push(seq.time()[a.frame], pa));
+        if pa == pb {
             assert_eq!(a.velocity, b.velocity);
         } else {
             changed += 1;
@@ -272,8 +277,8 @@ fn online_tracking_stays_close_to_batch_tracking() {
     for (a, b) in batch.regressions.iter().zip(&online.regressions) {
         assert_eq!(a.frame, b.frame);
         assert!((a.velocity[0] - b.velocity[0]).abs() < 1e-3, "{a:?} {b:?}");
-        assert_eq!(a.placement, b.placement);
     }
+    assert_eq!(batch.placements, online.placements);
     // The live trajectory differs from the global solve, but not wildly over 24 s.
     let end = seq.len() - 1;
     let gap = (batch.position[end] - online.position[end]).norm();
@@ -401,8 +406,8 @@ fn a_phone_carried_top_down_is_tracked_like_the_upright_one() {
         };
         let a = ridi::track(&upright, &model, &opts).unwrap();
         let b = ridi::track(&top_down, &model, &opts).unwrap();
+        assert_eq!(a.placements, b.placements, "online {online}");
         for (x, y) in a.regressions.iter().zip(&b.regressions) {
-            assert_eq!(x.placement, y.placement, "online {online}");
             let d = (x.velocity[0] - y.velocity[0]).hypot(x.velocity[1] - y.velocity[1]);
             assert!(d < 1e-3, "online {online}: {x:?} vs {y:?}");
         }
@@ -468,7 +473,10 @@ fn a_model_tracks_in_the_orientation_it_was_trained_with() {
         assert_eq!(u.pose.position, a.position[i], "frame {i}");
         assert_eq!(u.bias, a.bias[i], "frame {i}");
     }
-    assert_eq!(tracker.regressor().made(), a.regressions);
+    assert_eq!(
+        tracker.regressor().made(),
+        (a.regressions.as_slice(), a.placements.as_slice())
+    );
     let (report, _) = ridi::evaluate(&pre, &model, &EvalOptions::default()).unwrap();
     assert!(report.summary["ridi"].rte_5s_m.is_finite());
     // Recorded training options on an estimated sequence: an error naming it.
@@ -516,7 +524,10 @@ fn a_live_stream_gets_its_poses_sample_by_sample_dataset() {
     updates.clear();
     live.finish(&mut updates).unwrap();
     assert!(updates.is_empty());
-    assert_eq!(live.regressions(), whole.regressions.as_slice());
+    assert_eq!(
+        live.regressions(),
+        (whole.regressions.as_slice(), whole.placements.as_slice())
+    );
 
     // Estimated orientation: the first 20 frames wait for the initial tilt, then the stream
     // gives one pose per sample; refused samples (time going back, NaN) change nothing.
@@ -714,8 +725,9 @@ fn a_shorter_feature_window_is_the_models_own() {
     assert_eq!(batch.regressions[0].frame, 100);
     assert_eq!(batch.regressions[1].frame, 150);
     assert_eq!(batch.regressions.len(), online.regressions.len());
+    assert_eq!(batch.placements, online.placements);
     for (a, b) in batch.regressions.iter().zip(&online.regressions) {
-        assert_eq!((a.frame, a.placement), (b.frame, b.placement));
+        assert_eq!(a.frame, b.frame);
         assert!((a.velocity[1] - b.velocity[1]).abs() < 1e-3, "{a:?} {b:?}");
     }
     // 150 frames: too short for the paper's window, enough for this one.

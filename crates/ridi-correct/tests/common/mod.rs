@@ -1,7 +1,7 @@
 //! Synthetic walks with known truth, shared by the integration tests.
 #![allow(dead_code)]
 
-use ridi_correct::{Integrator, Knots, Pose, VelocityTarget};
+use ridi_correct::{FrameVelocity, Integrator, Knots, Pose};
 use ridi_frames::nalgebra::Vector3;
 use ridi_frames::{DeviceVec, ImuFrames, Rot, World, WorldFromDevice, WorldVec, stab_from_world};
 
@@ -112,17 +112,17 @@ impl Walk {
     }
 
     /// Exact regressed velocity (true horizontal S velocity) at `frame`.
-    pub(crate) fn target(&self, frame: usize) -> VelocityTarget {
+    pub(crate) fn target(&self, frame: usize) -> FrameVelocity {
         let vs = stab_from_world(self.orientation[frame], self.gravity[frame])
             * self.poses_true[frame].velocity;
-        VelocityTarget {
+        FrameVelocity {
             frame,
             velocity: vs.horizontal(),
         }
     }
 
     /// Exact targets at `start, start + every, ...`.
-    pub(crate) fn targets(&self, start: usize, every: usize) -> Vec<VelocityTarget> {
+    pub(crate) fn targets(&self, start: usize, every: usize) -> Vec<FrameVelocity> {
         (start..self.time.len())
             .step_by(every)
             .map(|f| self.target(f))

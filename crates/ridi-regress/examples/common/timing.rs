@@ -3,7 +3,8 @@
 
 use std::time::Instant;
 
-use ridi_regress::{Cascade, MatrixRef};
+use ridi_features::FeatureMatrixRef;
+use ridi_regress::Cascade;
 
 /// Peak resident memory of the process, MB (`VmHWM`).
 pub(crate) fn peak_mb() -> f64 {
@@ -29,7 +30,7 @@ pub(crate) fn thread_cpu_s() -> f64 {
 /// per query.
 pub(crate) fn time_one(
     model: &Cascade,
-    q: MatrixRef<'_>,
+    q: FeatureMatrixRef<'_>,
     rows: &[usize],
 ) -> Result<(f64, f64), String> {
     let (t, c) = (Instant::now(), thread_cpu_s());

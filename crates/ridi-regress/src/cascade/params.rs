@@ -6,7 +6,7 @@ use serde::{Deserialize, Serialize};
 use crate::config::SolverConfig;
 use crate::error::RegressError;
 use crate::grid::GridSpec;
-use crate::matrix::MatrixRef;
+use ridi_features::FeatureMatrixRef;
 
 /// How the RBF width is chosen.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -22,8 +22,8 @@ pub enum Gamma {
 
 impl Gamma {
     /// The width for training features `x`.
-    pub(super) fn resolve(self, x: MatrixRef<'_>) -> Result<f32, RegressError> {
-        let d = x.dim() as f64;
+    pub(super) fn resolve(self, x: FeatureMatrixRef<'_>) -> Result<f32, RegressError> {
+        let d = x.cols() as f64;
         let g = match self {
             Gamma::InverseDim => 1.0 / d,
             Gamma::Value(g) => g as f64,

@@ -10,8 +10,9 @@ use super::{Cascade, ClassModel};
 use crate::error::RegressError;
 use crate::expansion::weighted_sums;
 use crate::kernel;
-use crate::matrix::{Matrix, MatrixRef};
+use crate::matrix::View as _;
 use crate::svc;
+use ridi_features::{FeatureMatrix, FeatureMatrixRef};
 
 /// Queries per block in batched prediction (bounds temporaries to a few MB).
 const QUERY_BLOCK: usize = 256;
@@ -52,7 +53,7 @@ pub(super) enum Rows<'a> {
     /// The stored half-precision rows, widened a tile at a time.
     Stored,
     /// Exact rows in the stored order with their squared norms (reference evaluation).
-    Exact(&'a [(Matrix, Vec<f32>)]),
+    Exact(&'a [(FeatureMatrix, Vec<f32>)]),
 }
 
 /// Buffers of the single-query path, kept per thread so that a query allocates nothing.
@@ -77,14 +78,14 @@ impl Cascade {
     /// Classifies and regresses one query (the online path).
     pub fn predict_one(&self, q: &[f32]) -> Result<Prediction, RegressError> {
         if q.len() != self.dim {
-            return Err(RegressError::Shape(format!(
-                "query has {} values, model expects {}",
-                q.len(),
-                self.dim
-            )));
+            return Err(RegressError::LengthMismatch {
+                what: "query row",
+                expected: self.dim,
+                found: q.len(),
+            });
         }
         // Non-finite values are refused here.
-        MatrixRef::new(q, self.dim.max(1))?;
+        FeatureMatrixRef::new(q, self.dim.max(1))?;
         Ok(SCRATCH.with(|s| {
             let s = &mut *s.borrow_mut();
             let Some(p) = &self.projection else {
@@ -158,7 +159,7 @@ impl Cascade {
     }
 
     /// Classifies and regresses every row of `x` (batched GEMM path).
-    pub fn predict(&self, x: MatrixRef<'_>) -> Result<Vec<Prediction>, RegressError> {
+    pub fn predict(&self, x: FeatureMatrixRef<'_>) -> Result<Vec<Prediction>, RegressError> {
         self.check_dim(x)?;
         Ok(self.predict_blocks(Rows::Stored, x, None))
     }
@@ -168,7 +169,7 @@ impl Cascade {
     pub(super) fn predict_blocks(
         &self,
         rows: Rows<'_>,
-        x: MatrixRef<'_>,
+        x: FeatureMatrixRef<'_>,
         placement: Option<usize>,
     ) -> Vec<Prediction> {
         let mut out = vec![
@@ -191,13 +192,13 @@ impl Cascade {
     /// classifier), e.g. to evaluate regressors on ground-truth placements.
     pub fn predict_with_placement(
         &self,
-        x: MatrixRef<'_>,
+        x: FeatureMatrixRef<'_>,
         placement: usize,
     ) -> Result<Vec<StabHorizontal>, RegressError> {
         self.check_dim(x)?;
         if placement >= self.classes.len() {
-            return Err(RegressError::Shape(format!(
-                "placement {placement} of {}",
+            return Err(RegressError::InvalidParam(format!(
+                "placement {placement}, the model has {} placements",
                 self.classes.len()
             )));
         }
@@ -208,13 +209,13 @@ impl Cascade {
             .collect())
     }
 
-    pub(super) fn check_dim(&self, x: MatrixRef<'_>) -> Result<(), RegressError> {
-        if x.dim() != self.dim {
-            return Err(RegressError::Shape(format!(
-                "queries have {} features, model expects {}",
-                x.dim(),
-                self.dim
-            )));
+    pub(super) fn check_dim(&self, x: FeatureMatrixRef<'_>) -> Result<(), RegressError> {
+        if x.cols() != self.dim {
+            return Err(RegressError::LengthMismatch {
+                what: "query row",
+                expected: self.dim,
+                found: x.cols(),
+            });
         }
         Ok(())
     }
@@ -226,13 +227,13 @@ impl Cascade {
         &self,
         rows: Rows<'_>,
         p: usize,
-        q: MatrixRef<'_>,
+        q: FeatureMatrixRef<'_>,
         qn: &[f32],
         (r0, r1): (usize, usize),
         gamma: Option<f32>,
         out: &mut [f32],
     ) {
-        let run = |b: MatrixRef<'_>, nb: &[f32], o: &mut [f32]| match gamma {
+        let run = |b: FeatureMatrixRef<'_>, nb: &[f32], o: &mut [f32]| match gamma {
             Some(g) => kernel::cross_kernel(q, qn, b, nb, g, o),
             None => kernel::cross_sq_dist(q, qn, b, nb, o),
         };
@@ -246,7 +247,7 @@ impl Cascade {
                 for t0 in (r0..r1).step_by(WIDEN_ROWS) {
                     let t1 = (t0 + WIDEN_ROWS).min(r1);
                     cl.samples.rows_f32(t0, t1, &mut wide);
-                    let b = MatrixRef::trusted(&wide, cl.samples.dim());
+                    let b = FeatureMatrixRef::trusted(&wide, cl.samples.dim());
                     if t1 - t0 == w {
                         run(b, &cl.norms[t0..t1], out);
                         continue;
@@ -264,7 +265,7 @@ impl Cascade {
     fn predict_block(
         &self,
         rows: Rows<'_>,
-        q: MatrixRef<'_>,
+        q: FeatureMatrixRef<'_>,
         forced: Option<usize>,
         out: &mut [Prediction],
     ) {
@@ -276,7 +277,7 @@ impl Cascade {
             }
             _ => (None, kernel::sq_norms(q)),
         };
-        let q = projected.as_ref().map_or(q, Matrix::view);
+        let q = projected.as_ref().map_or(q, FeatureMatrix::view);
         // Squared distances to the classifier part of each placement.
         let dists: Vec<Vec<f32>> = (0..self.classes.len())
             .map(|p| {

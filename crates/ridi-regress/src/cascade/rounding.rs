@@ -10,8 +10,9 @@ use super::Cascade;
 use super::predict::Rows;
 use crate::error::RegressError;
 use crate::kernel;
-use crate::matrix::MatrixRef;
+use crate::matrix::View as _;
 use crate::store::SampleRows;
+use ridi_features::FeatureMatrixRef;
 
 /// How far the compact sample storage (half precision or projection,
 /// [`Storage`](crate::Storage)) moves predictions: the stored model against the same model
@@ -51,8 +52,8 @@ impl Cascade {
     /// what the [`Storage`](crate::Storage) changes. Fails when a stored row has no match.
     pub fn rounding_effect(
         &self,
-        training: MatrixRef<'_>,
-        queries: MatrixRef<'_>,
+        training: FeatureMatrixRef<'_>,
+        queries: FeatureMatrixRef<'_>,
     ) -> Result<RoundingEffect, RegressError> {
         self.check_dim(training)?;
         self.check_dim(queries)?;
@@ -81,10 +82,9 @@ impl Cascade {
                         .get(&key(&bytes))
                         .and_then(|c| c.iter().find(|&&i| forms[i] == bytes))
                         .copied()
-                        .ok_or_else(|| {
-                            RegressError::Shape(format!(
-                                "stored sample {j} of placement {p} is not a training row"
-                            ))
+                        .ok_or(RegressError::NotTrainingRow {
+                            placement: p,
+                            index: j,
                         })
                 })
                 .collect::<Result<Vec<usize>, _>>()?;

@@ -11,18 +11,19 @@ use crate::config;
 use crate::error::RegressError;
 use crate::f16mat::F16_MAX;
 use crate::grid;
-use crate::matrix::MatrixRef;
+use crate::matrix::View as _;
 use crate::progress::{Progress, ProgressEvent, Stage};
 use crate::projection::Projection;
 use crate::store::SampleRows;
 use crate::svc::{self, PairDual, SvcParams};
 use crate::svr;
+use ridi_features::FeatureMatrixRef;
 
 /// Training data: one row per sample.
 #[derive(Debug, Clone, Copy)]
 pub struct TrainingSet<'a> {
     /// Feature matrix (`n × dim`).
-    pub features: MatrixRef<'a>,
+    pub features: FeatureMatrixRef<'a>,
     /// Velocity targets in S (two horizontal components).
     pub targets: &'a [StabHorizontal],
     /// Placement of each sample, an index into `placement_names`.
@@ -49,16 +50,15 @@ fn report(
 }
 
 /// Half-precision storage cannot hold feature values beyond ±65504.
-fn check_f16_range(x: MatrixRef<'_>) -> Result<(), RegressError> {
+fn check_f16_range(x: FeatureMatrixRef<'_>) -> Result<(), RegressError> {
     match x.as_slice().iter().position(|v| v.abs() > F16_MAX) {
         None => Ok(()),
-        Some(pos) => Err(RegressError::NonFinite(format!(
-            "feature value {} at row {}, column {} exceeds the half-precision range of the \
-             model (±{F16_MAX}); standardize the features",
-            x.as_slice()[pos],
-            pos / x.dim(),
-            pos % x.dim()
-        ))),
+        Some(pos) => Err(RegressError::BeyondHalfPrecision {
+            what: "feature value",
+            value: x.as_slice()[pos],
+            row: pos / x.cols(),
+            column: pos % x.cols(),
+        }),
     }
 }
 
@@ -67,34 +67,45 @@ fn check_training_set(
     params: &CascadeParams,
 ) -> Result<Vec<Vec<usize>>, RegressError> {
     let n = data.features.rows();
-    if data.targets.len() != n || data.placements.len() != n || data.groups.len() != n {
-        return Err(RegressError::Shape(format!(
-            "{n} feature rows, {} targets, {} placements, {} group ids",
-            data.targets.len(),
-            data.placements.len(),
-            data.groups.len()
-        )));
+    for (what, found) in [
+        ("targets (one per feature row)", data.targets.len()),
+        ("placements (one per feature row)", data.placements.len()),
+        ("group ids (one per feature row)", data.groups.len()),
+    ] {
+        if found != n {
+            return Err(RegressError::LengthMismatch {
+                what,
+                expected: n,
+                found,
+            });
+        }
     }
     if data.placement_names.is_empty() {
         return Err(RegressError::NotEnoughData("no placements".into()));
     }
     let fd = data.feature_config.feature_dim();
-    if fd != data.features.dim() {
-        return Err(RegressError::Shape(format!(
-            "feature config describes {fd} values per row, features have {}",
-            data.features.dim()
-        )));
+    if fd != data.features.cols() {
+        return Err(RegressError::LengthMismatch {
+            what: "feature row (the feature configuration's)",
+            expected: fd,
+            found: data.features.cols(),
+        });
     }
     if let Some(i) = data.targets.iter().position(|t| !t.is_finite()) {
-        return Err(RegressError::NonFinite(format!("target of sample {i}")));
+        return Err(RegressError::NonFinite {
+            what: "target",
+            index: i,
+        });
     }
     let k = data.placement_names.len();
     let mut members = vec![Vec::new(); k];
     for (i, &p) in data.placements.iter().enumerate() {
         if p >= k {
-            return Err(RegressError::Shape(format!(
-                "sample {i} has placement {p}, only {k} names"
-            )));
+            return Err(RegressError::PlacementOutOfRange {
+                index: i,
+                placement: p,
+                names: k,
+            });
         }
         members[p].push(i);
     }
@@ -250,7 +261,7 @@ impl Cascade {
         }
         Ok(Self {
             feature_config: data.feature_config.clone(),
-            dim: x.dim(),
+            dim: x.cols(),
             placements: data.placement_names.to_vec(),
             classifier,
             regressor_gamma: gamma_r,
@@ -264,7 +275,7 @@ impl Cascade {
 fn build_class(
     c: usize,
     idx: &[usize],
-    xc: MatrixRef<'_>,
+    xc: FeatureMatrixRef<'_>,
     pairs: &[PairDual],
     duals: &[svr::SvrDual],
     chosen: &[(f64, f64)],

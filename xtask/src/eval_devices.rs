@@ -1,0 +1,975 @@
+//! `cargo xtask eval tyrex`: how well RIDI tracks a person, and a phone, its model never saw.
+//!
+//! Every protocol leaves one person out (train on two people, test on the third, three folds);
+//! they differ in which phones the model trains and is tested on:
+//!
+//! - both phones: train on every run of two people (Nexus 5 with and without magnetic
+//!   disturbance, iPhone 4S), test on every run of the third;
+//! - across devices: train on two people's Nexus 5 runs, test on the third person's iPhone 4S
+//!   runs, beside the model trained on the same people's iPhone 4S runs (and the reverse);
+//! - the 24 undisturbed Nexus 5 runs, the protocol of `--variants`, for continuity.
+//!
+//! The runs are the committed list [`RUN_LIST`], so that a fuller copy of the dataset does not
+//! change the protocol. Every figure is a mean over runs (a run split at a gap is first averaged
+//! into its run, weighted by frames) with a 95 % bootstrap interval over runs; RIDI's difference
+//! from PDR (step counting with the oracle step length) is paired run by run.
+
+use std::collections::BTreeMap;
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+use anyhow::{Context, Result, bail, ensure};
+use ridi::data::tyrex::{self, TyrexOptions};
+use ridi::data::{Sequence, write_atomically};
+use ridi::evaluate::{SequenceResult, check_evaluable};
+use ridi::features::Orientation;
+use ridi::regress::NoProgress;
+use ridi::{EvalOptions, GridChoice, PlacementMap, TrainOptions, apply_orientation};
+
+use crate::bootstrap::{self, Interval};
+use crate::eval_tyrex::{PEOPLE, interval_cell};
+
+/// The protocol's runs, relative to the workspace root.
+pub const RUN_LIST: &str = "datasets/protocols/tyrex-runs.txt";
+
+/// The phone of a run.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord)]
+enum Phone {
+    Nexus5,
+    IPhone4S,
+}
+
+impl Phone {
+    fn name(self) -> &'static str {
+        match self {
+            Phone::Nexus5 => "Nexus 5",
+            Phone::IPhone4S => "iPhone 4S",
+        }
+    }
+}
+
+/// One run of the list: `<layout>/<person>_<phone>_<condition>_<motion>`.
+#[derive(Debug, Clone, PartialEq)]
+struct Run {
+    /// The folder under `<tyrex root>/datasets`.
+    path: String,
+    /// The folder's name (what the reader names the run's sequences after).
+    name: String,
+    person: String,
+    phone: Phone,
+    /// Recorded near magnetic disturbances (`Dist`).
+    disturbed: bool,
+}
+
+impl Run {
+    /// `Nexus 5`, `Nexus 5 near disturbance` or `iPhone 4S`.
+    fn device_condition(&self) -> String {
+        if self.disturbed {
+            format!("{} near disturbance", self.phone.name())
+        } else {
+            self.phone.name().to_string()
+        }
+    }
+}
+
+/// Reads the run list; errors name the file and line.
+fn read_run_list(path: &Path) -> Result<Vec<Run>> {
+    let text = std::fs::read_to_string(path)
+        .with_context(|| format!("reading the run list {}", path.display()))?;
+    parse_run_list(&text).with_context(|| format!("in the run list {}", path.display()))
+}
+
+fn parse_run_list(text: &str) -> Result<Vec<Run>> {
+    let mut runs: Vec<Run> = Vec::new();
+    for (i, line) in text.lines().enumerate() {
+        let line = line.trim();
+        if line.is_empty() || line.starts_with('#') {
+            continue;
+        }
+        let run = parse_run(line).with_context(|| format!("line {}: {line:?}", i + 1))?;
+        ensure!(
+            runs.iter().all(|r| r.name != run.name),
+            "line {}: {} is listed twice",
+            i + 1,
+            run.name
+        );
+        runs.push(run);
+    }
+    ensure!(!runs.is_empty(), "no run listed");
+    Ok(runs)
+}
+
+fn parse_run(line: &str) -> Result<Run> {
+    let (layout, name) = line
+        .split_once('/')
+        .context("expected <android|ios>/<run folder>")?;
+    let fields: Vec<&str> = name.split('_').collect();
+    let [person, phone, condition, _motion] = fields[..] else {
+        bail!("expected a folder named <person>_<phone>_<NoDist|Dist>_<motion>");
+    };
+    let phone = match (layout, phone) {
+        ("android", "Nexus5") => Phone::Nexus5,
+        ("ios", "iPhone4S") => Phone::IPhone4S,
+        _ => bail!(
+            "unknown phone {phone:?} under {layout:?} (Nexus5 under android, iPhone4S under ios)"
+        ),
+    };
+    let disturbed = match condition {
+        "NoDist" => false,
+        "Dist" => true,
+        _ => bail!("unknown condition {condition:?} (NoDist or Dist)"),
+    };
+    ensure!(
+        PEOPLE.contains(&person),
+        "unknown person {person:?} (the protocol's people: {})",
+        PEOPLE.join(", ")
+    );
+    Ok(Run {
+        path: line.to_string(),
+        name: name.to_string(),
+        person: person.to_string(),
+        phone,
+        disturbed,
+    })
+}
+
+/// A set of runs a model trains on or is tested on.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord)]
+enum RunSet {
+    Every,
+    Nexus5,
+    IPhone4S,
+    /// The Nexus 5 runs without magnetic disturbance: the 24-run protocol.
+    Nexus5Undisturbed,
+}
+
+impl RunSet {
+    fn holds(self, run: &Run) -> bool {
+        match self {
+            RunSet::Every => true,
+            RunSet::Nexus5 => run.phone == Phone::Nexus5,
+            RunSet::IPhone4S => run.phone == Phone::IPhone4S,
+            RunSet::Nexus5Undisturbed => run.phone == Phone::Nexus5 && !run.disturbed,
+        }
+    }
+
+    fn name(self) -> &'static str {
+        match self {
+            RunSet::Every => "both phones",
+            RunSet::Nexus5 => "Nexus 5",
+            RunSet::IPhone4S => "iPhone 4S",
+            RunSet::Nexus5Undisturbed => "Nexus 5 without disturbance",
+        }
+    }
+}
+
+/// One row of the report: a model trained on `train`, tested on `test`, leaving one person out.
+#[derive(Debug, Clone, Copy)]
+struct Protocol {
+    name: &'static str,
+    train: RunSet,
+    test: RunSet,
+}
+
+const BOTH_PHONES: Protocol = Protocol {
+    name: "both phones",
+    train: RunSet::Every,
+    test: RunSet::Every,
+};
+
+const PROTOCOLS: [Protocol; 6] = [
+    BOTH_PHONES,
+    Protocol {
+        name: "Nexus 5 -> iPhone 4S",
+        train: RunSet::Nexus5,
+        test: RunSet::IPhone4S,
+    },
+    Protocol {
+        name: "iPhone 4S -> iPhone 4S",
+        train: RunSet::IPhone4S,
+        test: RunSet::IPhone4S,
+    },
+    Protocol {
+        name: "iPhone 4S -> Nexus 5",
+        train: RunSet::IPhone4S,
+        test: RunSet::Nexus5,
+    },
+    Protocol {
+        name: "Nexus 5 -> Nexus 5",
+        train: RunSet::Nexus5,
+        test: RunSet::Nexus5,
+    },
+    Protocol {
+        name: "24 Nexus 5 runs",
+        train: RunSet::Nexus5Undisturbed,
+        test: RunSet::Nexus5Undisturbed,
+    },
+];
+
+/// Pairs of protocols on the same test runs: a model that never saw the test phone, and the
+/// same people's model trained on it.
+const ACROSS: [(&str, &str); 2] = [
+    ("Nexus 5 -> iPhone 4S", "iPhone 4S -> iPhone 4S"),
+    ("iPhone 4S -> Nexus 5", "Nexus 5 -> Nexus 5"),
+];
+
+/// One figure of a run.
+struct Metric {
+    label: &'static str,
+    of: fn(&SequenceResult) -> f64,
+}
+
+fn method(r: &SequenceResult, key: &str, f: fn(&ridi::eval::TrajectoryMetrics) -> f64) -> f64 {
+    r.methods.get(key).map_or(f64::NAN, f)
+}
+
+const MSE_X: usize = 0;
+const MSE_Z: usize = 1;
+const RTE: usize = 2;
+const PATH_RATIO: usize = 4;
+const PLACEMENT: usize = 5;
+const PDR_RTE: usize = 6;
+
+const METRICS: [Metric; 9] = [
+    Metric {
+        label: "velocity MSE S-x (m/s)^2",
+        of: |r| r.velocity_mse[0],
+    },
+    Metric {
+        label: "velocity MSE S-z (m/s)^2",
+        of: |r| r.velocity_mse[1],
+    },
+    Metric {
+        label: "RTE 5 s (m)",
+        of: |r| method(r, "ridi", |m| m.rte_5s_m),
+    },
+    Metric {
+        label: "ATE (m)",
+        of: |r| method(r, "ridi", |m| m.ate_m),
+    },
+    Metric {
+        label: "path length ratio",
+        of: |r| method(r, "ridi", |m| m.path_length_ratio.unwrap_or(f64::NAN)),
+    },
+    Metric {
+        label: "placement accuracy",
+        of: |r| r.placement_accuracy.unwrap_or(f64::NAN),
+    },
+    Metric {
+        label: "PDR RTE 5 s (m)",
+        of: |r| method(r, "pdr", |m| m.rte_5s_m),
+    },
+    Metric {
+        label: "RIDI-MAG RTE 5 s (m)",
+        of: |r| method(r, "ridi_mag", |m| m.rte_5s_m),
+    },
+    Metric {
+        label: "STILL RTE 5 s (m)",
+        of: |r| method(r, "still", |m| m.rte_5s_m),
+    },
+];
+
+/// One tested sequence of one protocol.
+#[derive(Debug, Clone)]
+struct Tested {
+    /// Index into the run list.
+    run: usize,
+    frames: usize,
+    result: SequenceResult,
+    /// RIDI's RTE 5 s with the OS orientation's jumps as recorded, not bridged (the sequence's
+    /// own where it has none).
+    unbridged_rte: f64,
+}
+
+/// A run's figures: its sequences averaged, weighted by frames ([`METRICS`] order).
+#[derive(Debug, Clone)]
+struct RunFigures {
+    run: usize,
+    placement: String,
+    values: [f64; METRICS.len()],
+    /// [`Tested::unbridged_rte`], averaged the same way.
+    unbridged_rte: f64,
+    /// Whether a part of the run had orientation jumps.
+    jumps: bool,
+}
+
+/// Averages each run's parts into the run, weighted by their frames. A figure a part lacks
+/// (`NaN`, e.g. a path ratio without a path) leaves the part out of that figure's mean.
+fn per_run(tested: &[Tested]) -> Vec<RunFigures> {
+    type Sums = ([(f64, f64); METRICS.len()], (f64, f64), bool);
+    let mut runs: BTreeMap<usize, (String, Sums)> = BTreeMap::new();
+    for t in tested {
+        let e = runs.entry(t.run).or_insert_with(|| {
+            let placement = t.result.placement.clone().unwrap_or_else(|| "-".into());
+            (placement, ([(0.0, 0.0); METRICS.len()], (0.0, 0.0), false))
+        });
+        let w = t.frames as f64;
+        for (acc, m) in e.1.0.iter_mut().zip(&METRICS) {
+            let v = (m.of)(&t.result);
+            if v.is_finite() {
+                acc.0 += w * v;
+                acc.1 += w;
+            }
+        }
+        if t.unbridged_rte.is_finite() {
+            e.1.1.0 += w * t.unbridged_rte;
+            e.1.1.1 += w;
+        }
+        e.1.2 |= t.unbridged_rte != (METRICS[RTE].of)(&t.result);
+    }
+    let mean = |(s, w): (f64, f64)| if w > 0.0 { s / w } else { f64::NAN };
+    runs.into_iter()
+        .map(|(run, (placement, (sums, unbridged, jumps)))| RunFigures {
+            run,
+            placement,
+            values: sums.map(mean),
+            unbridged_rte: mean(unbridged),
+            jumps,
+        })
+        .collect()
+}
+
+/// Mean and interval of one figure over runs (runs without the figure left out).
+fn figure(runs: &[&RunFigures], k: usize) -> Option<Interval> {
+    let values: Vec<f64> = runs
+        .iter()
+        .map(|r| r.values[k])
+        .filter(|v| v.is_finite())
+        .collect();
+    bootstrap::runs_interval(&values)
+}
+
+/// RIDI's RTE 5 s minus PDR's, run by run.
+fn ridi_minus_pdr(runs: &[&RunFigures]) -> Option<Interval> {
+    let values: Vec<f64> = runs
+        .iter()
+        .map(|r| r.values[RTE] - r.values[PDR_RTE])
+        .filter(|v| v.is_finite())
+        .collect();
+    bootstrap::runs_interval(&values)
+}
+
+/// The figures of `runs` as table cells, then RIDI - PDR.
+fn cells(runs: &[&RunFigures]) -> String {
+    let mut row = format!("{} |", runs.len());
+    for k in 0..METRICS.len() {
+        let _ = write!(row, " {} |", interval_cell(figure(runs, k), false));
+    }
+    let _ = write!(row, " {} |", interval_cell(ridi_minus_pdr(runs), true));
+    row
+}
+
+fn table_header(first: &str) -> String {
+    let mut h = format!("| {first} | runs |");
+    for m in &METRICS {
+        let _ = write!(h, " {} |", m.label);
+    }
+    h.push_str(" RIDI - PDR RTE 5 s (m) |\n|");
+    h.push_str(&" --- |".repeat(METRICS.len() + 3));
+    h
+}
+
+/// What the protocol was run with.
+#[derive(Debug, Clone)]
+pub struct Options {
+    pub data: Option<PathBuf>,
+    pub out: Option<PathBuf>,
+    /// Protocols whose name contains this text.
+    pub only: Option<String>,
+    /// Training sample step in frames (`None`: ridi train's).
+    pub step: Option<usize>,
+    pub orientation: Orientation,
+}
+
+/// Runs the protocols and writes the report; returns its path.
+pub fn run(opts: Options) -> Result<PathBuf> {
+    let root = xtask::workspace_root();
+    let out = opts
+        .out
+        .clone()
+        .unwrap_or_else(|| root.join("docs/bench-devices.md"));
+    let protocols: Vec<Protocol> = PROTOCOLS
+        .into_iter()
+        .filter(|p| opts.only.as_deref().is_none_or(|o| p.name.contains(o)))
+        .collect();
+    if protocols.is_empty() {
+        let names: Vec<&str> = PROTOCOLS.iter().map(|p| p.name).collect();
+        bail!(
+            "no protocol's name contains {:?}; the protocols: {}",
+            opts.only.unwrap_or_default(),
+            names.join("; ")
+        );
+    }
+    let runs = read_run_list(&root.join(RUN_LIST))?;
+    let data = xtask::tyrex_root(opts.data.clone())?;
+    let started = Instant::now();
+    let needed = |r: &Run| {
+        protocols
+            .iter()
+            .any(|p| p.train.holds(r) || p.test.holds(r))
+    };
+    // Each run also read with its OS orientation jumps as recorded: the same models track both,
+    // which measures what bridging the jumps gains (`unbridged`, where a sequence has jumps).
+    let compare_jumps = opts.orientation == Orientation::Recorded;
+    let unbridged_opts = TyrexOptions {
+        bridge_orientation_jumps: false,
+        ..TyrexOptions::default()
+    };
+    let (mut seqs, mut run_of_seq, mut unbridged) = (Vec::new(), Vec::new(), Vec::new());
+    for (i, run) in runs.iter().enumerate().filter(|(_, r)| needed(r)) {
+        let dir = data.join("datasets").join(&run.path);
+        ensure!(
+            dir.is_dir(),
+            "{}: a run of {RUN_LIST} is missing from {}",
+            run.path,
+            data.display()
+        );
+        let read = tyrex::read(&dir, &TyrexOptions::default())
+            .with_context(|| format!("reading {}", dir.display()))?;
+        let raw = if compare_jumps {
+            tyrex::read(&dir, &unbridged_opts)?.sequences
+        } else {
+            Vec::new()
+        };
+        ensure!(
+            raw.is_empty() || raw.len() == read.sequences.len(),
+            "{}: bridging the orientation's jumps changed the parts",
+            run.path
+        );
+        for (k, s) in read.sequences.into_iter().enumerate() {
+            let raw = raw.get(k).filter(|r| r.orientation() != s.orientation());
+            unbridged.push(raw.cloned());
+            run_of_seq.push(i);
+            seqs.push(s);
+        }
+    }
+    let read_s = started.elapsed().as_secs_f64();
+    eprintln!(
+        "{} sequences of {} runs read in {read_s:.0} s",
+        seqs.len(),
+        runs.len()
+    );
+    apply_orientation(opts.orientation, &mut seqs)?;
+    PlacementMap::tyrex_groups().apply(&mut seqs);
+    for s in unbridged.iter_mut().flatten() {
+        PlacementMap::tyrex_groups().apply(std::slice::from_mut(s));
+    }
+
+    let mut train_opts = TrainOptions::default();
+    // The paper grid's search multiplies training by 48: the protocol fixes C and epsilon.
+    train_opts.cascade.regressors = GridChoice::None.regressors();
+    train_opts.features.orientation = opts.orientation;
+    if let Some(step) = opts.step {
+        train_opts.features.step = step;
+    }
+    let eval_opts = EvalOptions::default();
+
+    let mut tested: Vec<Vec<Tested>> = vec![Vec::new(); protocols.len()];
+    let mut skipped: Vec<String> = Vec::new();
+    let mut trainings: Vec<(RunSet, &str, usize, f64)> = Vec::new();
+    let mut sets: Vec<RunSet> = protocols.iter().map(|p| p.train).collect();
+    sets.sort_unstable();
+    sets.dedup();
+    for set in sets {
+        for person in PEOPLE {
+            let train: Vec<Sequence> = seqs
+                .iter()
+                .zip(&run_of_seq)
+                .filter(|&(_, &r)| set.holds(&runs[r]) && runs[r].person != person)
+                .map(|(s, _)| s.clone())
+                .collect();
+            let t0 = Instant::now();
+            let model = ridi::train(&train, &train_opts, &mut NoProgress)
+                .with_context(|| format!("training on {} without {person}", set.name()))?;
+            let secs = t0.elapsed().as_secs_f64();
+            eprintln!("  {}: trained without {person} in {secs:.0} s", set.name());
+            trainings.push((set, person, train.len(), secs));
+            for (p, rows) in protocols.iter().zip(&mut tested) {
+                if p.train != set {
+                    continue;
+                }
+                let (mut test, mut test_runs, mut raw) = (Vec::new(), Vec::new(), Vec::new());
+                for ((s, &r), u) in seqs.iter().zip(&run_of_seq).zip(&unbridged) {
+                    if !(p.test.holds(&runs[r]) && runs[r].person == person) {
+                        continue;
+                    }
+                    match check_evaluable(s, model.feature_config(), &eval_opts) {
+                        Ok(()) => {
+                            test.push(s.clone());
+                            test_runs.push(r);
+                            raw.extend(u.clone());
+                        }
+                        Err(e) => skipped.push(format!("{}: {e}", p.name)),
+                    }
+                }
+                if test.is_empty() {
+                    continue;
+                }
+                let (report, _) = ridi::evaluate(&test, &model, &eval_opts)?;
+                let raw_rte: BTreeMap<String, f64> = if raw.is_empty() {
+                    BTreeMap::new()
+                } else {
+                    let (r, _) = ridi::evaluate(&raw, &model, &eval_opts)?;
+                    r.sequences
+                        .iter()
+                        .map(|q| (q.name.clone(), (METRICS[RTE].of)(q)))
+                        .collect()
+                };
+                for ((result, s), run) in report.sequences.into_iter().zip(&test).zip(test_runs) {
+                    let unbridged_rte = raw_rte
+                        .get(&result.name)
+                        .copied()
+                        .unwrap_or_else(|| (METRICS[RTE].of)(&result));
+                    rows.push(Tested {
+                        run,
+                        frames: s.len(),
+                        result,
+                        unbridged_rte,
+                    });
+                }
+            }
+        }
+    }
+    skipped.sort();
+    skipped.dedup();
+    let figures: Vec<Vec<RunFigures>> = tested.iter().map(|t| per_run(t)).collect();
+    let md = report(
+        &Report {
+            runs: &runs,
+            protocols: &protocols,
+            figures: &figures,
+            trainings: &trainings,
+            skipped: &skipped,
+            opts: &opts,
+            train_opts: &train_opts,
+        },
+        started.elapsed().as_secs_f64(),
+    );
+    write_atomically(&out, |w| w.write_all(md.as_bytes()))?;
+    print!("{md}");
+    Ok(out)
+}
+
+/// Everything the markdown report shows.
+struct Report<'a> {
+    runs: &'a [Run],
+    protocols: &'a [Protocol],
+    /// Per protocol, per run.
+    figures: &'a [Vec<RunFigures>],
+    /// Model set, test person, training sequences, seconds.
+    trainings: &'a [(RunSet, &'a str, usize, f64)],
+    skipped: &'a [String],
+    opts: &'a Options,
+    train_opts: &'a TrainOptions,
+}
+
+fn report(r: &Report<'_>, total_s: f64) -> String {
+    let mut md = String::new();
+    let o = r.opts;
+    let mut command = "cargo xtask eval tyrex".to_string();
+    if let Some(only) = &o.only {
+        let _ = write!(command, " --only '{only}'");
+    }
+    if let Some(step) = o.step {
+        let _ = write!(command, " --step {step}");
+    }
+    if o.orientation == Orientation::Estimated {
+        command.push_str(" --orientation estimated");
+    }
+    let _ = writeln!(
+        md,
+        "# Accuracy on unseen people and phones: the Tyrex runs\n"
+    );
+    let _ = writeln!(
+        md,
+        "Command: `{command}` ({:.0} min in all on a 2-core machine). The {} runs of `{RUN_LIST}` \
+         ({} Nexus 5, {} of them near magnetic disturbance, and {} iPhone 4S; three people). \
+         Every protocol leaves one person out: a model trained on two people's runs is tested on \
+         the third person's, three folds. Training as `ridi train` does by default (one turned \
+         copy of each window, the speed regressor, standardized features, 4 placement groups), \
+         except: C = 10 and epsilon = 0.01 fixed instead of the paper grid's search; sample \
+         step {} frames{}; orientation {}. Tracking and evaluation as `ridi eval` does by \
+         default (trajectories aligned on the first 10 s).\n",
+        total_s / 60.0,
+        r.runs.len(),
+        r.runs.iter().filter(|x| x.phone == Phone::Nexus5).count(),
+        r.runs.iter().filter(|x| x.disturbed).count(),
+        r.runs.iter().filter(|x| x.phone == Phone::IPhone4S).count(),
+        r.train_opts.features.step,
+        if o.step.is_some() {
+            " (coarser than ridi train's 20: exact training on this many runs takes too long)"
+        } else {
+            ""
+        },
+        match o.orientation {
+            Orientation::Recorded => "as recorded (Android rotation vector, Core Motion attitude)",
+            Orientation::Estimated => "estimated from gyro and accelerometer",
+        },
+    );
+    let _ = writeln!(
+        md,
+        "Each figure is a mean over runs (the parts of a run split at a gap are first averaged \
+         into it, weighted by frames) with its 95 % bootstrap interval over runs ({} resamples). \
+         PDR counts steps with the oracle step length (the true path length over the steps \
+         counted); STILL stands still. RIDI - PDR is paired run by run: bold when its interval \
+         leaves out 0.\n",
+        bootstrap::DRAWS
+    );
+    let _ = writeln!(md, "## Per protocol\n\n{}", table_header("protocol"));
+    let all = |k: usize| r.figures[k].iter().collect::<Vec<_>>();
+    for (k, p) in r.protocols.iter().enumerate() {
+        let _ = writeln!(md, "| {} | {}", p.name, cells(&all(k)));
+    }
+    goals(&mut md, r);
+    across(&mut md, r);
+    if let Some(k) = r.protocols.iter().position(|p| p.name == BOTH_PHONES.name) {
+        let runs = all(k);
+        let _ = writeln!(
+            md,
+            "\n## Both phones, per device and condition\n\n{}",
+            table_header("device")
+        );
+        let mut groups: BTreeMap<String, Vec<&RunFigures>> = BTreeMap::new();
+        for f in &runs {
+            groups
+                .entry(r.runs[f.run].device_condition())
+                .or_default()
+                .push(f);
+        }
+        for (name, g) in &groups {
+            let _ = writeln!(md, "| {name} | {}", cells(g));
+        }
+        let _ = writeln!(
+            md,
+            "\n## Both phones, per placement\n\n{}",
+            table_header("placement")
+        );
+        let mut groups: BTreeMap<&str, Vec<&RunFigures>> = BTreeMap::new();
+        for f in &runs {
+            groups.entry(f.placement.as_str()).or_default().push(f);
+        }
+        for (name, g) in &groups {
+            let _ = writeln!(md, "| {name} | {}", cells(g));
+        }
+        let _ = writeln!(
+            md,
+            "\n## Both phones, per run\n\n| run | placement | RTE 5 s (m) | PDR RTE 5 s (m) | \
+             velocity MSE S-x / S-z | path length ratio | placement accuracy |\n| --- | --- | --- \
+             | --- | --- | --- | --- |"
+        );
+        for f in &runs {
+            let v = &f.values;
+            let _ = writeln!(
+                md,
+                "| {} | {} | {:.3} | {:.3} | {:.3} / {:.3} | {:.3} | {:.3} |",
+                r.runs[f.run].name,
+                f.placement,
+                v[RTE],
+                v[PDR_RTE],
+                v[MSE_X],
+                v[MSE_Z],
+                v[PATH_RATIO],
+                v[PLACEMENT]
+            );
+        }
+    }
+    jumps(&mut md, r);
+    let _ = writeln!(
+        md,
+        "\n## Training\n\n| model | without | sequences | seconds |\n| --- | --- | --- | --- |"
+    );
+    for (set, person, n, secs) in r.trainings {
+        let _ = writeln!(md, "| {} | {person} | {n} | {secs:.0} |", set.name());
+    }
+    if !r.skipped.is_empty() {
+        let _ = writeln!(md, "\n## Test sequences left out\n");
+        for s in r.skipped {
+            let _ = writeln!(md, "- {s}");
+        }
+    }
+    md
+}
+
+/// RTE 5 s of a model that never saw the test phone against the same people's model trained on
+/// it, on the same runs: the loss `cross / same - 1` with its paired interval.
+fn across(md: &mut String, r: &Report<'_>) {
+    let pairs: Vec<(usize, usize)> = ACROSS
+        .iter()
+        .filter_map(|(cross, same)| {
+            let at = |name: &str| r.protocols.iter().position(|p| p.name == name);
+            Some((at(cross)?, at(same)?))
+        })
+        .collect();
+    if pairs.is_empty() {
+        return;
+    }
+    let _ = writeln!(
+        md,
+        "\n## Across devices\n\nThe same test runs tracked by a model that never saw their \
+         phone and by the same people's model trained on it. Loss: the ratio of the mean RTE \
+         5 s minus 1, its interval from the same bootstrap over runs (paired).\n\n| test runs | \
+         model | RTE 5 s (m) | same-device model's RTE 5 s (m) | loss [95 %] |\n| --- | --- | \
+         --- | --- | --- |"
+    );
+    for (c, s) in pairs {
+        let (cross, same) = paired(&r.figures[c], &r.figures[s], RTE);
+        let loss = bootstrap::ratio_interval(&cross, &same).map(|i| Interval {
+            mean: i.mean - 1.0,
+            low: i.low - 1.0,
+            high: i.high - 1.0,
+        });
+        let _ = writeln!(
+            md,
+            "| {} | {} | {} | {} | {} |",
+            r.protocols[c].test.name(),
+            r.protocols[c].name,
+            interval_cell(bootstrap::runs_interval(&cross), false),
+            interval_cell(bootstrap::runs_interval(&same), false),
+            interval_cell(loss, true),
+        );
+    }
+}
+
+/// Figure `k` of the runs two protocols both tested, in the same order.
+fn paired(a: &[RunFigures], b: &[RunFigures], k: usize) -> (Vec<f64>, Vec<f64>) {
+    a.iter()
+        .filter_map(|x| {
+            let y = b.iter().find(|y| y.run == x.run)?;
+            (x.values[k].is_finite() && y.values[k].is_finite())
+                .then_some((x.values[k], y.values[k]))
+        })
+        .unzip()
+}
+
+/// What bridging the OS orientation's jumps by the gyro gains: RIDI's RTE 5 s on the runs with
+/// jumps, bridged (the reader's default) and as recorded, tracked by the same models.
+fn jumps(md: &mut String, r: &Report<'_>) {
+    let Some(k) = r.protocols.iter().position(|p| p.name == BOTH_PHONES.name) else {
+        return;
+    };
+    if r.opts.orientation != Orientation::Recorded {
+        return;
+    }
+    let _ = writeln!(
+        md,
+        "\n## Orientation jumps: bridged by the gyro or as recorded\n\nBoth phones' protocol, \
+         the runs where the OS orientation jumps (heading corrections and resets), tracked by the \
+         same models from the orientation with its jumps bridged by the gyro (the reader's \
+         default, `TyrexOptions::bridge_orientation_jumps`) and as recorded. RTE 5 s (m); the \
+         difference is paired run by run.\n\n| runs | count | bridged | as recorded | bridged - \
+         as recorded |\n| --- | --- | --- | --- | --- |"
+    );
+    let mut groups: BTreeMap<String, Vec<&RunFigures>> = BTreeMap::new();
+    for f in r.figures[k].iter().filter(|f| f.jumps) {
+        groups
+            .entry(r.runs[f.run].device_condition())
+            .or_default()
+            .push(f);
+        groups.entry("all".into()).or_default().push(f);
+    }
+    for (name, g) in &groups {
+        let bridged: Vec<f64> = g.iter().map(|f| f.values[RTE]).collect();
+        let raw: Vec<f64> = g.iter().map(|f| f.unbridged_rte).collect();
+        let diff: Vec<f64> = bridged.iter().zip(&raw).map(|(a, b)| a - b).collect();
+        let _ = writeln!(
+            md,
+            "| {name} | {} | {} | {} | {} |",
+            g.len(),
+            interval_cell(bootstrap::runs_interval(&bridged), false),
+            interval_cell(bootstrap::runs_interval(&raw), false),
+            interval_cell(bootstrap::runs_interval(&diff), true),
+        );
+    }
+}
+
+/// The every-phone issue's goals for ridi train's defaults, each with whether the figures meet it.
+fn goals(md: &mut String, r: &Report<'_>) {
+    let Some(k) = r.protocols.iter().position(|p| p.name == BOTH_PHONES.name) else {
+        return;
+    };
+    let runs: Vec<&RunFigures> = r.figures[k].iter().collect();
+    let mut lines = Vec::new();
+    let verdict = |met: Option<bool>| match met {
+        Some(true) => "met",
+        Some(false) => "not met",
+        None => "no figure",
+    };
+    let rte = figure(&runs, RTE);
+    lines.push(format!(
+        "RTE 5 s under 1.0 m: {} ({})",
+        interval_cell(rte, false),
+        verdict(rte.map(|i| i.mean < 1.0))
+    ));
+    let diff = ridi_minus_pdr(&runs);
+    lines.push(format!(
+        "better than PDR, the paired interval excluding 0: {} ({})",
+        interval_cell(diff, true),
+        verdict(diff.map(|i| i.high < 0.0))
+    ));
+    let ratio = figure(&runs, PATH_RATIO);
+    lines.push(format!(
+        "path length ratio 0.9-1.1: {} ({})",
+        interval_cell(ratio, false),
+        verdict(ratio.map(|i| (0.9..=1.1).contains(&i.mean)))
+    ));
+    for (label, k) in [("S-x", MSE_X), ("S-z", MSE_Z)] {
+        let mse = figure(&runs, k);
+        lines.push(format!(
+            "velocity MSE {label} under 0.15: {} ({})",
+            interval_cell(mse, false),
+            verdict(mse.map(|i| i.mean < 0.15))
+        ));
+    }
+    let acc = figure(&runs, PLACEMENT);
+    lines.push(format!(
+        "placement accuracy at least 0.95: {} ({})",
+        interval_cell(acc, false),
+        verdict(acc.map(|i| i.mean >= 0.95))
+    ));
+    let _ = writeln!(
+        md,
+        "\n## Goals (both phones; point estimates against the goal, intervals beside)\n"
+    );
+    for l in lines {
+        let _ = writeln!(md, "- {l}");
+    }
+    for (c, s) in ACROSS {
+        let at = |name: &str| r.protocols.iter().position(|p| p.name == name);
+        let (Some(c), Some(s)) = (at(c), at(s)) else {
+            continue;
+        };
+        let (cross, same) = paired(&r.figures[c], &r.figures[s], RTE);
+        let loss = bootstrap::ratio_interval(&cross, &same);
+        let _ = writeln!(
+            md,
+            "- {} loses at most 15 % RTE 5 s against {}: {} ({})",
+            r.protocols[c].name,
+            r.protocols[s].name,
+            loss.map_or("-".into(), |i| format!(
+                "{:+.1} % [{:+.1}, {:+.1}]",
+                100.0 * (i.mean - 1.0),
+                100.0 * (i.low - 1.0),
+                100.0 * (i.high - 1.0)
+            )),
+            verdict(loss.map(|i| i.mean <= 1.15))
+        );
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use ridi::eval::TrajectoryMetrics;
+
+    #[test]
+    fn the_committed_run_list_parses_and_spans_both_phones() {
+        let runs = read_run_list(&xtask::workspace_root().join(RUN_LIST)).unwrap();
+        assert_eq!(runs.len(), 66);
+        let count = |set: RunSet| runs.iter().filter(|r| set.holds(r)).count();
+        assert_eq!(count(RunSet::Nexus5), 42);
+        assert_eq!(count(RunSet::IPhone4S), 24);
+        assert_eq!(count(RunSet::Nexus5Undisturbed), 24);
+        for person in PEOPLE {
+            assert_eq!(runs.iter().filter(|r| r.person == person).count(), 22);
+        }
+    }
+
+    #[test]
+    fn run_list_errors_name_the_line() {
+        let err = |text: &str| format!("{:#}", parse_run_list(text).unwrap_err());
+        assert!(
+            err("# c\nandroid/Jakob_Nexus5_NoDist_AR\nios/Jakob_Nexus5_NoDist_AR\n")
+                .contains("line 3")
+        );
+        assert!(err("android/Jakob_Nexus5_Maybe_AR").contains("unknown condition"));
+        assert!(err("android/Anna_Nexus5_NoDist_AR").contains("unknown person"));
+        assert!(err("Jakob_Nexus5_NoDist_AR").contains("line 1"));
+        assert!(
+            err("android/Jakob_Nexus5_NoDist_AR\nandroid/Jakob_Nexus5_NoDist_AR").contains("twice")
+        );
+        assert!(err("# only a comment\n").contains("no run"));
+    }
+
+    fn result(name: &str, rte: f64, pdr: f64) -> SequenceResult {
+        let metrics = |rte| TrajectoryMetrics {
+            mpe_m: 0.0,
+            mpe_pct: None,
+            ate_m: 2.0 * rte,
+            rte_m: 0.0,
+            ate_ronin_m: 0.0,
+            rte_ronin_m: 0.0,
+            rte_5s_m: rte,
+            path_length_ratio: Some(1.0),
+        };
+        SequenceResult {
+            name: name.into(),
+            placement: Some("hand".into()),
+            path_length_m: 1.0,
+            alignment_extent_m: 2.0,
+            placement_accuracy: Some(1.0),
+            velocity_mse: [0.1, 0.2],
+            methods: [
+                ("ridi".to_string(), metrics(rte)),
+                ("pdr".to_string(), metrics(pdr)),
+            ]
+            .into_iter()
+            .collect(),
+        }
+    }
+
+    #[test]
+    fn parts_are_averaged_into_their_run_by_frames() {
+        let tested = vec![
+            Tested {
+                run: 3,
+                frames: 100,
+                result: result("A_part1", 1.0, 2.0),
+                unbridged_rte: 3.0,
+            },
+            Tested {
+                run: 3,
+                frames: 300,
+                result: result("A_part2", 3.0, 2.0),
+                unbridged_rte: 3.0,
+            },
+            Tested {
+                run: 1,
+                frames: 50,
+                result: result("B", 4.0, 1.0),
+                unbridged_rte: 4.0,
+            },
+        ];
+        let runs = per_run(&tested);
+        assert_eq!(runs.iter().map(|r| r.run).collect::<Vec<_>>(), [1, 3]);
+        assert_eq!(runs[1].values[RTE], 2.5);
+        assert_eq!(runs[1].values[PDR_RTE], 2.0);
+        // A part tracked differently unbridged marks its run; (100 * 3 + 300 * 3) / 400.
+        assert!(runs[1].jumps && !runs[0].jumps);
+        assert_eq!((runs[1].unbridged_rte, runs[0].unbridged_rte), (3.0, 4.0));
+        // No RIDI-MAG in these results: the figure is missing, not zero.
+        assert!(runs[0].values[7].is_nan());
+        let all: Vec<&RunFigures> = runs.iter().collect();
+        // Each run counts once: (4 + 2.5) / 2, and RIDI - PDR (3 + 0.5) / 2.
+        assert_eq!(figure(&all, RTE).unwrap().mean, 3.25);
+        assert_eq!(ridi_minus_pdr(&all).unwrap().mean, 1.75);
+        assert_eq!(figure(&all, 7), None);
+    }
+
+    #[test]
+    fn paired_figures_keep_only_runs_both_tested() {
+        let f = |run, rte| RunFigures {
+            run,
+            placement: "hand".into(),
+            unbridged_rte: rte,
+            jumps: false,
+            values: {
+                let mut v = [0.0; METRICS.len()];
+                v[RTE] = rte;
+                v
+            },
+        };
+        let (a, b) = paired(&[f(1, 2.0), f(2, 3.0)], &[f(2, 1.5), f(5, 9.0)], RTE);
+        assert_eq!((a, b), (vec![3.0], vec![1.5]));
+    }
+}
