@@ -905,6 +905,7 @@ mod tests {
         SequenceResult {
             name: name.into(),
             placement: Some("hand".into()),
+            device: None,
             path_length_m: 1.0,
             alignment_extent_m: 2.0,
             placement_accuracy: Some(1.0),

@@ -858,6 +858,7 @@ mod tests {
             result: SequenceResult {
                 name: name.into(),
                 placement: None,
+                device: None,
                 path_length_m: 1.0,
                 alignment_extent_m: 2.0,
                 placement_accuracy: Some(1.0),

@@ -58,6 +58,9 @@ pub struct SequenceResult {
     pub name: String,
     /// Placement label.
     pub placement: Option<String>,
+    /// The phone model it was recorded with ([`Sequence::device`]), when known.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub device: Option<String>,
     /// Horizontal ground-truth path length, metres.
     pub path_length_m: f64,
     /// How far the ground truth moved within the alignment window, metres
@@ -176,6 +179,7 @@ fn evaluate_one(seq: &Sequence, model: &Cascade, opts: &EvalOptions) -> Result<E
         result: SequenceResult {
             name: seq.name().to_string(),
             placement: seq.placement().map(str::to_string),
+            device: seq.device().map(|d| d.model().to_string()),
             path_length_m: ridi_eval::path_length(&gt2)?,
             alignment_extent_m: ridi_eval::target_extent(
                 &gt2[..opts.metrics.align.frame_count(seq.time())?],
@@ -360,8 +364,8 @@ fn fmt_opt(v: Option<f64>) -> String {
 }
 
 impl Report {
-    /// The markdown report: overall summary, per placement, per sequence, velocity and
-    /// placement results.
+    /// The markdown report: overall summary, per placement, per device (when the sequences
+    /// name theirs), per sequence, velocity and placement results.
     pub fn to_markdown(&self) -> String {
         let mut out = String::new();
         let _ = writeln!(out, "# RIDI evaluation\n");
@@ -424,14 +428,17 @@ impl Report {
             }
         }
         let reports = sequence_reports(self.sequences.iter());
-        let placements: BTreeSet<&str> = self
-            .sequences
-            .iter()
-            .filter_map(|s| s.placement.as_deref())
-            .collect();
-        if !placements.is_empty() {
-            let _ = writeln!(out, "\n## Per placement (mean RTE 5 s, m)\n");
-            let _ = write!(out, "| placement | sequences |");
+        let groups: [(&str, fn(&SequenceResult) -> Option<&str>); 2] = [
+            ("placement", |s| s.placement.as_deref()),
+            ("device", |s| s.device.as_deref()),
+        ];
+        for (what, key_of) in groups {
+            let keys: BTreeSet<&str> = self.sequences.iter().filter_map(key_of).collect();
+            if keys.is_empty() {
+                continue;
+            }
+            let _ = writeln!(out, "\n## Per {what} (mean RTE 5 s, m)\n");
+            let _ = write!(out, "| {what} | sequences |");
             for key in &self.methods {
                 let _ = write!(out, " {key} |");
             }
@@ -440,17 +447,19 @@ impl Report {
                 "\n| --- | --- |{}",
                 " --- |".repeat(self.methods.len())
             );
-            for p in placements {
-                let subset: Vec<SequenceReport> = reports
+            for k in keys {
+                let subset: Vec<SequenceReport> = self
+                    .sequences
                     .iter()
-                    .filter(|r| r.placement.as_deref() == Some(p))
-                    .cloned()
+                    .zip(&reports)
+                    .filter(|(s, _)| key_of(s) == Some(k))
+                    .map(|(_, r)| r.clone())
                     .collect();
                 let means: BTreeMap<String, TrajectoryMetrics> = summarize(&subset)
                     .into_iter()
                     .map(|s| (s.method, s.mean))
                     .collect();
-                let _ = write!(out, "| {p} | {} |", subset.len());
+                let _ = write!(out, "| {k} | {} |", subset.len());
                 for key in &self.methods {
                     let v = means.get(key).map(|m| m.rte_5s_m);
                     let _ = write!(out, " {} |", fmt_opt(v));
@@ -587,5 +596,72 @@ impl Traces {
             written.push(vel_path);
         }
         Ok(written)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn result(name: &str, device: Option<&str>, rte: f64) -> SequenceResult {
+        let metrics = TrajectoryMetrics {
+            mpe_m: 0.0,
+            mpe_pct: None,
+            ate_m: 0.0,
+            rte_m: 0.0,
+            ate_ronin_m: 0.0,
+            rte_ronin_m: 0.0,
+            rte_5s_m: rte,
+            path_length_ratio: Some(1.0),
+        };
+        SequenceResult {
+            name: name.into(),
+            placement: Some("hand".into()),
+            device: device.map(str::to_string),
+            path_length_m: 10.0,
+            alignment_extent_m: 5.0,
+            placement_accuracy: Some(1.0),
+            velocity_mse: [0.1, 0.1],
+            methods: [("ridi".to_string(), metrics)].into_iter().collect(),
+        }
+    }
+
+    fn report(sequences: Vec<SequenceResult>) -> Report {
+        Report {
+            sequences,
+            summary: BTreeMap::new(),
+            velocity_mse: [0.1, 0.1],
+            placement_accuracy: Some(1.0),
+            placement_confusion: None,
+            config: EvalConfig::default(),
+            methods: vec!["ridi".into()],
+            warnings: Vec::new(),
+        }
+    }
+
+    #[test]
+    fn results_are_grouped_by_device_when_the_sequences_name_theirs() {
+        let r = report(vec![
+            result("a", Some("Nexus 5"), 1.0),
+            result("b", Some("iPhone 4S"), 2.0),
+            result("c", Some("Nexus 5"), 3.0),
+            result("d", None, 9.0),
+        ]);
+        let md = r.to_markdown();
+        assert!(md.contains("## Per device (mean RTE 5 s, m)"), "{md}");
+        assert!(md.contains("| Nexus 5 | 2 | 2.000 |"), "{md}");
+        assert!(md.contains("| iPhone 4S | 1 | 2.000 |"), "{md}");
+        // The placement table still holds every sequence.
+        assert!(md.contains("| hand | 4 | 3.750 |"), "{md}");
+        // Without devices, no device table; JSON without the key reads as no device.
+        let none = report(vec![result("a", None, 1.0)]);
+        assert!(!none.to_markdown().contains("Per device"));
+        let json = serde_json::to_string(&none).unwrap();
+        assert!(!json.contains("\"device\""), "{json}");
+        let back: Report = serde_json::from_str(&json).unwrap();
+        assert_eq!(back.sequences[0].device, None);
+        let json = serde_json::to_string(&r).unwrap();
+        let back: Report = serde_json::from_str(&json).unwrap();
+        assert_eq!(back.sequences[1].device.as_deref(), Some("iPhone 4S"));
     }
 }

@@ -478,6 +478,7 @@ mod tests {
                 .map(|name| SequenceResult {
                     name: name.to_string(),
                     placement: None,
+                    device: None,
                     path_length_m: 12.5,
                     alignment_extent_m: 3.0,
                     placement_accuracy: None,
