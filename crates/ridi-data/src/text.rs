@@ -14,20 +14,47 @@ pub(crate) fn read_file(path: &Path) -> Result<Vec<u8>> {
     gunzip_if_gzip(bytes, path)
 }
 
+/// Largest ratio of decompressed to compressed size a gzip input may have: sensor text (time
+/// stamps, noisy readings) compresses 2-10 times; a file of newlines or zeros 400-1000 times (a
+/// gzip bomb: 2.9 MB would expand to 3 GB before any check could look at it).
+pub(crate) const MAX_GZIP_RATIO: u64 = 200;
+
+/// Decompressed size every gzip input may reach whatever its ratio (small files of constant
+/// values are fine), bytes.
+const GZIP_ALLOWANCE: u64 = 64 << 20;
+
 /// Decompresses gzip data (recognized by its magic bytes, whatever the file name), so every
-/// text format can be stored compressed (`data.csv.gz`).
+/// text format can be stored compressed (`data.csv.gz`). The output is bounded by
+/// [`MAX_GZIP_RATIO`] times the input (at least 64 MiB): beyond, an error, not the machine's
+/// memory.
 pub(crate) fn gunzip_if_gzip(bytes: Vec<u8>, path: &Path) -> Result<Vec<u8>> {
     if !bytes.starts_with(&[0x1f, 0x8b]) {
         return Ok(bytes);
     }
-    let mut out = Vec::with_capacity(bytes.len() * 4);
-    std::io::Read::read_to_end(&mut flate2::read::MultiGzDecoder::new(&bytes[..]), &mut out)
-        .map_err(|e| {
+    let limit = (bytes.len() as u64)
+        .saturating_mul(MAX_GZIP_RATIO)
+        .max(GZIP_ALLOWANCE);
+    let mut out = Vec::with_capacity(bytes.len().saturating_mul(4));
+    let decoder = flate2::read::MultiGzDecoder::new(&bytes[..]);
+    std::io::Read::read_to_end(&mut std::io::Read::take(decoder, limit + 1), &mut out).map_err(
+        |e| {
             DataError::format(
                 Location::file(path),
                 format!("corrupt or truncated gzip data: {e}"),
             )
-        })?;
+        },
+    )?;
+    if out.len() as u64 > limit {
+        return Err(DataError::format(
+            Location::file(path),
+            format!(
+                "decompresses to more than {limit} bytes, over {MAX_GZIP_RATIO} times its {} \
+                 compressed bytes: not a recording (sensor text compresses 2-10 times); \
+                 refused before it fills the memory",
+                bytes.len()
+            ),
+        ));
+    }
     Ok(out)
 }
 

@@ -179,3 +179,37 @@ fn tiny_and_huge_values_are_written_short_and_read_back_exactly() {
         seq
     );
 }
+
+/// A gzip bomb (a small `data.csv.gz` of newlines that expands a thousandfold) is refused while
+/// decompressing, naming the file, before it can fill the memory; a real compressed recording
+/// (ratio 2-10) reads.
+#[test]
+fn a_gzip_bomb_is_refused_while_decompressing() {
+    let dir = tempfile::tempdir().unwrap();
+    let gz = |name: &str, content: &dyn Fn(&mut dyn std::io::Write)| {
+        let path = dir.path().join(name);
+        std::fs::create_dir_all(path.parent().unwrap()).unwrap();
+        let mut enc = flate2::write::GzEncoder::new(Vec::new(), flate2::Compression::best());
+        content(&mut enc);
+        std::fs::write(&path, enc.finish().unwrap()).unwrap();
+        path
+    };
+    // 200 MB of newlines: about 200 KB compressed, 1000 times smaller.
+    let bomb = gz("bomb/data.csv.gz", &|w| {
+        let block = vec![b'\n'; 1 << 20];
+        for _ in 0..200 {
+            w.write_all(&block).unwrap();
+        }
+    });
+    let compressed = std::fs::metadata(&bomb).unwrap().len();
+    assert!(compressed < 1 << 20, "{compressed}");
+    let e = ridi_csv::read(&bomb, &ReadOptions::default()).unwrap_err();
+    let text = e.to_string();
+    assert!(
+        text.contains("bomb/data.csv.gz") && text.contains("over 200 times its"),
+        "{text}"
+    );
+    // A valid recording through gzip reads.
+    let ok = gz("ok/data.csv.gz", &|w| w.write_all(&valid_csv(500)).unwrap());
+    ridi_csv::read(&ok, &ReadOptions::default()).unwrap();
+}
