@@ -3,7 +3,8 @@
 //! One entry per line, `path,placement`: the path is absolute or relative to the list file's
 //! folder, the placement (e.g. `body`, `handheld`, `bag`, `leg`) is optional (`path` alone or
 //! `path,`). Blank lines and lines starting with `#` are skipped. Surrounding spaces are
-//! trimmed. A list that lists no sequence is an error.
+//! trimmed. A list that lists no sequence is an error, and so is one that is not a regular file
+//! or is larger than 64 MiB.
 //!
 //! [`ListEntry::read`] parses list files (syntax only); [`Listed`] holds the sequences read
 //! from them, with the checks that make them a dataset split.
@@ -15,6 +16,10 @@ use crate::detect::{read_sequence, source_files};
 use crate::error::{DataError, Location, Result};
 use crate::options::ReadOptions;
 use crate::text;
+
+/// Largest list file read, bytes: a million entries of 64-byte paths; a list larger than that
+/// is not one (`--list /dev/zero` used to grow until the kernel killed it).
+const MAX_LIST_BYTES: u64 = 64 << 20;
 
 /// One line of a list file.
 #[derive(Debug, Clone, PartialEq, Eq)]
@@ -41,7 +46,10 @@ impl ListEntry {
         let mut entries = Vec::new();
         for list in lists {
             let path = list.as_ref();
-            entries.extend(parse_list(&text::read_file(path)?, path)?);
+            entries.extend(parse_list(
+                &text::read_file_bounded(path, MAX_LIST_BYTES)?,
+                path,
+            )?);
         }
         Ok(entries)
     }

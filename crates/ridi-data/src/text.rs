@@ -10,6 +10,33 @@ use crate::{Channel, SequenceError, Validation};
 /// Reads a whole file; the readers parse from memory because one pass over a byte slice is much
 /// faster than buffered line reading with a `String` per line.
 pub(crate) fn read_file(path: &Path) -> Result<Vec<u8>> {
+    read_file_bounded(path, u64::MAX)
+}
+
+/// [`read_file`] of a file that is at most `max` bytes on disk, checked before reading: a list
+/// or a small table has a size its format bounds. Every read refuses what is not a regular
+/// file (a folder, `/dev/zero`, a pipe): a device can hand out bytes for ever.
+pub(crate) fn read_file_bounded(path: &Path, max: u64) -> Result<Vec<u8>> {
+    let meta = std::fs::metadata(path).map_err(|e| DataError::io(path, e))?;
+    if !meta.is_file() {
+        return Err(DataError::format(
+            Location::file(path),
+            if meta.is_dir() {
+                "is a folder, not a file"
+            } else {
+                "is not a regular file (a device, a pipe or a socket)"
+            },
+        ));
+    }
+    if meta.len() > max {
+        return Err(DataError::format(
+            Location::file(path),
+            format!(
+                "{} bytes: larger than such a file can be ({max} bytes at most)",
+                meta.len()
+            ),
+        ));
+    }
     let bytes = std::fs::read(path).map_err(|e| DataError::io(path, e))?;
     gunzip_if_gzip(bytes, path)
 }

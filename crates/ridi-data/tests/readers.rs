@@ -618,6 +618,31 @@ fn lists_without_sequences_are_errors() {
     }
 }
 
+/// A list that is a device, a folder or larger than any list is refused before it is read:
+/// `--list /dev/zero` used to grow until the kernel killed it.
+#[test]
+fn lists_that_are_not_regular_files_or_too_large_are_refused_unread() {
+    let dev = Path::new("/dev/zero");
+    if dev.exists() {
+        assert_err(
+            ListEntry::read(&[dev]),
+            &["/dev/zero", "not a regular file"],
+        );
+    }
+    let dir = tempfile::tempdir().unwrap();
+    assert_err(ListEntry::read(&[dir.path()]), &["is a folder"]);
+    // A sparse file of 3 GB: refused by its size, unread (its zeros would parse as a line).
+    let huge = dir.path().join("huge.txt");
+    std::fs::File::create(&huge)
+        .unwrap()
+        .set_len(3 << 30)
+        .unwrap();
+    assert_err(
+        ListEntry::read(&[&huge]),
+        &["huge.txt", "larger than such a file can be"],
+    );
+}
+
 #[test]
 fn lists_load_every_format_and_set_placements() {
     let d = dataset();
