@@ -75,6 +75,7 @@ mod android;
 mod detect;
 mod device;
 mod error;
+mod file_id;
 pub mod ilc;
 #[cfg(feature = "internals")]
 mod internals;
@@ -97,6 +98,7 @@ mod write;
 pub use detect::{Format, detect, read_sequence, source_files};
 pub use device::{DeviceError, DeviceInfo};
 pub use error::{DataError, Location, Result};
+pub use file_id::FileId;
 #[cfg(feature = "internals")]
 #[doc(hidden)]
 pub use internals::{

@@ -11,11 +11,11 @@
 
 use std::path::{Path, PathBuf};
 
-use crate::Sequence;
 use crate::detect::{read_sequence, source_files};
 use crate::error::{DataError, Location, Result};
 use crate::options::ReadOptions;
 use crate::text;
+use crate::{FileId, Sequence};
 
 /// Largest list file read, bytes: a million entries of 64-byte paths; a list larger than that
 /// is not one (`--list /dev/zero` used to grow until the kernel killed it).
@@ -132,7 +132,7 @@ impl Listed {
     /// any is read, so a typo fails fast with the list file and line; errors while reading a
     /// sequence name that sequence's file. Once read, two entries of the same data are refused.
     pub fn load(entries: Vec<ListEntry>, opts: &ReadOptions) -> Result<Self> {
-        let mut seen: Vec<(Vec<PathBuf>, &ListEntry)> = Vec::new();
+        let mut seen: Vec<(Vec<FileId>, &ListEntry)> = Vec::new();
         for e in &entries {
             if !e.path.exists() {
                 return Err(DataError::format(
@@ -211,14 +211,15 @@ impl Listed {
     }
 }
 
-/// The files a read of `e` takes data from, resolved and sorted: two entries with the same
-/// are one recording. `None` when the format is unknown (the read reports it).
-fn recording_files(e: &ListEntry) -> Option<Vec<PathBuf>> {
-    let mut files: Vec<PathBuf> = source_files(&e.path)
+/// The files a read of `e` takes data from, by identity ([`FileId`]: also through hard links
+/// and bind mounts), sorted: two entries with the same are one recording. `None` when the
+/// format is unknown or a file cannot be inspected (the read reports it).
+fn recording_files(e: &ListEntry) -> Option<Vec<FileId>> {
+    let mut files: Vec<FileId> = source_files(&e.path)
         .ok()?
         .iter()
-        .map(|f| f.canonicalize().unwrap_or_else(|_| f.clone()))
-        .collect();
+        .map(|f| FileId::of(f).ok())
+        .collect::<Option<_>>()?;
     files.sort();
     Some(files)
 }

@@ -581,6 +581,12 @@ mod tests {
             message(check_not_input(&out, &inputs, &[&dir.path().join("./out.csv")]).unwrap_err());
         assert!(e.ends_with("it is given as two outputs"), "{e}");
         assert_eq!(std::fs::read(&file).unwrap(), b"mine");
+        // A second name of the input (a hard link; a bind mount alike) is the input: paths
+        // differ, the file does not.
+        let second = dir.path().join("second-name.csv");
+        std::fs::hard_link(&file, &second).unwrap();
+        let e = message(check_not_input(&second, &inputs, &[]).unwrap_err());
+        assert!(e.contains("the command reads it"), "{e}");
     }
 
     /// An evaluation folder takes its reports and plots together, and a later evaluation

@@ -3,7 +3,9 @@
 use std::path::{Path, PathBuf};
 
 use ridi_data::tyrex::{self, TyrexOptions};
-use ridi_data::{DataError, Format, Location, ReadOptions, Sequence, detect, read_sequence};
+use ridi_data::{
+    DataError, FileId, Format, Location, ReadOptions, Sequence, detect, read_sequence,
+};
 
 /// Sequences read from one source, with the format they came in.
 #[derive(Debug, Clone)]
@@ -95,8 +97,8 @@ pub fn read_any(
 /// The files a command reads, resolved once, to refuse an output that would replace one.
 #[derive(Debug, Clone, Default)]
 pub struct ReadFiles {
-    /// (as given, resolved)
-    files: Vec<(PathBuf, PathBuf)>,
+    /// (as given, resolved, identity when it exists)
+    files: Vec<(PathBuf, PathBuf, Option<FileId>)>,
 }
 
 impl ReadFiles {
@@ -107,19 +109,24 @@ impl ReadFiles {
         let files = paths
             .into_iter()
             .flat_map(|p| ridi_data::source_files(p).unwrap_or_else(|_| vec![p.clone()]))
-            .filter_map(|f| resolved(&f).map(|r| (f, r)))
+            .filter_map(|f| {
+                let id = FileId::of(&f).ok();
+                resolved(&f).map(|r| (f, r, id))
+            })
             .collect();
         Self { files }
     }
 
-    /// The input `out` would replace, if any. Files beside a recording that its reader does
-    /// not take (a trajectory, notes) are not inputs.
+    /// The input `out` would replace, if any: by path (links, `..`) or, when `out` exists, by
+    /// file identity (also through hard links and bind mounts, which paths do not show). Files
+    /// beside a recording that its reader does not take (a trajectory, notes) are not inputs.
     pub fn overwritten_by(&self, out: &Path) -> Option<&Path> {
         let target = resolved(out)?;
+        let id = FileId::of(out).ok();
         self.files
             .iter()
-            .find(|(_, r)| *r == target)
-            .map(|(given, _)| given.as_path())
+            .find(|(_, r, i)| *r == target || (id.is_some() && *i == id))
+            .map(|(given, _, _)| given.as_path())
     }
 }
 
