@@ -363,6 +363,9 @@ fn fmt_opt(v: Option<f64>) -> String {
     v.map_or("-".into(), |v| format!("{v:.3}"))
 }
 
+/// What a table of `report.md` groups sequences by (placement, device).
+type GroupKey = fn(&SequenceResult) -> Option<&str>;
+
 impl Report {
     /// The markdown report: overall summary, per placement, per device (when the sequences
     /// name theirs), per sequence, velocity and placement results.
@@ -428,7 +431,7 @@ impl Report {
             }
         }
         let reports = sequence_reports(self.sequences.iter());
-        let groups: [(&str, fn(&SequenceResult) -> Option<&str>); 2] = [
+        let groups: [(&str, GroupKey); 2] = [
             ("placement", |s| s.placement.as_deref()),
             ("device", |s| s.device.as_deref()),
         ];
