@@ -277,9 +277,9 @@ struct Tested {
     run: usize,
     frames: usize,
     result: SequenceResult,
-    /// RIDI's RTE 5 s with the OS orientation's jumps as recorded, not bridged (the sequence's
-    /// own where it has none).
-    unbridged_rte: f64,
+    /// RIDI's RTE 5 s with the OS orientation's jumps bridged by the gyro (the sequence's own
+    /// where it has none).
+    bridged_rte: f64,
 }
 
 /// A run's figures: its sequences averaged, weighted by frames ([`METRICS`] order).
@@ -288,8 +288,8 @@ struct RunFigures {
     run: usize,
     placement: String,
     values: [f64; METRICS.len()],
-    /// [`Tested::unbridged_rte`], averaged the same way.
-    unbridged_rte: f64,
+    /// [`Tested::bridged_rte`], averaged the same way.
+    bridged_rte: f64,
     /// Whether a part of the run had orientation jumps.
     jumps: bool,
 }
@@ -312,21 +312,23 @@ fn per_run(tested: &[Tested]) -> Vec<RunFigures> {
                 acc.1 += w;
             }
         }
-        if t.unbridged_rte.is_finite() {
-            e.1.1.0 += w * t.unbridged_rte;
+        if t.bridged_rte.is_finite() {
+            e.1.1.0 += w * t.bridged_rte;
             e.1.1.1 += w;
         }
-        e.1.2 |= t.unbridged_rte != (METRICS[RTE].of)(&t.result);
+        e.1.2 |= t.bridged_rte != (METRICS[RTE].of)(&t.result);
     }
     let mean = |(s, w): (f64, f64)| if w > 0.0 { s / w } else { f64::NAN };
     runs.into_iter()
-        .map(|(run, (placement, (sums, unbridged, jumps)))| RunFigures {
-            run,
-            placement,
-            values: sums.map(mean),
-            unbridged_rte: mean(unbridged),
-            jumps,
-        })
+        .map(
+            |(run, (placement, (sums, bridged_sums, jumps)))| RunFigures {
+                run,
+                placement,
+                values: sums.map(mean),
+                bridged_rte: mean(bridged_sums),
+                jumps,
+            },
+        )
         .collect()
 }
 
@@ -409,14 +411,15 @@ pub fn run(opts: Options) -> Result<PathBuf> {
             .iter()
             .any(|p| p.train.holds(r) || p.test.holds(r))
     };
-    // Each run also read with its OS orientation jumps as recorded: the same models track both,
-    // which measures what bridging the jumps gains (`unbridged`, where a sequence has jumps).
+    // Each run also read with its OS orientation jumps bridged by the gyro: the same models
+    // track both, which measures what bridging would gain (`bridged`, where a sequence has
+    // jumps; the reader's default keeps them).
     let compare_jumps = opts.orientation == Orientation::Recorded;
-    let unbridged_opts = TyrexOptions {
-        bridge_orientation_jumps: false,
+    let bridging = TyrexOptions {
+        bridge_orientation_jumps: true,
         ..TyrexOptions::default()
     };
-    let (mut seqs, mut run_of_seq, mut unbridged) = (Vec::new(), Vec::new(), Vec::new());
+    let (mut seqs, mut run_of_seq, mut bridged) = (Vec::new(), Vec::new(), Vec::new());
     for (i, run) in runs.iter().enumerate().filter(|(_, r)| needed(r)) {
         let dir = data.join("datasets").join(&run.path);
         ensure!(
@@ -427,19 +430,19 @@ pub fn run(opts: Options) -> Result<PathBuf> {
         );
         let read = tyrex::read(&dir, &TyrexOptions::default())
             .with_context(|| format!("reading {}", dir.display()))?;
-        let raw = if compare_jumps {
-            tyrex::read(&dir, &unbridged_opts)?.sequences
+        let other = if compare_jumps {
+            tyrex::read(&dir, &bridging)?.sequences
         } else {
             Vec::new()
         };
         ensure!(
-            raw.is_empty() || raw.len() == read.sequences.len(),
+            other.is_empty() || other.len() == read.sequences.len(),
             "{}: bridging the orientation's jumps changed the parts",
             run.path
         );
         for (k, s) in read.sequences.into_iter().enumerate() {
-            let raw = raw.get(k).filter(|r| r.orientation() != s.orientation());
-            unbridged.push(raw.cloned());
+            let b = other.get(k).filter(|b| b.orientation() != s.orientation());
+            bridged.push(b.cloned());
             run_of_seq.push(i);
             seqs.push(s);
         }
@@ -452,7 +455,7 @@ pub fn run(opts: Options) -> Result<PathBuf> {
     );
     apply_orientation(opts.orientation, &mut seqs)?;
     PlacementMap::tyrex_groups().apply(&mut seqs);
-    for s in unbridged.iter_mut().flatten() {
+    for s in bridged.iter_mut().flatten() {
         PlacementMap::tyrex_groups().apply(std::slice::from_mut(s));
     }
 
@@ -489,8 +492,9 @@ pub fn run(opts: Options) -> Result<PathBuf> {
                 if p.train != set {
                     continue;
                 }
-                let (mut test, mut test_runs, mut raw) = (Vec::new(), Vec::new(), Vec::new());
-                for ((s, &r), u) in seqs.iter().zip(&run_of_seq).zip(&unbridged) {
+                let (mut test, mut test_runs, mut with_bridges) =
+                    (Vec::new(), Vec::new(), Vec::new());
+                for ((s, &r), u) in seqs.iter().zip(&run_of_seq).zip(&bridged) {
                     if !(p.test.holds(&runs[r]) && runs[r].person == person) {
                         continue;
                     }
@@ -498,7 +502,7 @@ pub fn run(opts: Options) -> Result<PathBuf> {
                         Ok(()) => {
                             test.push(s.clone());
                             test_runs.push(r);
-                            raw.extend(u.clone());
+                            with_bridges.extend(u.clone());
                         }
                         Err(e) => skipped.push(format!("{}: {e}", p.name)),
                     }
@@ -507,17 +511,17 @@ pub fn run(opts: Options) -> Result<PathBuf> {
                     continue;
                 }
                 let (report, _) = ridi::evaluate(&test, &model, &eval_opts)?;
-                let raw_rte: BTreeMap<String, f64> = if raw.is_empty() {
+                let bridged_rte: BTreeMap<String, f64> = if with_bridges.is_empty() {
                     BTreeMap::new()
                 } else {
-                    let (r, _) = ridi::evaluate(&raw, &model, &eval_opts)?;
+                    let (r, _) = ridi::evaluate(&with_bridges, &model, &eval_opts)?;
                     r.sequences
                         .iter()
                         .map(|q| (q.name.clone(), (METRICS[RTE].of)(q)))
                         .collect()
                 };
                 for ((result, s), run) in report.sequences.into_iter().zip(&test).zip(test_runs) {
-                    let unbridged_rte = raw_rte
+                    let bridged_rte = bridged_rte
                         .get(&result.name)
                         .copied()
                         .unwrap_or_else(|| (METRICS[RTE].of)(&result));
@@ -525,7 +529,7 @@ pub fn run(opts: Options) -> Result<PathBuf> {
                         run,
                         frames: s.len(),
                         result,
-                        unbridged_rte,
+                        bridged_rte,
                     });
                 }
             }
@@ -742,8 +746,8 @@ fn paired(a: &[RunFigures], b: &[RunFigures], k: usize) -> (Vec<f64>, Vec<f64>) 
         .unzip()
 }
 
-/// What bridging the OS orientation's jumps by the gyro gains: RIDI's RTE 5 s on the runs with
-/// jumps, bridged (the reader's default) and as recorded, tracked by the same models.
+/// What bridging the OS orientation's jumps by the gyro would gain: RIDI's RTE 5 s on the runs
+/// with jumps, as recorded (the reader's default) and bridged, tracked by the same models.
 fn jumps(md: &mut String, r: &Report<'_>) {
     let Some(k) = r.protocols.iter().position(|p| p.name == BOTH_PHONES.name) else {
         return;
@@ -753,10 +757,10 @@ fn jumps(md: &mut String, r: &Report<'_>) {
     }
     let _ = writeln!(
         md,
-        "\n## Orientation jumps: bridged by the gyro or as recorded\n\nBoth phones' protocol, \
+        "\n## Orientation jumps: as recorded or bridged by the gyro\n\nBoth phones' protocol, \
          the runs where the OS orientation jumps (heading corrections and resets), tracked by the \
-         same models from the orientation with its jumps bridged by the gyro (the reader's \
-         default, `TyrexOptions::bridge_orientation_jumps`) and as recorded. RTE 5 s (m); the \
+         same models from the orientation as recorded (the reader's default) and with its jumps \
+         bridged by the gyro (`TyrexOptions::bridge_orientation_jumps`). RTE 5 s (m); the \
          difference is paired run by run.\n\n| runs | count | bridged | as recorded | bridged - \
          as recorded |\n| --- | --- | --- | --- | --- |"
     );
@@ -769,8 +773,8 @@ fn jumps(md: &mut String, r: &Report<'_>) {
         groups.entry("all".into()).or_default().push(f);
     }
     for (name, g) in &groups {
-        let bridged: Vec<f64> = g.iter().map(|f| f.values[RTE]).collect();
-        let raw: Vec<f64> = g.iter().map(|f| f.unbridged_rte).collect();
+        let raw: Vec<f64> = g.iter().map(|f| f.values[RTE]).collect();
+        let bridged: Vec<f64> = g.iter().map(|f| f.bridged_rte).collect();
         let diff: Vec<f64> = bridged.iter().zip(&raw).map(|(a, b)| a - b).collect();
         let _ = writeln!(
             md,
@@ -926,28 +930,28 @@ mod tests {
                 run: 3,
                 frames: 100,
                 result: result("A_part1", 1.0, 2.0),
-                unbridged_rte: 3.0,
+                bridged_rte: 3.0,
             },
             Tested {
                 run: 3,
                 frames: 300,
                 result: result("A_part2", 3.0, 2.0),
-                unbridged_rte: 3.0,
+                bridged_rte: 3.0,
             },
             Tested {
                 run: 1,
                 frames: 50,
                 result: result("B", 4.0, 1.0),
-                unbridged_rte: 4.0,
+                bridged_rte: 4.0,
             },
         ];
         let runs = per_run(&tested);
         assert_eq!(runs.iter().map(|r| r.run).collect::<Vec<_>>(), [1, 3]);
         assert_eq!(runs[1].values[RTE], 2.5);
         assert_eq!(runs[1].values[PDR_RTE], 2.0);
-        // A part tracked differently unbridged marks its run; (100 * 3 + 300 * 3) / 400.
+        // A part tracked differently when bridged marks its run; (100 * 3 + 300 * 3) / 400.
         assert!(runs[1].jumps && !runs[0].jumps);
-        assert_eq!((runs[1].unbridged_rte, runs[0].unbridged_rte), (3.0, 4.0));
+        assert_eq!((runs[1].bridged_rte, runs[0].bridged_rte), (3.0, 4.0));
         // No RIDI-MAG in these results: the figure is missing, not zero.
         assert!(runs[0].values[7].is_nan());
         let all: Vec<&RunFigures> = runs.iter().collect();
@@ -962,7 +966,7 @@ mod tests {
         let f = |run, rte| RunFigures {
             run,
             placement: "hand".into(),
-            unbridged_rte: rte,
+            bridged_rte: rte,
             jumps: false,
             values: {
                 let mut v = [0.0; METRICS.len()];

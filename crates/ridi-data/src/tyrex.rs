@@ -204,7 +204,9 @@ pub struct TyrexOptions {
     /// a warning ([`MAX_MOCAP_TILT_DEG`]). Infinity trusts both.
     pub max_mocap_tilt_deg: f64,
     /// Bridge the OS orientation's jumps by the gyro, keeping the heading continuous across them
-    /// ([`bridge_orientation_jumps`]); on by default: a jump turns a track by up to 160 degrees.
+    /// ([`bridge_orientation_jumps`]). Off by default: on the disturbed Nexus 5 runs the jumps
+    /// mostly correct a heading the magnetic field had bent, and bridging them raised RIDI's
+    /// RTE 5 s by 0.22 m [0.02, 0.45] (`cargo xtask eval tyrex`, docs/bench-devices.md).
     pub bridge_orientation_jumps: bool,
     /// Limits every output sequence is checked against.
     pub validation: Validation,
@@ -221,7 +223,7 @@ impl Default for TyrexOptions {
             ground_truth: true,
             extra_time_diff_s: 0.0,
             max_mocap_tilt_deg: MAX_MOCAP_TILT_DEG,
-            bridge_orientation_jumps: true,
+            bridge_orientation_jumps: false,
             validation: Validation::default(),
         }
     }

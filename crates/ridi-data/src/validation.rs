@@ -426,7 +426,9 @@ pub fn orientation_jumps(
 /// recorded orientation is turned about the vertical by the heading the jump added beyond the
 /// gyro. The heading so stays continuous (an OS correction turns a track by up to 160 degrees on
 /// the Tyrex runs), while the tilt after a jump is the recorded one: the accelerometer makes it
-/// observable, and the jumps leave it nearly unchanged. The stretch after the last jump keeps
+/// observable, and the jumps leave it nearly unchanged. Whether that helps depends on the jumps:
+/// where they correct a heading a magnetic field had bent (the disturbed Tyrex runs) it keeps
+/// the bent heading, and tracking gets worse (docs/bench-devices.md). The stretch after the last jump keeps
 /// its recorded heading, the others are turned to join it. `gyro` must be in the orientation's
 /// device frame, rad/s.
 pub fn bridge_orientation_jumps(

@@ -776,7 +776,8 @@ fn source_files_of_a_run_include_its_ground_truth_beside_the_android_folder() {
 
 /// The OS orientation of a real run (`Jakob_Nexus5_Dist_BackPocket`) jumps for a few frames at
 /// hundreds of rad/s; one least-squares fit over all frames took that for a gyro in another
-/// unit. The run reads, with one warning giving the jumps' times.
+/// unit. The run reads, with one warning giving the jumps' times; bridging them by the gyro is
+/// an option.
 #[test]
 fn os_orientation_jumps_are_a_warning_not_a_gyro_unit_error() {
     let fx = Fixture::standard();
@@ -795,11 +796,7 @@ fn os_orientation_jumps_are_a_warning_not_a_gyro_unit_error() {
             })
             .collect()
     });
-    let as_recorded = TyrexOptions {
-        bridge_orientation_jumps: false,
-        ..TyrexOptions::default()
-    };
-    let read = tyrex::read(&fx.dir, &as_recorded).unwrap();
+    let read = tyrex::read(&fx.dir, &TyrexOptions::default()).unwrap();
     let [seq] = read.sequences.as_slice() else {
         panic!("{} parts", read.sequences.len())
     };
@@ -827,9 +824,13 @@ fn os_orientation_jumps_are_a_warning_not_a_gyro_unit_error() {
         warning[0]
     );
     assert!(!warning[0].contains("bridged"), "{}", warning[0]);
-    // By default the reader bridges them by the gyro: the same warning says so, and the
+    // Asked to, the reader bridges them by the gyro: the same warning says so, and the
     // orientation turns with the gyro throughout (here, back to the recorded heading).
-    let bridged = tyrex::read(&fx.dir, &TyrexOptions::default()).unwrap();
+    let bridging = TyrexOptions {
+        bridge_orientation_jumps: true,
+        ..TyrexOptions::default()
+    };
+    let bridged = tyrex::read(&fx.dir, &bridging).unwrap();
     let warning = bridged
         .warnings
         .iter()
@@ -858,6 +859,6 @@ fn os_orientation_jumps_are_a_warning_not_a_gyro_unit_error() {
     let clean = Fixture::standard();
     let read = tyrex::read(&clean.dir, &TyrexOptions::default()).unwrap();
     assert!(read.sequences[0].orientation_jumps().is_empty());
-    let raw = tyrex::read(&clean.dir, &as_recorded).unwrap();
+    let raw = tyrex::read(&clean.dir, &bridging).unwrap();
     assert_eq!(read.sequences, raw.sequences);
 }
