@@ -861,6 +861,122 @@ fn goals(md: &mut String, r: &Report<'_>) {
     }
 }
 
+/// One of RIDI's figures of a [`RunRow`].
+type RunFigure = fn(&RunRow) -> f64;
+/// Whether a run, by name, belongs to a group of runs.
+type RunGroup = fn(&str) -> bool;
+
+/// RIDI's figures of one run in a report's per-run table.
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct RunRow {
+    rte: f64,
+    pdr: f64,
+    mse: [f64; 2],
+    ratio: f64,
+    accuracy: f64,
+}
+
+/// The per-run table of both phones' protocol in a report [`report`] wrote, by run name.
+fn per_run_table(md: &str) -> Result<BTreeMap<String, RunRow>> {
+    let mut rows = BTreeMap::new();
+    let mut inside = false;
+    for (i, line) in md.lines().enumerate() {
+        if line.starts_with("## ") {
+            inside = line == "## Both phones, per run";
+            continue;
+        }
+        if !inside
+            || !line.starts_with("| ")
+            || line.starts_with("| run ")
+            || line.starts_with("| ---")
+        {
+            continue;
+        }
+        let cells: Vec<&str> = line.trim_matches('|').split('|').map(str::trim).collect();
+        let number = |s: &str| {
+            s.parse::<f64>()
+                .with_context(|| format!("line {}: `{s}` is not a number", i + 1))
+        };
+        let [name, _, rte, pdr, mse, ratio, accuracy] = cells[..] else {
+            bail!("line {}: expected 7 cells, found {}", i + 1, cells.len());
+        };
+        let (x, z) = mse
+            .split_once('/')
+            .with_context(|| format!("line {}: velocity MSE `{mse}`", i + 1))?;
+        rows.insert(
+            name.to_string(),
+            RunRow {
+                rte: number(rte)?,
+                pdr: number(pdr)?,
+                mse: [number(x.trim())?, number(z.trim())?],
+                ratio: number(ratio)?,
+                accuracy: number(accuracy)?,
+            },
+        );
+    }
+    ensure!(!rows.is_empty(), "no `## Both phones, per run` table");
+    Ok(rows)
+}
+
+/// `cargo xtask eval compare`: RIDI's figures of two reports on the runs both tested, paired
+/// run by run (`after - before`), per device and condition.
+pub fn compare(before: &Path, after: &Path) -> Result<String> {
+    let read = |p: &Path| -> Result<BTreeMap<String, RunRow>> {
+        let text =
+            std::fs::read_to_string(p).with_context(|| format!("reading {}", p.display()))?;
+        per_run_table(&text).with_context(|| format!("in {}", p.display()))
+    };
+    let (a, b) = (read(before)?, read(after)?);
+    let runs: Vec<(&String, &RunRow, &RunRow)> = a
+        .iter()
+        .filter_map(|(k, x)| Some((k, x, b.get(k)?)))
+        .collect();
+    ensure!(!runs.is_empty(), "the two reports share no run");
+    let mut md = format!(
+        "RIDI on the {} runs both reports tested: `{}` (before) and `{}` (after); means over \
+         runs, the difference after - before paired run by run with its 95 % bootstrap \
+         interval.\n\n| runs | count | figure | before | after | after - before |\n| --- | --- | \
+         --- | --- | --- | --- |\n",
+        runs.len(),
+        before.display(),
+        after.display()
+    );
+    let figures: [(&str, RunFigure); 6] = [
+        ("RTE 5 s (m)", |r| r.rte),
+        ("RIDI - PDR RTE 5 s (m)", |r| r.rte - r.pdr),
+        ("path length ratio", |r| r.ratio),
+        ("velocity MSE S-x", |r| r.mse[0]),
+        ("velocity MSE S-z", |r| r.mse[1]),
+        ("placement accuracy", |r| r.accuracy),
+    ];
+    let groups: [(&str, RunGroup); 4] = [
+        ("all", |_| true),
+        ("Nexus 5", |n| n.contains("_Nexus5_NoDist_")),
+        ("Nexus 5 near disturbance", |n| n.contains("_Nexus5_Dist_")),
+        ("iPhone 4S", |n| n.contains("_iPhone4S_")),
+    ];
+    for (group, holds) in groups {
+        let g: Vec<_> = runs.iter().filter(|(n, _, _)| holds(n)).collect();
+        if g.is_empty() {
+            continue;
+        }
+        for (label, f) in figures {
+            let x: Vec<f64> = g.iter().map(|(_, r, _)| f(r)).collect();
+            let y: Vec<f64> = g.iter().map(|(_, _, r)| f(r)).collect();
+            let d: Vec<f64> = x.iter().zip(&y).map(|(x, y)| y - x).collect();
+            let _ = writeln!(
+                md,
+                "| {group} | {} | {label} | {} | {} | {} |",
+                g.len(),
+                interval_cell(bootstrap::runs_interval(&x), false),
+                interval_cell(bootstrap::runs_interval(&y), false),
+                interval_cell(bootstrap::runs_interval(&d), true),
+            );
+        }
+    }
+    Ok(md)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -959,6 +1075,43 @@ mod tests {
         assert_eq!(figure(&all, RTE).unwrap().mean, 3.25);
         assert_eq!(ridi_minus_pdr(&all).unwrap().mean, 1.75);
         assert_eq!(figure(&all, 7), None);
+    }
+
+    #[test]
+    fn two_reports_compare_run_by_run() {
+        let table = |rte: [f64; 3]| {
+            format!(
+                "# x\n\n## Both phones, per run\n\n| run | placement | RTE 5 s (m) | PDR RTE 5 s (m) | \
+                 velocity MSE S-x / S-z | path length ratio | placement accuracy |\n| --- | --- | \
+                 --- | --- | --- | --- | --- |\n\
+                 | A_Nexus5_NoDist_AR | hand | {} | 2.0 | 0.1 / 0.2 | 0.9 | 1.0 |\n\
+                 | B_iPhone4S_NoDist_AR | hand | {} | 2.0 | 0.1 / 0.2 | 0.9 | 1.0 |\n\
+                 | C_Nexus5_Dist_AR | hand | {} | 2.0 | 0.1 / 0.2 | 0.9 | 1.0 |\n\n## Training\n\n\
+                 | model | without |\n",
+                rte[0], rte[1], rte[2]
+            )
+        };
+        let rows = per_run_table(&table([1.0, 2.0, 3.0])).unwrap();
+        assert_eq!(rows.len(), 3);
+        assert_eq!(rows["B_iPhone4S_NoDist_AR"].mse, [0.1, 0.2]);
+        let dir = tempfile::tempdir().unwrap();
+        let (a, b) = (dir.path().join("a.md"), dir.path().join("b.md"));
+        std::fs::write(&a, table([1.0, 2.0, 3.0])).unwrap();
+        std::fs::write(&b, table([1.5, 2.5, 3.5])).unwrap();
+        let md = compare(&a, &b).unwrap();
+        // Every run 0.5 m worse: resolved, whatever the resample.
+        assert!(
+            md.contains("| all | 3 | RTE 5 s (m) | 2.000 [1.00, 3.00] | 2.500 [1.50, 3.50] | **+0.500 [+0.500, +0.500]** |"),
+            "{md}"
+        );
+        assert!(md.contains("| iPhone 4S | 1 | RTE 5 s (m) |"), "{md}");
+        // A report without the table names the file.
+        std::fs::write(&b, "# nothing\n").unwrap();
+        let e = format!("{:#}", compare(&a, &b).unwrap_err());
+        assert!(
+            e.contains("b.md") && e.contains("no `## Both phones, per run` table"),
+            "{e}"
+        );
     }
 
     #[test]

@@ -102,6 +102,15 @@ enum Eval {
     /// sweep) and the Android rotation vector with the Tyrex motion capture, and write a
     /// markdown report.
     Orientation(OrientationArgs),
+    /// Compare two reports of `eval tyrex` (e.g. `--orientation recorded` and `estimated`):
+    /// RIDI's figures on the runs both tested (both phones' protocol), paired run by run, with
+    /// 95 % intervals; per device and condition.
+    Compare {
+        /// The reference report (docs/bench-devices.md of one setting).
+        before: PathBuf,
+        /// The report of the other setting.
+        after: PathBuf,
+    },
 }
 
 #[derive(Args)]
@@ -223,6 +232,9 @@ fn run(cli: Cli) -> Result<()> {
                 })?
             };
             println!("wrote {}", out.display());
+        }
+        Task::Eval(Eval::Compare { before, after }) => {
+            print!("{}", eval_devices::compare(&before, &after)?);
         }
         Task::Eval(Eval::Orientation(args)) | Task::EvalOrientation(args) => {
             let out = eval_orientation::run(args.data, args.out)?;
