@@ -9,7 +9,7 @@ use indicatif::{ProgressBar, ProgressStyle};
 use ridi::data::ListEntry;
 use ridi::features::FeatureConfig;
 use ridi::frames::UpAxis;
-use ridi::regress::{Cascade, ProgressEvent, RegressError, Stage, Storage};
+use ridi::regress::{Cascade, Nystrom, ProgressEvent, RegressError, Solver, Stage, Storage};
 use ridi::source::ReadFiles;
 use ridi::{
     GridChoice, Orientation, PipelineError, Purpose, TrainOptions, check_not_input,
@@ -47,6 +47,19 @@ pub(crate) struct Args {
     /// How the model stores its samples for prediction.
     #[arg(long, value_enum, default_value = "projected")]
     storage: StorageArg,
+    /// How the kernel machines are trained: `exact` (SMO, the paper's), or `nystrom`, which
+    /// approximates the RBF kernel on --landmarks training rows and trains linear machines
+    /// on those features: less training time and memory, a model and a query that do not
+    /// grow with the rows, velocities somewhat off the exact ones (measured in the
+    /// ridi-regress crate documentation).
+    #[arg(long, value_enum, default_value = "exact")]
+    solver: SolverArg,
+    /// Landmarks of `--solver nystrom` (rows drawn at random, seed 0), 2 to 16384: more
+    /// approximate the exact kernel machines more closely, at a cost per query and in
+    /// training linear in them.
+    #[arg(long, value_name = "N", default_value_t = Nystrom::DEFAULT_LANDMARKS,
+          value_parser = |s: &str| count(s, 2, Nystrom::MAX_LANDMARKS))]
+    landmarks: usize,
     /// Also train on N copies of each window turned about the vertical (features and
     /// velocity together), for phones carried at other headings than in the training
     /// recordings; 0 for the paper, at most 32.
@@ -125,6 +138,14 @@ impl From<StorageArg> for Storage {
 }
 
 #[derive(Clone, Copy, PartialEq, ValueEnum)]
+enum SolverArg {
+    /// The exact kernel machines (SMO).
+    Exact,
+    /// Nyström approximation: linear machines on kernel features of the landmarks.
+    Nystrom,
+}
+
+#[derive(Clone, Copy, PartialEq, ValueEnum)]
 enum UpAxisArg {
     /// Device +y at every attitude (the paper's S).
     PlusY,
@@ -169,6 +190,10 @@ pub(crate) fn run(args: Args) -> Result<()> {
     opts.cascade.regressors = GridChoice::from(args.grid).regressors();
     opts.cascade.storage = args.storage.into();
     opts.cascade.speed = !args.no_speed;
+    opts.cascade.method = match args.solver {
+        SolverArg::Exact => Solver::Exact,
+        SolverArg::Nystrom => Solver::Nystrom(Nystrom::new(args.landmarks, 0)?),
+    };
     let model = with_progress(|progress| ridi::train(listed.sequences(), &opts, progress))
         .map_err(|e| {
             let e = e.locate_in(&listed);

@@ -11,8 +11,8 @@ use criterion::{Criterion, criterion_group, criterion_main};
 use ridi_features::FeatureConfig;
 use ridi_features::FeatureMatrixRef;
 use ridi_regress::{
-    Cascade, CascadeParams, NoProgress, RegressorChoice, Storage, Svc, SvcParams, Svr, SvrParams,
-    TrainingSet,
+    Cascade, CascadeParams, NoProgress, Nystrom, RegressorChoice, Solver, Storage, Svc, SvcParams,
+    Svr, SvrParams, TrainingSet,
 };
 
 fn benches(c: &mut Criterion) {
@@ -78,6 +78,23 @@ fn benches(c: &mut Criterion) {
     }
     g.bench_function("cascade_predict_batch_2000", |b| {
         b.iter(|| model.predict(x).unwrap())
+    });
+    // The Nyström solver on the same rows: training (landmarks, features, linear machines)
+    // and one query against 1024 landmarks.
+    let nystrom = CascadeParams {
+        method: Solver::Nystrom(Nystrom::default()),
+        ..params.clone()
+    };
+    g.bench_function("cascade_train_nystrom_2000_1024", |b| {
+        b.iter(|| Cascade::train(&set, &nystrom, &mut NoProgress).unwrap())
+    });
+    let nys = Cascade::train(&set, &nystrom, &mut NoProgress).unwrap();
+    g.bench_function("cascade_predict_one_nystrom_1024", |b| {
+        let mut i = 0;
+        b.iter(|| {
+            i = (i + 1) % 2000;
+            nys.predict_one(x.row(i)).unwrap()
+        })
     });
     g.finish();
 }

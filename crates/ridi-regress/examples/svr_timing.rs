@@ -8,6 +8,8 @@
 //!            --save <path> (grid, cascade, query: save the trained model)
 //!            --storage half|projected (grid, cascade, query; default projected)
 //!            --queries Q (load-query: held-out queries, default 2000)
+//!            --solver exact|nystrom --landmarks M --seed S (grid, cascade, query; default
+//!            exact, 1024 landmarks, seed 0)
 //! ```
 //! `query <n> --save <path>` trains the cascade with fixed `C`/epsilon (no grid) and saves it;
 //! `load-query <n> <path>` loads it and times prediction on one core and batched, on the
@@ -26,8 +28,8 @@ use std::time::Instant;
 use ridi_features::FeatureConfig;
 use ridi_features::FeatureMatrixRef;
 use ridi_regress::{
-    Cascade, CascadeParams, GridSpec, Precompute, ProgressEvent, RegressorChoice, SolverConfig,
-    Storage, Svc, SvcParams, Svr, SvrParams, TrainingSet,
+    Cascade, CascadeParams, GridSpec, Nystrom, Precompute, ProgressEvent, RegressorChoice, Solver,
+    SolverConfig, Storage, Svc, SvcParams, Svr, SvrParams, TrainingSet,
 };
 
 fn arg<T: std::str::FromStr>(args: &[String], name: &str, default: T) -> T {
@@ -54,6 +56,9 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     }
     if args.iter().any(|a| a == "--precompute-classifier") {
         solver.classifier_kernel = Precompute::Auto;
+    }
+    if let Some(i) = args.iter().position(|a| a == "--max-iter") {
+        solver.smo.max_iter = args.get(i + 1).and_then(|v| v.parse().ok());
     }
     if task == "load-query" {
         return load_query(&args, n, k);
@@ -137,10 +142,24 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 Some("half") => Storage::Half,
                 Some(other) => return Err(format!("unknown storage {other}").into()),
             };
+            let method = match args
+                .iter()
+                .position(|a| a == "--solver")
+                .and_then(|i| args.get(i + 1))
+                .map(String::as_str)
+            {
+                None | Some("exact") => Solver::Exact,
+                Some("nystrom") => Solver::Nystrom(Nystrom::new(
+                    arg(&args, "--landmarks", Nystrom::DEFAULT_LANDMARKS),
+                    arg(&args, "--seed", 0),
+                )?),
+                Some(other) => return Err(format!("unknown solver {other}").into()),
+            };
             let params = CascadeParams {
                 regressors,
                 solver,
                 storage,
+                method,
                 ..CascadeParams::default()
             };
             let t = Instant::now();
@@ -159,7 +178,11 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             };
             let model = Cascade::train(&set, &params, &mut progress)?;
             let train = t.elapsed().as_secs_f64();
-            println!("storage: {:?}", model.stored_as());
+            println!(
+                "storage: {:?}, solver {:?}",
+                model.stored_as(),
+                model.solver()
+            );
             if let Some(path) = args
                 .iter()
                 .position(|a| a == "--save")
@@ -278,6 +301,7 @@ fn load_query(args: &[String], n: usize, k: usize) -> Result<(), Box<dyn std::er
     let dim = all.dim;
     let held_x = all.x[n * dim..].to_vec();
     let held_p = all.placement[n..].to_vec();
+    let held_y = all.y[n..].to_vec();
     drop(all);
     // Peak memory from here on: the model and the queries, not the generator's data.
     std::fs::write("/proc/self/clear_refs", "5")?;
@@ -302,6 +326,14 @@ fn load_query(args: &[String], n: usize, k: usize) -> Result<(), Box<dyn std::er
         .filter(|(a, b)| a.placement == **b)
         .count() as f64
         / nq as f64;
+    let rmse = (batch
+        .iter()
+        .zip(&held_y)
+        .map(|(a, t)| (a.velocity - *t).norm().powi(2))
+        .sum::<f64>()
+        / nq as f64)
+        .sqrt();
+    println!("held-out velocity RMSE {rmse:.4} m/s");
     println!(
         "predict_one, one thread, {nq} held-out queries: stream order {:.3} ms wall / {:.3} ms CPU, \
          shuffled {:.3} ms wall / {:.3} ms CPU per query",
@@ -319,6 +351,9 @@ fn load_query(args: &[String], n: usize, k: usize) -> Result<(), Box<dyn std::er
         nq as f64 / bt,
         peak_mb()
     );
+    if model.solver() != ridi_regress::Solver::Exact {
+        return Ok(());
+    }
     let train = synth::generate(n, k, 150, 42);
     let t = Instant::now();
     let r = model.rounding_effect(FeatureMatrixRef::new(&train.x, dim)?, q)?;

@@ -90,13 +90,15 @@ pub enum RegressError {
     /// The file was written by another format version: an older one (retrain the model) or a
     /// newer or unknown one.
     #[error(
-        "unsupported model file version {found}: this build reads version {supported} only \
-         (retrain a model from an older build; a newer one needs a newer build)"
+        "unsupported model file version {found}: this build reads versions {exact} (exact \
+         models) and {supported} (Nyström models) only (retrain a model from an older build; \
+         a newer one needs a newer build)",
+        exact = crate::model_file::EXACT_VERSION
     )]
     UnsupportedVersion {
         /// Version in the file.
         found: u32,
-        /// Version this build writes and reads.
+        /// Newest version this build writes and reads ([`crate::MODEL_FORMAT_VERSION`]).
         supported: u32,
     },
     /// The file ends before the length its header announces (or that length is corrupt).

@@ -14,6 +14,7 @@ use serde::{Deserialize, Serialize};
 use crate::cache::{FullKernel, KernelRows};
 use crate::config::SolverConfig;
 use crate::error::RegressError;
+use crate::linear::SplitMix64;
 use crate::progress::{Progress, ProgressEvent, Stage};
 use crate::svr::{self, SvrDual};
 
@@ -103,19 +104,8 @@ pub(crate) fn assign_folds(
         .map(|g| groups.iter().filter(|x| *x == g).count())
         .collect();
     // Fisher-Yates with SplitMix64: deterministic across platforms and library versions.
-    let mut state = seed;
-    let mut next = || {
-        state = state.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = state;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        z ^ (z >> 31)
-    };
     let mut order: Vec<usize> = (0..distinct.len()).collect();
-    for i in (1..order.len()).rev() {
-        let j = (next() % (i as u64 + 1)) as usize;
-        order.swap(i, j);
-    }
+    SplitMix64(seed).shuffle(&mut order);
     let mut fold_size = vec![0usize; k];
     let mut fold_of_group = vec![0usize; distinct.len()];
     for (rank, &g) in order.iter().enumerate() {
@@ -136,6 +126,31 @@ pub(crate) fn assign_folds(
     Ok((fold, k))
 }
 
+/// What every search starts with (after checking the spec): the fold of each sample, the
+/// number of folds (an error names the placement), the `C` values sorted and distinct (the
+/// chains index them) and the epsilon values.
+pub(crate) type Prepared = (Vec<usize>, usize, Vec<f64>, Vec<f64>);
+
+/// [`Prepared`] for one placement's search.
+pub(crate) fn prepare(
+    groups: &[u64],
+    spec: &GridSpec,
+    placement: &str,
+) -> Result<Prepared, RegressError> {
+    spec.validate()?;
+    let (fold, k) = assign_folds(groups, spec.folds, spec.seed).map_err(|e| match e {
+        RegressError::TooFewSequences { found, .. } => RegressError::TooFewSequences {
+            placement: placement.to_string(),
+            found,
+        },
+        other => other,
+    })?;
+    let mut cs = spec.c.clone();
+    cs.sort_by(f64::total_cmp);
+    cs.dedup();
+    Ok((fold, k, cs, spec.epsilon.clone()))
+}
+
 /// Best `(C, epsilon)` of each channel from a results table (lowest MSE; ties to the first
 /// row, i.e. smaller `C`, then smaller epsilon).
 pub(crate) fn best(rows: &[GridRow], channels: usize) -> Vec<(f64, f64)> {
@@ -153,7 +168,7 @@ pub(crate) fn best(rows: &[GridRow], channels: usize) -> Vec<(f64, f64)> {
 }
 
 /// Result of one grid point of a chain: `(C index, epsilon index, MSE, iterations)`.
-type ChainPoint = (usize, usize, f64, usize);
+pub(crate) type ChainPoint = (usize, usize, f64, usize);
 
 /// Orders the grid points into warm-start chains of `(C index, epsilon index)`, one per `C`
 /// with epsilon descending: each fit starts from the previous one of its chain (for
@@ -161,7 +176,7 @@ type ChainPoint = (usize, usize, f64, usize);
 /// the widest tube, has few support vectors and is cheap cold. On the paper grid this takes
 /// 40 % fewer SMO iterations than chains along `C` with scaled warm starts, and leaves
 /// `|C|` independent chains per fold and channel for the threads.
-fn chains(cs: &[f64], eps: &[f64]) -> Vec<Vec<(usize, usize)>> {
+pub(crate) fn chains(cs: &[f64], eps: &[f64]) -> Vec<Vec<(usize, usize)>> {
     let mut by_eps: Vec<usize> = (0..eps.len()).collect();
     by_eps.sort_by(|&a, &b| eps[b].total_cmp(&eps[a]));
     (0..cs.len())
@@ -181,19 +196,8 @@ pub(crate) fn search(
     placement: &str,
     progress: &mut dyn Progress,
 ) -> Result<Vec<GridRow>, RegressError> {
-    spec.validate()?;
     let smo = &solver.smo;
-    let (fold, k) = assign_folds(groups, spec.folds, spec.seed).map_err(|e| match e {
-        RegressError::TooFewSequences { found, .. } => RegressError::TooFewSequences {
-            placement: placement.to_string(),
-            found,
-        },
-        other => other,
-    })?;
-    let mut cs = spec.c.clone();
-    cs.sort_by(f64::total_cmp);
-    cs.dedup();
-    let eps = spec.epsilon.clone();
+    let (fold, k, cs, eps) = prepare(groups, spec, placement)?;
     let channels = targets.len();
     let total = k * channels * eps.len() * cs.len();
     let stage = Stage::Grid { placement };
@@ -307,10 +311,28 @@ pub(crate) fn search(
     if cancelled.load(Ordering::Relaxed) {
         return Err(RegressError::Cancelled);
     }
+    let per_task: Vec<(usize, usize, Vec<ChainPoint>)> = tasks
+        .iter()
+        .zip(results)
+        .map(|(&(f, ch, _), res)| (f, ch, res))
+        .collect();
+    Ok(tabulate(placement, &cs, &eps, channels, k, &per_task))
+}
+
+/// The results table in `(channel, C, epsilon)` order from the chain results of every
+/// `(fold, channel)` task (`cs` sorted and distinct, as the chains index it).
+pub(crate) fn tabulate(
+    placement: &str,
+    cs: &[f64],
+    eps: &[f64],
+    channels: usize,
+    k: usize,
+    results: &[(usize, usize, Vec<ChainPoint>)],
+) -> Vec<GridRow> {
     // (MSE, iterations) by channel, C, epsilon and fold.
     let (nc, ne) = (cs.len(), eps.len());
     let mut cell = vec![(f64::NAN, 0usize); channels * nc * ne * k];
-    for (&(f, ch, _), res) in tasks.iter().zip(&results) {
+    for (f, ch, res) in results {
         for &(ci, e, mse, it) in res {
             cell[((ch * nc + ci) * ne + e) * k + f] = (mse, it);
         }
@@ -333,7 +355,7 @@ pub(crate) fn search(
             }
         }
     }
-    Ok(table)
+    table
 }
 
 #[cfg(test)]

@@ -42,6 +42,42 @@
 //! distance pass per placement feeds the classifier and is reused by the regressors
 //! ([`Cascade::predict`] batches with GEMM, [`Cascade::predict_one`] streams the rows once).
 //!
+//! # Nyström solver
+//!
+//! [`CascadeParams::method`] = [`Solver::Nystrom`] trains the same cascade approximately:
+//! `m` landmarks (default 1024) drawn uniformly from all training rows with a fixed seed,
+//! the RBF kernel (same widths) projected on the span of their feature maps,
+//! `φ(x) = Λ^{-1/2} Uᵀ k(L, x)` with `K(L, L) = UΛUᵀ` (eigenvalues below `1e-6` of the largest
+//! dropped), and every machine linear on `φ`: the one-vs-one classifier (same pairs, `C` and
+//! votes) by the dual coordinate descent of Hsieh et al. (2008), each epsilon-SVR (same `C`,
+//! epsilon and grid) by that of Ho & Lin (2012), with LIBLINEAR's stopping rules
+//! ([`Nystrom::DEFAULT_TOL`]). What is approximated: the kernel beyond the landmarks' span,
+//! and the offset, which a constant feature carries and so is regularized (the regressors fit
+//! targets centred on their mean). Training is the landmarks' fixed cost (`O(m²·dim + m³)`)
+//! plus `O(rows·m·(dim + m))` for the features and `O(rows·m)` per epoch (the epochs to
+//! LIBLINEAR's tolerance grew with the rows in the measurement below); the model keeps
+//! the landmarks (in the same [`Storage`]) and one weight per landmark and machine, `W^{-1/2}`
+//! folded in; a query is one kernel row against the landmarks. With every training row a
+//! landmark it reproduces the exact cascade to within 1 cm/s (tested); with fewer it
+//! approximates it (tested bounds).
+//!
+//! Measured once on synthetic IMU-like features (`benches/synth.rs`, 1200 values, 4
+//! placements, `C` = 10, epsilon = 0.01, no grid; 2 shared cores of an Intel Xeon, load
+//! average about 5 from another job), `cargo run --release -p ridi-regress --example
+//! svr_timing -- query N --solver exact|nystrom --save F`, then `load-query N F`:
+//!
+//! | rows | solver | train | peak RSS | model | one query | held-out RMSE | placement |
+//! | --- | --- | --- | --- | --- | --- | --- | --- |
+//! | 20,000 | exact | 23.0 s | 510 MB | 15.0 MB | 0.34 ms | 0.180 m/s | 0.953 |
+//! | 20,000 | Nyström 1024 | 18.8 s | 378 MB | 3.9 MB | 0.19 ms | 0.282 m/s | 0.943 |
+//! | 40,000 | exact | 94.1 s | 1466 MB | 25.9 MB | 0.61 ms | 0.279 m/s | 0.962 |
+//! | 40,000 | Nyström 1024 | 71.3 s | 632 MB | 3.9 MB | 0.18 ms | 0.378 m/s | 0.970 |
+//!
+//! (one query: CPU time on one thread; held-out: 2000 windows of later sequences.) The
+//! model and the query no longer grow with the rows; on these features 1024 landmarks cost
+//! about 0.1 m/s of RMSE, and the query is bound by projecting it (544 principal directions
+//! here) and streaming the landmarks, above the 50 µs aimed for.
+//!
 //! # Small or degenerate placements
 //!
 //! - A placement name without samples, or with fewer than
@@ -55,8 +91,8 @@
 //! # Model files
 //!
 //! [`Cascade::save`] and [`Cascade::load`] (or [`Cascade::to_bytes`] and
-//! [`Cascade::from_bytes`]): the magic number [`MODEL_MAGIC`], the format version
-//! [`MODEL_FORMAT_VERSION`], a CRC32, and a bincode 2 payload including the
+//! [`Cascade::from_bytes`]): the magic number [`MODEL_MAGIC`], the format version (7 for an
+//! exact model, 8 = [`MODEL_FORMAT_VERSION`] for a Nyström one), a CRC32, and a bincode 2 payload including the
 //! [`ridi_features::FeatureConfig`]; atomic writes, deterministic bytes. That configuration is
 //! how a model is used: its features must be computed with it, and its velocities are in the S
 //! its `up_axis` defines (give the same `up_axis` to a correction of them, ridi-correct's
@@ -128,10 +164,12 @@ mod grid;
 #[cfg(feature = "bench-internals")]
 mod internals;
 mod kernel;
+mod linear;
 #[cfg(feature = "linfa")]
 mod linfa_impl;
 mod matrix;
 mod model_file;
+mod nystrom;
 mod progress;
 mod projection;
 #[cfg(target_arch = "x86_64")]
@@ -152,6 +190,7 @@ pub use crate::grid::{GridRow, GridSpec};
 #[doc(hidden)]
 pub use crate::internals::{assign_folds, gram, sq_norms};
 pub use crate::model_file::{MODEL_FORMAT_VERSION, MODEL_MAGIC};
+pub use crate::nystrom::{Nystrom, Solver};
 pub use crate::progress::{NoProgress, Progress, ProgressEvent, Stage};
 pub use crate::smo::SmoSettings;
 pub use crate::svc::{Svc, SvcParams};

@@ -18,6 +18,12 @@
 //! an optional speed regressor per placement ([`crate::CascadeParams::speed`]); the feature
 //! configuration with its definition of S (`up_axis`) and the orientation its inputs come from
 //! (`orientation`).
+//! Version 8 is a Nyström model ([`crate::Solver::Nystrom`]): a kind tag (1), the cascade
+//! exactly as version 7 lays it out (its placements without samples), then the landmarks in
+//! the same storage and one weight per landmark and machine. An exact model is still written
+//! as version 7, so its bytes did not change; both are read. An unknown kind is a decode
+//! error.
+//!
 //! Older files are refused with [`RegressError::UnsupportedVersion`] (retrain the model):
 //! version 6 had neither `up_axis` nor `orientation` (its S was always the paper's, its
 //! orientation whatever the caller passed), version 5 no speed regressor, version 4 stored
@@ -37,8 +43,17 @@ use crate::error::RegressError;
 
 /// The first bytes of every model file.
 pub const MODEL_MAGIC: [u8; 8] = *b"RIDIREG\0";
-/// The model file format version this build writes and reads.
-pub const MODEL_FORMAT_VERSION: u32 = 7;
+/// The newest model file format version this build writes and reads: 8, a Nyström model
+/// ([`crate::Solver::Nystrom`]). An exact model is written as version 7, byte for byte as
+/// before version 8 existed; this build reads both ([`Cascade::format_version`]).
+pub const MODEL_FORMAT_VERSION: u32 = NYSTROM_VERSION;
+/// Format of an exact model.
+pub(crate) const EXACT_VERSION: u32 = 7;
+/// Format of a Nyström model: a kind tag, the cascade as in version 7, the Nyström part.
+pub(crate) const NYSTROM_VERSION: u32 = 8;
+/// The kind tag of a version-8 payload that is a Nyström model (the tag leaves room for
+/// other approximate kinds without another version).
+const NYSTROM_KIND: u32 = 1;
 const HEADER: usize = 8 + 4 + 8 + 4;
 /// Refuses to allocate for absurd payload lengths from a corrupt header.
 const MAX_PAYLOAD: u64 = 1 << 40;
@@ -75,11 +90,16 @@ impl Cascade {
 }
 
 fn encode(model: &Cascade) -> Result<Vec<u8>, RegressError> {
-    let payload = bincode::serde::encode_to_vec(model, bincode_config())
-        .map_err(|e| RegressError::Encode(e.to_string()))?;
+    let payload = match model.nystrom_parts() {
+        None => bincode::serde::encode_to_vec(model, bincode_config()),
+        Some(parts) => {
+            bincode::serde::encode_to_vec((NYSTROM_KIND, model, parts), bincode_config())
+        }
+    }
+    .map_err(|e| RegressError::Encode(e.to_string()))?;
     let mut out = Vec::with_capacity(HEADER + payload.len());
     out.extend_from_slice(&MODEL_MAGIC);
-    out.extend_from_slice(&MODEL_FORMAT_VERSION.to_le_bytes());
+    out.extend_from_slice(&model.format_version().to_le_bytes());
     out.extend_from_slice(&(payload.len() as u64).to_le_bytes());
     out.extend_from_slice(&crc32fast::hash(&payload).to_le_bytes());
     out.extend_from_slice(&payload);
@@ -111,7 +131,7 @@ fn decode(bytes: &[u8]) -> Result<Cascade, RegressError> {
         w
     };
     let version = u32::from_le_bytes(word(8..12)[..4].try_into().unwrap_or([0; 4]));
-    if version != MODEL_FORMAT_VERSION {
+    if version != EXACT_VERSION && version != NYSTROM_VERSION {
         return Err(RegressError::UnsupportedVersion {
             found: version,
             supported: MODEL_FORMAT_VERSION,
@@ -140,10 +160,29 @@ fn decode(bytes: &[u8]) -> Result<Cascade, RegressError> {
             found,
         });
     }
+    let decode_err = |e: bincode::error::DecodeError| RegressError::Decode(e.to_string());
+    let mut rest = payload;
+    if version == NYSTROM_VERSION {
+        let (kind, used): (u32, usize) =
+            bincode::serde::decode_from_slice(rest, bincode_config()).map_err(decode_err)?;
+        if kind != NYSTROM_KIND {
+            return Err(RegressError::Decode(format!(
+                "unknown model kind {kind} in a version {version} file (this build knows kind \
+                 {NYSTROM_KIND}, Nyström)"
+            )));
+        }
+        rest = &rest[used..];
+    }
     let (mut model, used): (Cascade, usize) =
-        bincode::serde::decode_from_slice(payload, bincode_config())
-            .map_err(|e| RegressError::Decode(e.to_string()))?;
-    if used != payload.len() {
+        bincode::serde::decode_from_slice(rest, bincode_config()).map_err(decode_err)?;
+    rest = &rest[used..];
+    if version == NYSTROM_VERSION {
+        let (parts, used) =
+            bincode::serde::decode_from_slice(rest, bincode_config()).map_err(decode_err)?;
+        model.set_nystrom_parts(parts);
+        rest = &rest[used..];
+    }
+    if !rest.is_empty() {
         return Err(RegressError::Decode("payload longer than the model".into()));
     }
     model.finish_decode()?;

@@ -4,8 +4,8 @@ use ridi_features::FeatureMatrixRef;
 use ridi_features::ridi_frames::StabHorizontal;
 use ridi_features::{FeatureChannel, FeatureConfig, FeatureError};
 use ridi_regress::{
-    Cascade, CascadeParams, GridSpec, NoProgress, ProgressEvent, RegressError, RegressorChoice,
-    Stage, Storage, StoredAs, Svc, SvcParams, TrainingSet,
+    Cascade, CascadeParams, GridSpec, NoProgress, Nystrom, ProgressEvent, RegressError,
+    RegressorChoice, Solver, Stage, Storage, StoredAs, Svc, SvcParams, TrainingSet,
 };
 use ridi_test_support::{SplitMix64, assert_names_file};
 
@@ -278,13 +278,16 @@ fn training_is_deterministic_and_model_files_round_trip() {
             "cut at {cut}"
         );
     }
+    // Exact models are version 7 (8 is a Nyström model, whose payload this is not).
+    assert_eq!(&bytes[8..12], &7u32.to_le_bytes());
+    assert_eq!(a.format_version(), 7);
     let mut newer = bytes.clone();
-    newer[8..12].copy_from_slice(&8u32.to_le_bytes());
+    newer[8..12].copy_from_slice(&9u32.to_le_bytes());
     assert!(matches!(
         Cascade::from_bytes(&newer),
         Err(RegressError::UnsupportedVersion {
-            found: 8,
-            supported: 7
+            found: 9,
+            supported: 8
         })
     ));
     // Versions 1 (f32 samples), 2 (half precision only), 3 (an f32 block of leading
@@ -295,7 +298,7 @@ fn training_is_deterministic_and_model_files_round_trip() {
         older[8..12].copy_from_slice(&v.to_le_bytes());
         let err = Cascade::from_bytes(&older).unwrap_err();
         assert!(
-            matches!(err, RegressError::UnsupportedVersion { found, supported: 7 } if found == v)
+            matches!(err, RegressError::UnsupportedVersion { found, supported: 8 } if found == v)
         );
         assert!(err.to_string().contains("retrain"), "{err}");
     }
@@ -547,4 +550,271 @@ impl Data {
             feature_config: &self.config,
         }
     }
+}
+
+// ---- The Nyström solver ----
+
+fn fixed(storage: Storage, method: Solver) -> CascadeParams {
+    CascadeParams {
+        regressors: RegressorChoice::Fixed {
+            c: 10.0,
+            epsilon: 0.01,
+        },
+        storage,
+        method,
+        ..CascadeParams::default()
+    }
+}
+
+/// Largest velocity difference per channel between two sets of predictions, and the share
+/// of queries given the same placement.
+fn compare(a: &[ridi_regress::Prediction], b: &[ridi_regress::Prediction]) -> (f64, [f64; 2]) {
+    let mut max = [0.0f64; 2];
+    let mut same = 0;
+    for (p, q) in a.iter().zip(b) {
+        if p.placement != q.placement {
+            continue;
+        }
+        same += 1;
+        for (ch, m) in max.iter_mut().enumerate() {
+            *m = m.max((p.velocity[ch] - q.velocity[ch]).abs());
+        }
+    }
+    (same as f64 / a.len() as f64, max)
+}
+
+#[test]
+fn nystrom_with_every_row_a_landmark_reproduces_the_exact_cascade() {
+    // 480 rows, all of them landmarks: φ(a)·φ(b) is then the kernel itself on the training
+    // rows, and the linear machines are the kernel machines except for the offset, which
+    // the linear ones regularize, and the stopping rules. Tight tolerances on both sides.
+    let data = make(3, 4, 40, 1);
+    let test = make(3, 2, 20, 99);
+    let xt = FeatureMatrixRef::new(&test.x, 24).unwrap();
+    let mut exact = fixed(Storage::Half, Solver::Exact);
+    exact.solver.smo.tol = 1e-5;
+    let exact = Cascade::train(&data.set(), &exact, &mut NoProgress).unwrap();
+    let cfg = Nystrom::new(480, 0).unwrap().with_tol(1e-4).unwrap();
+    let mut nys = fixed(Storage::Half, Solver::Nystrom(cfg));
+    nys.solver.smo.max_iter = Some(20_000);
+    let nys = Cascade::train(&data.set(), &nys, &mut NoProgress).unwrap();
+    assert_eq!(nys.solver(), Solver::Nystrom(cfg));
+    assert_eq!(nys.stored_samples(0), 480);
+    let (pe, pn) = (exact.predict(xt).unwrap(), nys.predict(xt).unwrap());
+    let (agree, max) = compare(&pe, &pn);
+    assert_eq!(agree, 1.0);
+    // Measured: 4.5e-3 and 1.7e-3 m/s on targets of about 1 m/s (the regularized offset);
+    // 1 cm/s is the bound.
+    assert!(max.iter().all(|&d| d < 1e-2), "{max:?}");
+    // The single-query path agrees with the batched one (summation order only).
+    for (i, b) in pn.iter().enumerate() {
+        let one = nys.predict_one(xt.row(i)).unwrap();
+        assert_eq!(one.placement, b.placement);
+        assert!((one.velocity - b.velocity).norm() < 1e-4, "query {i}");
+    }
+}
+
+#[test]
+fn nystrom_with_few_landmarks_stays_within_a_measured_bound_of_the_exact_cascade() {
+    let data = make(3, 4, 40, 1);
+    let test = make(3, 2, 20, 99);
+    let xt = FeatureMatrixRef::new(&test.x, 24).unwrap();
+    let exact = Cascade::train(
+        &data.set(),
+        &fixed(Storage::DEFAULT, Solver::Exact),
+        &mut NoProgress,
+    )
+    .unwrap();
+    let pe = exact.predict(xt).unwrap();
+    let mse = |p: &[ridi_regress::Prediction]| {
+        p.iter()
+            .zip(&test.y)
+            .map(|(p, t)| (p.velocity - *t).norm().powi(2))
+            .sum::<f64>()
+            / p.len() as f64
+    };
+    // 480 rows. Measured (max |dv| S-x, S-z; held-out MSE, exact 4.0e-4): 120 landmarks
+    // 0.048, 0.037 m/s, 1.03e-3; 60 landmarks 0.070, 0.046 m/s, 1.23e-3. Bounds 1.5x that.
+    for (m, bound, mse_bound) in [(120, 0.072, 1.6e-3), (60, 0.105, 1.9e-3)] {
+        let cfg = Nystrom::new(m, 3).unwrap();
+        let model = Cascade::train(
+            &data.set(),
+            &fixed(Storage::DEFAULT, Solver::Nystrom(cfg)),
+            &mut NoProgress,
+        )
+        .unwrap();
+        let pn = model.predict(xt).unwrap();
+        let (agree, max) = compare(&pe, &pn);
+        assert_eq!(agree, 1.0, "{m} landmarks");
+        assert!(max.iter().all(|&d| d < bound), "{m} landmarks: {max:?}");
+        assert!(
+            mse(&pn) < mse_bound,
+            "{m} landmarks: MSE {} (exact {})",
+            mse(&pn),
+            mse(&pe)
+        );
+    }
+}
+
+#[test]
+fn nystrom_classifier_separates_separable_placements_and_the_grid_runs() {
+    // Four placements, each shifting its own quarter of the features: separable.
+    let data = make(4, 3, 20, 11);
+    let test = make(4, 1, 25, 12);
+    let xt = FeatureMatrixRef::new(&test.x, 24).unwrap();
+    let params = CascadeParams {
+        method: Solver::Nystrom(Nystrom::new(64, 5).unwrap()),
+        ..small_grid()
+    };
+    let mut events = Vec::new();
+    let mut progress = |e: &ProgressEvent<'_>| {
+        events.push((format!("{:?}", e.stage), e.done, e.total));
+        true
+    };
+    let model = Cascade::train(&data.set(), &params, &mut progress).unwrap();
+    let pred = model.predict(xt).unwrap();
+    let correct = pred
+        .iter()
+        .zip(&test.placement)
+        .filter(|(p, t)| p.placement == **t)
+        .count();
+    assert_eq!(correct, 100, "placement accuracy {correct}/100");
+    // The grid: 4 placements × 2 channels × 4 points, the best point chosen per channel.
+    assert_eq!(model.grid_results().len(), 32);
+    for p in 0..4 {
+        for (ch, &(c, e)) in model.regressor_params(p).unwrap().iter().enumerate() {
+            let best = model
+                .grid_results()
+                .iter()
+                .filter(|r| r.placement == data.names[p] && r.channel as usize == ch)
+                .min_by(|a, b| a.mse.total_cmp(&b.mse))
+                .unwrap();
+            assert_eq!((best.c, best.epsilon), (c, e));
+            assert!(best.mse.is_finite() && best.iterations > 0);
+        }
+    }
+    assert!(
+        events
+            .iter()
+            .any(|e| e.0 == "Classifier" && e.1 == 6 && e.2 == 6)
+    );
+    assert!(
+        events
+            .iter()
+            .any(|e| e.0.starts_with("Grid") && e.1 == 24 && e.2 == 24)
+    );
+    // Known placements skip the classifier.
+    let forced = model.predict_with_placement(xt, 2).unwrap();
+    assert_eq!(forced.len(), 100);
+}
+
+#[test]
+fn nystrom_models_are_deterministic_compact_and_round_trip() {
+    let data = make(2, 3, 30, 5);
+    let cfg = Nystrom::new(32, 9).unwrap();
+    let params = CascadeParams {
+        speed: true,
+        ..fixed(Storage::DEFAULT, Solver::Nystrom(cfg))
+    };
+    let a = Cascade::train(&data.set(), &params, &mut NoProgress).unwrap();
+    let b = Cascade::train(&data.set(), &params, &mut NoProgress).unwrap();
+    let bytes = a.to_bytes().unwrap();
+    assert_eq!(
+        bytes,
+        b.to_bytes().unwrap(),
+        "same data and seed, same bytes"
+    );
+    assert_eq!(&bytes[8..12], &8u32.to_le_bytes());
+    assert_eq!(a.format_version(), 8);
+    let other = CascadeParams {
+        method: Solver::Nystrom(Nystrom::new(32, 10).unwrap()),
+        ..params.clone()
+    };
+    let c = Cascade::train(&data.set(), &other, &mut NoProgress).unwrap();
+    assert_ne!(
+        c.to_bytes().unwrap(),
+        bytes,
+        "another seed, other landmarks"
+    );
+    let back = Cascade::from_bytes(&bytes).unwrap();
+    assert_eq!(back, a);
+    let xt = data.set().features;
+    assert_eq!(back.predict(xt).unwrap(), a.predict(xt).unwrap());
+    assert!(back.speed_params(0).is_some());
+
+    // Both kinds load from files side by side.
+    let exact = Cascade::train(
+        &data.set(),
+        &fixed(Storage::DEFAULT, Solver::Exact),
+        &mut NoProgress,
+    )
+    .unwrap();
+    let dir = std::env::temp_dir().join(format!("ridi-regress-nystrom-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let (pa, pe) = (dir.join("nystrom.ridi"), dir.join("exact.ridi"));
+    a.save(&pa).unwrap();
+    exact.save(&pe).unwrap();
+    assert_eq!(Cascade::load(&pa).unwrap(), a);
+    assert_eq!(Cascade::load(&pe).unwrap(), exact);
+    assert_eq!(Cascade::load(&pe).unwrap().solver(), Solver::Exact);
+
+    // An unknown kind tag (the payload's first byte) is refused, by name.
+    let mut kind = bytes.clone();
+    kind[24] = 7;
+    let crc = crc32fast::hash(&kind[24..]);
+    kind[20..24].copy_from_slice(&crc.to_le_bytes());
+    match Cascade::from_bytes(&kind) {
+        Err(RegressError::Decode(m)) => assert!(m.contains("unknown model kind 7"), "{m}"),
+        other => panic!("expected a decode error, got {other:?}"),
+    }
+    // A corrupt Nyström part (a weight made NaN, checksum fixed) is refused.
+    let mut nan = bytes.clone();
+    let at = nan.len() - 8;
+    nan[at..].copy_from_slice(&f64::NAN.to_le_bytes());
+    let crc = crc32fast::hash(&nan[24..]);
+    nan[20..24].copy_from_slice(&crc.to_le_bytes());
+    assert!(matches!(
+        Cascade::from_bytes(&nan),
+        Err(RegressError::Decode(_))
+    ));
+    std::fs::remove_dir_all(&dir).unwrap();
+
+    // The model is the landmarks and a weight per landmark and machine, not the rows.
+    assert!(
+        bytes.len() < exact.to_bytes().unwrap().len(),
+        "{} bytes",
+        bytes.len()
+    );
+    assert!(matches!(
+        a.rounding_effect(xt, xt),
+        Err(RegressError::InvalidParam(_))
+    ));
+}
+
+#[test]
+fn nystrom_settings_are_checked() {
+    for bad in [0, 1, Nystrom::MAX_LANDMARKS + 1] {
+        assert!(
+            matches!(Nystrom::new(bad, 0), Err(RegressError::InvalidParam(_))),
+            "{bad}"
+        );
+    }
+    let ok = Nystrom::new(2, 0).unwrap();
+    assert_eq!(
+        (ok.landmarks(), ok.seed(), ok.tol()),
+        (2, 0, Nystrom::DEFAULT_TOL)
+    );
+    for tol in [0.0, -1.0, f64::NAN, f64::INFINITY] {
+        assert!(ok.with_tol(tol).is_err(), "{tol}");
+    }
+    // The training set's own checks still come first.
+    let data = make(2, 2, 10, 1);
+    let params = CascadeParams {
+        classifier_c: -1.0,
+        ..fixed(Storage::DEFAULT, Solver::Nystrom(ok))
+    };
+    assert!(matches!(
+        Cascade::train(&data.set(), &params, &mut NoProgress),
+        Err(RegressError::InvalidParam(_))
+    ));
 }

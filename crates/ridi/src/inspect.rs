@@ -3,7 +3,7 @@
 use ridi_data::{Format, Sequence};
 use ridi_features::FeatureChannel;
 use ridi_frames::UpAxis;
-use ridi_regress::{Cascade, GridRow, MODEL_FORMAT_VERSION, StoredAs};
+use ridi_regress::{Cascade, GridRow, Solver, StoredAs};
 use serde::Serialize;
 
 use crate::orientation::Orientation;
@@ -267,8 +267,11 @@ impl std::fmt::Display for Inspection {
 /// trained), as JSON with `--json`.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct ModelInspection {
-    /// Model file format version ([`ridi_regress::MODEL_FORMAT_VERSION`]).
+    /// Model file format version ([`Cascade::format_version`]: 7 exact, 8 Nyström).
     pub format_version: u32,
+    /// Landmarks of a Nyström model (`None`: exact kernel machines,
+    /// [`ridi_regress::Solver`]); every placement shares them.
+    pub landmarks: Option<usize>,
     /// Frames per feature window.
     pub window: usize,
     /// Frames between training windows.
@@ -357,7 +360,11 @@ pub fn inspect_model(model: &Cascade) -> ModelInspection {
         })
         .collect();
     ModelInspection {
-        format_version: MODEL_FORMAT_VERSION,
+        format_version: model.format_version(),
+        landmarks: match model.solver() {
+            Solver::Exact => None,
+            Solver::Nystrom(n) => Some(n.landmarks()),
+        },
         window: config.window,
         step: config.step,
         feature_sigma: config.feature_sigma,
@@ -403,6 +410,12 @@ impl std::fmt::Display for ModelInspection {
             f,
             "orientation: {orientation} (track and eval use the same)"
         )?;
+        if let Some(m) = self.landmarks {
+            writeln!(
+                f,
+                "solver: Nyström, {m} landmarks shared by every placement (their samples below)"
+            )?;
+        }
         match self.projected_components {
             None => writeln!(f, "samples stored: {} values in half precision", self.dim)?,
             Some(components) => writeln!(

@@ -14,10 +14,11 @@
 //! and reuses thread-local buffers.
 //!
 //! One module per job: `params` (what to train with), `train` (the training set, its checks and
-//! the fits), `predict` (the batched and the single-query path), `rounding` (what the compact
+//! the fits), `approx` (the fits by the Nyström solver), `predict` (the batched and the single-query path), `rounding` (what the compact
 //! storage changes) and `validate` (the consistency checks of a decoded model file). This
 //! module holds the trained model and what it reports about itself.
 
+mod approx;
 mod params;
 mod predict;
 mod rounding;
@@ -28,6 +29,7 @@ use ridi_features::FeatureConfig;
 use serde::{Deserialize, Serialize};
 
 use crate::grid::GridRow;
+use crate::nystrom::{Nystrom, Solver};
 use crate::projection::Projection;
 use crate::store::SampleRows;
 use crate::svr::FitInfo;
@@ -49,6 +51,30 @@ pub struct Cascade {
     grid: Vec<GridRow>,
     /// Principal directions the samples are stored on (`None`: half-precision features).
     projection: Option<Projection>,
+    /// The Nyström solver's landmarks and weights ([`Solver::Nystrom`]); its placements then
+    /// store no samples. Not in the exact model's payload (whose bytes stay those of format
+    /// 7): the model file writes it after the cascade, as format 8.
+    #[serde(skip)]
+    nystrom: Option<Box<NystromParts>>,
+}
+
+/// What a Nyström model adds to the cascade: the landmarks shared by every machine and one
+/// weight per landmark and machine (`W^{-1/2}` folded in); the offsets stay where the exact
+/// model keeps them (`ClassifierHead::rho`, `ClassModel::reg_rho`, `SpeedRegressor::rho`).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub(crate) struct NystromParts {
+    /// Landmark draw (the landmarks asked for and the seed).
+    config: Nystrom,
+    landmarks: SampleRows,
+    /// Squared norms of the stored landmarks: recomputed on load, not stored.
+    #[serde(skip)]
+    norms: Vec<f32>,
+    /// Rank of `W` kept per width: regressors, classifier.
+    rank: [u32; 2],
+    /// `landmarks × pairs` row-major: classifier weights.
+    clf_weights: Vec<f64>,
+    /// Per placement, `landmarks × channels` row-major: regressor weights.
+    reg_weights: Vec<Vec<f64>>,
 }
 
 /// How a trained model stores its samples ([`Cascade::stored_as`]).
@@ -161,8 +187,44 @@ impl Cascade {
         }
     }
 
-    /// Stored samples of placement `p` (shared by its classifier part and both regressors).
+    /// Stored samples of placement `p` (shared by its classifier part and both regressors);
+    /// for a Nyström model, the landmarks, which every placement shares.
     pub fn stored_samples(&self, p: usize) -> usize {
-        self.classes.get(p).map_or(0, |c| c.samples.rows())
+        match &self.nystrom {
+            Some(n) if p < self.classes.len() => n.landmarks.rows(),
+            _ => self.classes.get(p).map_or(0, |c| c.samples.rows()),
+        }
+    }
+
+    /// How the model was trained: [`Solver::Exact`], or [`Solver::Nystrom`] with the landmarks
+    /// it holds (fewer than asked for when the training set had fewer rows) and their seed.
+    pub fn solver(&self) -> Solver {
+        match &self.nystrom {
+            None => Solver::Exact,
+            Some(n) => Solver::Nystrom(
+                Nystrom::new(n.landmarks.rows().max(2), n.config.seed())
+                    .and_then(|c| c.with_tol(n.config.tol()))
+                    .unwrap_or(n.config),
+            ),
+        }
+    }
+
+    /// The Nyström part the model file writes after the cascade (format 8).
+    pub(crate) fn nystrom_parts(&self) -> Option<&NystromParts> {
+        self.nystrom.as_deref()
+    }
+
+    /// Attaches a decoded Nyström part (before [`Self::finish_decode`]).
+    pub(crate) fn set_nystrom_parts(&mut self, parts: NystromParts) {
+        self.nystrom = Some(Box::new(parts));
+    }
+
+    /// Format version of this model's file: 7 for an exact model, 8 for a Nyström one.
+    pub fn format_version(&self) -> u32 {
+        if self.nystrom.is_some() {
+            crate::model_file::NYSTROM_VERSION
+        } else {
+            crate::model_file::EXACT_VERSION
+        }
     }
 }

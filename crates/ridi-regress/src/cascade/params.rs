@@ -6,6 +6,7 @@ use serde::{Deserialize, Serialize};
 use crate::config::SolverConfig;
 use crate::error::RegressError;
 use crate::grid::GridSpec;
+use crate::nystrom::Solver;
 use ridi_features::FeatureMatrixRef;
 
 /// How the RBF width is chosen.
@@ -109,6 +110,10 @@ pub struct CascadeParams {
     pub regressors: RegressorChoice,
     /// Solver, memory and kernel strategy.
     pub solver: SolverConfig,
+    /// Exact kernel machines (SMO, the default) or their Nyström approximation (linear
+    /// machines on features of shared landmarks; [`Solver::Nystrom`]). Both take the same
+    /// `C`, epsilon, RBF widths and grid.
+    pub method: Solver,
     /// Placements with fewer training samples are rejected with
     /// [`RegressError::NotEnoughData`] (default 10).
     pub min_class_samples: usize,
@@ -132,6 +137,7 @@ impl Default for CascadeParams {
             regressor_gamma: Gamma::InverseDim,
             regressors: RegressorChoice::Grid(GridSpec::default()),
             solver: SolverConfig::default(),
+            method: Solver::Exact,
             min_class_samples: 10,
             storage: Storage::DEFAULT,
             speed: false,

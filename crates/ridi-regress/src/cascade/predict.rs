@@ -6,7 +6,7 @@ use std::cell::RefCell;
 use rayon::prelude::*;
 use ridi_features::ridi_frames::StabHorizontal;
 
-use super::{Cascade, ClassModel};
+use super::{Cascade, ClassModel, NystromParts};
 use crate::error::RegressError;
 use crate::expansion::weighted_sums;
 use crate::kernel;
@@ -88,13 +88,17 @@ impl Cascade {
         FeatureMatrixRef::new(q, self.dim.max(1))?;
         Ok(SCRATCH.with(|s| {
             let s = &mut *s.borrow_mut();
+            let single = |c: &Self, q: &[f32], qn: f32, s: &mut Scratch| match &c.nystrom {
+                Some(n) => c.predict_single_nystrom(n, q, qn, s),
+                None => c.predict_single(q, qn, s),
+            };
             let Some(p) = &self.projection else {
-                return self.predict_single(q, kernel::dot(q, q), s);
+                return single(self, q, kernel::dot(q, q), s);
             };
             let mut z = std::mem::take(&mut s.z);
             z.resize(p.stored_dim(), 0.0);
             let qn = p.project_one(q, &mut s.centred, &mut z);
-            let out = self.predict_single(&z, qn, s);
+            let out = single(self, &z, qn, s);
             s.z = z;
             out
         }))
@@ -155,6 +159,97 @@ impl Cascade {
         Prediction {
             placement,
             velocity: cl.velocity(v),
+        }
+    }
+
+    /// The single-query path of a Nyström model: one pass over the landmarks, then a dot
+    /// product per classifier pair and per channel of the chosen placement.
+    fn predict_single_nystrom(
+        &self,
+        n: &NystromParts,
+        q: &[f32],
+        qn: f32,
+        s: &mut Scratch,
+    ) -> Prediction {
+        let m = n.landmarks.rows();
+        s.dist.resize(m, 0.0);
+        s.kv.resize(m, 0.0);
+        n.landmarks.dots(q, 0, &mut s.dist);
+        kernel::dist_from_dots(&mut s.dist, qn, &n.norms);
+        let placement = match &self.classifier {
+            None => 0,
+            Some(head) => {
+                kernel::exp_neg_scaled(&s.dist, head.gamma, &mut s.kv);
+                s.dec.resize(head.pairs.len(), 0.0);
+                weighted_sum(&s.kv, &n.clf_weights, &mut s.dec);
+                s.dec.iter_mut().zip(&head.rho).for_each(|(v, r)| *v -= r);
+                s.votes.resize(self.classes.len(), 0);
+                svc::vote(&s.dec, &head.pairs, self.classes.len(), &mut s.votes)
+            }
+        };
+        if self
+            .classifier
+            .as_ref()
+            .is_none_or(|h| h.gamma != self.regressor_gamma)
+        {
+            kernel::exp_neg_scaled(&s.dist, self.regressor_gamma, &mut s.kv);
+        }
+        let cl = &self.classes[placement];
+        let mut v = [0.0f64; 3];
+        let v = &mut v[..cl.channels()];
+        weighted_sum(&s.kv, &n.reg_weights[placement], v);
+        Prediction {
+            placement,
+            velocity: cl.velocity(v),
+        }
+    }
+
+    /// The batched path of a Nyström model: one distance block from the queries to the
+    /// landmarks (as training computed the features), then weighted sums.
+    fn predict_block_nystrom(
+        &self,
+        n: &NystromParts,
+        q: FeatureMatrixRef<'_>,
+        forced: Option<usize>,
+        out: &mut [Prediction],
+    ) {
+        let (rows, m) = (q.rows(), n.landmarks.rows());
+        let (projected, qn) = match &self.projection {
+            Some(p) => {
+                let (z, n) = p.project(q);
+                (Some(z), n)
+            }
+            None => (None, kernel::sq_norms(q)),
+        };
+        let qv = projected.as_ref().map_or(q, FeatureMatrix::view);
+        let mut wide = Vec::new();
+        n.landmarks.rows_f32(0, m, &mut wide);
+        let lv = FeatureMatrixRef::trusted(&wide, n.landmarks.dim());
+        let mut d = vec![0.0f32; rows * m];
+        kernel::cross_sq_dist(qv, &qn, lv, &n.norms, &mut d);
+        let mut kv = vec![0.0f32; d.len()];
+        match (forced, &self.classifier) {
+            (Some(p), _) => out.iter_mut().for_each(|o| o.placement = p),
+            (None, None) => out.iter_mut().for_each(|o| o.placement = 0),
+            (None, Some(head)) => {
+                let np = head.pairs.len();
+                kernel::exp_neg_scaled(&d, head.gamma, &mut kv);
+                let mut dec = vec![0.0f64; rows * np];
+                weighted_sums(&kv, &n.clf_weights, np, &mut dec);
+                let mut votes = vec![0u32; self.classes.len()];
+                for (o, row) in out.iter_mut().zip(dec.chunks_exact_mut(np)) {
+                    row.iter_mut().zip(&head.rho).for_each(|(v, r)| *v -= r);
+                    o.placement = svc::vote(row, &head.pairs, self.classes.len(), &mut votes);
+                }
+            }
+        }
+        kernel::exp_neg_scaled(&d, self.regressor_gamma, &mut kv);
+        let mut v = [0.0f64; 3];
+        for (o, k) in out.iter_mut().zip(kv.chunks_exact(m)) {
+            let cl = &self.classes[o.placement];
+            let v = &mut v[..cl.channels()];
+            weighted_sum(k, &n.reg_weights[o.placement], v);
+            o.velocity = cl.velocity(v);
         }
     }
 
@@ -269,6 +364,9 @@ impl Cascade {
         forced: Option<usize>,
         out: &mut [Prediction],
     ) {
+        if let Some(n) = &self.nystrom {
+            return self.predict_block_nystrom(n, q, forced, out);
+        }
         let m = q.rows();
         let (projected, qn) = match (rows, &self.projection) {
             (Rows::Stored, Some(p)) => {

@@ -49,12 +49,20 @@ impl Cascade {
     /// Compares [`Self::predict`] with the same model evaluated with the exact `f32` training
     /// rows in full dimension: each stored row is matched to the row of `training` (the rows
     /// the model was trained on) whose stored form (rounded, or projected) it is. Measures
-    /// what the [`Storage`](crate::Storage) changes. Fails when a stored row has no match.
+    /// what the [`Storage`](crate::Storage) changes. Fails when a stored row has no match, and
+    /// for a Nyström model ([`Solver::Nystrom`](crate::Solver::Nystrom)).
     pub fn rounding_effect(
         &self,
         training: FeatureMatrixRef<'_>,
         queries: FeatureMatrixRef<'_>,
     ) -> Result<RoundingEffect, RegressError> {
+        if self.nystrom.is_some() {
+            return Err(RegressError::InvalidParam(
+                "rounding_effect compares an exact model with its training rows; a Nyström \
+                 model stores landmarks"
+                    .into(),
+            ));
+        }
         self.check_dim(training)?;
         self.check_dim(queries)?;
         let key = |bytes: &[u8]| {

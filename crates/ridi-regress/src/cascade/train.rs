@@ -5,6 +5,7 @@ use rayon::prelude::*;
 use ridi_features::FeatureConfig;
 use ridi_features::ridi_frames::StabHorizontal;
 
+use super::approx::Resolved;
 use super::{Cascade, ClassModel, ClassifierHead, SpeedRegressor};
 use super::{CascadeParams, RegressorChoice, Storage};
 use crate::config;
@@ -12,6 +13,7 @@ use crate::error::RegressError;
 use crate::f16mat::F16_MAX;
 use crate::grid;
 use crate::matrix::View as _;
+use crate::nystrom::{Nystrom, Solver};
 use crate::progress::{Progress, ProgressEvent, Stage};
 use crate::projection::Projection;
 use crate::store::SampleRows;
@@ -36,7 +38,7 @@ pub struct TrainingSet<'a> {
     pub feature_config: &'a FeatureConfig,
 }
 
-fn report(
+pub(super) fn report(
     progress: &mut dyn Progress,
     stage: Stage<'_>,
     done: usize,
@@ -46,6 +48,31 @@ fn report(
         Ok(())
     } else {
         Err(RegressError::Cancelled)
+    }
+}
+
+/// Targets of rows `idx` per channel: S-x, S-z and, as a third channel, the speed.
+pub(super) fn channel_targets(
+    data: &TrainingSet<'_>,
+    idx: &[usize],
+    channels: usize,
+) -> Vec<Vec<f64>> {
+    let target = |i: usize, ch: usize| {
+        let t = data.targets[i];
+        if ch < 2 { t[ch] } else { t.norm() }
+    };
+    (0..channels)
+        .map(|ch| idx.iter().map(|&i| target(i, ch)).collect())
+        .collect()
+}
+
+/// Names the placement in a grid search's lack of data.
+pub(super) fn in_placement(name: &str) -> impl FnOnce(RegressError) -> RegressError + '_ {
+    move |e| match e {
+        RegressError::NotEnoughData(m) => {
+            RegressError::NotEnoughData(format!("placement '{name}': {m}"))
+        }
+        other => other,
     }
 }
 
@@ -127,6 +154,10 @@ fn check_training_set(
         }
         RegressorChoice::Grid(g) => g.validate()?,
     }
+    if let Solver::Nystrom(n) = params.method {
+        // A deserialized config is checked too (the type's constructor checks the others).
+        Nystrom::new(n.landmarks(), n.seed())?.with_tol(n.tol())?;
+    }
     Ok(members)
 }
 
@@ -148,6 +179,15 @@ impl Cascade {
         };
         if projection.is_none() {
             check_f16_range(x)?;
+        }
+        if let Solver::Nystrom(cfg) = params.method {
+            let resolved = Resolved {
+                members,
+                gamma_c,
+                gamma_r,
+                projection,
+            };
+            return Self::train_nystrom(data, params, cfg, resolved, progress);
         }
 
         let (classifier, pair_duals) = if k >= 2 {
@@ -190,13 +230,7 @@ impl Cascade {
                 params.solver.regressor_kernel,
             );
             let channels = 2 + usize::from(params.speed);
-            let target = |i: usize, ch: usize| {
-                let t = data.targets[i];
-                if ch < 2 { t[ch] } else { t.norm() }
-            };
-            let targets: Vec<Vec<f64>> = (0..channels)
-                .map(|ch| idx.iter().map(|&i| target(i, ch)).collect())
-                .collect();
+            let targets = channel_targets(data, idx, channels);
             let chosen: Vec<(f64, f64)> = match &params.regressors {
                 RegressorChoice::Fixed { c, epsilon } => vec![(*c, *epsilon); channels],
                 RegressorChoice::Grid(spec) => {
@@ -210,12 +244,7 @@ impl Cascade {
                         name,
                         progress,
                     )
-                    .map_err(|e| match e {
-                        RegressError::NotEnoughData(m) => {
-                            RegressError::NotEnoughData(format!("placement '{name}': {m}"))
-                        }
-                        other => other,
-                    })?;
+                    .map_err(in_placement(name))?;
                     let best = grid::best(&table, channels);
                     grid_rows.extend(table);
                     best
@@ -268,6 +297,7 @@ impl Cascade {
             classes,
             grid: grid_rows,
             projection,
+            nystrom: None,
         })
     }
 }

@@ -11,7 +11,61 @@ impl Cascade {
         for cl in &mut self.classes {
             cl.norms = cl.samples.norms();
         }
-        self.check()
+        if let Some(n) = &mut self.nystrom {
+            n.norms = n.landmarks.norms();
+        }
+        self.check()?;
+        self.check_nystrom()
+    }
+
+    /// The Nyström part: landmarks in the model's storage, one weight per landmark and
+    /// machine, finite; placements without samples of their own.
+    fn check_nystrom(&self) -> Result<(), RegressError> {
+        let Some(n) = &self.nystrom else {
+            return Ok(());
+        };
+        let bad = |m: &str| Err(RegressError::Decode(format!("Nyström model: {m}")));
+        n.landmarks.check()?;
+        let m = n.landmarks.rows();
+        let stored_dim = self
+            .projection
+            .as_ref()
+            .map_or(self.dim, |p| p.stored_dim());
+        if m < 1
+            || n.landmarks.is_projected() != self.projection.is_some()
+            || n.landmarks.dim() != stored_dim
+            || n.norms.len() != m
+        {
+            return bad("landmark sizes");
+        }
+        let np = self.classifier.as_ref().map_or(0, |h| h.pairs.len());
+        if n.clf_weights.len() != m * np || n.reg_weights.len() != self.classes.len() {
+            return bad("weight sizes");
+        }
+        for (cl, w) in self.classes.iter().zip(&n.reg_weights) {
+            if cl.samples.rows() != 0 || w.len() != m * cl.channels() {
+                return bad("placement sizes");
+            }
+        }
+        let offsets = self.classes.iter().flat_map(|c| {
+            c.reg_rho
+                .iter()
+                .copied()
+                .chain(c.speed.as_ref().map(|s| s.rho))
+        });
+        let head = self.classifier.iter().flat_map(|h| h.rho.iter().copied());
+        if !n
+            .clf_weights
+            .iter()
+            .chain(n.reg_weights.iter().flatten())
+            .copied()
+            .chain(offsets)
+            .chain(head)
+            .all(f64::is_finite)
+        {
+            return bad("non-finite weight or offset");
+        }
+        Ok(())
     }
 
     /// Consistency checks after decoding (the checksum only guards against corruption, not
