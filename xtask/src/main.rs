@@ -141,6 +141,9 @@ struct TyrexArgs {
     /// accelerometer.
     #[arg(long, value_name = "SOURCE", default_value = "recorded", value_parser = ["recorded", "estimated"], conflicts_with = "variants")]
     orientation: String,
+    /// Train with the Nyström solver on this many landmarks instead of the exact SMO.
+    #[arg(long, value_name = "N", conflicts_with = "variants")]
+    landmarks: Option<usize>,
 }
 
 #[derive(Args)]
@@ -229,6 +232,7 @@ fn run(cli: Cli) -> Result<()> {
                         "estimated" => ridi::features::Orientation::Estimated,
                         _ => ridi::features::Orientation::Recorded,
                     },
+                    landmarks: args.landmarks,
                 })?
             };
             println!("wrote {}", out.display());
