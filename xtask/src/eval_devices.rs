@@ -587,7 +587,7 @@ fn report(r: &Report<'_>, total_s: f64) -> String {
         command.push_str(" --orientation estimated");
     }
     if let Some(m) = o.landmarks {
-        let _ = write!(command, " --solver nystrom --landmarks {m}");
+        let _ = write!(command, " --landmarks {m}");
     }
     let _ = writeln!(
         md,
