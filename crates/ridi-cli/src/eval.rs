@@ -8,6 +8,7 @@ use indicatif::ProgressBar;
 
 use ridi::data::ListEntry;
 use ridi::eval::{AlignWindow, EvalConfig};
+use ridi::source::ReadFiles;
 use ridi::{
     EvalFolder, EvalOptions, EvalPlots, EvalWritten, Method, Purpose, Report, TrackOptions,
 };
@@ -68,6 +69,11 @@ pub(crate) fn run(args: Args) -> Result<()> {
         args.placement_map.as_deref(),
         Purpose::Evaluation,
     )?;
+    let mut read = args.list.clone();
+    read.push(args.model.clone());
+    read.extend(args.placement_map.iter().map(PathBuf::from));
+    read.extend(listed.entries().iter().map(|e| e.path.clone()));
+    let folder = folder.reading(ReadFiles::of(&read));
     let opts = EvalOptions {
         methods,
         track: TrackOptions {

@@ -648,6 +648,31 @@ fn convert_train_track_and_eval() {
         "{}",
         stderr(&out)
     );
+    // The model at a name the evaluation writes inside --out: refused before anything moves.
+    let inside = dir.path().join("eval-into-model");
+    std::fs::create_dir_all(&inside).unwrap();
+    let model_inside = inside.join("report.json");
+    std::fs::copy(&model, &model_inside).unwrap();
+    let out = ridi(&[
+        "eval",
+        "--list",
+        s(&test_list),
+        "--model",
+        s(&model_inside),
+        "--out",
+        s(&inside),
+        "--methods",
+        "ridi",
+        "--plots",
+        "none",
+    ]);
+    assert!(
+        !out.status.success() && stderr(&out).contains("the command reads it"),
+        "{}",
+        stderr(&out)
+    );
+    assert_eq!(std::fs::read(&model_inside).unwrap(), model_bytes);
+    assert!(!inside.join("report.md").exists());
     assert_eq!(std::fs::read(&model).unwrap(), model_bytes);
     assert_eq!(std::fs::read(&recording).unwrap(), recording_bytes);
     assert!(

@@ -323,6 +323,8 @@ impl EvalPlots {
 pub struct EvalFolder {
     dir: PathBuf,
     plots: EvalPlots,
+    /// What the evaluation reads: no file it writes may replace one.
+    inputs: ReadFiles,
 }
 
 /// What [`EvalFolder::write`] wrote.
@@ -353,7 +355,15 @@ impl EvalFolder {
         Ok(Self {
             dir: dir.to_path_buf(),
             plots,
+            inputs: ReadFiles::default(),
         })
+    }
+
+    /// The same folder, refusing to write any file that would replace one of `inputs` (the
+    /// model, the lists, the recordings): [`EvalFolder::write`] checks every name it writes,
+    /// plots included, before anything is replaced.
+    pub fn reading(self, inputs: ReadFiles) -> Self {
+        Self { inputs, ..self }
     }
 
     /// The folder, as given.
@@ -414,6 +424,15 @@ impl EvalFolder {
             written
                 .reports
                 .extend(file.file_name().map(|name| out.join(name)));
+        }
+        // Names are known only now (plots per sequence); nothing is replaced yet.
+        for path in written
+            .reports
+            .iter()
+            .chain(&written.plots)
+            .chain(&written.model)
+        {
+            check_not_input(path, &self.inputs, &[])?;
         }
         staging.commit()?;
         // The new report is in place: an old plot that cannot go is worth a warning only.
@@ -587,6 +606,34 @@ mod tests {
         std::fs::hard_link(&file, &second).unwrap();
         let e = message(check_not_input(&second, &inputs, &[]).unwrap_err());
         assert!(e.contains("the command reads it"), "{e}");
+    }
+
+    /// An evaluation whose input (here its model) lies at a name it writes inside `--out`
+    /// fails before replacing anything, and the input stays.
+    #[test]
+    fn an_evaluation_never_writes_over_what_it_reads() {
+        let dir = tempfile::tempdir().unwrap();
+        let out = dir.path().join("eval");
+        std::fs::create_dir(&out).unwrap();
+        let model = out.join("report.json");
+        std::fs::write(&model, "the model").unwrap();
+        let folder = EvalFolder::new(&out, EvalPlots::None)
+            .unwrap()
+            .reading(ReadFiles::of([&model]));
+        let e = folder
+            .write(&report(&["a"]), &[], None)
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("report.json") && e.contains("the command reads it"),
+            "{e}"
+        );
+        assert_eq!(std::fs::read(&model).unwrap(), b"the model");
+        assert!(!out.join("report.md").exists());
+        // Without that input, the same folder is written.
+        let folder = EvalFolder::new(&out, EvalPlots::None).unwrap();
+        folder.write(&report(&["a"]), &[], None).unwrap();
+        assert!(out.join("report.md").exists());
     }
 
     /// An evaluation folder takes its reports and plots together, and a later evaluation
