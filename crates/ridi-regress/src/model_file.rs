@@ -81,11 +81,12 @@ impl Cascade {
         save(self, path.as_ref())
     }
 
-    /// Reads and validates a model file.
+    /// Reads and validates a model file. The header is read and checked first, and the
+    /// payload length it declares must match the file's size, so a device, a huge file or
+    /// one of another kind is refused after 24 bytes, not read whole.
     pub fn load(path: impl AsRef<Path>) -> Result<Self, RegressError> {
         let path = path.as_ref();
-        let bytes = std::fs::read(path).map_err(io_err(path))?;
-        decode(&bytes)
+        decode(&read_bounded(path)?)
     }
 }
 
@@ -187,6 +188,64 @@ fn decode(bytes: &[u8]) -> Result<Cascade, RegressError> {
     }
     model.finish_decode()?;
     Ok(model)
+}
+
+/// The bytes of the model file `path`, read only as far as its header allows: what is not a
+/// regular file, or whose header is not a model's or declares another size than the file's,
+/// is refused after the header.
+fn read_bounded(path: &Path) -> Result<Vec<u8>, RegressError> {
+    use std::io::Read as _;
+    let mut file = std::fs::File::open(path).map_err(io_err(path))?;
+    let meta = file.metadata().map_err(io_err(path))?;
+    if !meta.is_file() {
+        return Err(io_err(path)(std::io::Error::new(
+            std::io::ErrorKind::InvalidInput,
+            "not a regular file (a folder, a device or a pipe): a model is a file",
+        )));
+    }
+    let mut header = Vec::with_capacity(HEADER);
+    (&mut file)
+        .take(HEADER as u64)
+        .read_to_end(&mut header)
+        .map_err(io_err(path))?;
+    if header.len() < HEADER {
+        // Too short for a header: decode says whether it is a cut model or none.
+        return Ok(header);
+    }
+    // Magic and version first: their errors say more than a length.
+    if header[..MODEL_MAGIC.len()] != MODEL_MAGIC {
+        return Err(RegressError::BadMagic);
+    }
+    let len = u64::from_le_bytes(header[12..20].try_into().unwrap_or([0; 8]));
+    let declared = (HEADER as u64).saturating_add(len);
+    if len > MAX_PAYLOAD || declared != meta.len() {
+        // decode names the version, the truncation or the trailing bytes from the header and
+        // the file's size, without reading the payload.
+        let version = u32::from_le_bytes(header[8..12].try_into().unwrap_or([0; 4]));
+        if version != EXACT_VERSION && version != NYSTROM_VERSION {
+            return Err(RegressError::UnsupportedVersion {
+                found: version,
+                supported: MODEL_FORMAT_VERSION,
+            });
+        }
+        return Err(if meta.len() < declared {
+            RegressError::Truncated {
+                expected: declared,
+                found: meta.len(),
+            }
+        } else {
+            RegressError::Decode(format!(
+                "{} trailing bytes after the payload",
+                meta.len() - declared
+            ))
+        });
+    }
+    let mut bytes = header;
+    bytes.reserve_exact(len as usize);
+    file.take(len)
+        .read_to_end(&mut bytes)
+        .map_err(io_err(path))?;
+    Ok(bytes)
 }
 
 fn io_err(path: &Path) -> impl FnOnce(std::io::Error) -> RegressError + '_ {

@@ -312,6 +312,46 @@ fn training_is_deterministic_and_model_files_round_trip() {
     // bytes, and the `ridi` binary adds the file's name to them, as its tests check).
     let missing = std::path::Path::new("/nonexistent/model.ridi");
     assert_names_file(&Cascade::load(missing).unwrap_err(), missing);
+
+    // `load` reads the header first: a device, a folder, a huge file that is no model, one
+    // whose header declares another size, are refused without reading the rest.
+    let dir = std::env::temp_dir().join(format!("ridi-regress-load-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let zero = std::path::Path::new("/dev/zero");
+    if zero.exists() {
+        let e = Cascade::load(zero).unwrap_err();
+        assert_names_file(&e, zero);
+        assert!(e.to_string().contains("not a regular file"), "{e}");
+    }
+    assert!(Cascade::load(&dir).is_err());
+    let huge = dir.join("huge.ridi");
+    std::fs::File::create(&huge)
+        .unwrap()
+        .set_len(3 << 30)
+        .unwrap();
+    assert!(matches!(Cascade::load(&huge), Err(RegressError::BadMagic)));
+    let padded = dir.join("padded.ridi");
+    let mut f = std::fs::File::create(&padded).unwrap();
+    std::io::Write::write_all(&mut f, &bytes).unwrap();
+    f.set_len(3 << 30).unwrap();
+    let e = Cascade::load(&padded).unwrap_err();
+    assert!(e.to_string().contains("trailing bytes"), "{e}");
+    let cut = dir.join("cut.ridi");
+    std::fs::write(&cut, &bytes[..bytes.len() - 1]).unwrap();
+    assert!(matches!(
+        Cascade::load(&cut),
+        Err(RegressError::Truncated { .. })
+    ));
+    let newer_file = dir.join("newer.ridi");
+    std::fs::write(&newer_file, &newer[..30]).unwrap();
+    assert!(matches!(
+        Cascade::load(&newer_file),
+        Err(RegressError::UnsupportedVersion { found: 9, .. })
+    ));
+    let whole = dir.join("whole.ridi");
+    std::fs::write(&whole, &bytes).unwrap();
+    assert_eq!(Cascade::load(&whole).unwrap(), a);
+    std::fs::remove_dir_all(&dir).unwrap();
 }
 
 #[test]
