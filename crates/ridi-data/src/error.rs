@@ -42,9 +42,28 @@ impl Location {
     }
 }
 
+/// `path` for a message, with control characters escaped (`\n`, `\u{1b}`): a file name may
+/// hold a line break or a terminal escape sequence, which printed raw would split the one-line
+/// error or retitle and clear the user's terminal.
+pub(crate) fn shown(path: &Path) -> String {
+    let text = path.display().to_string();
+    if !text.chars().any(char::is_control) {
+        return text;
+    }
+    text.chars()
+        .map(|c| {
+            if c.is_control() {
+                c.escape_default().to_string()
+            } else {
+                c.to_string()
+            }
+        })
+        .collect()
+}
+
 impl fmt::Display for Location {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        write!(f, "{}", self.path.display())?;
+        f.write_str(&shown(&self.path))?;
         if let Some(line) = self.line {
             write!(f, ":{line}")?;
         }
@@ -61,7 +80,7 @@ impl fmt::Display for Location {
 #[derive(Debug, thiserror::Error)]
 pub enum DataError {
     /// The file could not be opened, read or written.
-    #[error("{}: {error}", path.display())]
+    #[error("{}: {error}", shown(path))]
     Io {
         /// The file.
         path: PathBuf,
@@ -114,3 +133,27 @@ impl DataError {
 
 /// Result of the readers and writers.
 pub type Result<T, E = DataError> = std::result::Result<T, E>;
+
+#[cfg(test)]
+mod escaping_tests {
+    use super::*;
+
+    #[test]
+    fn control_characters_in_file_names_are_escaped_in_messages() {
+        let evil = Path::new("data/\u{1b}]0;owned\u{7}\u{1b}[2J\nnext/data.csv");
+        let at = Location::line(evil, 3).with_field("time");
+        let text = at.to_string();
+        assert_eq!(
+            text,
+            "data/\\u{1b}]0;owned\\u{7}\\u{1b}[2J\\nnext/data.csv:3: field `time`"
+        );
+        assert!(!text.chars().any(char::is_control));
+        let io = DataError::io(evil, std::io::Error::other("gone")).to_string();
+        assert!(!io.chars().any(char::is_control), "{io:?}");
+        // Plain names are unchanged.
+        assert_eq!(
+            Location::file(Path::new("a b/ü.csv")).to_string(),
+            "a b/ü.csv"
+        );
+    }
+}

@@ -505,3 +505,31 @@ fn tyrex_runs_without_motion_capture_are_skipped_or_converted_with_a_warning() {
         );
     }
 }
+
+/// A sequence whose name a list file cannot hold (read back as a comment, as two fields or two
+/// lines, or trimmed) is refused, naming its folder, before anything is written.
+#[test]
+fn names_a_list_file_cannot_hold_are_refused_before_writing() {
+    let dir = tempfile::tempdir().unwrap();
+    for (name, why) in [
+        ("#hash", "comment"),
+        ("a,b", "comma"),
+        ("two\nlines", "control character"),
+        (" padded", "trimmed"),
+    ] {
+        let src = sources_named(
+            &dir.path().join(format!("case{}", name.len())),
+            &["fine", name],
+        );
+        let out = dir.path().join("out");
+        let e = convert(&src, &out, &ConvertOptions::default())
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains(&format!("{name:?}")) && e.contains(why) && e.contains("rename the folder"),
+            "{name:?}: {e}"
+        );
+        assert!(!e.contains('\n'), "the name is escaped: {e:?}");
+        assert!(!out.exists(), "{name:?}");
+    }
+}
