@@ -4,7 +4,9 @@
 #![no_main]
 
 use libfuzzer_sys::fuzz_target;
-use ridi_data::tyrex::{self, TyrexOptions};
+
+#[path = "common/tyrex_run.rs"]
+mod tyrex_run;
 
 const FILES: [&str; 5] = [
     "accelerometer.txt",
@@ -15,23 +17,5 @@ const FILES: [&str; 5] = [
 ];
 
 fuzz_target!(|data: &[u8]| {
-    let Ok(root) = tempfile::tempdir() else {
-        return;
-    };
-    let run = root.path().join("datasets/ios/A_iPhone4S_NoDist_Texting");
-    let qualisys = root.path().join("datasets/qualisys");
-    if std::fs::create_dir_all(&run).is_err() || std::fs::create_dir_all(&qualisys).is_err() {
-        return;
-    }
-    let mut parts = data.split(|&b| b == 0);
-    for name in FILES {
-        let content = parts.next().unwrap_or_default();
-        if std::fs::write(run.join(name), content).is_err() {
-            return;
-        }
-    }
-    if let Some(mat) = parts.next() {
-        let _ = std::fs::write(qualisys.join("A_iPhone4S_NoDist_Texting.mat"), mat);
-    }
-    let _ = tyrex::read(&run, &TyrexOptions::default());
+    tyrex_run::read_run(data, "ios", "A_iPhone4S_NoDist_Texting", &FILES);
 });

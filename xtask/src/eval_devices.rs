@@ -334,19 +334,19 @@ fn per_run(tested: &[Tested]) -> Vec<RunFigures> {
 
 /// Mean and interval of one figure over runs (runs without the figure left out).
 fn figure(runs: &[&RunFigures], k: usize) -> Option<Interval> {
-    let values: Vec<f64> = runs
-        .iter()
-        .map(|r| r.values[k])
-        .filter(|v| v.is_finite())
-        .collect();
-    bootstrap::runs_interval(&values)
+    interval_of(runs, |r| r.values[k])
 }
 
 /// RIDI's RTE 5 s minus PDR's, run by run.
 fn ridi_minus_pdr(runs: &[&RunFigures]) -> Option<Interval> {
+    interval_of(runs, |r| r.values[RTE] - r.values[PDR_RTE])
+}
+
+/// Mean and interval over runs of `value` (runs without it left out).
+fn interval_of(runs: &[&RunFigures], value: impl Fn(&RunFigures) -> f64) -> Option<Interval> {
     let values: Vec<f64> = runs
         .iter()
-        .map(|r| r.values[RTE] - r.values[PDR_RTE])
+        .map(|r| value(r))
         .filter(|v| v.is_finite())
         .collect();
     bootstrap::runs_interval(&values)
@@ -710,13 +710,7 @@ fn report(r: &Report<'_>, total_s: f64) -> String {
 /// RTE 5 s of a model that never saw the test phone against the same people's model trained on
 /// it, on the same runs: the loss `cross / same - 1` with its paired interval.
 fn across(md: &mut String, r: &Report<'_>) {
-    let pairs: Vec<(usize, usize)> = ACROSS
-        .iter()
-        .filter_map(|(cross, same)| {
-            let at = |name: &str| r.protocols.iter().position(|p| p.name == name);
-            Some((at(cross)?, at(same)?))
-        })
-        .collect();
+    let pairs = cross_device(r);
     if pairs.is_empty() {
         return;
     }
@@ -728,9 +722,8 @@ fn across(md: &mut String, r: &Report<'_>) {
          model | RTE 5 s (m) | same-device model's RTE 5 s (m) | loss [95 %] |\n| --- | --- | \
          --- | --- | --- |"
     );
-    for (c, s) in pairs {
-        let (cross, same) = paired(&r.figures[c], &r.figures[s], RTE);
-        let loss = bootstrap::ratio_interval(&cross, &same).map(|i| Interval {
+    for p in pairs {
+        let loss = p.ratio.map(|i| Interval {
             mean: i.mean - 1.0,
             low: i.low - 1.0,
             high: i.high - 1.0,
@@ -738,13 +731,42 @@ fn across(md: &mut String, r: &Report<'_>) {
         let _ = writeln!(
             md,
             "| {} | {} | {} | {} | {} |",
-            r.protocols[c].test.name(),
-            r.protocols[c].name,
-            interval_cell(bootstrap::runs_interval(&cross), false),
-            interval_cell(bootstrap::runs_interval(&same), false),
+            r.protocols[p.cross].test.name(),
+            r.protocols[p.cross].name,
+            interval_cell(bootstrap::runs_interval(&p.cross_rte), false),
+            interval_cell(bootstrap::runs_interval(&p.same_rte), false),
             interval_cell(loss, true),
         );
     }
+}
+
+/// One pair of [`ACROSS`] that the report ran: RIDI's RTE 5 s on the runs both protocols
+/// tested, and the ratio of their means (cross / same) with its paired interval.
+struct CrossDevice {
+    cross: usize,
+    same: usize,
+    cross_rte: Vec<f64>,
+    same_rte: Vec<f64>,
+    ratio: Option<Interval>,
+}
+
+fn cross_device(r: &Report<'_>) -> Vec<CrossDevice> {
+    let at = |name: &str| r.protocols.iter().position(|p| p.name == name);
+    ACROSS
+        .iter()
+        .filter_map(|(cross, same)| {
+            let (cross, same) = (at(cross)?, at(same)?);
+            let (cross_rte, same_rte) = paired(&r.figures[cross], &r.figures[same], RTE);
+            let ratio = bootstrap::ratio_interval(&cross_rte, &same_rte);
+            Some(CrossDevice {
+                cross,
+                same,
+                cross_rte,
+                same_rte,
+                ratio,
+            })
+        })
+        .collect()
 }
 
 /// Figure `k` of the runs two protocols both tested, in the same order.
@@ -850,18 +872,13 @@ fn goals(md: &mut String, r: &Report<'_>) {
     for l in lines {
         let _ = writeln!(md, "- {l}");
     }
-    for (c, s) in ACROSS {
-        let at = |name: &str| r.protocols.iter().position(|p| p.name == name);
-        let (Some(c), Some(s)) = (at(c), at(s)) else {
-            continue;
-        };
-        let (cross, same) = paired(&r.figures[c], &r.figures[s], RTE);
-        let loss = bootstrap::ratio_interval(&cross, &same);
+    for p in cross_device(r) {
+        let loss = p.ratio;
         let _ = writeln!(
             md,
             "- {} loses at most 15 % RTE 5 s against {}: {} ({})",
-            r.protocols[c].name,
-            r.protocols[s].name,
+            r.protocols[p.cross].name,
+            r.protocols[p.same].name,
             loss.map_or("-".into(), |i| format!(
                 "{:+.1} % [{:+.1}, {:+.1}]",
                 100.0 * (i.mean - 1.0),
@@ -992,7 +1009,7 @@ pub fn compare(before: &Path, after: &Path) -> Result<String> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use ridi::eval::TrajectoryMetrics;
+    use crate::eval_tyrex::tests::metrics_with_rte;
 
     #[test]
     fn the_committed_run_list_parses_and_spans_both_phones() {
@@ -1024,16 +1041,7 @@ mod tests {
     }
 
     fn result(name: &str, rte: f64, pdr: f64) -> SequenceResult {
-        let metrics = |rte| TrajectoryMetrics {
-            mpe_m: 0.0,
-            mpe_pct: None,
-            ate_m: 2.0 * rte,
-            rte_m: 0.0,
-            ate_ronin_m: 0.0,
-            rte_ronin_m: 0.0,
-            rte_5s_m: rte,
-            path_length_ratio: Some(1.0),
-        };
+        let metrics = metrics_with_rte;
         SequenceResult {
             name: name.into(),
             placement: Some("hand".into()),

@@ -839,12 +839,14 @@ pub fn run(
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
     use ridi::eval::TrajectoryMetrics;
 
-    fn seq(name: &str, frames: usize, rte: f64) -> SeqRow {
-        let metrics = TrajectoryMetrics {
+    /// Metrics of a trajectory with RTE 5 s `rte` and ATE twice that, a path of the right
+    /// length (the test fixture of both protocols' tables).
+    pub(crate) fn metrics_with_rte(rte: f64) -> TrajectoryMetrics {
+        TrajectoryMetrics {
             mpe_m: 0.0,
             mpe_pct: None,
             ate_m: 2.0 * rte,
@@ -853,7 +855,11 @@ mod tests {
             rte_ronin_m: 0.0,
             rte_5s_m: rte,
             path_length_ratio: Some(1.0),
-        };
+        }
+    }
+
+    fn seq(name: &str, frames: usize, rte: f64) -> SeqRow {
+        let metrics = metrics_with_rte(rte);
         SeqRow {
             result: SequenceResult {
                 name: name.into(),

@@ -63,6 +63,12 @@ pub fn build(data: &Path, out: &Path) -> Result<()> {
         if last <= first + 1 {
             bail!("{}: part too short", dir.display());
         }
+        if let Some(why) = ridi_data::unlistable_name(&name) {
+            bail!(
+                "{}: the run name cannot be a list line ({why})",
+                dir.display()
+            );
+        }
         let mut seq = part.slice(first..last);
         seq.set_name(name.clone());
         let folder = out.join(&name).join("processed");

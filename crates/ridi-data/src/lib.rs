@@ -105,7 +105,7 @@ pub use internals::{
     CellArray, CharArray, MAX_DEPTH, MatClass, MatFile, MatValue, Numeric, StructArray,
     interpolate_vec3, parse_list,
 };
-pub use list::{ListEntry, Listed};
+pub use list::{ListEntry, Listed, unlistable_name};
 pub use options::ReadOptions;
 pub use processed::PROCESSED_COLUMNS;
 pub use ridi_frames;

@@ -21,6 +21,25 @@ use crate::{FileId, Sequence};
 /// is not one (`--list /dev/zero` used to grow until the kernel killed it).
 const MAX_LIST_BYTES: u64 = 64 << 20;
 
+/// Why `name` cannot be the path of a list line (`path,placement`, `#` comments, trimmed),
+/// if it cannot: written, it would be read back as a comment, as several fields or lines, or as
+/// another name.
+pub fn unlistable_name(name: &str) -> Option<&'static str> {
+    if name.is_empty() {
+        Some("it is empty")
+    } else if name.starts_with('#') {
+        Some("a line starting with `#` is a comment")
+    } else if name.contains(',') {
+        Some("a comma separates the placement")
+    } else if name.chars().any(char::is_control) {
+        Some("it holds a control character such as a line break")
+    } else if name.trim() != name {
+        Some("list lines are trimmed of surrounding spaces")
+    } else {
+        None
+    }
+}
+
 /// One line of a list file.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct ListEntry {
@@ -259,4 +278,19 @@ fn copy_error(e: &ListEntry, first: &ListEntry) -> DataError {
 /// recordings cost a length and a timestamp compare (phone clocks count nanoseconds from boot).
 fn same_data(a: &Sequence, b: &Sequence) -> bool {
     a.time() == b.time() && a.gyro() == b.gyro() && a.acce() == b.acce()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn names_a_list_file_cannot_hold_are_named() {
+        for name in ["#hash", "a,b", "two\nlines", " padded", "tab\t", ""] {
+            assert!(unlistable_name(name).is_some(), "{name:?}");
+        }
+        for name in ["walk_1", "a b", "Jakob_iPhone4S_NoDist_AR_part2", "ünïcode"] {
+            assert_eq!(unlistable_name(name), None, "{name:?}");
+        }
+    }
 }

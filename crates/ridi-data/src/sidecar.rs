@@ -69,27 +69,12 @@ pub fn sidecar_path(data: &Path) -> PathBuf {
 /// What the sidecar of `data` holds; nothing without a sidecar.
 pub(crate) fn read(data: &Path) -> Result<Sidecar> {
     let path = sidecar_path(data);
-    let meta = match std::fs::metadata(&path) {
-        Ok(m) => m,
+    match std::fs::metadata(&path) {
         Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(Sidecar::default()),
         Err(e) => return Err(DataError::io(&path, e)),
-    };
-    if !meta.is_file() {
-        return Err(DataError::format(
-            Location::file(&path),
-            "the sidecar of the data file is not a regular file",
-        ));
+        Ok(_) => {}
     }
-    if meta.len() > MAX_BYTES {
-        return Err(DataError::format(
-            Location::file(&path),
-            format!(
-                "{} bytes: not a ridi-rs sidecar (a few lines, at most {MAX_BYTES} bytes)",
-                meta.len()
-            ),
-        ));
-    }
-    let bytes = text::read_file(&path)?;
+    let bytes = text::read_file_bounded(&path, MAX_BYTES)?;
     parse(text::as_text(&bytes, &path)?, &path)
 }
 

@@ -22,9 +22,9 @@ pub(crate) fn read_file_bounded(path: &Path, max: u64) -> Result<Vec<u8>> {
         return Err(DataError::format(
             Location::file(path),
             if meta.is_dir() {
-                "is a folder, not a file"
+                "is a folder: it is not a regular file"
             } else {
-                "is not a regular file (a device, a pipe or a socket)"
+                "is a device, a pipe or a socket: it is not a regular file"
             },
         ));
     }

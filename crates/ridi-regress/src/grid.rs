@@ -184,6 +184,45 @@ pub(crate) fn chains(cs: &[f64], eps: &[f64]) -> Vec<Vec<(usize, usize)>> {
         .collect()
 }
 
+/// The progress of a grid search whose points are fitted in parallel: one count behind a lock,
+/// and a flag the workers poll once the caller cancels.
+pub(crate) struct GridProgress<'p> {
+    done: Mutex<(usize, &'p mut dyn Progress)>,
+    cancelled: AtomicBool,
+    stage: Stage<'p>,
+    total: usize,
+}
+
+impl<'p> GridProgress<'p> {
+    pub(crate) fn new(progress: &'p mut dyn Progress, stage: Stage<'p>, total: usize) -> Self {
+        Self {
+            done: Mutex::new((0, progress)),
+            cancelled: AtomicBool::new(false),
+            stage,
+            total,
+        }
+    }
+
+    /// Counts one fitted point and reports it; a refusal cancels the search.
+    pub(crate) fn step(&self) {
+        let mut guard = self.done.lock().unwrap_or_else(|p| p.into_inner());
+        guard.0 += 1;
+        let done = guard.0;
+        if !guard.1.report(&ProgressEvent {
+            stage: self.stage,
+            done,
+            total: self.total,
+        }) {
+            self.cancelled.store(true, Ordering::Relaxed);
+        }
+    }
+
+    /// Whether the caller cancelled the search.
+    pub(crate) fn cancelled(&self) -> bool {
+        self.cancelled.load(Ordering::Relaxed)
+    }
+}
+
 /// Runs the grid for every channel of `targets` (`targets[ch][s]` for base sample `s`) and
 /// returns the table in `(channel, C, epsilon)` order. `solver.kernel_memory` bounds the copy
 /// of a fold's kernel block.
@@ -220,8 +259,7 @@ pub(crate) fn search(
     let tasks: Vec<(usize, usize, usize)> = (0..k)
         .flat_map(|f| (0..channels).flat_map(move |ch| (0..nh).map(move |h| (f, ch, h))))
         .collect();
-    let done = Mutex::new((0usize, progress));
-    let cancelled = AtomicBool::new(false);
+    let progress = GridProgress::new(progress, stage, total);
     // Per task: `(C index, epsilon index, MSE, iterations)` along its chain. `fold_rows` is
     // the kernel the fold's training problem indexes with `local` (its own block, or the
     // class kernel with `train`).
@@ -231,7 +269,7 @@ pub(crate) fn search(
         let mut prev: Option<SvrDual> = None;
         let mut out = Vec::with_capacity(chains[h].len());
         for &(ci, e) in &chains[h] {
-            if cancelled.load(Ordering::Relaxed) {
+            if progress.cancelled() {
                 break;
             }
             let c = cs[ci];
@@ -251,16 +289,7 @@ pub(crate) fn search(
             }
             out.push((ci, e, sse / val.len().max(1) as f64, dual.iterations));
             prev = Some(dual);
-            let mut guard = done.lock().unwrap_or_else(|p| p.into_inner());
-            guard.0 += 1;
-            let n = guard.0;
-            if !guard.1.report(&ProgressEvent {
-                stage,
-                done: n,
-                total,
-            }) {
-                cancelled.store(true, Ordering::Relaxed);
-            }
+            progress.step();
         }
         out
     };
@@ -308,7 +337,7 @@ pub(crate) fn search(
             .map(|m| m.into_inner().unwrap_or_else(|p| p.into_inner()))
             .collect()
     };
-    if cancelled.load(Ordering::Relaxed) {
+    if progress.cancelled() {
         return Err(RegressError::Cancelled);
     }
     let per_task: Vec<(usize, usize, Vec<ChainPoint>)> = tasks

@@ -107,13 +107,23 @@ fn encode(model: &Cascade) -> Result<Vec<u8>, RegressError> {
     Ok(out)
 }
 
-fn decode(bytes: &[u8]) -> Result<Cascade, RegressError> {
+/// What a model file's header declares.
+struct Header {
+    version: u32,
+    /// Payload length in bytes.
+    len: u64,
+    crc: u32,
+}
+
+/// Checks the header at the start of `bytes`, of a file of `size` bytes (`bytes` may be only
+/// its header): magic number, version, and the declared payload length against the size.
+fn check_header(bytes: &[u8], size: u64) -> Result<Header, RegressError> {
     if bytes.len() < MODEL_MAGIC.len() || bytes[..MODEL_MAGIC.len()] != MODEL_MAGIC {
         return Err(
             if bytes.len() < MODEL_MAGIC.len() && MODEL_MAGIC.starts_with(bytes) {
                 RegressError::Truncated {
                     expected: HEADER as u64,
-                    found: bytes.len() as u64,
+                    found: size,
                 }
             } else {
                 RegressError::BadMagic
@@ -123,7 +133,7 @@ fn decode(bytes: &[u8]) -> Result<Cascade, RegressError> {
     if bytes.len() < HEADER {
         return Err(RegressError::Truncated {
             expected: HEADER as u64,
-            found: bytes.len() as u64,
+            found: size,
         });
     }
     let word = |r: std::ops::Range<usize>| -> [u8; 8] {
@@ -141,18 +151,23 @@ fn decode(bytes: &[u8]) -> Result<Cascade, RegressError> {
     let len = u64::from_le_bytes(word(12..20));
     let crc = u32::from_le_bytes(word(20..24)[..4].try_into().unwrap_or([0; 4]));
     let expected = (HEADER as u64).saturating_add(len);
-    if len > MAX_PAYLOAD || (bytes.len() as u64) < expected {
+    if len > MAX_PAYLOAD || size < expected {
         return Err(RegressError::Truncated {
             expected,
-            found: bytes.len() as u64,
+            found: size,
         });
     }
-    if (bytes.len() as u64) > expected {
+    if size > expected {
         return Err(RegressError::Decode(format!(
             "{} trailing bytes after the payload",
-            bytes.len() as u64 - expected
+            size - expected
         )));
     }
+    Ok(Header { version, len, crc })
+}
+
+fn decode(bytes: &[u8]) -> Result<Cascade, RegressError> {
+    let Header { version, crc, .. } = check_header(bytes, bytes.len() as u64)?;
     let payload = &bytes[HEADER..];
     let found = crc32fast::hash(payload);
     if found != crc {
@@ -203,44 +218,12 @@ fn read_bounded(path: &Path) -> Result<Vec<u8>, RegressError> {
             "not a regular file (a folder, a device or a pipe): a model is a file",
         )));
     }
-    let mut header = Vec::with_capacity(HEADER);
+    let mut bytes = Vec::with_capacity(HEADER);
     (&mut file)
         .take(HEADER as u64)
-        .read_to_end(&mut header)
+        .read_to_end(&mut bytes)
         .map_err(io_err(path))?;
-    if header.len() < HEADER {
-        // Too short for a header: decode says whether it is a cut model or none.
-        return Ok(header);
-    }
-    // Magic and version first: their errors say more than a length.
-    if header[..MODEL_MAGIC.len()] != MODEL_MAGIC {
-        return Err(RegressError::BadMagic);
-    }
-    let len = u64::from_le_bytes(header[12..20].try_into().unwrap_or([0; 8]));
-    let declared = (HEADER as u64).saturating_add(len);
-    if len > MAX_PAYLOAD || declared != meta.len() {
-        // decode names the version, the truncation or the trailing bytes from the header and
-        // the file's size, without reading the payload.
-        let version = u32::from_le_bytes(header[8..12].try_into().unwrap_or([0; 4]));
-        if version != EXACT_VERSION && version != NYSTROM_VERSION {
-            return Err(RegressError::UnsupportedVersion {
-                found: version,
-                supported: MODEL_FORMAT_VERSION,
-            });
-        }
-        return Err(if meta.len() < declared {
-            RegressError::Truncated {
-                expected: declared,
-                found: meta.len(),
-            }
-        } else {
-            RegressError::Decode(format!(
-                "{} trailing bytes after the payload",
-                meta.len() - declared
-            ))
-        });
-    }
-    let mut bytes = header;
+    let Header { len, .. } = check_header(&bytes, meta.len())?;
     bytes.reserve_exact(len as usize);
     file.take(len)
         .read_to_end(&mut bytes)

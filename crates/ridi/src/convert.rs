@@ -5,8 +5,8 @@ use std::path::{Path, PathBuf};
 
 use rayon::prelude::*;
 use ridi_data::{
-    DataError, DeviceInfo, Format, Location, ReadOptions, detect, sidecar_path, write_atomically,
-    write_ridi_csv,
+    DataError, DeviceInfo, Format, Location, ReadOptions, detect, sidecar_path, unlistable_name,
+    write_atomically, write_ridi_csv,
 };
 use ridi_data::{ilc, tyrex};
 
@@ -275,25 +275,6 @@ fn check_overwrites(
     Ok(())
 }
 
-/// Why `name` cannot be a line of a list file (`name,placement`, `#` comments, trimmed), if it
-/// cannot: written, it would be read back as a comment, as several fields or lines, or as
-/// another name.
-fn unlistable(name: &str) -> Option<&'static str> {
-    if name.is_empty() {
-        Some("it is empty")
-    } else if name.starts_with('#') {
-        Some("a line starting with `#` is a comment")
-    } else if name.contains(',') {
-        Some("a comma separates the placement")
-    } else if name.chars().any(char::is_control) {
-        Some("it holds a control character such as a line break")
-    } else if name.trim() != name {
-        Some("list lines are trimmed of surrounding spaces")
-    } else {
-        None
-    }
-}
-
 /// The person of a Tyrex run name `<Person>_<Phone>_<Dist>_<Motion>`, also for the parts
 /// of a split run (`..._<Motion>_part2`).
 fn tyrex_subject(name: &str) -> Option<&str> {
@@ -383,7 +364,7 @@ pub fn convert(
                     None => None,
                 };
                 let seq = resampled.as_ref().unwrap_or(seq);
-                if let Some(why) = unlistable(seq.name()) {
+                if let Some(why) = unlistable_name(seq.name()) {
                     return Err(DataError::format(
                         Location::file(dir),
                         format!(
@@ -460,16 +441,6 @@ pub fn convert(
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    #[test]
-    fn names_a_list_file_cannot_hold_are_named() {
-        for name in ["#hash", "a,b", "two\nlines", " padded", "tab\t", ""] {
-            assert!(unlistable(name).is_some(), "{name:?}");
-        }
-        for name in ["walk_1", "a b", "Jakob_iPhone4S_NoDist_AR_part2", "ünïcode"] {
-            assert_eq!(unlistable(name), None, "{name:?}");
-        }
-    }
 
     #[test]
     fn subject_is_the_first_part_of_a_tyrex_name() {

@@ -4,9 +4,6 @@
 //! machines by dual coordinate descent (crate::linear) with the exact path's `C`, epsilon,
 //! pairs and votes. Only the weights folded back onto the landmarks are kept.
 
-use std::sync::Mutex;
-use std::sync::atomic::{AtomicBool, Ordering};
-
 use rayon::prelude::*;
 
 use super::train::{TrainingSet, channel_targets, in_placement, report};
@@ -16,7 +13,7 @@ use crate::error::RegressError;
 use crate::grid::{self, ChainPoint, GridSpec};
 use crate::linear::{self, LinearFit, Rows, Stop};
 use crate::nystrom::{self, Map, Nystrom, Whitening};
-use crate::progress::{Progress, ProgressEvent, Stage};
+use crate::progress::{Progress, Stage};
 use crate::projection::Projection;
 use crate::store::SampleRows;
 use crate::svr::FitInfo;
@@ -90,8 +87,7 @@ fn grid_search(
     let tasks: Vec<(usize, usize, usize)> = (0..k)
         .flat_map(|f| (0..channels).flat_map(move |ch| (0..nh).map(move |h| (f, ch, h))))
         .collect();
-    let done = Mutex::new((0usize, progress));
-    let cancelled = AtomicBool::new(false);
+    let progress = grid::GridProgress::new(progress, stage, total);
     // Every task is a sequential chain of its own: the results do not depend on the threads.
     let results: Vec<(usize, usize, Vec<ChainPoint>)> = tasks
         .par_iter()
@@ -106,7 +102,7 @@ fn grid_search(
             let mut prev: Option<Vec<f64>> = None;
             let mut out = Vec::with_capacity(chains[h].len());
             for &(ci, e) in &chains[h] {
-                if cancelled.load(Ordering::Relaxed) {
+                if progress.cancelled() {
                     break;
                 }
                 let fit = svr_centred(rows, &y, cs[ci], eps[e], prev.take(), stop);
@@ -120,21 +116,12 @@ fn grid_search(
                     .sum();
                 out.push((ci, e, sse / vl.len().max(1) as f64, fit.epochs));
                 prev = Some(fit.dual);
-                let mut guard = done.lock().unwrap_or_else(|p| p.into_inner());
-                guard.0 += 1;
-                let n = guard.0;
-                if !guard.1.report(&ProgressEvent {
-                    stage,
-                    done: n,
-                    total,
-                }) {
-                    cancelled.store(true, Ordering::Relaxed);
-                }
+                progress.step();
             }
             (f, ch, out)
         })
         .collect();
-    if cancelled.load(Ordering::Relaxed) {
+    if progress.cancelled() {
         return Err(RegressError::Cancelled);
     }
     Ok(grid::tabulate(placement, &cs, &eps, channels, k, &results))
