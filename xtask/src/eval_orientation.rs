@@ -467,13 +467,14 @@ fn write_report(s: &mut String, eval: &Evaluation, command: &str) -> std::fmt::R
         "- **estimator**: `ridi_frames::estimate_orientation` (Mahony filter, gyro + \
          accelerometer, no magnetometer) on the part's time, gyro and accelerometer, default \
          `FilterConfig` ({}, max_bias {}, integral_max_error {}, max_dt {}, accel_tolerance {}, \
-         init_samples {});",
+         init_samples {}, settle_time {} s);",
         config_label(default),
         default.max_bias,
         default.integral_max_error,
         default.max_dt,
         default.accel_tolerance,
-        default.init_samples
+        default.init_samples,
+        default.settle_time
     )?;
     writeln!(
         s,

@@ -94,6 +94,13 @@ pub struct FilterConfig {
     pub accel_tolerance: f64,
     /// Number of leading nonzero accelerometer samples averaged for the initial tilt.
     pub init_samples: usize,
+    /// Seconds of a settling pass, 0 for none: the filter runs forward over the first
+    /// `settle_time` seconds from the initial tilt and back to the first sample, and starts
+    /// from the tilt reached there (with zero heading). The mean of 0.1 s of accelerometer
+    /// while walking is several degrees off, and the filter forgets a start error only as
+    /// `exp(-kp t)`; the two passes spend that time before the first output instead of on
+    /// it. A stream holds its first `settle_time` seconds back.
+    pub settle_time: f64,
 }
 
 impl Default for FilterConfig {
@@ -106,6 +113,7 @@ impl Default for FilterConfig {
             max_dt: 0.1,
             accel_tolerance: 2.0,
             init_samples: 20,
+            settle_time: 2.0,
         }
     }
 }
@@ -137,6 +145,11 @@ impl FilterConfig {
         if self.accel_tolerance.is_nan() || self.accel_tolerance < 0.0 {
             return Err(EstimateError::InvalidConfig("accel_tolerance must be >= 0"));
         }
+        if !(self.settle_time.is_finite() && self.settle_time >= 0.0) {
+            return Err(EstimateError::InvalidConfig(
+                "settle_time must be finite and >= 0",
+            ));
+        }
         if self.init_samples == 0 {
             return Err(EstimateError::InvalidConfig("init_samples must be >= 1"));
         }
@@ -164,7 +177,8 @@ pub fn initial_orientation(up: DeviceVec) -> WorldFromDevice {
 /// Estimates the device orientation at every sample from time stamps (s), gyroscope (rad/s)
 /// and accelerometer (m/s^2, including gravity, i.e. reading up at rest), all in the device
 /// frame. Starts from [`initial_orientation`] of the mean of the first
-/// [`FilterConfig::init_samples`] nonzero accelerometer samples.
+/// [`FilterConfig::init_samples`] nonzero accelerometer samples, settled over the first
+/// [`FilterConfig::settle_time`] seconds.
 ///
 /// Time must not decrease; steps longer than [`FilterConfig::max_dt`] are clamped to it and
 /// repeated time stamps integrate nothing. Zero accelerometer samples skip the gravity
@@ -224,8 +238,9 @@ fn run_batch(
 /// The estimator of [`estimate_orientation`], one sample at a time, for live streams.
 ///
 /// The first orientation needs the initial tilt, the mean of the first
-/// [`FilterConfig::init_samples`] nonzero accelerometer samples, so samples are held until
-/// that many have arrived (0.1 s at 200 Hz with the default 20) and then come out together;
+/// [`FilterConfig::init_samples`] nonzero accelerometer samples settled over the first
+/// [`FilterConfig::settle_time`], so samples are held until both have arrived (2 s with the
+/// defaults) and then come out together;
 /// from then on each [`push`](Self::push) gives the orientation of its own sample.
 /// [`finish`](Self::finish) releases samples still held at the end of a stream. Pushing a
 /// whole recording and finishing gives exactly [`estimate_orientation`]'s result, whatever
@@ -337,7 +352,8 @@ impl OrientationFilter {
         if acce.norm() > 0.0 {
             self.pending_nonzero += 1;
         }
-        if self.pending_nonzero >= self.config.init_samples {
+        let settled = self.start.is_some() || time - self.pending[0].0 >= self.config.settle_time;
+        if self.pending_nonzero >= self.config.init_samples && settled {
             self.release(out)?;
         }
         Ok(())
@@ -368,20 +384,19 @@ impl OrientationFilter {
     fn release(&mut self, out: &mut Vec<WorldFromDevice>) -> Result<(), EstimateError> {
         let acce: Vec<DeviceVec> = self.pending.iter().map(|p| p.2).collect();
         let mean_up = mean_leading_nonzero(&acce, self.config.init_samples);
+        let reference_norm = mean_up.map_or(0.0, |g| g.norm());
         let initial = match (self.start, mean_up) {
             (Some(q), _) => q,
+            (None, Some(up)) if self.config.settle_time > 0.0 => settled_start(
+                initial_orientation(up),
+                reference_norm,
+                &self.pending,
+                &self.config,
+            ),
             (None, Some(up)) => initial_orientation(up),
             (None, None) => return Err(EstimateError::NoGravity),
         };
-        let (time, gyro, acce) = self.pending[0];
-        let mut r = Running {
-            q: *initial.quaternion(),
-            integral: Vector3::zeros(),
-            reference_norm: mean_up.map_or(0.0, |g| g.norm()),
-            time,
-            gyro,
-            acce,
-        };
+        let mut r = Running::at(initial, reference_norm, self.pending[0]);
         out.push(initial);
         for &(t, g, a) in &self.pending[1..] {
             out.push(r.step(t, g, a, &self.config));
@@ -392,7 +407,50 @@ impl OrientationFilter {
     }
 }
 
+/// The start [`FilterConfig::settle_time`] asks for: from `initial`, forward over `held` and
+/// back to its first sample (time and gyro negated, so the filter turns the other way), then
+/// the tilt reached with zero heading, so that the heading reference stays the first frame.
+fn settled_start(
+    initial: WorldFromDevice,
+    reference_norm: f64,
+    held: &[(f64, DeviceVec, DeviceVec)],
+    config: &FilterConfig,
+) -> WorldFromDevice {
+    let (Some((first, rest)), Some(&(t, g, a))) = (held.split_first(), held.last()) else {
+        return initial;
+    };
+    let mut r = Running::at(initial, reference_norm, *first);
+    for &(t, g, a) in rest {
+        r.step(t, g, a, config);
+    }
+    let mut back = Running {
+        // The bias the forward pass learnt is the gyro's; backwards the gyro is negated.
+        integral: -r.integral,
+        ..Running::at(Rot::from_unit_quaternion(r.q), reference_norm, (-t, -g, a))
+    };
+    for &(t, g, a) in held.iter().rev().skip(1) {
+        back.step(-t, -g, a, config);
+    }
+    let up = back.q.inverse_transform_vector(UP_W.vector());
+    initial_orientation(DeviceVec::from_vector(up))
+}
+
 impl Running {
+    fn at(
+        q: WorldFromDevice,
+        reference_norm: f64,
+        (time, gyro, acce): (f64, DeviceVec, DeviceVec),
+    ) -> Self {
+        Self {
+            q: *q.quaternion(),
+            integral: Vector3::zeros(),
+            reference_norm,
+            time,
+            gyro,
+            acce,
+        }
+    }
+
     /// Advances from the previous sample to this one and returns this one's orientation.
     fn step(
         &mut self,
@@ -606,6 +664,54 @@ mod tests {
     }
 
     #[test]
+    fn settling_pass_removes_a_start_error_before_the_first_output() {
+        // A still, tilted phone whose first 0.1 s carry a sideways jolt: the initial tilt
+        // from those samples is off by about 17 degrees.
+        let truth = WorldFromDevice::from_scaled_axis(Vector3::new(0.3, -0.2, 0.5));
+        let n = 1200;
+        let t = times(n, 200.0);
+        let gyro = vec![DeviceVec::ZERO; n];
+        let jolt = DeviceVec::new(3.0, 0.0, 0.0);
+        let acce: Vec<_> = (0..n)
+            .map(|i| gravity_in_device(truth, G) + if i < 20 { jolt } else { DeviceVec::ZERO })
+            .collect();
+        let first_error = |settle_time: f64| {
+            let config = FilterConfig {
+                settle_time,
+                ..FilterConfig::default()
+            };
+            let est = estimate_orientation(&t, &gyro, &acce, &config).unwrap();
+            tilt_error(est[0], truth).to_degrees()
+        };
+        assert!(first_error(0.0) > 15.0, "{}", first_error(0.0));
+        // Forward and back through 2 s take e^-2 of it; the jolt, met again at the end of
+        // the backward pass, puts a little back.
+        assert!(first_error(2.0) < 4.0, "{}", first_error(2.0));
+        // The settled start keeps the heading reference: S of the first frame has no yaw.
+        let est = estimate_orientation(&t, &gyro, &acce, &FilterConfig::default()).unwrap();
+        let s_w = stab_from_world(est[0], gravity_in_device(est[0], G));
+        let zero = Rot::<Stabilized, World>::from_axis_angle(&Vector3::x_axis(), -PI / 2.0);
+        assert!(s_w.angle_to(&zero) < 1e-9);
+        // A stream shorter than the settling time still gets every orientation at finish.
+        let mut filter = OrientationFilter::new(FilterConfig::default()).unwrap();
+        let mut out = Vec::new();
+        for i in 0..100 {
+            filter.push(t[i], gyro[i], acce[i], &mut out).unwrap();
+        }
+        assert!(out.is_empty());
+        filter.finish(&mut out).unwrap();
+        assert_eq!(out.len(), 100);
+        assert!(
+            FilterConfig {
+                settle_time: f64::NAN,
+                ..FilterConfig::default()
+            }
+            .validate()
+            .is_err()
+        );
+    }
+
+    #[test]
     fn constant_yaw_rate_reproduces_heading() {
         let rate = 0.3; // rad/s about world (and device) z for a flat phone
         let hz = 200.0;
@@ -811,11 +917,12 @@ mod tests {
                     filter.push(t[i], gyro[i], acce[i], &mut out).unwrap();
                 }
                 // Nothing comes out before the initial tilt is known: 7 zero samples and
-                // 20 nonzero ones.
+                // 20 nonzero ones, and the settling time (2 s: sample 400 is the first at
+                // or after it).
                 let pushed = (c * chunk + range.len()).min(n);
                 assert_eq!(
                     out.len(),
-                    if pushed < 27 { 0 } else { pushed },
+                    if pushed < 401 { 0 } else { pushed },
                     "chunk {chunk}"
                 );
             }

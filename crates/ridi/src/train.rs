@@ -5,7 +5,7 @@ use std::collections::BTreeSet;
 use rayon::prelude::*;
 use ridi_data::Sequence;
 use ridi_features::{
-    FeatureConfig, FeatureExtractor, FeatureMatrix, FeatureMatrixRef, GroundTruthView,
+    FeatureConfig, FeatureExtractor, FeatureMatrix, FeatureMatrixRef, GroundTruthView, Orientation,
     SampleSchedule, Standardization, compute_targets,
 };
 use ridi_frames::{StabHorizontal, UpAxis};
@@ -49,10 +49,13 @@ impl GridChoice {
 /// additions measured on the Tyrex leave-one-subject-out protocol (docs/bench-accuracy.md):
 /// one turned copy of each training window, taken every [`default_step`]`(1)` = 20 frames
 /// instead of 10 (so the rows, and the training time, stay the paper's), a speed regressor
-/// per placement, and S built on device -y while the phone is upside down
-/// ([`UpAxis::PlusOrMinusY`]). Set `turned_copies: 0`, `features.step: 10`,
-/// `features.up_axis: UpAxis::PlusY` and `cascade.speed: false` for the paper's cascade on
-/// standardized features, and `standardize: false` too for the original's raw features.
+/// per placement, S built on device -y while the phone is upside down
+/// ([`UpAxis::PlusOrMinusY`]), and the orientation estimated from gyro and accelerometer
+/// ([`Orientation::Estimated`]; measured on the across-devices protocol, docs/bench-devices.md).
+/// Set `turned_copies: 0`, `features.step: 10`, `features.up_axis: UpAxis::PlusY`,
+/// `features.orientation: Orientation::Recorded` and `cascade.speed: false` for the paper's
+/// cascade on standardized features, and `standardize: false` too for the original's raw
+/// features.
 #[derive(Debug, Clone, PartialEq)]
 pub struct TrainOptions {
     /// Feature configuration (its `standardization` is filled in when `standardize` is set).
@@ -80,6 +83,7 @@ impl Default for TrainOptions {
             features: FeatureConfig {
                 step: default_step(1),
                 up_axis: UpAxis::PlusOrMinusY,
+                orientation: Orientation::Estimated,
                 ..FeatureConfig::default()
             },
             standardize: true,
