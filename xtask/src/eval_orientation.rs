@@ -674,10 +674,10 @@ fn write_report(s: &mut String, eval: &Evaluation, command: &str) -> std::fmt::R
             p.excluded_s,
             e.tilt_rms_deg,
             e.tilt_mean_deg,
-            e.drift_deg_per_min,
+            signed_2dp(e.drift_deg_per_min),
             r.tilt_rms_deg,
             r.tilt_mean_deg,
-            r.drift_deg_per_min
+            signed_2dp(r.drift_deg_per_min)
         )?;
     }
 
@@ -707,6 +707,11 @@ pub fn run(data: Option<PathBuf>, out: Option<PathBuf>) -> Result<PathBuf> {
     ridi_data::write_atomically(&out, |w| w.write_all(report.as_bytes()))
         .with_context(|| format!("writing {}", out.display()))?;
     Ok(out)
+}
+
+/// `x` for a `{:+.2}` cell: a value that rounds to zero prints as `+0.00`, not `-0.00`.
+fn signed_2dp(x: f64) -> f64 {
+    if (x * 100.0).round() == 0.0 { 0.0 } else { x }
 }
 
 #[cfg(test)]

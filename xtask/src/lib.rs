@@ -6,6 +6,8 @@ pub mod checksum;
 pub mod download;
 pub mod fetch;
 pub mod manifest;
+pub mod ronin_lists;
+pub mod rust_version;
 pub mod tidy;
 
 use std::path::PathBuf;

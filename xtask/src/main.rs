@@ -51,6 +51,9 @@ enum Task {
     /// Fast convention checks (no build): each crate's dependencies match the layer table of
     /// docs/ARCHITECTURE.md, no error enum uses a retired spelling, no new public module.
     Tidy,
+    /// Check that the workspace's rust-version is at least that of every package in Cargo.lock
+    /// (`cargo metadata`) and that the README names it.
+    RustVersion,
     /// Print the sha256sum list of every file under a folder (sorted), e.g. to regenerate
     /// datasets/<name>.sha256.
     Checksums { folder: PathBuf },
@@ -139,7 +142,7 @@ struct TyrexArgs {
     step: Option<u64>,
     /// Device orientation the models see: as recorded, or estimated from gyro and
     /// accelerometer.
-    #[arg(long, value_name = "SOURCE", default_value = "recorded", value_parser = ["recorded", "estimated"], conflicts_with = "variants")]
+    #[arg(long, value_name = "SOURCE", default_value = "estimated", value_parser = ["recorded", "estimated"], conflicts_with = "variants")]
     orientation: String,
     /// Train with the Nyström solver on this many landmarks instead of the exact SMO.
     #[arg(long, value_name = "N", conflicts_with = "variants")]
@@ -186,7 +189,8 @@ fn run(cli: Cli) -> Result<()> {
                 trust_unpinned,
                 progress: true,
             };
-            match fetch::fetch(ds, &opts)? {
+            let outcome = fetch::fetch(ds, &opts)?;
+            match &outcome {
                 Outcome::AlreadyPresent { path, source } => {
                     println!("{dataset}: already in {} (from {source})", path.display());
                 }
@@ -197,7 +201,7 @@ fn run(cli: Cli) -> Result<()> {
                     files,
                 } => {
                     println!("{dataset}: {files} files in {}", path.display());
-                    if !verified {
+                    if !*verified {
                         match archive_sha256 {
                             Some(sha) => println!(
                                 "{dataset}: UNPINNED archive, sha256 {sha}; to pin it set \
@@ -213,8 +217,24 @@ fn run(cli: Cli) -> Result<()> {
                     }
                 }
             }
+            if dataset == "ronin" {
+                // RoNIN's split lists, with each sequence's folder in the release.
+                let (Outcome::AlreadyPresent { path, .. } | Outcome::Installed { path, .. }) =
+                    &outcome;
+                let protocols = root.join("datasets/protocols/ronin");
+                let (written, warnings) = xtask::ronin_lists::write_lists(path, &protocols)?;
+                for w in warnings {
+                    eprintln!("warning: {w}");
+                }
+                println!(
+                    "{dataset}: {} split lists in {}",
+                    written.len(),
+                    path.display()
+                );
+            }
         }
         Task::Tidy => xtask::tidy::run(&xtask::workspace_root())?,
+        Task::RustVersion => xtask::rust_version::run(&xtask::workspace_root())?,
         Task::Checksums { folder } => {
             let list = checksum::list_tree(&folder)?;
             print!("{}", checksum::format_list(&list));

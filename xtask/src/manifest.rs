@@ -170,7 +170,7 @@ files = "demo.sha256"
     fn the_committed_manifest_is_valid_and_names_the_expected_datasets() {
         let path = crate::workspace_root().join("datasets/manifest.toml");
         let m = Manifest::load(&path).unwrap();
-        for name in ["ridi", "tyrex", "indoor-location-competition-20"] {
+        for name in ["ridi", "tyrex", "indoor-location-competition-20", "ronin"] {
             let ds = m.get(name).unwrap();
             assert!(!ds.urls.is_empty(), "{name} has no url");
         }

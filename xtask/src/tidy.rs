@@ -24,7 +24,14 @@ use anyhow::{Context, Result, bail};
 pub const PUBLIC_MODULES: &[(&str, &[&str])] = &[
     (
         "ridi-data",
-        &["ilc", "ridi_csv", "ridi_plain", "ridi_raw", "tyrex"],
+        &[
+            "ilc",
+            "ridi_csv",
+            "ridi_plain",
+            "ridi_raw",
+            "ronin",
+            "tyrex",
+        ],
     ),
     (
         "ridi",

@@ -5,12 +5,12 @@ use std::path::PathBuf;
 use anyhow::Result;
 use clap::ValueEnum;
 
-use ridi::data::{Format, ReadOptions};
+use ridi::data::{Format, ReadOptions, shown};
 
 #[derive(clap::Args)]
 pub(crate) struct Args {
-    /// A sequence (file or folder), a folder of sequences, a Tyrex dataset root, or a folder
-    /// searched for Indoor Location Competition path files.
+    /// A sequence (file or folder), a folder of sequences (RIDI, RoNIN), a Tyrex dataset root,
+    /// or a folder searched for Indoor Location Competition path files.
     source: PathBuf,
     /// Output folder.
     #[arg(long)]
@@ -18,8 +18,8 @@ pub(crate) struct Args {
     /// Source format (detected when omitted).
     #[arg(long, value_enum)]
     from: Option<FromFormat>,
-    /// Resample every sequence to this rate, Hz (linear interpolation, slerp for
-    /// rotations); a gap longer than 5 frame intervals is refused: split it first.
+    /// Resample every sequence to this rate, 1.001 to 9990 Hz (linear interpolation, slerp
+    /// for rotations); a gap longer than 5 frame intervals is refused: split it first.
     #[arg(long, value_name = "HZ", value_parser = rate_hz)]
     rate: Option<f64>,
 }
@@ -34,6 +34,8 @@ enum FromFormat {
     Tyrex,
     /// Indoor Location Competition 2.0 path files (a file, or a folder searched recursively).
     Ilc,
+    /// RoNIN sequence folders (data.hdf5 and info.json; one, or a folder of them).
+    Ronin,
 }
 
 impl From<FromFormat> for Format {
@@ -43,17 +45,21 @@ impl From<FromFormat> for Format {
             FromFormat::RidiCsv => Format::RidiCsv,
             FromFormat::Tyrex => Format::Tyrex,
             FromFormat::Ilc => Format::Ilc,
+            FromFormat::Ronin => Format::Ronin,
         }
     }
 }
 
-/// `--rate`: 1 Hz to 10 kHz, the frame intervals (1 s to 0.1 ms) the readers accept
-/// (`ridi_data::Validation::time_step_range`); phone sensors deliver 5-500 Hz.
+/// `--rate`: within [`ridi::convert::RATE_HZ`], the rates whose frames the readers accept
+/// (less than 1 s apart, at least 0.1 ms in the median); phone sensors deliver 5-500 Hz.
 fn rate_hz(text: &str) -> std::result::Result<f64, String> {
+    let (min, max) = ridi::convert::RATE_HZ;
     match text.parse::<f64>() {
-        Ok(x) if (1.0..=10_000.0).contains(&x) => Ok(x),
+        Ok(x) if (min..=max).contains(&x) => Ok(x),
         _ => Err(format!(
-            "`{text}` is not a rate of 1 to 10000 Hz (frames 1 s to 0.1 ms apart)"
+            "`{text}` is not a rate from {min} to {max} Hz: resampled frames must be less than \
+             1 s apart (the longest gap a recording may have) and at least 0.1 ms apart (the \
+             shortest step the readers accept)"
         )),
     }
 }
@@ -74,17 +80,17 @@ pub(crate) fn run(
     ridi::check_output_folder(&out)?;
     let summary = ridi::convert::convert(&source, &out, &opts)?;
     for w in &summary.warnings {
-        eprintln!("warning: {w}");
+        eprintln!("warning: {}", shown(w));
     }
     for c in &summary.sequences {
         outln!(
             "{}  {}",
-            c.path.display(),
+            shown(&c.path),
             c.placement.as_deref().unwrap_or("-")
         );
     }
     for l in &summary.lists {
-        outln!("list: {}", l.display());
+        outln!("list: {}", shown(l));
     }
     Ok(())
 }

@@ -5,6 +5,8 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{Result, bail};
 
+use ridi::data::shown;
+
 use crate::{Grid, Plots, eval, train};
 
 #[derive(clap::Args)]
@@ -28,7 +30,7 @@ pub(crate) fn run(args: Args) -> Result<()> {
     if !data.join("list_train.txt").is_file() {
         bail!(
             "no bundled sample at {} (give its folder with --data)",
-            data.display()
+            shown(&data)
         );
     }
     let demo = ridi::Demo::prepare(&data, &args.out, args.grid.into(), args.plots.into())?;

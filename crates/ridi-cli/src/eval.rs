@@ -6,7 +6,7 @@ use std::path::PathBuf;
 use anyhow::Result;
 use indicatif::ProgressBar;
 
-use ridi::data::ListEntry;
+use ridi::data::{ListEntry, shown};
 use ridi::eval::{AlignWindow, EvalConfig};
 use ridi::source::ReadFiles;
 use ridi::{
@@ -109,14 +109,14 @@ pub(crate) fn with_spinner<T>(n: usize, evaluate: impl FnOnce() -> T) -> T {
 /// files written on stdout.
 pub(crate) fn print_written(report: &Report, written: &EvalWritten, folder: &EvalFolder) {
     for w in &written.warnings {
-        eprintln!("warning: {w}");
+        eprintln!("warning: {}", shown(w));
     }
     print_summary(report);
     let stale = written.stale_plots;
     outln!(
         "wrote {} files into {} (report.md, report.json{}){}",
         written.plots.len() + written.reports.len(),
-        folder.dir().display(),
+        shown(folder.dir()),
         if folder.plots() != EvalPlots::None {
             ", plots/"
         } else {
@@ -132,7 +132,7 @@ pub(crate) fn print_written(report: &Report, written: &EvalWritten, folder: &Eva
 
 fn print_summary(report: &Report) {
     for w in &report.warnings {
-        eprintln!("warning: {w}");
+        eprintln!("warning: {}", shown(w));
     }
     let weak = report
         .sequences

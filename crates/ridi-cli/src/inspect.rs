@@ -29,6 +29,18 @@ pub(crate) fn run(Args { sequence, json }: Args) -> Result<()> {
         }
         return Ok(());
     }
+    // A recording that streams is summed up as it is read, in memory that does not grow with
+    // its length.
+    if ridi::data::detect(&sequence).is_ok_and(|f| f.streams()) {
+        let rows = ridi::data::RowReader::open(&sequence, &ReadOptions::default())?;
+        let report = ridi::inspect::inspect_stream(rows)?;
+        if json {
+            outln!("{}", serde_json::to_string_pretty(&report)?);
+        } else {
+            out!("{report}");
+        }
+        return Ok(());
+    }
     let loaded = ridi::read_any(&sequence, None, &ReadOptions::default())?;
     let mut reports = Vec::new();
     for seq in &loaded.sequences {

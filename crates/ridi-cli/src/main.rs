@@ -9,7 +9,7 @@ use anyhow::{Context, Result};
 use clap::{Parser, Subcommand, ValueEnum};
 
 use ridi::correct::PlacementSmoother;
-use ridi::data::{ListEntry, Listed, ReadOptions};
+use ridi::data::{ListEntry, Listed, ReadOptions, shown};
 use ridi::eval::AlignWindow;
 use ridi::regress::Cascade;
 use ridi::{EvalPlots, GridChoice, PlacementMap, Purpose};
@@ -211,7 +211,7 @@ fn load_listed(entries: Vec<ListEntry>, map: Option<&str>, purpose: Purpose) -> 
 }
 
 fn load_model(path: &Path) -> Result<Cascade> {
-    Cascade::load(path).with_context(|| format!("cannot load model {}", path.display()))
+    Cascade::load(path).with_context(|| format!("cannot load model {}", shown(path)))
 }
 
 /// One line: the outermost context and every cause, as users asked for. Errors that already
@@ -231,8 +231,38 @@ fn one_line(e: &anyhow::Error) -> String {
     line
 }
 
+/// Ctrl-C (SIGINT), SIGTERM and SIGHUP: the temporary files and staging folders of the run are
+/// removed ([`ridi::data::remove_temporaries_for_exit`], which lets a folder commit under way
+/// finish first), then the program exits with 128 + the signal's number (130 for Ctrl-C), as
+/// a shell reports a program a signal ended. Signals are the binary's business, not the
+/// library's. Without a handler (it could not be installed), a signal ends the program as by
+/// default, and the next run removes what it left.
+fn clean_up_on_signals() {
+    use signal_hook::consts::{SIGHUP, SIGINT, SIGTERM};
+    let Ok(mut signals) = signal_hook::iterator::Signals::new([SIGINT, SIGTERM, SIGHUP]) else {
+        return;
+    };
+    let spawned = std::thread::Builder::new()
+        .name("signals".into())
+        .spawn(move || {
+            if let Some(signal) = signals.forever().next() {
+                ridi::data::remove_temporaries_for_exit();
+                let name = match signal {
+                    SIGINT => "SIGINT",
+                    SIGTERM => "SIGTERM",
+                    _ => "SIGHUP",
+                };
+                eprintln!("error: interrupted ({name}); the run's temporary files are removed");
+                std::process::exit(128 + signal);
+            }
+        });
+    drop(spawned);
+}
+
 fn main() -> ExitCode {
-    let result = match Cli::parse().command {
+    let cli = Cli::parse();
+    clean_up_on_signals();
+    let result = match cli.command {
         Command::Inspect(args) => inspect::run(args),
         Command::Convert(args) => convert::run(args),
         Command::Train(args) => train::run(args),
@@ -243,7 +273,7 @@ fn main() -> ExitCode {
     match result {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
-            eprintln!("error: {}", one_line(&e));
+            eprintln!("error: {}", shown(one_line(&e)));
             ExitCode::FAILURE
         }
     }

@@ -4,9 +4,9 @@ use std::path::PathBuf;
 
 use anyhow::{Context, Result, bail};
 
-use ridi::data::ReadOptions;
+use ridi::data::{ReadOptions, shown};
 use ridi::source::ReadFiles;
-use ridi::{TrackOptions, TrackOutput, apply_orientation};
+use ridi::{PipelineError, TrackOptions, TrackOutput, apply_orientation};
 
 use crate::{MAX_FRAMES_APART, count, non_negative, placement_smoothing, positive};
 
@@ -52,19 +52,63 @@ pub(crate) fn run(args: Args) -> Result<()> {
         output = output.with_plot(plot, &inputs)?;
     }
     let model = crate::load_model(&args.model)?;
+    let opts = track_options(&args);
+    // Online without a plot, a recording that streams is tracked as it is read, in memory that
+    // does not grow with its length; a plot needs the whole trajectory.
+    if args.online
+        && args.plot.is_none()
+        && ridi::data::detect(&args.sequence).is_ok_and(|f| f.streams())
+    {
+        let rows = ridi::data::RowReader::open(&args.sequence, &ReadOptions::default())?;
+        let track = output
+            .write_stream(rows, &model, &opts)
+            .map_err(|e| match e {
+                e @ (PipelineError::Data(_) | PipelineError::Output(_)) => anyhow::Error::from(e),
+                e => anyhow::Error::from(e)
+                    .context(format!("cannot track {}", args.sequence.display())),
+            })?;
+        let n = track.regressions;
+        outln!(
+            "{}: {} frames, {n} regression{} -> {}",
+            track.name,
+            track.frames,
+            if n == 1 { "" } else { "s" },
+            args.out.display()
+        );
+        return Ok(());
+    }
     let mut loaded = ridi::read_any(&args.sequence, None, &ReadOptions::default())?;
     for w in &loaded.warnings {
-        eprintln!("warning: {w}");
+        eprintln!("warning: {}", shown(w));
     }
     // The model's orientation, once, so that the plot shows what was tracked.
     apply_orientation(model.feature_config().orientation, &mut loaded.sequences)?;
     let [seq] = &loaded.sequences[..] else {
         bail!(
             "{} holds {} sequences; convert it with `ridi convert` and track each",
-            args.sequence.display(),
+            shown(&args.sequence),
             loaded.sequences.len()
         );
     };
+    let track = ridi::track(seq, &model, &opts)
+        .with_context(|| format!("cannot track {}", shown(&args.sequence)))?;
+    output.write(seq, &track)?;
+    let n = track.regressions.len();
+    outln!(
+        "{}: {} frames, {n} regression{} -> {}",
+        seq.name(),
+        track.time.len(),
+        if n == 1 { "" } else { "s" },
+        shown(&args.out)
+    );
+    if let Some(plot) = &args.plot {
+        outln!("plot: {}", shown(plot));
+    }
+    Ok(())
+}
+
+/// The tracking options `args` ask for.
+fn track_options(args: &Args) -> TrackOptions {
     let mut opts = TrackOptions {
         regress_every: args.regress_every,
         online: args.online,
@@ -75,19 +119,5 @@ pub(crate) fn run(args: Args) -> Result<()> {
     if args.estimate_initial_velocity {
         opts.correction.initial_velocity = ridi::correct::InitialVelocity::Estimate;
     }
-    let track = ridi::track(seq, &model, &opts)
-        .with_context(|| format!("cannot track {}", args.sequence.display()))?;
-    output.write(seq, &track)?;
-    let n = track.regressions.len();
-    outln!(
-        "{}: {} frames, {n} regression{} -> {}",
-        seq.name(),
-        track.time.len(),
-        if n == 1 { "" } else { "s" },
-        args.out.display()
-    );
-    if let Some(plot) = &args.plot {
-        outln!("plot: {}", plot.display());
-    }
-    Ok(())
+    opts
 }

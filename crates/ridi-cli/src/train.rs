@@ -6,7 +6,7 @@ use anyhow::{Context, Result};
 use clap::ValueEnum;
 use indicatif::{ProgressBar, ProgressStyle};
 
-use ridi::data::ListEntry;
+use ridi::data::{ListEntry, shown};
 use ridi::features::FeatureConfig;
 use ridi::frames::UpAxis;
 use ridi::regress::{Cascade, Nystrom, ProgressEvent, RegressError, Solver, Stage, Storage};
@@ -39,10 +39,12 @@ pub(crate) struct Args {
     /// Classifier C (paper: 10).
     #[arg(long, default_value_t = 10.0, value_parser = positive)]
     classifier_c: f64,
-    /// Orientation to train and track with: as recorded, or estimated from gyro +
-    /// accelerometer (straighter tracks where the recorded one uses the magnetometer
-    /// indoors). The model records it: `ridi track` and `ridi eval` use the same.
-    #[arg(long, value_enum, default_value = "recorded")]
+    /// Orientation to train and track with: estimated from gyro + accelerometer, or as
+    /// recorded (the original RIDI). The estimate gives longer, straighter tracks where the
+    /// recorded one uses the magnetometer indoors and lower velocity errors on the iPhone
+    /// (docs/bench-devices.md). The model records it: `ridi track` and `ridi eval` use the
+    /// same.
+    #[arg(long, value_enum, default_value = "estimated")]
     orientation: OrientationArg,
     /// How the model stores its samples for prediction.
     #[arg(long, value_enum, default_value = "projected")]
@@ -212,8 +214,8 @@ pub(crate) fn run(args: Args) -> Result<()> {
             }
         })?;
     print_training(&model);
-    ridi::save_model(&model, out).with_context(|| format!("cannot write {}", out.display()))?;
-    outln!("model: {}", out.display());
+    ridi::save_model(&model, out).with_context(|| format!("cannot write {}", shown(out)))?;
+    outln!("model: {}", shown(out));
     Ok(())
 }
 

@@ -138,6 +138,46 @@ fn still_tyrex_run(dir: &Path, name: &str, frames: usize, gap_at: Option<usize>)
     run
 }
 
+/// A Tyrex run's Qualisys file that is a folder or a link to a device is an error naming the
+/// file, for every command that reads the run; a missing one is no error (the run has no
+/// ground truth).
+#[test]
+fn a_qualisys_file_that_is_not_a_file_is_an_error() {
+    let dir = tempfile::tempdir().unwrap();
+    let android = dir.path().join("datasets/android");
+    let run = still_tyrex_run(&android, "Ann_Nexus5_NoDist_Texting", 4000, None);
+    let qualisys = dir.path().join("datasets/qualisys");
+    std::fs::create_dir_all(&qualisys).unwrap();
+    let mat = qualisys.join("Ann_Nexus5_NoDist_Texting.mat");
+    let out = ridi(&["inspect", s(&run)]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    for make in [
+        (|m: &Path| std::fs::create_dir(m).unwrap()) as fn(&Path),
+        |m: &Path| std::os::unix::fs::symlink("/dev/zero", m).unwrap(),
+    ] {
+        make(&mat);
+        for args in [
+            vec!["inspect", s(&run)],
+            vec![
+                "convert",
+                s(dir.path()),
+                "--out",
+                s(&dir.path().join("conv")),
+            ],
+        ] {
+            let out = ridi(&args);
+            let err = stderr(&out);
+            assert!(
+                out.status.code() == Some(1)
+                    && err.contains(&format!("{}: ", s(&mat)))
+                    && err.contains("not a regular file"),
+                "{args:?}: {err}"
+            );
+        }
+        let _ = std::fs::remove_dir(&mat).or_else(|_| std::fs::remove_file(&mat));
+    }
+}
+
 #[test]
 fn errors_are_one_line_with_a_non_zero_exit() {
     let dir = tempfile::tempdir().unwrap();
@@ -348,7 +388,15 @@ fn convert_train_track_and_eval() {
     let paper = dir.path().join("paper.ridi");
     let out = train(
         &paper,
-        &["--turned-copies", "0", "--no-speed", "--up-axis", "plus-y"],
+        &[
+            "--turned-copies",
+            "0",
+            "--no-speed",
+            "--up-axis",
+            "plus-y",
+            "--orientation",
+            "recorded",
+        ],
     );
     assert!(out.status.success(), "{}", stderr(&out));
     let printed = String::from_utf8_lossy(&out.stdout);
@@ -868,14 +916,27 @@ fn convert_writes_all_or_nothing() {
         "{err}"
     );
     assert!(!conv.exists());
-    // A rate no phone records at is the flag's error, not the recording's.
-    for rate in ["0.5", "100000", "1e300"] {
+    // A rate no phone records at is the flag's error, not the recording's: also 1 Hz and
+    // 10 kHz, whose frames the readers would refuse (a step of 1 s is a gap, one of 0.1 ms
+    // below the shortest step, once rounded).
+    for rate in ["0.5", "1", "10000", "100000", "1e300"] {
         let out = ridi(&["convert", s(&texting), "--out", s(&conv), "--rate", rate]);
         let err = stderr(&out);
         assert!(
-            out.status.code() == Some(2) && err.contains("--rate") && err.contains("1 to 10000 Hz"),
+            out.status.code() == Some(2)
+                && err.contains("--rate")
+                && err.contains("from 1.001 to 9990 Hz"),
             "{err}"
         );
+    }
+    // Its bounds themselves convert, and the results read back.
+    for rate in ["1.001", "9990"] {
+        let out_dir = dir.path().join(format!("rate-{rate}"));
+        let out = ridi(&["convert", s(&texting), "--out", s(&out_dir), "--rate", rate]);
+        assert!(out.status.success(), "{rate}: {}", stderr(&out));
+        let seq = out_dir.join("Thibaud_Nexus5_NoDist_Texting");
+        let out = ridi(&["inspect", s(&seq)]);
+        assert!(out.status.success(), "{rate}: {}", stderr(&out));
     }
 
     // The source of another format than --from says what it is and what was expected.

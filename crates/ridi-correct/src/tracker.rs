@@ -468,6 +468,11 @@ impl<R: VelocityRegressor> Tracker<R> {
         &self.regressor
     }
 
+    /// The regressor, to take what it kept for reports (the tracker relies on no state of it).
+    pub fn regressor_mut(&mut self) -> &mut R {
+        &mut self.regressor
+    }
+
     /// The bias currently applied to new frames, device frame.
     pub fn bias(&self) -> DeviceVec {
         self.bias

@@ -6,7 +6,7 @@ use std::path::{Path, PathBuf};
 use crate::Sequence;
 use crate::error::{DataError, Location, Result};
 use crate::options::ReadOptions;
-use crate::{ilc, ridi_csv, ridi_plain, ridi_raw, tyrex};
+use crate::{ilc, ridi_csv, ridi_plain, ridi_raw, ronin, tyrex};
 
 /// The dataset formats ridi-data knows.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
@@ -21,6 +21,8 @@ pub enum Format {
     Tyrex,
     /// Indoor Location Competition 2.0 path file (see [`ilc`]).
     Ilc,
+    /// RoNIN sequence folder with `data.hdf5` and `info.json` (see [`ronin`]).
+    Ronin,
 }
 
 impl fmt::Display for Format {
@@ -31,6 +33,7 @@ impl fmt::Display for Format {
             Format::RidiRaw => "RIDI raw folder",
             Format::Tyrex => "Tyrex folder",
             Format::Ilc => "Indoor Location Competition path file",
+            Format::Ronin => "RoNIN folder",
         })
     }
 }
@@ -61,12 +64,16 @@ impl Format {
                 "an Indoor Location Competition path file is a `.txt` of \
                  `unix_ms<TAB>TYPE_...` records"
             }
+            Format::Ronin => {
+                "a RoNIN sequence is a folder (a000_1, ...) with data.hdf5 and info.json; a \
+                 RoNIN split folder (train_dataset_1, ...) holds the sequence folders"
+            }
         }
     }
 }
 
 /// What [`detect`] found: the format and the file or folder its reader takes.
-fn locate(path: &Path) -> Result<(Format, PathBuf)> {
+pub(crate) fn locate(path: &Path) -> Result<(Format, PathBuf)> {
     if path.is_file() {
         let name = path
             .file_name()
@@ -83,10 +90,16 @@ fn locate(path: &Path) -> Result<(Format, PathBuf)> {
             };
             return Ok((format, path.to_path_buf()));
         }
+        if name == ronin::DATA_FILE || name == ronin::INFO_FILE {
+            // A file of a RoNIN sequence stands for its folder.
+            if let Some(folder) = path.parent().filter(|f| ronin::looks_like(f)) {
+                return Ok((Format::Ronin, folder.to_path_buf()));
+            }
+        }
         return Err(DataError::format(
             Location::file(path),
-            "unknown file type: expected a RIDI `.csv` or `data_plain.txt`, or an Indoor \
-             Location Competition path `.txt`",
+            "unknown file type: expected a RIDI `.csv` or `data_plain.txt`, an Indoor \
+             Location Competition path `.txt`, or a RoNIN sequence's data.hdf5",
         ));
     }
     if !path.is_dir() {
@@ -126,14 +139,17 @@ fn locate(path: &Path) -> Result<(Format, PathBuf)> {
     {
         return Ok((Format::Tyrex, path.to_path_buf()));
     }
+    if ronin::looks_like(path) {
+        return Ok((Format::Ronin, path.to_path_buf()));
+    }
     if ridi_raw::looks_like(path) {
         return Ok((Format::RidiRaw, path.to_path_buf()));
     }
     Err(DataError::format(
         Location::file(path),
         "not a known dataset folder: expected processed/data.csv, data.csv, data_plain.txt, \
-         a RIDI raw folder (gyro.txt, acce.txt, ...) or a Tyrex folder (accelerometer.txt, \
-         gyroscope-calibrated.txt or attitude.txt)",
+         a RIDI raw folder (gyro.txt, acce.txt, ...), a Tyrex folder (accelerometer.txt, \
+         gyroscope-calibrated.txt or attitude.txt) or a RoNIN folder (data.hdf5, info.json)",
     ))
 }
 
@@ -154,6 +170,7 @@ pub fn source_files(path: impl AsRef<Path>) -> Result<Vec<PathBuf>> {
             files.extend(sidecar.is_file().then_some(sidecar));
             return Ok(files);
         }
+        Format::Ronin => ronin::files(&at).into(),
         Format::RidiRaw => ridi_raw::FILES
             .iter()
             .map(|(name, _)| at.join(name))
@@ -181,7 +198,8 @@ pub fn source_files(path: impl AsRef<Path>) -> Result<Vec<PathBuf>> {
 /// gzip-compressed (`*.csv.gz`, `*.txt.gz`). Folders, first match wins: `processed/data.csv`
 /// (or `.csv.gz`), `data.csv` (or `.csv.gz`), `processed/data_plain.txt`, `data_plain.txt`, a
 /// Tyrex folder of either layout (`accelerometer.txt`, `gyroscope-calibrated.txt` or
-/// `attitude.txt`; [`tyrex::layout_of`] tells which), a RIDI raw folder (any of
+/// `attitude.txt`; [`tyrex::layout_of`] tells which), a RoNIN folder (`data.hdf5`; the file
+/// itself, or its `info.json`, stands for the folder), a RIDI raw folder (any of
 /// [`ridi_raw::REQUIRED`]). A folder with only some of the files its format needs is
 /// detected as that format, and reading it names the files it lacks.
 pub fn detect(path: impl AsRef<Path>) -> Result<Format> {
@@ -214,6 +232,7 @@ pub fn read_sequence(path: impl AsRef<Path>, opts: &ReadOptions) -> Result<Seque
         Format::RidiPlain => ridi_plain::read(&file, opts),
         Format::RidiRaw => ridi_raw::read(&file, opts),
         Format::Ilc => Ok(ilc::read(&file, &ilc::IlcOptions::from(opts))?.sequence),
+        Format::Ronin => Ok(ronin::read(&file, &ronin::RoninOptions::from(opts))?.sequence),
         Format::Tyrex => {
             let mut read = crate::tyrex::read(&file, &crate::tyrex::TyrexOptions::from(opts))?;
             match read.sequences.len() {

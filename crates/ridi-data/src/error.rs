@@ -42,11 +42,13 @@ impl Location {
     }
 }
 
-/// `path` for a message, with control characters escaped (`\n`, `\u{1b}`): a file name may
-/// hold a line break or a terminal escape sequence, which printed raw would split the one-line
-/// error or retitle and clear the user's terminal.
-pub(crate) fn shown(path: &Path) -> String {
-    let text = path.display().to_string();
+/// `text` (a path, a sequence name, a message) for a message, with control characters escaped
+/// (`\n`, `\u{1b}`): a file or sequence name may hold a line break or a terminal escape
+/// sequence, which printed raw would split the one-line error or retitle and clear the user's
+/// terminal. The one escaping of ridi-rs: its messages and the `ridi` command's output go
+/// through it. Bytes that are not UTF-8 are shown as U+FFFD, as `Path::display` shows them.
+pub fn shown(text: impl AsRef<std::ffi::OsStr>) -> String {
+    let text = Path::new(text.as_ref()).display().to_string();
     if !text.chars().any(char::is_control) {
         return text;
     }
@@ -88,7 +90,7 @@ pub enum DataError {
         error: std::io::Error,
     },
     /// The content is not what the format says.
-    #[error("{at}: {message}")]
+    #[error("{at}: {}", shown(message))]
     Format {
         /// Where.
         at: Location,
@@ -96,7 +98,7 @@ pub enum DataError {
         message: String,
     },
     /// The data parsed but do not make a valid sequence.
-    #[error("{}: {error}", path.display())]
+    #[error("{}: {error}", shown(path))]
     Sequence {
         /// The file or folder the sequence came from.
         path: PathBuf,

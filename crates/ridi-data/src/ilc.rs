@@ -839,7 +839,7 @@ mod tests {
                 "1574559494300\tTYPE_WIFI",
                 "1574559494300 TYPE_WIFI",
                 "p/abc.txt:9: field `type`: expected a record `unix_ms<TAB>TYPE_...<TAB>values`, \
-                 found `1574559494300 TYPE_WIFI\tssid\tbssid\t-60\t5...`",
+                 found `1574559494300 TYPE_WIFI\\tssid\\tbssid\\t-60\\t5...`",
             ),
             (
                 "1574559496000\tTYPE_WAYPOINT\t1\t5",

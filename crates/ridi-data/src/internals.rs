@@ -10,6 +10,7 @@ use ridi_frames::{Frame, Vec3};
 use crate::ListEntry;
 use crate::error::Result;
 
+pub use crate::hdf5::{Hdf5Array, Hdf5File};
 pub use crate::mat::{
     CellArray, CharArray, MAX_DEPTH, MatClass, MatFile, MatValue, Numeric, StructArray,
 };

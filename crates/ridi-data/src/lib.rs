@@ -18,12 +18,17 @@
 //! | RIDI raw recorder folder (`gyro.txt`, `acce.txt`, ..., `pose.txt`) | [`ridi_raw::read`] | |
 //! | Tyrex smartphone benchmark run folder (Android or iOS text files, Qualisys `.mat` ground truth) | [`tyrex::read`] | |
 //! | Indoor Location Competition 2.0 path file (`unix_ms<TAB>TYPE_...` records, waypoints) | [`ilc::read`] | |
+//! | RoNIN sequence folder (`data.hdf5`, `info.json`) | [`ronin::read`] | |
 //! | dataset list file (`path,placement` per line) | [`ListEntry::read`], [`Listed`] | |
 //!
 //! [`detect`] tells the format of a file or folder and [`read_sequence`] reads any of them
 //! (a Tyrex run only when it is not split into parts; it drops the reader's warnings, which
 //! [`tyrex::read`] returns). [`ReadOptions`] holds the validation limits and the
 //! raw synchronization settings.
+//!
+//! [`RowReader`] reads a RIDI `data.csv` or `data_plain.txt` row by row, in memory that does not
+//! grow with the recording, with the same checks and errors as the whole-file readers
+//! ([`Format::streams`] says which formats stream).
 //!
 //! Conventions at the file edges: time is nanoseconds in files and seconds (absolute, `f64`)
 //! in a [`Sequence`]; quaternions are `w, x, y, z` in processed files and `x, y, z, w` in raw
@@ -34,8 +39,8 @@
 //!
 //! # Features
 //!
-//! - `internals` (off): the MAT-file reader, the list parser on bytes and the interpolation
-//!   that the fuzz targets (`fuzz/`), this crate's tests and its benches use; not a supported
+//! - `internals` (off): the MAT-file and HDF5 readers, the list parser on bytes and the
+//!   interpolation that the fuzz targets (`fuzz/`), this crate's tests and its benches use; not a supported
 //!   API.
 //!
 //! # Example
@@ -76,6 +81,7 @@ mod detect;
 mod device;
 mod error;
 mod file_id;
+mod hdf5;
 pub mod ilc;
 #[cfg(feature = "internals")]
 mod internals;
@@ -87,9 +93,12 @@ mod resample;
 pub mod ridi_csv;
 pub mod ridi_plain;
 pub mod ridi_raw;
+pub mod ronin;
 mod sequence;
 mod sequence_error;
 mod sidecar;
+mod stream;
+mod temporaries;
 mod text;
 pub mod tyrex;
 mod validation;
@@ -97,13 +106,13 @@ mod write;
 
 pub use detect::{Format, detect, read_sequence, source_files};
 pub use device::{DeviceError, DeviceInfo};
-pub use error::{DataError, Location, Result};
+pub use error::{DataError, Location, Result, shown};
 pub use file_id::FileId;
 #[cfg(feature = "internals")]
 #[doc(hidden)]
 pub use internals::{
-    CellArray, CharArray, MAX_DEPTH, MatClass, MatFile, MatValue, Numeric, StructArray,
-    interpolate_vec3, parse_list,
+    CellArray, CharArray, Hdf5Array, Hdf5File, MAX_DEPTH, MatClass, MatFile, MatValue, Numeric,
+    StructArray, interpolate_vec3, parse_list,
 };
 pub use list::{ListEntry, Listed, unlistable_name};
 pub use options::ReadOptions;
@@ -112,6 +121,12 @@ pub use ridi_frames;
 pub use sequence::{Channel, GroundTruth, OrientationSource, Sequence, SequenceParts};
 pub use sequence_error::SequenceError;
 pub use sidecar::{SIDECAR_SUFFIX, sidecar_path};
+pub use stream::{MedianTest, Row, RowReader, median_interval};
+pub use temporaries::{
+    STAGING_LOCK, STAGING_PREFIX, StaleTemporary, TEMPORARY_FILE_PREFIX, TemporariesHold,
+    Temporary, hold_temporaries, register_temporary, remove_temporaries_for_exit, remove_temporary,
+    stale_temporaries, temporary_prefix,
+};
 pub use validation::{
     GYRO_SCALE_MIN_RATE, LINACCE_SCALE_MIN_RMS, MAX_JUMP_SHARE, ORIENTATION_JUMP_RATE,
     OrientationJump, Validation, bridge_orientation_jumps, orientation_jumps,

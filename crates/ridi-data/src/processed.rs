@@ -178,23 +178,56 @@ fn rotations(table: &Table, at: usize, path: &Path) -> Result<Vec<WorldFromDevic
         .rows
         .iter()
         .zip(&table.lines)
-        .map(|(r, &line)| {
-            rotation_wxyz([r[at], r[at + 1], r[at + 2], r[at + 3]]).map_err(|e| {
-                DataError::format(
-                    Location::line(path, line).with_field(PROCESSED_COLUMNS[at]),
-                    format!(
-                        "`{}..{}` is not a rotation: {e}",
-                        PROCESSED_COLUMNS[at],
-                        PROCESSED_COLUMNS[at + 3]
-                    ),
-                )
-            })
-        })
+        .map(|(r, &line)| rotation_at(r, at, path, line))
         .collect()
 }
 
-fn gt(r: &[f64; 27]) -> &[f64] {
+/// The rotation in the four columns of `r` from `at` on (`ori_*` or `rv_*`), read from `line`.
+pub(crate) fn rotation_at(
+    r: &[f64; 27],
+    at: usize,
+    path: &Path,
+    line: usize,
+) -> Result<WorldFromDevice> {
+    rotation_wxyz([r[at], r[at + 1], r[at + 2], r[at + 3]]).map_err(|e| {
+        DataError::format(
+            Location::line(path, line).with_field(PROCESSED_COLUMNS[at]),
+            format!(
+                "`{}..{}` is not a rotation: {e}",
+                PROCESSED_COLUMNS[at],
+                PROCESSED_COLUMNS[at + 3]
+            ),
+        )
+    })
+}
+
+pub(crate) fn gt(r: &[f64; 27]) -> &[f64] {
     &r[POS..RV]
+}
+
+/// The error for the ground truth of row `r`, read from `line`, which has a NaN while other
+/// rows have ground truth (`None`: no NaN in `r`).
+pub(crate) fn ground_truth_nan(r: &[f64; 27], path: &Path, line: usize) -> Option<DataError> {
+    let k = gt(r).iter().position(|v| v.is_nan())?;
+    let (nan, given): (Vec<usize>, Vec<usize>) = (0..gt(r).len()).partition(|&j| gt(r)[j].is_nan());
+    let names = |js: &[usize]| -> String {
+        let names: Vec<&str> = js.iter().map(|&j| PROCESSED_COLUMNS[POS + j]).collect();
+        names.join(", ")
+    };
+    let message = if given.is_empty() {
+        "ground truth is NaN here but present on other rows (all NaN means none)".to_string()
+    } else {
+        format!(
+            "ground truth is incomplete: {} NaN but {} given (give every ground-truth \
+             column, or NaN in all of them on every row for none)",
+            names(&nan),
+            names(&given)
+        )
+    };
+    Some(DataError::format(
+        Location::line(path, line).with_field(PROCESSED_COLUMNS[POS + k]),
+        message,
+    ))
 }
 
 /// Ground truth of the table: `None` when its columns are absent or NaN on every row; an error
@@ -207,29 +240,9 @@ fn ground_truth(table: &Table, path: &Path) -> Result<Option<GroundTruth>> {
         return Ok(None);
     }
     for (r, &line) in table.rows.iter().zip(&table.lines) {
-        let Some(k) = gt(r).iter().position(|v| v.is_nan()) else {
-            continue;
-        };
-        let (nan, given): (Vec<usize>, Vec<usize>) =
-            (0..gt(r).len()).partition(|&j| gt(r)[j].is_nan());
-        let names = |js: &[usize]| -> String {
-            let names: Vec<&str> = js.iter().map(|&j| PROCESSED_COLUMNS[POS + j]).collect();
-            names.join(", ")
-        };
-        let message = if given.is_empty() {
-            "ground truth is NaN here but present on other rows (all NaN means none)".to_string()
-        } else {
-            format!(
-                "ground truth is incomplete: {} NaN but {} given (give every ground-truth \
-                 column, or NaN in all of them on every row for none)",
-                names(&nan),
-                names(&given)
-            )
-        };
-        return Err(DataError::format(
-            Location::line(path, line).with_field(PROCESSED_COLUMNS[POS + k]),
-            message,
-        ));
+        if let Some(e) = ground_truth_nan(r, path, line) {
+            return Err(e);
+        }
     }
     Ok(Some(GroundTruth {
         position: vec3::<ridi_frames::World>(&table.rows, POS),

@@ -46,14 +46,14 @@ fn header_name(cell: &str) -> &str {
 
 /// The [`PROCESSED_COLUMNS`] index fed by each file column (`None` for the index and unknown
 /// columns).
-struct Header {
-    line: usize,
+pub(crate) struct Header {
+    pub(crate) line: usize,
     slots: Vec<Option<usize>>,
-    has_magnet: bool,
-    has_ground_truth: bool,
+    pub(crate) has_magnet: bool,
+    pub(crate) has_ground_truth: bool,
 }
 
-fn parse_header(line: usize, content: &str, path: &Path) -> Result<Header> {
+pub(crate) fn parse_header(line: usize, content: &str, path: &Path) -> Result<Header> {
     let at = |field: &str| Location::line(path, line).with_field(field);
     let mut slots = Vec::new();
     let mut found = [false; 27];
@@ -93,25 +93,34 @@ fn parse_header(line: usize, content: &str, path: &Path) -> Result<Header> {
     })
 }
 
-fn parse_table(text: &str, path: &Path) -> Result<Table> {
-    let mut lines = text::lines(text);
-    let Some((header_line, header)) = lines.next() else {
-        return Err(DataError::format(
-            Location::file(path),
-            "file is empty: expected a header line and data rows",
-        ));
-    };
-    let header = parse_header(header_line, header, path)?;
-    let width = header.slots.len();
-    let mut rows = Vec::new();
-    let mut row_lines = Vec::new();
-    for (line, content) in lines {
+/// The error for a file without a header line.
+pub(crate) fn empty_file(path: &Path) -> DataError {
+    DataError::format(
+        Location::file(path),
+        "file is empty: expected a header line and data rows",
+    )
+}
+
+/// The error for a file with a header line on `line` and no data rows.
+pub(crate) fn no_rows(path: &Path, line: usize) -> DataError {
+    DataError::format(
+        Location::line(path, line),
+        "only a header line, no data rows",
+    )
+}
+
+impl Header {
+    /// Parses data line `line` (`content`, without its line ending) into the
+    /// [`PROCESSED_COLUMNS`]; columns that are not in the file stay NaN (assembling never
+    /// reads them).
+    pub(crate) fn parse_row(&self, line: usize, content: &str, path: &Path) -> Result<[f64; 27]> {
+        let width = self.slots.len();
         let width_error = |fields: usize| {
             DataError::format(
                 Location::line(path, line),
                 format!(
                     "{fields} fields where the header on line {} has {width}{}",
-                    header.line,
+                    self.line,
                     if fields < width {
                         " (truncated line?)"
                     } else {
@@ -120,23 +129,31 @@ fn parse_table(text: &str, path: &Path) -> Result<Table> {
                 ),
             )
         };
-        // Columns that are not in the file stay NaN; assemble never reads them.
-        let row = processed::parse_row(
+        processed::parse_row(
             || text::cells(content, b','),
-            |c| header.slots.get(c).copied().flatten(),
+            |c| self.slots.get(c).copied().flatten(),
             width,
             width_error,
             path,
             line,
-        )?;
-        rows.push(row);
+        )
+    }
+}
+
+fn parse_table(text: &str, path: &Path) -> Result<Table> {
+    let mut lines = text::lines(text);
+    let Some((header_line, header)) = lines.next() else {
+        return Err(empty_file(path));
+    };
+    let header = parse_header(header_line, header, path)?;
+    let mut rows = Vec::new();
+    let mut row_lines = Vec::new();
+    for (line, content) in lines {
+        rows.push(header.parse_row(line, content, path)?);
         row_lines.push(line);
     }
     if rows.is_empty() {
-        return Err(DataError::format(
-            Location::line(path, header.line),
-            "only a header line, no data rows",
-        ));
+        return Err(no_rows(path, header.line));
     }
     let last_row = row_lines.last().map(|&l| Location::line(path, l));
     text::check_line_break(text, last_row, "")?;

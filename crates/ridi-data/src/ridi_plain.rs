@@ -28,14 +28,22 @@ pub fn parse(bytes: &[u8], path: &Path, opts: &ReadOptions) -> Result<Sequence> 
     processed::assemble(table, path, opts)
 }
 
-fn parse_table(text: &str, path: &Path) -> Result<Table> {
-    let mut lines = text::lines(text);
-    let Some((header_line, header)) = lines.next() else {
-        return Err(DataError::format(
-            Location::file(path),
-            "file is empty: expected a `N 27` line and N rows",
-        ));
-    };
+/// The first line of a `data_plain.txt`: the rows it announces, on `line`.
+pub(crate) struct Header {
+    pub(crate) line: usize,
+    pub(crate) rows: usize,
+}
+
+/// The error for a file without its `N 27` line.
+pub(crate) fn empty_file(path: &Path) -> DataError {
+    DataError::format(
+        Location::file(path),
+        "file is empty: expected a `N 27` line and N rows",
+    )
+}
+
+/// Parses the `N 27` line `header`, line `header_line`.
+pub(crate) fn parse_header(header_line: usize, header: &str, path: &Path) -> Result<Header> {
     let mut cells = header.split_ascii_whitespace();
     let (Some(n), Some(width), None) = (cells.next(), cells.next(), cells.next()) else {
         return Err(DataError::format(
@@ -60,17 +68,41 @@ fn parse_table(text: &str, path: &Path) -> Result<Table> {
             "announces no rows",
         ));
     }
-    // The count comes from the file: cap the reservation so a bogus count cannot exhaust memory.
-    let mut rows = Vec::with_capacity(n.min(1 << 20));
-    let mut row_lines = Vec::with_capacity(n.min(1 << 20));
-    let mut last_line = header_line;
-    for (line, content) in lines {
-        if rows.len() == n {
-            return Err(DataError::format(
-                Location::line(path, line),
-                format!("more rows than the {n} announced on line {header_line}"),
-            ));
-        }
+    Ok(Header {
+        line: header_line,
+        rows: n,
+    })
+}
+
+impl Header {
+    /// The error for row `read + 1`, on `line`, beyond the announced count.
+    pub(crate) fn too_many(&self, path: &Path, line: usize) -> DataError {
+        DataError::format(
+            Location::line(path, line),
+            format!(
+                "more rows than the {} announced on line {}",
+                self.rows, self.line
+            ),
+        )
+    }
+
+    /// The error for a file that ends, after line `last_line`, with `read` rows of fewer than
+    /// announced (`None`: as many as announced).
+    pub(crate) fn too_few(&self, path: &Path, read: usize, last_line: usize) -> Option<DataError> {
+        (read < self.rows).then(|| {
+            DataError::format(
+                Location::line(path, last_line),
+                format!(
+                    "file ends after {read} of the {} rows announced on line {}",
+                    self.rows, self.line
+                ),
+            )
+        })
+    }
+
+    /// Parses data line `line` (`content`, without its line ending).
+    pub(crate) fn parse_row(&self, line: usize, content: &str, path: &Path) -> Result<[f64; 27]> {
+        let width = PROCESSED_COLUMNS.len();
         let width_error = |fields: usize| {
             DataError::format(
                 Location::line(path, line),
@@ -84,26 +116,38 @@ fn parse_table(text: &str, path: &Path) -> Result<Table> {
                 ),
             )
         };
-        let row = processed::parse_row(
+        processed::parse_row(
             || content.split_ascii_whitespace(),
             |k| (k < PROCESSED_COLUMNS.len()).then_some(k),
             width,
             width_error,
             path,
             line,
-        )?;
-        rows.push(row);
+        )
+    }
+}
+
+fn parse_table(text: &str, path: &Path) -> Result<Table> {
+    let mut lines = text::lines(text);
+    let Some((header_line, header)) = lines.next() else {
+        return Err(empty_file(path));
+    };
+    let header = parse_header(header_line, header, path)?;
+    let n = header.rows;
+    // The count comes from the file: cap the reservation so a bogus count cannot exhaust memory.
+    let mut rows = Vec::with_capacity(n.min(1 << 20));
+    let mut row_lines = Vec::with_capacity(n.min(1 << 20));
+    let mut last_line = header_line;
+    for (line, content) in lines {
+        if rows.len() == n {
+            return Err(header.too_many(path, line));
+        }
+        rows.push(header.parse_row(line, content, path)?);
         row_lines.push(line);
         last_line = line;
     }
-    if rows.len() < n {
-        return Err(DataError::format(
-            Location::line(path, last_line),
-            format!(
-                "file ends after {} of the {n} rows announced on line {header_line}",
-                rows.len()
-            ),
-        ));
+    if let Some(e) = header.too_few(path, rows.len(), last_line) {
+        return Err(e);
     }
     let last_row = row_lines.last().map(|&l| Location::line(path, l));
     text::check_line_break(text, last_row, "")?;

@@ -26,16 +26,24 @@ pub enum OrientationSource {
     Estimated,
     /// Ground-truth orientation (Tango, motion capture) used as the device orientation.
     GroundTruth,
+    /// The gyro integrated from a known start orientation (RoNIN's `gyro_integration`, which
+    /// RoNIN picks when the game rotation vector's end error is 20 degrees or more and this
+    /// one's is the smallest).
+    GyroIntegration,
+    /// An offline EKF estimate shipped with the data (RoNIN's `pose/ekf_ori`).
+    Ekf,
 }
 
 impl OrientationSource {
     /// Every source, in declaration order.
-    pub const ALL: [OrientationSource; 5] = [
+    pub const ALL: [OrientationSource; 7] = [
         OrientationSource::GameRotationVector,
         OrientationSource::RotationVector,
         OrientationSource::CoreMotionAttitude,
         OrientationSource::Estimated,
         OrientationSource::GroundTruth,
+        OrientationSource::GyroIntegration,
+        OrientationSource::Ekf,
     ];
 
     /// The name in files (`game-rotation-vector`, ...; serde's name too).
@@ -46,6 +54,8 @@ impl OrientationSource {
             OrientationSource::CoreMotionAttitude => "core-motion-attitude",
             OrientationSource::Estimated => "estimated",
             OrientationSource::GroundTruth => "ground-truth",
+            OrientationSource::GyroIntegration => "gyro-integration",
+            OrientationSource::Ekf => "ekf",
         }
     }
 }
@@ -58,6 +68,8 @@ impl fmt::Display for OrientationSource {
             OrientationSource::CoreMotionAttitude => "Core Motion attitude",
             OrientationSource::Estimated => "estimated",
             OrientationSource::GroundTruth => "ground truth",
+            OrientationSource::GyroIntegration => "gyro integration",
+            OrientationSource::Ekf => "EKF",
         })
     }
 }

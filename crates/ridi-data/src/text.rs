@@ -17,17 +17,7 @@ pub(crate) fn read_file(path: &Path) -> Result<Vec<u8>> {
 /// or a small table has a size its format bounds. Every read refuses what is not a regular
 /// file (a folder, `/dev/zero`, a pipe): a device can hand out bytes for ever.
 pub(crate) fn read_file_bounded(path: &Path, max: u64) -> Result<Vec<u8>> {
-    let meta = std::fs::metadata(path).map_err(|e| DataError::io(path, e))?;
-    if !meta.is_file() {
-        return Err(DataError::format(
-            Location::file(path),
-            if meta.is_dir() {
-                "is a folder: it is not a regular file"
-            } else {
-                "is a device, a pipe or a socket: it is not a regular file"
-            },
-        ));
-    }
+    let meta = regular_file(path)?;
     if meta.len() > max {
         return Err(DataError::format(
             Location::file(path),
@@ -39,6 +29,23 @@ pub(crate) fn read_file_bounded(path: &Path, max: u64) -> Result<Vec<u8>> {
     }
     let bytes = std::fs::read(path).map_err(|e| DataError::io(path, e))?;
     gunzip_if_gzip(bytes, path)
+}
+
+/// The metadata of `path`, refused when it is not a regular file (a folder, `/dev/zero`, a
+/// pipe): a device can hand out bytes for ever.
+pub(crate) fn regular_file(path: &Path) -> Result<std::fs::Metadata> {
+    let meta = std::fs::metadata(path).map_err(|e| DataError::io(path, e))?;
+    if !meta.is_file() {
+        return Err(DataError::format(
+            Location::file(path),
+            if meta.is_dir() {
+                "is a folder: it is not a regular file"
+            } else {
+                "is a device, a pipe or a socket: it is not a regular file"
+            },
+        ));
+    }
+    Ok(meta)
 }
 
 /// Largest ratio of decompressed to compressed size a gzip input may have: sensor text (time
@@ -58,9 +65,7 @@ pub(crate) fn gunzip_if_gzip(bytes: Vec<u8>, path: &Path) -> Result<Vec<u8>> {
     if !bytes.starts_with(&[0x1f, 0x8b]) {
         return Ok(bytes);
     }
-    let limit = (bytes.len() as u64)
-        .saturating_mul(MAX_GZIP_RATIO)
-        .max(GZIP_ALLOWANCE);
+    let limit = gzip_limit(bytes.len() as u64);
     let mut out = Vec::with_capacity(bytes.len().saturating_mul(4));
     let decoder = flate2::read::MultiGzDecoder::new(&bytes[..]);
     std::io::Read::read_to_end(&mut std::io::Read::take(decoder, limit + 1), &mut out).map_err(
@@ -72,17 +77,28 @@ pub(crate) fn gunzip_if_gzip(bytes: Vec<u8>, path: &Path) -> Result<Vec<u8>> {
         },
     )?;
     if out.len() as u64 > limit {
-        return Err(DataError::format(
-            Location::file(path),
-            format!(
-                "decompresses to more than {limit} bytes, over {MAX_GZIP_RATIO} times its {} \
-                 compressed bytes: not a recording (sensor text compresses 2-10 times); \
-                 refused before it fills the memory",
-                bytes.len()
-            ),
-        ));
+        return Err(gzip_too_large(path, limit, bytes.len() as u64));
     }
     Ok(out)
+}
+
+/// How many bytes a gzip input of `compressed` bytes may decompress to ([`gunzip_if_gzip`]).
+pub(crate) fn gzip_limit(compressed: u64) -> u64 {
+    compressed
+        .saturating_mul(MAX_GZIP_RATIO)
+        .max(GZIP_ALLOWANCE)
+}
+
+/// The error for a gzip input of `compressed` bytes that decompresses beyond `limit`.
+pub(crate) fn gzip_too_large(path: &Path, limit: u64, compressed: u64) -> DataError {
+    DataError::format(
+        Location::file(path),
+        format!(
+            "decompresses to more than {limit} bytes, over {MAX_GZIP_RATIO} times its \
+             {compressed} compressed bytes: not a recording (sensor text compresses 2-10 \
+             times); refused before it fills the memory"
+        ),
+    )
 }
 
 /// The bytes as UTF-8 text without a leading byte-order mark; the error names the first line
@@ -123,16 +139,21 @@ pub(crate) fn check_line_break(
 ) -> Result<()> {
     match last_record {
         Some(at) if !content.trim_end_matches([' ', '\t', '\r']).ends_with('\n') => {
-            Err(DataError::format(
-                at,
-                format!(
-                    "the file ends inside this record, without a line break: cut off while \
-                     being written?{hint}"
-                ),
-            ))
+            Err(cut_off(at, hint))
         }
         _ => Ok(()),
     }
+}
+
+/// The error of [`check_line_break`] for the record at `at`.
+pub(crate) fn cut_off(at: Location, hint: &str) -> DataError {
+    DataError::format(
+        at,
+        format!(
+            "the file ends inside this record, without a line break: cut off while being \
+             written?{hint}"
+        ),
+    )
 }
 
 /// Cells of a line separated by the ASCII byte `sep`, like `str::split` but with a plain byte
@@ -231,34 +252,45 @@ pub(crate) fn check_time(
     max_gap_s: f64,
 ) -> Result<()> {
     for (i, w) in time.windows(2).enumerate() {
-        let (prev, next) = (w[0], w[1]);
         let line = lines.get(i + 1).copied().unwrap_or(0);
         let prev_line = lines.get(i).copied().unwrap_or(0);
-        let at = || Location::line(path, line).with_field(field);
-        if next == prev {
-            return Err(DataError::format(
-                at(),
-                format!("duplicate timestamp (same as line {prev_line})"),
-            ));
-        }
-        if next < prev {
-            return Err(DataError::format(
-                at(),
-                format!(
-                    "timestamp goes back by {:.9} s from line {prev_line}",
-                    prev - next
-                ),
-            ));
-        }
-        if next - prev > max_gap_s {
-            return Err(DataError::format(
-                at(),
-                format!(
-                    "gap of {:.3} s since line {prev_line} exceeds the limit of {max_gap_s} s",
-                    next - prev
-                ),
-            ));
-        }
+        check_step((w[0], prev_line), (w[1], line), path, field, max_gap_s)?;
+    }
+    Ok(())
+}
+
+/// [`check_time`] of one step: from `prev` to `next` (each a time in seconds and its line).
+pub(crate) fn check_step(
+    (prev, prev_line): (f64, usize),
+    (next, line): (f64, usize),
+    path: &Path,
+    field: &str,
+    max_gap_s: f64,
+) -> Result<()> {
+    let at = || Location::line(path, line).with_field(field);
+    if next == prev {
+        return Err(DataError::format(
+            at(),
+            format!("duplicate timestamp (same as line {prev_line})"),
+        ));
+    }
+    if next < prev {
+        return Err(DataError::format(
+            at(),
+            format!(
+                "timestamp goes back by {:.9} s from line {prev_line}",
+                prev - next
+            ),
+        ));
+    }
+    if next - prev > max_gap_s {
+        return Err(DataError::format(
+            at(),
+            format!(
+                "gap of {:.3} s since line {prev_line} exceeds the limit of {max_gap_s} s",
+                next - prev
+            ),
+        ));
     }
     Ok(())
 }
@@ -294,6 +326,16 @@ pub(crate) fn sequence_field(channel: Channel, axis: Option<usize>) -> String {
 pub(crate) fn sequence_error(
     path: &Path,
     lines: Option<&[usize]>,
+    fields: &dyn Fields,
+    e: SequenceError,
+) -> DataError {
+    sequence_error_at(path, |i| lines.and_then(|l| l.get(i)).copied(), fields, e)
+}
+
+/// [`sequence_error`] with the line of frame `i` as `line_of(i)` says (`None`: unknown).
+pub(crate) fn sequence_error_at(
+    path: &Path,
+    line_of: impl Fn(usize) -> Option<usize>,
     fields: &dyn Fields,
     e: SequenceError,
 ) -> DataError {
@@ -340,8 +382,8 @@ pub(crate) fn sequence_error(
         }
         _ => return DataError::sequence(path, e),
     };
-    match lines.and_then(|l| l.get(index)) {
-        Some(&line) => DataError::format(Location::line(path, line).with_field(field), message),
+    match line_of(index) {
+        Some(line) => DataError::format(Location::line(path, line).with_field(field), message),
         None if matches!(
             e,
             SequenceError::Implausible { .. } | SequenceError::GroundTruthJump { .. }

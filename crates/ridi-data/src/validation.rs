@@ -210,7 +210,7 @@ impl Validation {
     /// than two frames pass.
     pub fn check_speed(&self, time: &[f64], position: &[WorldVec]) -> Result<(), SequenceError> {
         let step_speed =
-            |i: usize| (position[i] - position[i - 1]).norm() / (time[i] - time[i - 1]);
+            |i: usize| Self::step_speed(position[i] - position[i - 1], time[i] - time[i - 1]);
         let n = time.len().min(position.len());
         let mut speeds: Vec<f64> = (1..n).map(step_speed).collect();
         if speeds.is_empty() {
@@ -224,7 +224,7 @@ impl Validation {
             });
         }
         // A NaN speed (equal times) must not pass either.
-        let too_fast = |v: f64| v.is_nan() || v > self.max_speed;
+        let too_fast = |v: f64| self.too_fast(v);
         let Some(later) = (1..n).find(|&i| too_fast(step_speed(i))) else {
             return Ok(());
         };
@@ -233,16 +233,33 @@ impl Validation {
         let first_only = later == 1 && !(2..n).any(|i| too_fast(step_speed(i)));
         let index = if first_only { 0 } else { later };
         let step = (position[later] - position[later - 1]).to_array();
+        Err(self.jump(index, step, time[later] - time[later - 1]))
+    }
+
+    /// The speed of the ground truth's `step` of `dt` seconds, as [`Self::check_speed`]
+    /// computes it.
+    pub(crate) fn step_speed(step: WorldVec, dt: f64) -> f64 {
+        step.norm() / dt
+    }
+
+    /// Whether [`Self::check_speed`] counts a step of `speed` as too fast.
+    pub(crate) fn too_fast(&self, speed: f64) -> bool {
+        speed.is_nan() || speed > self.max_speed
+    }
+
+    /// The error of [`Self::check_speed`] for a `step` of `dt` seconds too fast, at frame
+    /// `index`.
+    pub(crate) fn jump(&self, index: usize, step: [f64; 3], dt: f64) -> SequenceError {
         let axis = (0..3)
             .max_by(|&a, &b| step[a].abs().total_cmp(&step[b].abs()))
             .unwrap_or(0);
-        Err(SequenceError::GroundTruthJump {
+        SequenceError::GroundTruthJump {
             index,
             axis,
             distance: norm(step),
-            dt: time[later] - time[later - 1],
+            dt,
             max: self.max_speed,
-        })
+        }
     }
 
     /// Checks mean |acce| against mean |gravity| (both m/s^2) with
@@ -289,6 +306,17 @@ impl Validation {
             ww += w * w;
             n += 1;
         }
+        self.gyro_scale_verdict(gw, ww, n)
+    }
+
+    /// [`Self::check_gyro_scale`] of the sums over `n` steps of gyro times orientation rate
+    /// (`gw`) and orientation rate squared (`ww`).
+    pub(crate) fn gyro_scale_verdict(
+        &self,
+        gw: f64,
+        ww: f64,
+        n: usize,
+    ) -> Result<(), SequenceError> {
         if n == 0 || (ww / n as f64).sqrt() < GYRO_SCALE_MIN_RATE {
             return Ok(());
         }
@@ -318,6 +346,18 @@ impl Validation {
             }
             n += 1;
         }
+        self.linacce_scale_verdict(dl, ll, dd, n)
+    }
+
+    /// [`Self::check_linacce_scale`] of its sums over `n` frames: of (acce - gravity) times
+    /// linacce (`dl`), linacce squared (`ll`) and (acce - gravity) squared (`dd`).
+    pub(crate) fn linacce_scale_verdict(
+        &self,
+        dl: f64,
+        ll: f64,
+        dd: f64,
+        n: usize,
+    ) -> Result<(), SequenceError> {
         if n == 0 || (dd / n as f64).sqrt() < LINACCE_SCALE_MIN_RMS {
             return Ok(());
         }
@@ -370,7 +410,7 @@ pub struct OrientationJump {
 
 /// Per step `k - 1 -> k`: `k`, the time step, the orientation's rotation rate and the gyro's
 /// (the mean of the two readings), rad/s; steps whose time does not increase are skipped.
-fn step_rates<'a>(
+pub(crate) fn step_rates<'a>(
     time: &'a [f64],
     gyro: &'a [DeviceVec],
     orientation: &'a [WorldFromDevice],

@@ -31,6 +31,10 @@ use crate::Sequence;
 use crate::error::{DataError, Result};
 use crate::processed::PROCESSED_COLUMNS;
 use crate::sidecar;
+use crate::temporaries::{
+    TEMPORARY_FILE_PREFIX, Temporary, register_temporary, remove_temporary, stale_temporaries,
+    temporary_prefix,
+};
 
 /// The 27 values of frame `i` in [`PROCESSED_COLUMNS`] order, time excluded (slot 0 is unused).
 fn row(seq: &Sequence, i: usize) -> [f64; 27] {
@@ -81,10 +85,12 @@ pub fn write_atomically(
     write_pending(path, content)?.commit()
 }
 
-/// [`write_atomically`] up to the rename: `content` is written in full (and synced) to a
-/// temporary file in `path`'s folder, which [`PendingFile::commit`] renames to `path`. Dropped
-/// without a commit, the temporary file is removed and `path` left as it was. For outputs that
-/// are to replace their files together, or not at all.
+/// [`write_atomically`] up to the rename: `content` is written in full (and synced) to a temporary
+/// file in `path`'s folder (`.ridi-tmp-<pid>-XXXXXX`, locked while written: see
+/// [`register_temporary`](crate::register_temporary), and those that killed runs left there are
+/// removed first), which [`PendingFile::commit`] renames to `path`. Dropped without a commit, the
+/// temporary file is removed and `path` left as it was. For outputs that are to replace their files
+/// together, or not at all.
 pub fn write_pending(
     path: &Path,
     content: impl FnOnce(&mut dyn Write) -> std::io::Result<()>,
@@ -94,14 +100,27 @@ pub fn write_pending(
         _ => Path::new("."),
     };
     let io = |e| DataError::io(path, e);
+    // What a killed run of any ridi-rs program left here goes first.
+    for stale in stale_temporaries(dir, TEMPORARY_FILE_PREFIX) {
+        remove_temporary(&stale.path);
+    }
+    let prefix = temporary_prefix(TEMPORARY_FILE_PREFIX);
     let mut builder = tempfile::Builder::new();
+    builder.prefix(&prefix);
     // Temporary files are private (0600) by default; an output file is for others to read too.
     #[cfg(unix)]
     {
         use std::os::unix::fs::PermissionsExt;
         builder.permissions(std::fs::Permissions::from_mode(0o644));
     }
-    let mut tmp = builder.tempfile_in(dir).map_err(io)?;
+    let (mut tmp, registered) = register_temporary(|| {
+        let tmp = builder.tempfile_in(dir)?;
+        // Locked while this process writes it: a later run tells it from a killed one's.
+        tmp.as_file().lock()?;
+        let path = tmp.path().to_path_buf();
+        Ok((tmp, path))
+    })
+    .map_err(io)?;
     {
         let mut w = std::io::BufWriter::with_capacity(1 << 16, tmp.as_file_mut());
         content(&mut w).map_err(io)?;
@@ -111,6 +130,7 @@ pub fn write_pending(
     Ok(PendingFile {
         tmp,
         path: path.to_path_buf(),
+        _registered: registered,
     })
 }
 
@@ -119,6 +139,7 @@ pub fn write_pending(
 pub struct PendingFile {
     tmp: tempfile::NamedTempFile,
     path: std::path::PathBuf,
+    _registered: Temporary,
 }
 
 impl PendingFile {

@@ -144,9 +144,9 @@
 //!
 //! # Features
 //!
-//! - `linfa` (on by default): linfa's `Fit` for [`SvrParams`] and [`SvcParams`] and `Predict`
-//!   for [`Svr`] and [`Svc`] (on `f32` datasets), and the `linfa` and `ndarray` versions they
-//!   are built against. Without it (`default-features = false`) the crate depends on neither.
+//! - `linfa` (off): linfa's `Fit` for [`SvrParams`] and [`SvcParams`] and `Predict` for
+//!   [`Svr`] and [`Svc`] (on `f32` datasets), and the `linfa` and `ndarray` versions they are
+//!   built against. Without it the crate depends on neither.
 //! - `bench-internals` (off): kernel and cross-validation internals that the crate's benches
 //!   and timing examples measure or reuse; not a supported API.
 //!

@@ -166,6 +166,26 @@ fn check_header(bytes: &[u8], size: u64) -> Result<Header, RegressError> {
     Ok(Header { version, len, crc })
 }
 
+/// What a payload that passed the checksum yet does not decode means for the file, in words:
+/// bincode's own text is its debug form (`UnexpectedEnd { additional: 1 }`,
+/// `InvalidIntegerType { expected: U32, found: Reserved }`), which says nothing to a user.
+fn decode_words(e: &bincode::error::DecodeError) -> String {
+    use bincode::error::DecodeError as E;
+    match e {
+        E::UnexpectedEnd { additional } => format!(
+            "its payload ends {additional} byte{} before the model does: the file was cut short \
+             before its checksum was written, or edited",
+            if *additional == 1 { "" } else { "s" }
+        ),
+        E::LimitExceeded => {
+            "a length in its payload is larger than any model's: the file is corrupt".into()
+        }
+        _ => "its payload holds a value no model has (a number of the wrong size, an unknown \
+              kind or label): the file is corrupt, edited, or from an incompatible build"
+            .into(),
+    }
+}
+
 fn decode(bytes: &[u8]) -> Result<Cascade, RegressError> {
     let Header { version, crc, .. } = check_header(bytes, bytes.len() as u64)?;
     let payload = &bytes[HEADER..];
@@ -176,7 +196,7 @@ fn decode(bytes: &[u8]) -> Result<Cascade, RegressError> {
             found,
         });
     }
-    let decode_err = |e: bincode::error::DecodeError| RegressError::Decode(e.to_string());
+    let decode_err = |e: bincode::error::DecodeError| RegressError::Decode(decode_words(&e));
     let mut rest = payload;
     if version == NYSTROM_VERSION {
         let (kind, used): (u32, usize) =

@@ -817,6 +817,32 @@ fn nystrom_models_are_deterministic_compact_and_round_trip() {
         Cascade::from_bytes(&nan),
         Err(RegressError::Decode(_))
     ));
+    // A payload cut short, or holding a value of no model, under a consistent header and
+    // checksum (a file edited, or written by a broken build): said in words, not in bincode's
+    // debug text (`UnexpectedEnd { additional: 1 }`, `InvalidIntegerType { .. }`).
+    let reheader = |mut b: Vec<u8>| {
+        let len = (b.len() - 24) as u64;
+        b[12..20].copy_from_slice(&len.to_le_bytes());
+        let crc = crc32fast::hash(&b[24..]);
+        b[20..24].copy_from_slice(&crc.to_le_bytes());
+        b
+    };
+    let mut cut = bytes.clone();
+    cut.pop();
+    let mut odd = bytes.clone();
+    odd[25] = 0xff;
+    for (b, words) in [
+        (reheader(cut), "ends 1 byte before the model does"),
+        (reheader(odd), "holds a value no model has"),
+    ] {
+        match Cascade::from_bytes(&b) {
+            Err(e @ RegressError::Decode(_)) => {
+                let m = e.to_string();
+                assert!(m.contains(words) && !m.contains('{'), "{m}");
+            }
+            other => panic!("expected a decode error, got {other:?}"),
+        }
+    }
     std::fs::remove_dir_all(&dir).unwrap();
 
     // The model is the landmarks and a weight per landmark and machine, not the rows.

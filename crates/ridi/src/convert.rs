@@ -47,12 +47,19 @@ pub struct ConvertOptions {
     pub from: Option<Format>,
     /// How to read (validation limits).
     pub read: ReadOptions,
-    /// Resample every sequence to this rate, Hz ([`Sequence::resampled`]); `None` keeps each
-    /// sequence's timeline.
+    /// Resample every sequence to this rate, Hz ([`Sequence::resampled`]), within
+    /// [`RATE_HZ`]; `None` keeps each sequence's timeline.
     ///
     /// [`Sequence::resampled`]: ridi_data::Sequence::resampled
     pub rate_hz: Option<f64>,
 }
+
+/// The rates a conversion resamples to, Hz, both included: 1.001 to 9,990. The readers (with
+/// the default [`ridi_data::Validation`]) refuse frames 1 s apart or more (`max_gap_s`) and a
+/// median step under 0.1 ms (`time_step_range`); a uniform timeline at exactly 1 Hz or
+/// 10 kHz lands on either side of those bounds once its times are added up in floating point
+/// and written as whole nanoseconds, so the range keeps 0.1 % from each.
+pub const RATE_HZ: (f64, f64) = (1.001, 9990.0);
 
 /// Longest gap `--rate` interpolates across, in frame intervals of the source: longer ones
 /// would be filled with invented frames, so the recording has to be split there first.
@@ -169,7 +176,8 @@ fn detected_sources(source: &Path) -> Result<Sources, DataError> {
         DataError::format(
             Location::file(source),
             "no sequence found: expected a RIDI data.csv, data_plain.txt or raw folder, a Tyrex \
-             folder or root, a folder of those, or Indoor Location Competition path files",
+             folder or root, a RoNIN sequence folder, a folder of those, or Indoor Location \
+             Competition path files",
         )
     })
 }

@@ -41,7 +41,11 @@ pub enum PipelineError {
     #[error("plot: {0}")]
     Plot(crate::plot::PlotError),
     /// A sequence lacks what a stage needs (ground truth, placement, enough frames).
-    #[error("sequence `{sequence}`: {message}")]
+    #[error(
+        "sequence `{}`: {}",
+        ridi_data::shown(sequence),
+        ridi_data::shown(message)
+    )]
     Sequence {
         /// Sequence name.
         sequence: String,
@@ -65,7 +69,7 @@ pub enum PipelineError {
         source: Box<PipelineError>,
     },
     /// A file the pipeline writes or reads itself (models, reports, placement maps).
-    #[error("{}: {message}", path.display())]
+    #[error("{}: {message}", ridi_data::shown(path))]
     File {
         /// The file.
         path: PathBuf,

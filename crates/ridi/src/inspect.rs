@@ -23,16 +23,45 @@ pub struct Stats {
 }
 
 impl Stats {
-    /// Statistics of `values` (all zero when empty).
-    pub fn of(values: impl Iterator<Item = f64> + Clone) -> Stats {
-        let (mut n, mut sum, mut min, mut max) = (0usize, 0.0, f64::INFINITY, f64::NEG_INFINITY);
-        for v in values.clone() {
-            n += 1;
-            sum += v;
-            min = min.min(v);
-            max = max.max(v);
+    /// Statistics of `values` (all zero when empty), in one pass (the sum, the extremes, and the sums of the
+    /// differences from the first value and of their squares).
+    pub fn of(values: impl Iterator<Item = f64>) -> Stats {
+        let mut sum = StatsSum::default();
+        values.for_each(|v| sum.push(v));
+        sum.stats()
+    }
+}
+
+/// [`Stats`] summed one value at a time, so that a stream too long to hold has them: the sum,
+/// the extremes, and the sums of the values' differences from the first and of their squares
+/// (shifted so that a small spread about a large mean keeps its digits).
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+struct StatsSum {
+    n: usize,
+    sum: f64,
+    min: f64,
+    max: f64,
+    shift: f64,
+    d: f64,
+    dd: f64,
+}
+
+impl StatsSum {
+    fn push(&mut self, v: f64) {
+        if self.n == 0 {
+            (self.min, self.max, self.shift) = (v, v, v);
         }
-        if n == 0 {
+        self.n += 1;
+        self.sum += v;
+        self.min = self.min.min(v);
+        self.max = self.max.max(v);
+        let d = v - self.shift;
+        self.d += d;
+        self.dd += d * d;
+    }
+
+    fn stats(&self) -> Stats {
+        if self.n == 0 {
             return Stats {
                 mean: 0.0,
                 std: 0.0,
@@ -40,15 +69,102 @@ impl Stats {
                 max: 0.0,
             };
         }
-        let mean = sum / n as f64;
-        let var = values.map(|v| (v - mean).powi(2)).sum::<f64>() / n as f64;
+        let n = self.n as f64;
+        let var = ((self.dd - self.d * self.d / n) / n).max(0.0);
         Stats {
-            mean,
+            mean: self.sum / n,
             std: var.sqrt(),
-            min,
-            max,
+            min: self.min,
+            max: self.max,
         }
     }
+}
+
+/// What [`Inspection`] is made of, from a whole sequence or a stream of rows.
+struct Summary {
+    format: Format,
+    name: String,
+    device: Option<ridi_data::DeviceInfo>,
+    placement: Option<String>,
+    frames: usize,
+    duration: f64,
+    max_gap: f64,
+    /// The median rate, when it is off [`RATE_HZ`] by more than [`RATE_TOLERANCE`].
+    rate_off: Option<f64>,
+    orientation_source: Option<ridi_data::OrientationSource>,
+    gravity_norm: Stats,
+    upside_down: usize,
+    acce_norm: Stats,
+    has_magnet: bool,
+    has_steps: bool,
+    has_ground_truth: bool,
+    path_length: Option<f64>,
+}
+
+/// The horizontal distance between two ground-truth positions, as
+/// [`Sequence::path_length`] sums it.
+fn horizontal_step(a: ridi_frames::WorldVec, b: ridi_frames::WorldVec) -> f64 {
+    ((b.x() - a.x()).powi(2) + (b.y() - a.y()).powi(2)).sqrt()
+}
+
+/// Inspects the recording `rows` reads, in one pass over its rows (memory that does not grow
+/// with its length): what [`inspect`] reports of the sequence the whole-file reader gives.
+///
+/// # Errors
+/// What reading the recording refuses ([`ridi_data::RowReader::finish`]).
+pub fn inspect_stream(mut rows: ridi_data::RowReader) -> crate::Result<Inspection> {
+    let (mut gravity, mut acce) = (StatsSum::default(), StatsSum::default());
+    let (mut upside_down, mut max_gap) = (0usize, 0.0f64);
+    let mut rate = ridi_data::MedianTest::default();
+    let (mut first, mut last) = (None::<f64>, None::<f64>);
+    let mut path = -0.0;
+    let mut previous_position = None;
+    let mut has_ground_truth = false;
+    for row in rows.by_ref() {
+        let row = row?;
+        if let Some(t) = last {
+            max_gap = max_gap.max(row.time - t);
+            crate::track::count_rate(&mut rate, row.time - t);
+        }
+        first.get_or_insert(row.time);
+        last = Some(row.time);
+        gravity.push(row.gravity.norm());
+        acce.push(row.acce.norm());
+        upside_down += usize::from(UpAxis::is_upside_down(row.gravity));
+        if let Some((p, _)) = row.ground_truth {
+            has_ground_truth = true;
+            if let Some(q) = previous_position {
+                path += horizontal_step(q, p);
+            }
+            previous_position = Some(p);
+        }
+    }
+    let file = rows.path().to_path_buf();
+    let opts = rows.options().clone();
+    let summary = Summary {
+        format: rows.format(),
+        name: rows.name().to_string(),
+        device: rows.device().cloned(),
+        placement: None,
+        frames: rows.rows(),
+        duration: last.zip(first).map_or(0.0, |(l, f)| l - f),
+        max_gap,
+        rate_off: None,
+        orientation_source: rows.orientation_source(),
+        gravity_norm: gravity.stats(),
+        upside_down,
+        acce_norm: acce.stats(),
+        has_magnet: rows.has_magnet(),
+        has_steps: false,
+        has_ground_truth,
+        path_length: has_ground_truth.then_some(path),
+    };
+    rows.finish()?;
+    let rate_off = crate::track::rate_off(&rate, &file, &opts)?;
+    Ok(report(Summary {
+        rate_off: rate_off.filter(|_| summary.frames >= 2),
+        ..summary
+    }))
 }
 
 /// Everything `ridi inspect` prints, as JSON with `--json`.
@@ -97,33 +213,60 @@ pub struct Inspection {
 
 /// Inspects `seq`, read as `format`.
 pub fn inspect(seq: &Sequence, format: Format) -> Inspection {
-    let gravity_norm = Stats::of(seq.gravity().iter().map(|g| g.norm()));
-    let upside_down = seq
-        .gravity()
-        .iter()
-        .filter(|&&g| UpAxis::is_upside_down(g))
-        .count();
-    let upside_down_fraction = upside_down as f64 / seq.len().max(1) as f64;
-    let acce_norm = Stats::of(seq.acce().iter().map(|a| a.norm()));
-    let rate_hz = seq.rate_hz();
-    let max_gap_s = seq.max_gap();
-    let mut warnings = Vec::new();
     let median_rate = seq.median_rate_hz();
+    let off = (median_rate - RATE_HZ).abs() > RATE_TOLERANCE * RATE_HZ;
+    report(Summary {
+        format,
+        name: seq.name().to_string(),
+        device: seq.device().cloned(),
+        placement: seq.placement().map(str::to_string),
+        frames: seq.len(),
+        duration: seq.duration(),
+        max_gap: seq.max_gap(),
+        rate_off: (seq.len() >= 2 && off).then_some(median_rate),
+        orientation_source: seq.orientation_source(),
+        gravity_norm: Stats::of(seq.gravity().iter().map(|g| g.norm())),
+        upside_down: seq
+            .gravity()
+            .iter()
+            .filter(|&&g| UpAxis::is_upside_down(g))
+            .count(),
+        acce_norm: Stats::of(seq.acce().iter().map(|a| a.norm())),
+        has_magnet: seq.magnet().is_some(),
+        has_steps: seq.steps().is_some(),
+        has_ground_truth: seq.ground_truth().is_some(),
+        path_length: seq.path_length(),
+    })
+}
+
+/// The report of a [`Summary`]: its figures and the warnings they call for.
+fn report(s: Summary) -> Inspection {
+    let gravity_norm = s.gravity_norm;
+    let upside_down_fraction = s.upside_down as f64 / s.frames.max(1) as f64;
+    let acce_norm = s.acce_norm;
+    // As `Sequence::rate_hz`: the mean rate, 0 for a single frame.
+    let rate_hz = if s.duration > 0.0 {
+        (s.frames - 1) as f64 / s.duration
+    } else {
+        0.0
+    };
+    let max_gap_s = s.max_gap;
+    let mut warnings = Vec::new();
     let window = ridi_features::FeatureConfig::default().window;
-    if seq.len() < 2 {
+    if s.frames < 2 {
         warnings.push("a single frame: no rate, nothing to train, track or evaluate".into());
-    } else if (median_rate - RATE_HZ).abs() > RATE_TOLERANCE * RATE_HZ {
+    } else if let Some(median_rate) = s.rate_off {
         warnings.push(format!(
             "rate {median_rate:.1} Hz (median frame interval): train, track and eval need \
              {RATE_HZ} Hz (within {:.0} %)",
             RATE_TOLERANCE * 100.0
         ));
     }
-    if (2..=window).contains(&seq.len()) {
+    if (2..=window).contains(&s.frames) {
         warnings.push(format!(
             "{} frames: no whole feature window of the default {window} frames before any of \
              them, nothing to train, track or evaluate with such a model",
-            seq.len()
+            s.frames
         ));
     }
     if rate_hz > 0.0 && max_gap_s > 5.0 / rate_hz {
@@ -159,35 +302,31 @@ pub fn inspect(seq: &Sequence, format: Format) -> Inspection {
             100.0 * upside_down_fraction
         ));
     }
-    if seq.duration() < 10.0 {
+    if s.duration < 10.0 {
         warnings.push("shorter than 10 s: too short for the paper's alignment".into());
     }
-    if seq.ground_truth().is_none() {
+    if !s.has_ground_truth {
         warnings.push("no ground truth: usable for tracking, not for training".into());
     }
     Inspection {
-        format: format.to_string(),
-        name: seq.name().to_string(),
-        device: seq.device().map(|d| d.model().to_string()),
-        device_imu_rate_hz: seq.device().and_then(|d| d.imu_rate_hz()),
-        placement: seq.placement().map(str::to_string),
-        frames: seq.len(),
-        duration_s: seq.duration(),
+        format: s.format.to_string(),
+        name: s.name,
+        device: s.device.as_ref().map(|d| d.model().to_string()),
+        device_imu_rate_hz: s.device.as_ref().and_then(|d| d.imu_rate_hz()),
+        placement: s.placement,
+        frames: s.frames,
+        duration_s: s.duration,
         rate_hz,
         max_gap_s,
-        orientation_source: seq.orientation_source().map(|s| s.to_string()),
+        orientation_source: s.orientation_source.map(|o| o.to_string()),
         gravity_norm,
         upside_down_fraction,
         acce_norm,
-        has_magnet: seq.magnet().is_some(),
-        has_steps: seq.steps().is_some(),
-        ground_truth_coverage: if seq.ground_truth().is_some() {
-            1.0
-        } else {
-            0.0
-        },
+        has_magnet: s.has_magnet,
+        has_steps: s.has_steps,
+        ground_truth_coverage: if s.has_ground_truth { 1.0 } else { 0.0 },
         // `+ 0.0` turns the -0.0 of a path without steps into 0.0 for printing.
-        path_length_m: seq.path_length().map(|l| l + 0.0),
+        path_length_m: s.path_length.map(|l| l + 0.0),
         warnings,
     }
 }

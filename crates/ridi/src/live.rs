@@ -156,8 +156,9 @@ impl SensorReading {
 ///
 /// With a model trained on the recorded orientation, every push gives its own frame's update.
 /// With an estimated orientation, the first frames wait until the estimator knows the initial
-/// tilt (the first 20 nonzero accelerometer samples, 0.1 s at 200 Hz) and then come out
-/// together; [`finish`](Self::finish) releases what a stream too short for that leaves.
+/// tilt (its settling pass over the first
+/// [`FilterConfig::settle_time`](ridi_frames::FilterConfig::settle_time), 2 s) and then come
+/// out together; [`finish`](Self::finish) releases what a stream too short for that leaves.
 /// Pushing a whole recording gives exactly the poses of `ridi track --online`
 /// ([`track`](crate::track()) with [`TrackOptions::online`]), which runs through this type.
 ///
@@ -329,6 +330,18 @@ impl<'m> LiveTracker<'m> {
     /// each ([`CascadeRegressor::made`]).
     pub fn regressions(&self) -> (&[FrameVelocity], &[usize]) {
         self.tracker.regressor().made()
+    }
+
+    /// Takes the regressions made since the last call (or the start): the velocities at their
+    /// frames and the placement of each. A caller that writes them out as it goes (`ridi track
+    /// --online` of a long recording) so keeps none; [`regressions`](Self::regressions) then
+    /// holds only those made since.
+    pub fn take_regressions(&mut self) -> (Vec<FrameVelocity>, Vec<usize>) {
+        let r = self.tracker.regressor_mut();
+        (
+            std::mem::take(&mut r.made),
+            std::mem::take(&mut r.placements),
+        )
     }
 
     /// The streaming tracker underneath (statistics, buffered poses, the current bias).

@@ -55,12 +55,18 @@ pub fn oriented(seq: &Sequence, choice: Orientation) -> Result<Cow<'_, Sequence>
             seq,
             &FilterConfig::default(),
         )?)),
-        (Orientation::Recorded, true) => Err(PipelineError::sequence(
-            seq.name(),
-            "carries an orientation estimated from gyro and accelerometer, but the model or \
-             training options expect the recorded one (train with --orientation estimated)",
-        )),
+        (Orientation::Recorded, true) => Err(recorded_wanted(seq.name())),
     }
+}
+
+/// The error of [`oriented`] for the sequence `name` whose orientation was estimated where the
+/// recorded one is wanted.
+pub(crate) fn recorded_wanted(name: &str) -> PipelineError {
+    PipelineError::sequence(
+        name,
+        "carries an orientation estimated from gyro and accelerometer, but the model or \
+         training options expect the recorded one (train with --orientation estimated)",
+    )
 }
 
 /// [`oriented`] for every sequence, in place.

@@ -8,9 +8,9 @@
 //! - [`TrackOutput`]: a trajectory CSV and, optionally, its plot, both written in full before
 //!   either replaces a file.
 //! - [`EvalFolder`]: an evaluation's folder (`report.json`, `report.md`, `plots/`, and the
-//!   model for the demo), written through [`Staging`] all or nothing, then cleared of the
-//!   plots an earlier evaluation left there that this one did not write, so that the folder
-//!   matches its report.
+//!   model for the demo), written through [`Staging`] all or nothing, the plots an earlier
+//!   evaluation left there that this one did not write removed with the same commit, so that
+//!   the folder matches its report.
 //! - [`save_model`]: a model file.
 //!
 //! Every file goes through [`ridi_data::write_atomically`] (or [`ridi_data::write_pending`],
@@ -33,15 +33,29 @@ use crate::track::Track;
 #[non_exhaustive]
 pub enum OutputError {
     /// The folder of an output file does not exist.
-    #[error("cannot write {}: the folder {} does not exist", path.display(), folder.display())]
+    #[error(
+        "cannot write {}: the folder {} does not exist",
+        ridi_data::shown(path),
+        ridi_data::shown(folder)
+    )]
     NoFolder {
         /// The output file.
         path: PathBuf,
         /// Its folder.
         folder: PathBuf,
     },
+    /// An output file's path ends in `/` (or `.`, `..`): it names a folder, even one that does
+    /// not exist, which no file can be written as.
+    #[error(
+        "cannot write {}: a path ending in `/` names a folder; give a file name",
+        ridi_data::shown(path)
+    )]
+    FolderName {
+        /// The output file.
+        path: PathBuf,
+    },
     /// An output file's path is a folder.
-    #[error("cannot write {}: it is a folder", path.display())]
+    #[error("cannot write {}: it is a folder", ridi_data::shown(path))]
     IsFolder {
         /// The output file.
         path: PathBuf,
@@ -49,8 +63,8 @@ pub enum OutputError {
     /// The folder of an output file takes no new files.
     #[error(
         "cannot write {}: cannot create files in {} ({kind})",
-        path.display(),
-        folder.display()
+        ridi_data::shown(path),
+        ridi_data::shown(folder)
     )]
     FolderNotWritable {
         /// The output file.
@@ -61,13 +75,20 @@ pub enum OutputError {
         kind: std::io::ErrorKind,
     },
     /// An output folder is a file.
-    #[error("cannot write into {}: it is a file, not a folder", dir.display())]
+    #[error(
+        "cannot write into {}: it is a file, not a folder",
+        ridi_data::shown(dir)
+    )]
     IsFile {
         /// The output folder.
         dir: PathBuf,
     },
     /// An output folder would have to be made inside a file.
-    #[error("cannot write into {}: {} is a file, not a folder", dir.display(), file.display())]
+    #[error(
+        "cannot write into {}: {} is a file, not a folder",
+        ridi_data::shown(dir),
+        ridi_data::shown(file)
+    )]
     InsideFile {
         /// The output folder.
         dir: PathBuf,
@@ -77,8 +98,8 @@ pub enum OutputError {
     /// An output folder could not be made, or takes no new entries.
     #[error(
         "cannot write into {}: cannot create folders in {} ({kind})",
-        dir.display(),
-        existing.display()
+        ridi_data::shown(dir),
+        ridi_data::shown(existing)
     )]
     ParentNotWritable {
         /// The output folder.
@@ -91,8 +112,8 @@ pub enum OutputError {
     /// An output would replace a file the command reads.
     #[error(
         "cannot write {}: the command reads it ({}); choose another output",
-        path.display(),
-        input.display()
+        ridi_data::shown(path),
+        ridi_data::shown(input)
     )]
     Input {
         /// The output.
@@ -101,7 +122,7 @@ pub enum OutputError {
         input: PathBuf,
     },
     /// One file is given as two outputs, which would overwrite each other.
-    #[error("cannot write {}: it is given as two outputs", path.display())]
+    #[error("cannot write {}: it is given as two outputs", ridi_data::shown(path))]
     TwoOutputs {
         /// The output.
         path: PathBuf,
@@ -111,7 +132,7 @@ pub enum OutputError {
     #[error(transparent)]
     PlotFormat(crate::plot::PlotError),
     /// Writing an output file failed.
-    #[error("cannot write {}", path.display())]
+    #[error("cannot write {}", ridi_data::shown(path))]
     Write {
         /// The output file.
         path: PathBuf,
@@ -120,7 +141,7 @@ pub enum OutputError {
         source: Box<PipelineError>,
     },
     /// Writing into an output folder failed.
-    #[error("cannot write into {}", dir.display())]
+    #[error("cannot write into {}", ridi_data::shown(dir))]
     WriteInto {
         /// The output folder.
         dir: PathBuf,
@@ -143,6 +164,11 @@ impl OutputError {
 /// no new files, or the path itself a folder. For a check before long work (training,
 /// tracking) rather than a failure after it.
 pub fn check_output_file(path: &Path) -> Result<(), OutputError> {
+    if names_a_folder(path) {
+        return Err(OutputError::FolderName {
+            path: path.to_path_buf(),
+        });
+    }
     let folder = folder_of(path);
     if !folder.is_dir() {
         return Err(OutputError::NoFolder {
@@ -161,6 +187,17 @@ pub fn check_output_file(path: &Path) -> Result<(), OutputError> {
         folder: folder.to_path_buf(),
         kind,
     })
+}
+
+/// Whether `path` can only name a folder: it ends in a separator, or in `.` or `..`
+/// (`Path::file_name` looks through a trailing `/` and `/.`; the system does not).
+fn names_a_folder(path: &Path) -> bool {
+    let text = path.as_os_str().as_encoded_bytes();
+    let last = text
+        .rsplit(|&b| std::path::is_separator(char::from(b)))
+        .next()
+        .unwrap_or_default();
+    matches!(last, b"" | b"." | b"..")
 }
 
 /// Refuses an output folder that exists as something else (a file) or could not be written
@@ -287,6 +324,37 @@ impl TrackOutput {
         csv.commit().map_err(|e| OutputError::write(&self.csv, e))?;
         Ok(())
     }
+
+    /// Tracks the recording `rows` reads, online, writing the trajectory CSV as the poses come
+    /// (memory that does not grow with the recording; the same CSV as [`Self::write`] of an
+    /// online [`crate::track()`]) under a
+    /// temporary name beside it, renamed into place once the whole recording was tracked and
+    /// checked. A failure leaves the file as it was. No plot: drawing one needs the whole
+    /// trajectory.
+    pub fn write_stream(
+        &self,
+        rows: ridi_data::RowReader,
+        model: &Cascade,
+        opts: &crate::TrackOptions,
+    ) -> Result<crate::track::StreamedTrack> {
+        let mut tracked = None;
+        let pending = write_pending(&self.csv, |w| {
+            let t = crate::track::track_stream(rows, model, opts, w)?;
+            let failed = t.is_err();
+            tracked = Some(t);
+            match failed {
+                true => Err(std::io::Error::other("not tracked")),
+                false => Ok(()),
+            }
+        });
+        if let Some(Err(e)) = tracked {
+            return Err(e);
+        }
+        let csv = pending.map_err(|e| OutputError::write(&self.csv, e))?;
+        csv.commit().map_err(|e| OutputError::write(&self.csv, e))?;
+        // `write_pending` ran the content, which tracked.
+        tracked.unwrap_or_else(|| Err(PipelineError::Live("the recording was not tracked".into())))
+    }
 }
 
 /// Which plots an evaluation draws beside its report.
@@ -339,8 +407,8 @@ pub struct EvalWritten {
     pub model: Option<PathBuf>,
     /// How many plots of an earlier evaluation were removed from `plots/`.
     pub stale_plots: usize,
-    /// What went wrong after the new files were in place (an old plot that could not be
-    /// removed), one sentence each: worth a warning, not a failure.
+    /// What went wrong after the new files were in place, one sentence each: worth a warning,
+    /// not a failure. (Old plots now go with the commit, so none so far.)
     pub warnings: Vec<String>,
 }
 
@@ -378,11 +446,11 @@ impl EvalFolder {
 
     /// Writes `report`, the plots of `traces` and, when given, `model` under the file name
     /// `model.0`, all or nothing ([`Staging`]): a failure on the way leaves the folder as it
-    /// was. (The staging folder exists only while the files are written, so a killed write
-    /// leaves nothing behind.) Then removes the plots of the sequences of the `report.json`
-    /// it replaced, and of `report`, that it did not write (other sequences, the other format,
-    /// or no plots), so that `plots/` matches the report; other files there stay, and `plots/`
-    /// goes if that empties it.
+    /// was, and a kill is finished or rolled back by the next write into it. The same commit
+    /// removes the plots of the sequences of the `report.json` it replaces, and of `report`,
+    /// that it did not write (other sequences, the other format, or no plots), so that
+    /// `plots/` matches the report; other files there stay, and `plots/` goes if that empties
+    /// it.
     pub fn write(
         &self,
         report: &Report,
@@ -394,7 +462,7 @@ impl EvalFolder {
         // Read before report.json is replaced: whose plots an earlier evaluation wrote.
         let mut plotted = earlier_sequences(out);
         plotted.extend(report.sequences.iter().map(|s| s.name.clone()));
-        let staging = Staging::new(out).map_err(|e| OutputError::WriteInto {
+        let mut staging = Staging::new(out).map_err(|e| OutputError::WriteInto {
             dir: out.clone(),
             source: Box::new(e.into()),
         })?;
@@ -411,7 +479,10 @@ impl EvalFolder {
         if let Some(ext) = self.plots.extension() {
             let staged = staging.dir(Path::new("plots"))?;
             for t in traces {
-                for file in t.plot(&staged, ext)? {
+                for file in t
+                    .plot(&staged, ext)
+                    .map_err(|e| named_as_output(e, &staging))?
+                {
                     written
                         .plots
                         .extend(file.file_name().map(|name| plot_dir.join(name)));
@@ -420,7 +491,10 @@ impl EvalFolder {
         }
         #[cfg(not(feature = "plot"))]
         let _ = traces;
-        for file in report.write(&staging.dir(Path::new(""))?)? {
+        let reports = report
+            .write(&staging.dir(Path::new(""))?)
+            .map_err(|e| named_as_output(e, &staging))?;
+        for file in reports {
             written
                 .reports
                 .extend(file.file_name().map(|name| out.join(name)));
@@ -434,13 +508,42 @@ impl EvalFolder {
         {
             check_not_input(path, &self.inputs, &[])?;
         }
-        staging.commit()?;
-        // The new report is in place: an old plot that cannot go is worth a warning only.
-        match remove_stale_plots(&plot_dir, &plotted, &written.plots) {
-            Ok(n) => written.stale_plots = n,
-            Err(warning) => written.warnings.push(warning),
+        // The old plots go with the commit: the folder matches one report, whenever it stops.
+        for rel in stale_plots(&plot_dir, &plotted, &written.plots) {
+            staging.remove(&rel);
+            written.stale_plots += 1;
         }
+        staging.commit()?;
+        // Only succeeds when nothing else is in the folder.
+        let _ = std::fs::remove_dir(&plot_dir);
         Ok(written)
+    }
+}
+
+/// `e` with the staged file it names (inside the staging folder) named as the output file it
+/// was to become: what a user can look for (a full disk when writing `plots/a.trajectory.png`).
+fn named_as_output(e: PipelineError, staging: &Staging) -> PipelineError {
+    #[cfg(feature = "plot")]
+    use crate::plot::PlotError;
+    match e {
+        PipelineError::Data(ridi_data::DataError::Io { path, error }) => ridi_data::DataError::Io {
+            path: staging.destination(&path),
+            error,
+        }
+        .into(),
+        #[cfg(feature = "plot")]
+        PipelineError::Plot(PlotError::Io { path, error }) => PipelineError::Plot(PlotError::Io {
+            path: staging.destination(&path),
+            error,
+        }),
+        #[cfg(feature = "plot")]
+        PipelineError::Plot(PlotError::Render { path, message }) => {
+            PipelineError::Plot(PlotError::Render {
+                path: staging.destination(&path),
+                message,
+            })
+        }
+        e => e,
     }
 }
 
@@ -452,33 +555,28 @@ fn earlier_sequences(dir: &Path) -> Vec<String> {
         .unwrap_or_default()
 }
 
-/// Removes the plots an earlier evaluation left in `dir` that this one did not write
-/// (`written`). Only the plot files of `sequences` (those of the earlier report and of this
-/// evaluation) are touched, so other files in `dir` stay; `dir` goes if that empties it. The
-/// error is a sentence for a warning.
-fn remove_stale_plots(
-    dir: &Path,
-    sequences: &[String],
-    written: &[PathBuf],
-) -> std::result::Result<usize, String> {
-    let mut removed = 0;
+/// The plots an earlier evaluation left in `dir` that this one did not write (`written`),
+/// relative to the evaluation folder (`dir`'s parent). Only the plot files of `sequences` (those
+/// of the earlier report and of this evaluation) are named, so other files in `dir` stay.
+fn stale_plots(dir: &Path, sequences: &[String], written: &[PathBuf]) -> Vec<PathBuf> {
+    let mut stale = Vec::new();
     // A name that is not a plain file name (an edited report.json) must not reach outside.
     let plain = |name: &&String| Path::new(name.as_str()).file_name() == Some(name.as_ref());
     for name in sequences.iter().filter(plain) {
         for kind in ["trajectory", "velocity"] {
             for ext in ["png", "svg"] {
-                let path = dir.join(format!("{name}.{kind}.{ext}"));
-                if path.is_file() && !written.contains(&path) {
-                    std::fs::remove_file(&path)
-                        .map_err(|e| format!("cannot remove {}: {e}", path.display()))?;
-                    removed += 1;
+                let file = format!("{name}.{kind}.{ext}");
+                let path = dir.join(&file);
+                if path.is_file() && !written.contains(&path) && !stale.contains(&file) {
+                    stale.push(file);
                 }
             }
         }
     }
-    // Only succeeds when nothing else is in the folder.
-    let _ = std::fs::remove_dir(dir);
-    Ok(removed)
+    stale
+        .into_iter()
+        .map(|file| Path::new("plots").join(file))
+        .collect()
 }
 
 #[cfg(test)]
@@ -547,18 +645,17 @@ mod tests {
             std::fs::write(p, "x").unwrap();
             p.to_path_buf()
         };
-        let outside = file(&dir.path().join("x.trajectory.png"));
-        let old = file(&plots.join("a.velocity.svg"));
+        file(&dir.path().join("x.trajectory.png"));
+        file(&plots.join("a.velocity.svg"));
         let kept = file(&plots.join("a.trajectory.png"));
-        let mine = file(&plots.join("b.trajectory.png"));
+        file(&plots.join("b.trajectory.png"));
         report(&["a", "../x", ""]).write(dir.path()).unwrap();
         let names = earlier_sequences(dir.path());
         assert_eq!(names, ["a", "../x", ""]);
         assert_eq!(
-            remove_stale_plots(&plots, &names, std::slice::from_ref(&kept)).unwrap(),
-            1
+            stale_plots(&plots, &names, std::slice::from_ref(&kept)),
+            [Path::new("plots/a.velocity.svg")]
         );
-        assert!(!old.exists() && kept.exists() && mine.exists() && outside.exists());
         for text in ["{ cut", r#"{"sequences":[{"name":"a"}]}"#] {
             std::fs::write(dir.path().join("report.json"), text).unwrap();
             assert!(earlier_sequences(dir.path()).is_empty(), "{text}");
@@ -577,6 +674,14 @@ mod tests {
         assert!(e.ends_with("no does not exist"), "{e}");
         let e = message(check_output_file(dir.path()).unwrap_err());
         assert!(e.ends_with("it is a folder"), "{e}");
+        // A folder that does not exist yet, named as one: refused before any work, not when
+        // the file is renamed into place.
+        for name in ["new/", "new/.", "new/..", "."] {
+            let e = message(check_output_file(&dir.path().join(name)).unwrap_err());
+            assert!(e.contains("names a folder"), "{name}: {e}");
+        }
+        let e = message(check_output_file(Path::new("new/")).unwrap_err());
+        assert!(e.starts_with("cannot write new/: "), "{e}");
         assert!(check_output_folder(&dir.path().join("a/b/c")).is_ok());
         let e = message(check_output_folder(&file).unwrap_err());
         assert!(e.ends_with("it is a file, not a folder"), "{e}");

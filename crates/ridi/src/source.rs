@@ -27,7 +27,7 @@ pub(crate) fn is_a(path: &Path, want: Format) -> bool {
         Format::RidiCsv | Format::RidiPlain => {
             matches!(detect(path), Ok(Format::RidiCsv | Format::RidiPlain))
         }
-        Format::Tyrex | Format::Ilc => detect(path).is_ok_and(|f| f == want),
+        Format::Tyrex | Format::Ilc | Format::Ronin => detect(path).is_ok_and(|f| f == want),
     }
 }
 
@@ -56,7 +56,7 @@ pub(crate) fn with_article(name: &str) -> String {
 }
 
 /// Reads the sequence(s) at `path`: a RIDI `data.csv`, `data_plain.txt`, RIDI raw folder,
-/// Tyrex sequence folder or Indoor Location Competition path file. `from` forces a format
+/// Tyrex sequence folder, Indoor Location Competition path file or RoNIN sequence folder. `from` forces a format
 /// instead of detecting it: a source that is not one is an error saying what it is and what
 /// the format looks like; a folder read as a RIDI raw folder names the raw files it lacks.
 pub fn read_any(

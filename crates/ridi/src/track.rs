@@ -3,7 +3,7 @@
 use std::path::Path;
 
 use ridi_correct::{CorrectionConfig, FrameVelocity, correct};
-use ridi_data::{RoundTrip, Sequence, write_atomically};
+use ridi_data::{RoundTrip, RowReader, Sequence, write_atomically};
 use ridi_features::{
     FeatureConfig, FeatureExtractor, FeatureMatrixRef, Orientation, SampleSchedule,
 };
@@ -55,10 +55,7 @@ impl Track {
     pub(crate) fn csv(&self, w: &mut dyn std::io::Write) -> std::io::Result<()> {
         let mut next = 0;
         let mut current: Option<&str> = None;
-        writeln!(
-            w,
-            "time,pos_x,pos_y,pos_z,vel_x,vel_y,vel_z,placement,bias_x,bias_y,bias_z"
-        )?;
+        csv_header(w)?;
         for i in 0..self.time.len() {
             while next < self.regressions.len() && self.regressions[next].frame <= i {
                 current = self
@@ -67,23 +64,8 @@ impl Track {
                     .map(String::as_str);
                 next += 1;
             }
-            let (p, v, b) = (self.position[i], self.velocity[i], self.bias[i]);
-            let r = RoundTrip;
-            writeln!(
-                w,
-                "{},{},{},{},{},{},{},{},{},{},{}",
-                r(self.time[i]),
-                r(p.x()),
-                r(p.y()),
-                r(p.z()),
-                r(v.x()),
-                r(v.y()),
-                r(v.z()),
-                current.unwrap_or(""),
-                r(b.x()),
-                r(b.y()),
-                r(b.z())
-            )?;
+            let pose = (self.position[i], self.velocity[i]);
+            csv_row(w, self.time[i], pose, current, self.bias[i])?;
         }
         Ok(())
     }
@@ -118,6 +100,40 @@ impl Track {
         )?;
         Ok(())
     }
+}
+
+/// The header of a trajectory CSV ([`Track::write_csv`]).
+fn csv_header(w: &mut dyn std::io::Write) -> std::io::Result<()> {
+    writeln!(
+        w,
+        "time,pos_x,pos_y,pos_z,vel_x,vel_y,vel_z,placement,bias_x,bias_y,bias_z"
+    )
+}
+
+/// One row of a trajectory CSV: a frame's time, position and velocity, placement and bias.
+fn csv_row(
+    w: &mut dyn std::io::Write,
+    time: f64,
+    (p, v): (WorldVec, WorldVec),
+    placement: Option<&str>,
+    b: DeviceVec,
+) -> std::io::Result<()> {
+    let r = RoundTrip;
+    writeln!(
+        w,
+        "{},{},{},{},{},{},{},{},{},{},{}",
+        r(time),
+        r(p.x()),
+        r(p.y()),
+        r(p.z()),
+        r(v.x()),
+        r(v.y()),
+        r(v.z()),
+        placement.unwrap_or(""),
+        r(b.x()),
+        r(b.y()),
+        r(b.z())
+    )
 }
 
 /// Regresses placement and velocity every `opts.regress_every` frames from the first full
@@ -207,19 +223,24 @@ fn check_gaps(seq: &Sequence, max_dt: f64) -> Result<()> {
     let t = seq.time();
     match t.windows(2).position(|w| w[1] - w[0] > max_dt) {
         None => Ok(()),
-        Some(i) => Err(PipelineError::sequence(
-            seq.name(),
-            format!(
-                "a gap of {:.3} s between frames {i} and {} ({:.3} s and {:.3} s from the \
-                 start) is longer than the {max_dt} s the correction integrates across; split \
-                 the recording at its gaps",
-                t[i + 1] - t[i],
-                i + 1,
-                t[i] - t[0],
-                t[i + 1] - t[0]
-            ),
-        )),
+        Some(i) => Err(gap_error(seq.name(), i, (t[i], t[i + 1]), t[0], max_dt)),
     }
+}
+
+/// The error of [`check_gaps`] for the gap from frame `i` (times `t`, the first frame's `t0`).
+fn gap_error(name: &str, i: usize, t: (f64, f64), t0: f64, max_dt: f64) -> PipelineError {
+    PipelineError::sequence(
+        name,
+        format!(
+            "a gap of {:.3} s between frames {i} and {} ({:.3} s and {:.3} s from the \
+             start) is longer than the {max_dt} s the correction integrates across; split \
+             the recording at its gaps",
+            t.1 - t.0,
+            i + 1,
+            t.0 - t0,
+            t.1 - t0
+        ),
+    )
 }
 
 /// The IMU rate every model assumes: feature windows, sample steps, regressions and
@@ -238,30 +259,60 @@ pub const RATE_TOLERANCE: f64 = 0.1;
 pub(crate) fn check_frames(seq: &Sequence, config: &FeatureConfig) -> Result<()> {
     let n = seq.len();
     if n <= config.window {
-        return Err(PipelineError::sequence(
-            seq.name(),
-            format!(
-                "has {n} frames ({:.2} s): no velocity can be regressed before a whole feature \
-                 window of {} frames ({:.1} s at {RATE_HZ} Hz)",
-                seq.duration(),
-                config.window,
-                config.window as f64 / RATE_HZ
-            ),
-        ));
+        return Err(too_short(seq.name(), n, seq.duration(), config));
     }
     let rate = seq.median_rate_hz();
     if (rate - RATE_HZ).abs() > RATE_TOLERANCE * RATE_HZ {
-        return Err(PipelineError::sequence(
-            seq.name(),
-            format!(
-                "has a rate of {rate:.1} Hz (median frame interval); models count windows and \
-                 knots in frames of a {RATE_HZ} Hz stream (within {:.0} %): resample it with \
-                 `ridi convert <recording> --out <folder> --rate {RATE_HZ}`",
-                RATE_TOLERANCE * 100.0
-            ),
-        ));
+        return Err(wrong_rate(seq.name(), rate));
     }
     Ok(())
+}
+
+/// The error of [`check_frames`] for `n` frames over `duration` seconds.
+fn too_short(name: &str, n: usize, duration: f64, config: &FeatureConfig) -> PipelineError {
+    PipelineError::sequence(
+        name,
+        format!(
+            "has {n} frames ({duration:.2} s): no velocity can be regressed before a whole \
+             feature window of {} frames ({:.1} s at {RATE_HZ} Hz)",
+            config.window,
+            config.window as f64 / RATE_HZ
+        ),
+    )
+}
+
+/// The error of [`check_frames`] for a median `rate`.
+fn wrong_rate(name: &str, rate: f64) -> PipelineError {
+    PipelineError::sequence(
+        name,
+        format!(
+            "has a rate of {rate:.1} Hz (median frame interval); models count windows and \
+             knots in frames of a {RATE_HZ} Hz stream (within {:.0} %): resample it with \
+             `ridi convert <recording> --out <folder> --rate {RATE_HZ}`",
+            RATE_TOLERANCE * 100.0
+        ),
+    )
+}
+
+/// Counts a frame `interval` (seconds) towards the median rate [`check_frames`] judges:
+/// `low`, a rate above [`RATE_HZ`] beyond the tolerance, holds for short intervals, `high` for
+/// long ones.
+pub(crate) fn count_rate(test: &mut ridi_data::MedianTest, interval: f64) {
+    let off = 1.0 / interval - RATE_HZ;
+    let tolerance = RATE_TOLERANCE * RATE_HZ;
+    test.push(off > tolerance, -off > tolerance);
+}
+
+/// The median rate of the recording at `path` when [`count_rate`] says it is off, Hz.
+pub(crate) fn rate_off(
+    test: &ridi_data::MedianTest,
+    path: &Path,
+    opts: &ridi_data::ReadOptions,
+) -> Result<Option<f64>> {
+    if !(test.median_low() || test.median_high()) {
+        return Ok(None);
+    }
+    Ok(Some(1.0 / ridi_data::median_interval(path, opts)?))
 }
 
 /// [`check_gaps`] and [`check_frames`]: what tracking and evaluation need of a sequence.
@@ -314,5 +365,153 @@ fn track_online(seq: &Sequence, model: &Cascade, opts: &TrackOptions) -> Result<
         regressions: live.regressions().0.to_vec(),
         placements: live.regressions().1.to_vec(),
         placement_names: model.placements().to_vec(),
+    })
+}
+
+/// What [`crate::TrackOutput::write_stream`] tracked.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct StreamedTrack {
+    /// The sequence's name.
+    pub name: String,
+    /// Frames tracked (rows written).
+    pub frames: usize,
+    /// Regressions made.
+    pub regressions: usize,
+}
+
+/// `ridi track --online` of a recording read as a stream ([`RowReader`]): each row is
+/// pushed into a [`LiveTracker`] as it is read and each pose written to `out` as a row of the
+/// trajectory CSV ([`Track::write_csv`]) as it becomes known, so that memory does not grow with
+/// the recording. The rows and the checks are those of [`track`] with
+/// [`TrackOptions::online`] on the sequence the whole-file reader gives: the same CSV, bit for
+/// bit; an error (also one found at the end, such as a recording's rate) leaves `out` partly
+/// written, for the caller to discard ([`crate::TrackOutput::write_stream`]).
+///
+/// The outer error is a failed write of `out`; the inner one what reading the recording
+/// refuses ([`RowReader`], [`RowReader::finish`]) and what [`track`] refuses of it.
+pub(crate) fn track_stream(
+    rows: RowReader,
+    model: &Cascade,
+    opts: &TrackOptions,
+    out: &mut dyn std::io::Write,
+) -> std::io::Result<Result<StreamedTrack>> {
+    let mut failed = None;
+    let tracked = track_rows(rows, model, opts, out, &mut failed);
+    match failed {
+        Some(e) => Err(e),
+        None => Ok(tracked),
+    }
+}
+
+/// [`track_stream`], with a failed write of `out` in `failed`.
+fn track_rows(
+    mut rows: RowReader,
+    model: &Cascade,
+    opts: &TrackOptions,
+    out: &mut dyn std::io::Write,
+    failed: &mut Option<std::io::Error>,
+) -> Result<StreamedTrack> {
+    let name = rows.name().to_string();
+    if model.feature_config().orientation == Orientation::Recorded
+        && rows.orientation_source() == Some(ridi_data::OrientationSource::Estimated)
+    {
+        return Err(crate::orientation::recorded_wanted(&name));
+    }
+    let mut written = |e: std::io::Error| {
+        let message = e.to_string();
+        *failed = Some(e);
+        PipelineError::Live(message)
+    };
+    let written = &mut written;
+    let names = model.placements();
+    let mut live = LiveTracker::new(model, opts)?;
+    csv_header(out).map_err(&mut *written)?;
+    let max_dt = opts.correction.max_dt;
+    let mut rate = ridi_data::MedianTest::default();
+    // Times of the frames pushed whose pose is not out yet, and the regressions made whose
+    // frame has no row yet.
+    let mut times = std::collections::VecDeque::new();
+    let mut made = std::collections::VecDeque::new();
+    let mut placement: Option<&str> = None;
+    let mut updates = Vec::new();
+    let (mut frames, mut regressions) = (0usize, 0usize);
+    let (mut first, mut previous) = (None::<f64>, None::<f64>);
+    let mut write = |updates: &mut Vec<ridi_correct::Update>,
+                     live: &mut LiveTracker<'_>,
+                     times: &mut std::collections::VecDeque<f64>|
+     -> std::io::Result<()> {
+        let (velocities, placements) = live.take_regressions();
+        regressions += velocities.len();
+        made.extend(velocities.iter().map(|v| v.frame).zip(placements));
+        for u in updates.drain(..) {
+            let frame = u.frame as usize;
+            while made.front().is_some_and(|&(f, _)| f <= frame) {
+                let (_, p) = made.pop_front().unwrap_or_default();
+                placement = names.get(p).map(String::as_str);
+            }
+            let time = times.pop_front().unwrap_or(f64::NAN);
+            csv_row(
+                out,
+                time,
+                (u.pose.position, u.pose.velocity),
+                placement,
+                u.bias,
+            )?;
+            frames += 1;
+        }
+        Ok(())
+    };
+    let mut i = 0usize;
+    while let Some(row) = rows.next() {
+        let row = row?;
+        if rows.refused() {
+            break;
+        }
+        let t0 = *first.get_or_insert(row.time);
+        if let Some(p) = previous {
+            if row.time - p > max_dt {
+                rows.finish()?;
+                return Err(gap_error(&name, i - 1, (p, row.time), t0, max_dt));
+            }
+            count_rate(&mut rate, row.time - p);
+        }
+        previous = Some(row.time);
+        let reading = SensorReading {
+            time: row.time,
+            gyro: row.gyro,
+            acce: row.acce,
+            recorded: Some(crate::live::Recorded {
+                orientation: row.orientation,
+                gravity: row.gravity,
+                linacce: row.linacce,
+            }),
+        };
+        times.push_back(row.time);
+        if let Err(e) = live.push(&reading, &mut updates) {
+            // What reading refuses comes first, as when the recording is read whole.
+            rows.finish()?;
+            return Err(PipelineError::sequence(&name, format!("frame {i}: {e}")));
+        }
+        write(&mut updates, &mut live, &mut times).map_err(&mut *written)?;
+        i += 1;
+    }
+    let path = rows.path().to_path_buf();
+    let read_opts = rows.options().clone();
+    rows.finish()?;
+    let config = model.feature_config();
+    if i <= config.window {
+        let duration = previous.zip(first).map_or(0.0, |(l, f)| l - f);
+        return Err(too_short(&name, i, duration, config));
+    }
+    if let Some(r) = rate_off(&rate, &path, &read_opts)? {
+        return Err(wrong_rate(&name, r));
+    }
+    live.finish(&mut updates)
+        .map_err(|e| PipelineError::sequence(&name, e.to_string()))?;
+    write(&mut updates, &mut live, &mut times).map_err(written)?;
+    Ok(StreamedTrack {
+        name,
+        frames,
+        regressions,
     })
 }

@@ -89,7 +89,10 @@ use plotters::style::{FontStyle, register_font};
 #[non_exhaustive]
 pub enum PlotError {
     /// The output path does not end in `.svg` or `.png`.
-    #[error("cannot plot to {}: unsupported file extension, expected .svg or .png", path.display())]
+    #[error(
+        "cannot plot to {}: unsupported file extension, expected .svg or .png",
+        ridi_data::shown(path)
+    )]
     UnsupportedFormat {
         /// The rejected output path.
         path: PathBuf,
@@ -145,7 +148,7 @@ pub enum PlotError {
     #[error("invalid plot options: {0}")]
     InvalidOptions(String),
     /// Creating, writing or renaming the output file failed.
-    #[error("cannot write plot {}: {error}", path.display())]
+    #[error("cannot write plot {}: {error}", ridi_data::shown(path))]
     Io {
         /// The output path.
         path: PathBuf,
@@ -153,7 +156,7 @@ pub enum PlotError {
         error: std::io::Error,
     },
     /// The drawing library failed.
-    #[error("cannot render plot {}: {message}", path.display())]
+    #[error("cannot render plot {}: {message}", ridi_data::shown(path))]
     Render {
         /// The output path.
         path: PathBuf,

@@ -1,0 +1,160 @@
+//! numpy arrays in and out.
+//!
+//! In: float64 arrays of any layout (C or Fortran order, strided slices, negative strides) are
+//! read in place through an ndarray view, without a contiguous copy first; the one copy made is
+//! into the `Sequence`'s own storage. Another dtype is a `TypeError`, another shape a
+//! `ValueError`, both naming the argument; values (NaN, units) are checked by the facade's own
+//! validation, which names the array and the frame.
+//!
+//! Out: each array is built once in Rust and handed to numpy without a further copy.
+
+use numpy::ndarray::{Array2, ArrayView2};
+use numpy::{
+    IntoPyArray, PyArray1, PyArray2, PyArrayDescrMethods, PyArrayMethods, PyReadonlyArray1,
+    PyReadonlyArray2, PyUntypedArray, PyUntypedArrayMethods, dtype,
+};
+use pyo3::exceptions::PyTypeError;
+use pyo3::prelude::*;
+use ridi::frames::nalgebra::{Quaternion, UnitQuaternion};
+use ridi::frames::{Frame, QuatError, Vec3, WorldFromDevice};
+
+use crate::errors;
+
+/// `shape` as numpy prints it: `(100, 3)`, `(100,)`.
+fn shape_text(shape: &[usize]) -> String {
+    match shape {
+        [n] => format!("({n},)"),
+        _ => {
+            let dims: Vec<String> = shape.iter().map(usize::to_string).collect();
+            format!("({})", dims.join(", "))
+        }
+    }
+}
+
+/// `obj` as a numpy array of float64, or a `TypeError` naming the argument `name`.
+fn float64<'py>(obj: &Bound<'py, PyAny>, name: &str) -> PyResult<Bound<'py, PyUntypedArray>> {
+    let Ok(array) = obj.cast::<PyUntypedArray>() else {
+        return Err(PyTypeError::new_err(format!(
+            "`{name}` must be a numpy array of float64, not {}",
+            obj.get_type().name()?
+        )));
+    };
+    let found = array.dtype();
+    if !found.is_equiv_to(&dtype::<f64>(obj.py())) {
+        return Err(PyTypeError::new_err(format!(
+            "`{name}` has dtype {found}; ridi takes float64 (np.asarray({name}, dtype=np.float64))"
+        )));
+    }
+    Ok(array.clone())
+}
+
+/// The `(frames, cols)` float64 array `obj`, argument `name`; `frames` is the length of `time`
+/// when known.
+pub(crate) fn matrix<'py>(
+    obj: &Bound<'py, PyAny>,
+    name: &str,
+    cols: usize,
+    frames: Option<usize>,
+) -> PyResult<PyReadonlyArray2<'py, f64>> {
+    let array = float64(obj, name)?;
+    let shape = array.shape();
+    let fits = shape.len() == 2 && shape[1] == cols && frames.is_none_or(|n| shape[0] == n);
+    if !fits {
+        let rows = match frames {
+            Some(n) => format!("{n}, one row per frame of `time`"),
+            None => "N".to_string(),
+        };
+        return Err(errors::value(format!(
+            "`{name}` must have shape ({rows}, {cols}); it has shape {}",
+            shape_text(shape)
+        )));
+    }
+    Ok(array.cast::<PyArray2<f64>>()?.readonly())
+}
+
+/// The 1-D float64 array `obj`, argument `name`, of `frames` values when given.
+pub(crate) fn vector<'py>(
+    obj: &Bound<'py, PyAny>,
+    name: &str,
+    frames: Option<usize>,
+) -> PyResult<PyReadonlyArray1<'py, f64>> {
+    let array = float64(obj, name)?;
+    let shape = array.shape();
+    if shape.len() != 1 || frames.is_some_and(|n| shape[0] != n) {
+        let rows = frames.map_or("N".to_string(), |n| format!("{n}"));
+        return Err(errors::value(format!(
+            "`{name}` must have shape ({rows},); it has shape {}",
+            shape_text(shape)
+        )));
+    }
+    Ok(array.cast::<PyArray1<f64>>()?.readonly())
+}
+
+/// The rows of `(N, 3)` `view` as vectors of frame `F`.
+pub(crate) fn vecs<F: Frame>(view: ArrayView2<'_, f64>) -> Vec<Vec3<F>> {
+    view.rows()
+        .into_iter()
+        .map(|r| Vec3::new(r[0], r[1], r[2]))
+        .collect()
+}
+
+/// The rows of `(N, 4)` `view` as orientations, `[w, x, y, z]` (the order of RIDI's files);
+/// a row that is not a unit quaternion is an error naming `name` and the frame.
+pub(crate) fn rotations(view: ArrayView2<'_, f64>, name: &str) -> PyResult<Vec<WorldFromDevice>> {
+    view.rows()
+        .into_iter()
+        .enumerate()
+        .map(|(i, r)| {
+            rotation([r[0], r[1], r[2], r[3]])
+                .map_err(|e| errors::value(format!("`{name}` at frame {i}: {e}")))
+        })
+        .collect()
+}
+
+/// `[w, x, y, z]` as a rotation, checked as the readers check one ([`Rot::from_wxyz`]). One
+/// already unit to round-off is kept as given: normalizing it again would move its last bits,
+/// and a sequence rebuilt from another's arrays, or a stream pushed from one, would not track
+/// exactly as the original.
+///
+/// [`Rot::from_wxyz`]: ridi::frames::Rot::from_wxyz
+pub(crate) fn rotation(c: [f64; 4]) -> Result<WorldFromDevice, QuatError> {
+    let checked = WorldFromDevice::from_wxyz(c)?;
+    let norm2: f64 = c.iter().map(|x| x * x).sum();
+    if (norm2 - 1.0).abs() > 8.0 * f64::EPSILON {
+        return Ok(checked);
+    }
+    let q = Quaternion::new(c[0], c[1], c[2], c[3]);
+    Ok(WorldFromDevice::from_unit_quaternion(
+        UnitQuaternion::new_unchecked(q),
+    ))
+}
+
+/// `rows` as a `(N, C)` float64 array.
+pub(crate) fn rows_out<'py, const C: usize>(
+    py: Python<'py>,
+    rows: impl ExactSizeIterator<Item = [f64; C]>,
+) -> Bound<'py, PyArray2<f64>> {
+    let n = rows.len();
+    let flat: Vec<f64> = rows.flat_map(|r| r.into_iter()).collect();
+    Array2::from_shape_vec((n, C), flat)
+        .expect("n rows of C values")
+        .into_pyarray(py)
+}
+
+/// Vectors as a `(N, 3)` float64 array.
+pub(crate) fn vecs_out<'py, F: Frame>(py: Python<'py>, v: &[Vec3<F>]) -> Bound<'py, PyArray2<f64>> {
+    rows_out(py, v.iter().map(|x| x.to_array()))
+}
+
+/// Orientations as a `(N, 4)` float64 array, `[w, x, y, z]`.
+pub(crate) fn rotations_out<'py>(
+    py: Python<'py>,
+    q: &[WorldFromDevice],
+) -> Bound<'py, PyArray2<f64>> {
+    rows_out(py, q.iter().map(|q| q.to_wxyz()))
+}
+
+/// Values as a 1-D float64 array.
+pub(crate) fn vector_out<'py>(py: Python<'py>, v: Vec<f64>) -> Bound<'py, PyArray1<f64>> {
+    v.into_pyarray(py)
+}

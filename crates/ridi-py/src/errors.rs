@@ -1,0 +1,117 @@
+//! Rust errors as Python exceptions: `OSError` (and its subclasses) for files that cannot be
+//! read or written, `ValueError` for data, lists and options that are wrong. The message is the
+//! one line the command line prints after `error:`, naming the file, line and field, or the
+//! sequence, array and frame.
+
+use std::error::Error;
+use std::io::ErrorKind;
+use std::path::Path;
+
+use pyo3::PyErr;
+use pyo3::exceptions::{
+    PyFileExistsError, PyFileNotFoundError, PyIsADirectoryError, PyNotADirectoryError, PyOSError,
+    PyPermissionError, PyValueError,
+};
+use ridi::PipelineError;
+use ridi::data::DataError;
+use ridi::regress::RegressError;
+
+/// The error and its causes on one line, each cause once: the command line's `one_line`.
+pub(crate) fn one_line(e: &(dyn Error + 'static)) -> String {
+    let mut line = String::new();
+    let mut next: Option<&(dyn Error + 'static)> = Some(e);
+    while let Some(cause) = next {
+        let text = cause.to_string();
+        if !line.contains(&text) {
+            if !line.is_empty() {
+                line.push_str(": ");
+            }
+            line.push_str(&text);
+        }
+        next = cause.source();
+    }
+    line
+}
+
+/// The `OSError` subclass Python raises for `kind`.
+fn os_error(kind: ErrorKind, message: String) -> PyErr {
+    match kind {
+        ErrorKind::NotFound => PyFileNotFoundError::new_err(message),
+        ErrorKind::PermissionDenied => PyPermissionError::new_err(message),
+        ErrorKind::AlreadyExists => PyFileExistsError::new_err(message),
+        ErrorKind::IsADirectory => PyIsADirectoryError::new_err(message),
+        ErrorKind::NotADirectory => PyNotADirectoryError::new_err(message),
+        _ => PyOSError::new_err(message),
+    }
+}
+
+/// What kind of exception an error is: `Some(kind)` for a file that could not be read or
+/// written, `None` for bad data.
+fn file_kind(e: &PipelineError) -> Option<ErrorKind> {
+    match e {
+        PipelineError::Data(d) => data_kind(d),
+        PipelineError::Regress(r) => regress_kind(r),
+        PipelineError::Output(_) => Some(ErrorKind::Other),
+        // Reports and placement maps: a file that is not there is a file error, one that does
+        // not parse a data error.
+        PipelineError::File { path, .. } if !path.exists() => Some(ErrorKind::NotFound),
+        PipelineError::Listed { source, .. } => file_kind(source),
+        _ => None,
+    }
+}
+
+fn data_kind(e: &DataError) -> Option<ErrorKind> {
+    match e {
+        DataError::Io { error, .. } => Some(error.kind()),
+        // A source that is not there (a list line naming a missing recording is the list's
+        // error, at its line).
+        DataError::Format { at, .. } if at.line.is_none() && !at.path.exists() => {
+            Some(ErrorKind::NotFound)
+        }
+        _ => None,
+    }
+}
+
+fn regress_kind(e: &RegressError) -> Option<ErrorKind> {
+    match e {
+        RegressError::Io { error, .. } => Some(error.kind()),
+        _ => None,
+    }
+}
+
+/// A pipeline error as a Python exception.
+pub(crate) fn pipeline(e: PipelineError) -> PyErr {
+    pipeline_in(e, None)
+}
+
+/// A pipeline error as a Python exception, its message prefixed with `context` when given
+/// (`cannot write m.ridi`, as the command line says it).
+pub(crate) fn pipeline_in(e: PipelineError, context: Option<String>) -> PyErr {
+    let message = match context {
+        Some(c) => format!("{c}: {}", one_line(&e)),
+        None => one_line(&e),
+    };
+    match file_kind(&e) {
+        Some(kind) => os_error(kind, message),
+        None => PyValueError::new_err(message),
+    }
+}
+
+/// A reader's error as a Python exception.
+pub(crate) fn data(e: DataError) -> PyErr {
+    pipeline(PipelineError::Data(e))
+}
+
+/// A model file's error (loading or saving `path`), worded as the command line words it.
+pub(crate) fn model_file(e: RegressError, doing: &str, path: &Path) -> PyErr {
+    let message = format!("{doing} {}: {}", path.display(), one_line(&e));
+    match regress_kind(&e) {
+        Some(kind) => os_error(kind, message),
+        None => PyValueError::new_err(message),
+    }
+}
+
+/// Bad input of the Python caller itself (an option, an array).
+pub(crate) fn value(message: impl Into<String>) -> PyErr {
+    PyValueError::new_err(message.into())
+}

@@ -1,0 +1,103 @@
+//! `ridi.evaluate`.
+
+use std::path::PathBuf;
+
+use pyo3::prelude::*;
+use pyo3::types::PyDict;
+use ridi::eval::EvalConfig;
+use ridi::{EvalOptions, Method, PipelineError, Purpose, Report, TrackOptions, load_listed};
+
+use crate::errors;
+use crate::model::{Model, json_dict};
+use crate::options::{self, Inputs};
+
+/// Evaluates RIDI and its baselines against ground truth, as ``ridi eval`` does, and returns
+/// the report as a dict with the keys of its ``report.json`` (``sequences``, ``summary``,
+/// ``velocity_mse``, ``placement_accuracy``, ``placement_confusion``, ``config``, ``methods``,
+/// ``warnings``; a NaN is None, as ``null`` in the file). Nothing is written.
+///
+/// ``data`` is a list file, several, or a list of ``ridi.Sequence`` with ground truth.
+/// ``methods`` are keys of ``ridi.METHODS`` (default: all, in that order); ``placement_map``,
+/// ``placement_window`` (seconds, 0 for the paper's per-window labels), ``align`` (seconds,
+/// or ``"all"``) and ``jobs`` are ``ridi eval``'s options with its defaults.
+///
+/// >>> report = ridi.evaluate("datasets/sample/list_test.txt", model,
+/// ...                        placement_map="tyrex4")           # doctest: +SKIP
+/// >>> report["summary"]["ridi"]["rte_5s_m"]                   # doctest: +SKIP
+/// 1.02
+#[pyfunction]
+#[pyo3(signature = (
+    data, model, *, methods=None, placement_map=None, placement_window=10.0, align=None,
+    jobs=None,
+))]
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn evaluate<'py>(
+    py: Python<'py>,
+    data: &Bound<'py, PyAny>,
+    model: &Bound<'py, Model>,
+    methods: Option<Vec<String>>,
+    placement_map: Option<PathBuf>,
+    placement_window: f64,
+    align: Option<&Bound<'py, PyAny>>,
+    jobs: Option<usize>,
+) -> PyResult<Bound<'py, PyDict>> {
+    let inputs = Inputs::extract(data)?;
+    let methods = match methods {
+        None => Method::ALL.to_vec(),
+        Some(names) => {
+            let mut methods: Vec<Method> = Vec::new();
+            for m in &names {
+                let m = m.parse::<Method>().map_err(errors::value)?;
+                if !methods.contains(&m) {
+                    methods.push(m);
+                }
+            }
+            methods
+        }
+    };
+    let opts = EvalOptions {
+        methods,
+        track: TrackOptions {
+            placement_smoothing: options::placement_smoothing(placement_window)?,
+            ..TrackOptions::default()
+        },
+        metrics: EvalConfig {
+            align: match align {
+                Some(a) => options::align(a)?,
+                None => EvalConfig::default().align,
+            },
+            ..EvalConfig::default()
+        },
+    };
+    let map = options::placement_map(placement_map)?;
+    let model = &model.get().inner;
+    let report = py
+        .detach(|| {
+            options::with_jobs(jobs, || -> ridi::Result<Report> {
+                match inputs {
+                    Inputs::Lists(lists) => {
+                        let entries =
+                            ridi::data::ListEntry::read(&lists).map_err(PipelineError::from)?;
+                        let listed = load_listed(
+                            entries,
+                            map.as_ref(),
+                            Purpose::Evaluation,
+                            &options::read_options(),
+                        )?;
+                        ridi::evaluate(listed.sequences(), model, &opts)
+                            .map(|(report, _)| report)
+                            .map_err(|e| e.locate_in(&listed))
+                    }
+                    Inputs::Sequences(mut seqs) => {
+                        if let Some(map) = &map {
+                            map.apply(&mut seqs);
+                        }
+                        ridi::evaluate(&seqs, model, &opts).map(|(report, _)| report)
+                    }
+                }
+            })
+        })?
+        .map_err(errors::pipeline)?;
+    let json = serde_json::to_string(&report).map_err(|e| errors::value(e.to_string()))?;
+    json_dict(py, &json)
+}

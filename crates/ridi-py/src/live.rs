@@ -1,0 +1,199 @@
+//! `ridi.LiveTracker` and `ridi.Update`.
+
+use std::sync::{Arc, Mutex, MutexGuard};
+
+use pyo3::prelude::*;
+use ridi::correct::Update as RidiUpdate;
+use ridi::frames::DeviceVec;
+use ridi::regress::Cascade;
+use ridi::{Orientation, Recorded, SensorReading};
+
+use crate::arrays::rotation;
+use crate::errors;
+use crate::model::Model;
+use crate::options;
+use crate::track::Regressions;
+
+/// One frame's pose as a stream knows it: what ``LiveTracker.push`` returns.
+#[pyclass(frozen, module = "ridi")]
+pub(crate) struct Update {
+    /// Stream index of the frame (from 0, across restarts).
+    #[pyo3(get)]
+    frame: u64,
+    /// Timestamp, seconds.
+    #[pyo3(get)]
+    time: f64,
+    /// Position ``(x, y, z)``, metres from the start, world frame.
+    #[pyo3(get)]
+    position: (f64, f64, f64),
+    /// Velocity ``(x, y, z)``, m/s, world frame.
+    #[pyo3(get)]
+    velocity: (f64, f64, f64),
+    /// The accelerometer bias applied from this frame on ``(x, y, z)``, m/s², device frame.
+    #[pyo3(get)]
+    bias: (f64, f64, f64),
+    /// True when this sample started a new segment after a gap longer than 0.1 s.
+    #[pyo3(get)]
+    restarted: bool,
+}
+
+fn triple(v: [f64; 3]) -> (f64, f64, f64) {
+    (v[0], v[1], v[2])
+}
+
+impl From<RidiUpdate> for Update {
+    fn from(u: RidiUpdate) -> Self {
+        Self {
+            frame: u.frame,
+            time: u.pose.time,
+            position: triple(u.pose.position.to_array()),
+            velocity: triple(u.pose.velocity.to_array()),
+            bias: triple(u.bias.to_array()),
+            restarted: u.restarted,
+        }
+    }
+}
+
+#[pymethods]
+impl Update {
+    fn __repr__(&self) -> String {
+        let p = self.position;
+        format!(
+            "Update(frame={}, time={}, position=({:.3}, {:.3}, {:.3}))",
+            self.frame, self.time, p.0, p.1, p.2
+        )
+    }
+}
+
+/// Tracks a live stream with a trained model: push each sample as it arrives, get the poses
+/// that became known (``ridi::LiveTracker``). Pushing a whole recording gives exactly the poses
+/// of ``ridi.track(seq, model, online=True)`` and ``ridi track --online``.
+///
+/// A model trained on the recorded orientation needs ``orientation`` (``[w, x, y, z]``),
+/// ``gravity`` and ``linacce`` with every sample; one trained with
+/// ``orientation="estimated"`` estimates its own from gyro and accelerometer, and its first
+/// frames come out together once it knows the initial tilt (``finish`` releases what a short
+/// stream leaves). A refused sample (non-finite, beyond any phone sensor, not after the
+/// previous one) raises ``ValueError`` and leaves the tracker as it was; a gap longer than
+/// 0.1 s starts a new segment (``Update.restarted``).
+///
+/// >>> live = ridi.LiveTracker(model)                      # doctest: +SKIP
+/// >>> for i in range(len(seq)):                           # doctest: +SKIP
+/// ...     for u in live.push(seq.time[i], seq.gyro[i], seq.acce[i],
+/// ...                        orientation=seq.orientation[i],
+/// ...                        gravity=seq.gravity[i], linacce=seq.linacce[i]):
+/// ...         print(u.time, u.position)
+#[pyclass(frozen, module = "ridi")]
+pub(crate) struct LiveTracker {
+    // Declared before `model`, so dropped before it: the tracker borrows the model.
+    live: Mutex<ridi::LiveTracker<'static>>,
+    model: Arc<Cascade>,
+}
+
+impl LiveTracker {
+    fn lock(&self) -> MutexGuard<'_, ridi::LiveTracker<'static>> {
+        // A panic inside the tracker is a bug that pyo3 already reported; the state it left is
+        // the tracker's own business, as for a refused sample.
+        self.live.lock().unwrap_or_else(|p| p.into_inner())
+    }
+}
+
+#[pymethods]
+impl LiveTracker {
+    #[new]
+    #[pyo3(signature = (
+        model, *, regress_every=50, lambda_=0.1, estimate_initial_velocity=false,
+        placement_window=10.0,
+    ))]
+    fn new(
+        model: &Bound<'_, Model>,
+        regress_every: usize,
+        lambda_: f64,
+        estimate_initial_velocity: bool,
+        placement_window: f64,
+    ) -> PyResult<Self> {
+        let opts = options::track_options(
+            true,
+            regress_every,
+            lambda_,
+            estimate_initial_velocity,
+            placement_window,
+        )?;
+        let model = Arc::clone(&model.get().inner);
+        // SAFETY: the cascade lives in `model`'s heap allocation, which this tracker keeps
+        // alive (and never moves or mutates) for as long as `live` exists: `live` is dropped
+        // first (field order), and neither field is ever replaced.
+        let cascade: &'static Cascade = unsafe { &*Arc::as_ptr(&model) };
+        let live = ridi::LiveTracker::new(cascade, &opts).map_err(errors::pipeline)?;
+        Ok(Self {
+            live: Mutex::new(live),
+            model,
+        })
+    }
+
+    /// Adds one sample: ``time`` in seconds, ``gyro`` (rad/s) and ``acce`` (m/s², with
+    /// gravity) as 3 values in the device frame, and for a model trained on the recorded
+    /// orientation the phone's ``orientation`` ``[w, x, y, z]``, ``gravity`` and ``linacce``.
+    /// Returns the updates of the frames whose pose became known (one, except while an
+    /// estimated orientation starts up).
+    #[pyo3(signature = (time, gyro, acce, *, orientation=None, gravity=None, linacce=None))]
+    #[allow(clippy::too_many_arguments)]
+    fn push(
+        &self,
+        py: Python<'_>,
+        time: f64,
+        gyro: [f64; 3],
+        acce: [f64; 3],
+        orientation: Option<[f64; 4]>,
+        gravity: Option<[f64; 3]>,
+        linacce: Option<[f64; 3]>,
+    ) -> PyResult<Vec<Update>> {
+        let recorded = match (orientation, gravity, linacce) {
+            (None, None, None) => None,
+            (Some(q), Some(g), Some(l)) => Some(Recorded {
+                orientation: rotation(q)
+                    .map_err(|e| errors::value(format!("`orientation` at t = {time} s: {e}")))?,
+                gravity: DeviceVec::from_array(g),
+                linacce: DeviceVec::from_array(l),
+            }),
+            _ => {
+                return Err(errors::value(
+                    "give `orientation`, `gravity` and `linacce` together, or none of them",
+                ));
+            }
+        };
+        if recorded.is_none() && self.model.feature_config().orientation == Orientation::Recorded {
+            return Err(errors::value(
+                "the model was trained on the recorded orientation: give `orientation`, \
+                 `gravity` and `linacce` with every sample (or train with \
+                 orientation=\"estimated\")",
+            ));
+        }
+        let sample = SensorReading {
+            time,
+            gyro: DeviceVec::from_array(gyro),
+            acce: DeviceVec::from_array(acce),
+            recorded,
+        };
+        let mut out = Vec::with_capacity(1);
+        py.detach(|| self.lock().push(&sample, &mut out))
+            .map_err(errors::pipeline)?;
+        Ok(out.into_iter().map(Update::from).collect())
+    }
+
+    /// Ends the stream: the updates of frames still waiting for an estimated orientation.
+    fn finish(&self, py: Python<'_>) -> PyResult<Vec<Update>> {
+        let mut out = Vec::new();
+        py.detach(|| self.lock().finish(&mut out))
+            .map_err(errors::pipeline)?;
+        Ok(out.into_iter().map(Update::from).collect())
+    }
+
+    /// Every regression made so far (frames are stream indices).
+    #[getter]
+    fn regressions(&self) -> Regressions {
+        let live = self.lock();
+        let (velocities, placements) = live.regressions();
+        Regressions::of(velocities, placements, self.model.placements())
+    }
+}

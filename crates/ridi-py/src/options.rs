@@ -1,0 +1,183 @@
+//! The options of the `ridi` commands as keyword arguments: their names (flag spelled as a
+//! Python name), defaults and bounds are the command line's (crates/ridi-cli), and they become
+//! the same facade options the commands build.
+
+use std::path::PathBuf;
+
+use pyo3::exceptions::PyTypeError;
+use pyo3::prelude::*;
+use ridi::PlacementMap;
+use ridi::correct::{InitialVelocity, PlacementSmoother};
+use ridi::data::{ReadOptions, Sequence as RidiSequence};
+use ridi::eval::AlignWindow;
+
+use crate::errors;
+use crate::sequence::Sequence;
+
+/// Largest `regress_every` and training `step`: one minute at 200 Hz (`ridi`'s
+/// `MAX_FRAMES_APART`).
+pub(crate) const MAX_FRAMES_APART: usize = 12_000;
+/// Largest `turned_copies` (`ridi train --turned-copies`).
+pub(crate) const MAX_TURNED_COPIES: usize = 32;
+/// Smallest and largest training `window` (`ridi train --window`).
+pub(crate) const WINDOW_RANGE: (usize, usize) = (20, 600);
+/// Largest `jobs` (`--jobs`).
+pub(crate) const MAX_JOBS: usize = 4096;
+
+/// `value` of the option `name`, one of `choices` (`(name, value)` pairs), or a `ValueError`
+/// listing them.
+pub(crate) fn choice<T: Copy>(name: &str, value: &str, choices: &[(&str, T)]) -> PyResult<T> {
+    match choices.iter().find(|(n, _)| *n == value) {
+        Some((_, v)) => Ok(*v),
+        None => {
+            let names: Vec<String> = choices.iter().map(|(n, _)| format!("'{n}'")).collect();
+            Err(errors::value(format!(
+                "`{name}` is '{value}'; expected one of {}",
+                names.join(", ")
+            )))
+        }
+    }
+}
+
+/// A whole number in `min..=max` for option `name`.
+pub(crate) fn count(name: &str, value: usize, min: usize, max: usize) -> PyResult<usize> {
+    if (min..=max).contains(&value) {
+        Ok(value)
+    } else {
+        Err(errors::value(format!(
+            "`{name}` is {value}; expected a whole number from {min} to {max}"
+        )))
+    }
+}
+
+/// A finite number above 0 for option `name`.
+pub(crate) fn positive(name: &str, value: f64) -> PyResult<f64> {
+    if value.is_finite() && value > 0.0 {
+        Ok(value)
+    } else {
+        Err(errors::value(format!(
+            "`{name}` is {value}; expected a finite number above 0"
+        )))
+    }
+}
+
+/// `placement_window` (seconds; 0 turns the majority vote off), as `--placement-window`.
+pub(crate) fn placement_smoothing(window_s: f64) -> PyResult<Option<PlacementSmoother>> {
+    if !(window_s.is_finite() && window_s >= 0.0) {
+        return Err(errors::value(format!(
+            "`placement_window` is {window_s}; expected a finite number of at least 0"
+        )));
+    }
+    Ok((window_s > 0.0).then_some(PlacementSmoother { window_s }))
+}
+
+/// `align`: seconds, or `"all"` for the whole run, as `ridi eval --align`.
+pub(crate) fn align(value: &Bound<'_, PyAny>) -> PyResult<AlignWindow> {
+    if let Ok(text) = value.extract::<String>() {
+        if text.eq_ignore_ascii_case("all") {
+            return Ok(AlignWindow::All);
+        }
+        return Err(errors::value(format!(
+            "`align` is '{text}'; expected seconds above 0 or 'all'"
+        )));
+    }
+    let seconds: f64 = value.extract().map_err(|_| {
+        PyTypeError::new_err("`align` must be a number of seconds or 'all'".to_string())
+    })?;
+    Ok(AlignWindow::Seconds(positive("align", seconds)?))
+}
+
+/// The tracking options of `ridi track` (and `ridi eval`'s `--placement-window`): the facade's
+/// defaults with the flags given.
+pub(crate) fn track_options(
+    online: bool,
+    regress_every: usize,
+    lambda: f64,
+    estimate_initial_velocity: bool,
+    placement_window: f64,
+) -> PyResult<ridi::TrackOptions> {
+    let mut opts = ridi::TrackOptions {
+        regress_every: count("regress_every", regress_every, 1, MAX_FRAMES_APART)?,
+        online,
+        placement_smoothing: placement_smoothing(placement_window)?,
+        ..ridi::TrackOptions::default()
+    };
+    opts.correction.lambda = positive("lambda_", lambda)?;
+    if estimate_initial_velocity {
+        opts.correction.initial_velocity = InitialVelocity::Estimate;
+    }
+    Ok(opts)
+}
+
+/// `placement_map`: `"tyrex4"` or a file of `label,class` lines, as `--placement-map`.
+pub(crate) fn placement_map(map: Option<PathBuf>) -> PyResult<Option<PlacementMap>> {
+    map.map(|m| {
+        if m.as_os_str() == "tyrex4" {
+            Ok(PlacementMap::tyrex_groups())
+        } else {
+            PlacementMap::read(&m).map_err(errors::pipeline)
+        }
+    })
+    .transpose()
+}
+
+/// The `ReadOptions` every command reads with.
+pub(crate) fn read_options() -> ReadOptions {
+    ReadOptions::default()
+}
+
+/// What training and evaluation take: list files (as `--list`), or sequences already read.
+pub(crate) enum Inputs {
+    /// List files, read as one list.
+    Lists(Vec<PathBuf>),
+    /// Sequences (copies: the facade takes a slice of them).
+    Sequences(Vec<RidiSequence>),
+}
+
+impl Inputs {
+    /// `data`: a list file (`str` or `os.PathLike`), several, or `Sequence`s.
+    pub(crate) fn extract(data: &Bound<'_, PyAny>) -> PyResult<Inputs> {
+        if let Ok(path) = data.extract::<PathBuf>() {
+            return Ok(Inputs::Lists(vec![path]));
+        }
+        let wrong = || {
+            PyTypeError::new_err(
+                "expected a list file (str or os.PathLike), a list of them, or a list of \
+                 ridi.Sequence",
+            )
+        };
+        let items: Vec<Bound<'_, PyAny>> = data
+            .try_iter()
+            .map_err(|_| wrong())?
+            .collect::<PyResult<_>>()?;
+        if items.iter().all(|i| i.cast::<Sequence>().is_ok()) && !items.is_empty() {
+            let seqs = items
+                .iter()
+                .map(|i| Ok(i.cast::<Sequence>()?.get().inner.clone()))
+                .collect::<PyResult<_>>()?;
+            return Ok(Inputs::Sequences(seqs));
+        }
+        let lists = items
+            .iter()
+            .map(|i| i.extract::<PathBuf>().map_err(|_| wrong()))
+            .collect::<PyResult<Vec<_>>>()?;
+        if lists.is_empty() {
+            return Err(errors::value("no list file and no sequence given"));
+        }
+        Ok(Inputs::Lists(lists))
+    }
+}
+
+/// Runs `f` on `jobs` worker threads (all cores when `None`), as `--jobs` does for a command.
+pub(crate) fn with_jobs<T: Send>(jobs: Option<usize>, f: impl FnOnce() -> T + Send) -> PyResult<T> {
+    match jobs {
+        None => Ok(f()),
+        Some(n) => {
+            let pool = rayon::ThreadPoolBuilder::new()
+                .num_threads(count("jobs", n, 1, MAX_JOBS)?)
+                .build()
+                .map_err(|e| errors::value(format!("cannot set up the worker threads: {e}")))?;
+            Ok(pool.install(f))
+        }
+    }
+}

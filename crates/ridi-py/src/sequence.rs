@@ -1,0 +1,455 @@
+//! `ridi.Sequence`, `ridi.read`, `ridi.read_any` and `ridi.read_list`.
+
+use std::path::PathBuf;
+
+use numpy::{PyArray1, PyArray2};
+use pyo3::exceptions::PyUserWarning;
+use pyo3::prelude::*;
+use ridi::data::{
+    DeviceInfo, Format, GroundTruth, ListEntry, Listed, OrientationSource,
+    Sequence as RidiSequence, SequenceParts,
+};
+use ridi::frames::{Frame, Vec3};
+use ridi::{Purpose, load_listed};
+
+use crate::arrays::{matrix, rotations, rotations_out, vecs, vecs_out, vector, vector_out};
+use crate::errors;
+use crate::options::{self, choice};
+
+/// The formats, by the names of `ridi convert --from` (and `ridi-plain` for `data_plain.txt`).
+const FORMATS: [(&str, Format); 6] = [
+    ("ridi-csv", Format::RidiCsv),
+    ("ridi-plain", Format::RidiPlain),
+    ("ridi-raw", Format::RidiRaw),
+    ("tyrex", Format::Tyrex),
+    ("ilc", Format::Ilc),
+    ("ronin", Format::Ronin),
+];
+
+/// The name of `format` in [`FORMATS`]; a format added to the readers since is named as they
+/// print it.
+fn format_name(format: Format) -> String {
+    FORMATS
+        .iter()
+        .find(|(_, f)| *f == format)
+        .map_or_else(|| format.to_string(), |(n, _)| n.to_string())
+}
+
+/// One recording on one timeline: IMU channels, device orientation and, where present, ground
+/// truth, as numpy arrays (each property returns a new float64 array).
+///
+/// Read one with ``ridi.read(path)``, or build one from arrays: the arrays are validated as any
+/// reader's input is (equal lengths, finite values, increasing time without long gaps,
+/// plausible units), and an error names the array and the frame. Frames: the device frame is
+/// Android's sensor frame, orientations are Hamilton world-from-device quaternions in
+/// ``[w, x, y, z]`` order, the world frame has z up.
+///
+/// Example:
+///
+/// >>> import numpy as np, ridi
+/// >>> n = 400
+/// >>> t = np.arange(n) / 200.0
+/// >>> up = np.tile([0.0, 9.81, 0.0], (n, 1))          # phone upright, at rest
+/// >>> q = np.tile([0.7071068, 0.7071068, 0.0, 0.0], (n, 1))  # device y axis up
+/// >>> seq = ridi.Sequence(t, np.zeros((n, 3)), up, up, q, name="still")
+/// >>> seq.gravity.shape, round(seq.duration, 3)
+/// ((400, 3), 1.995)
+#[pyclass(frozen, module = "ridi")]
+pub(crate) struct Sequence {
+    pub(crate) inner: RidiSequence,
+    format: Option<Format>,
+}
+
+impl Sequence {
+    pub(crate) fn of(inner: RidiSequence, format: Option<Format>) -> Self {
+        Self { inner, format }
+    }
+}
+
+#[pymethods]
+impl Sequence {
+    #[new]
+    #[pyo3(signature = (
+        time, gyro, acce, gravity, orientation, *, linacce=None, name="sequence".to_string(),
+        placement=None, magnet=None, ground_truth_position=None, ground_truth_orientation=None,
+        steps=None, orientation_source=None, device=None, device_imu_rate_hz=None,
+    ))]
+    #[allow(clippy::too_many_arguments)]
+    fn new(
+        time: &Bound<'_, PyAny>,
+        gyro: &Bound<'_, PyAny>,
+        acce: &Bound<'_, PyAny>,
+        gravity: &Bound<'_, PyAny>,
+        orientation: &Bound<'_, PyAny>,
+        linacce: Option<&Bound<'_, PyAny>>,
+        name: String,
+        placement: Option<String>,
+        magnet: Option<&Bound<'_, PyAny>>,
+        ground_truth_position: Option<&Bound<'_, PyAny>>,
+        ground_truth_orientation: Option<&Bound<'_, PyAny>>,
+        steps: Option<&Bound<'_, PyAny>>,
+        orientation_source: Option<&str>,
+        device: Option<&str>,
+        device_imu_rate_hz: Option<f64>,
+    ) -> PyResult<Self> {
+        let time = vector(time, "time", None)?;
+        let n = time.as_array().len();
+        fn three<F: Frame>(obj: &Bound<'_, PyAny>, name: &str, n: usize) -> PyResult<Vec<Vec3<F>>> {
+            matrix(obj, name, 3, Some(n)).map(|a| vecs(a.as_array()))
+        }
+        let four = |obj: &Bound<'_, PyAny>, name: &str| {
+            matrix(obj, name, 4, Some(n)).and_then(|a| rotations(a.as_array(), name))
+        };
+        let (gyro, acce, gravity) = (
+            three(gyro, "gyro", n)?,
+            three(acce, "acce", n)?,
+            three(gravity, "gravity", n)?,
+        );
+        // Accelerometer minus gravity, as the RIDI files define it, unless given.
+        let linacce = match linacce {
+            Some(l) => three(l, "linacce", n)?,
+            None => acce.iter().zip(&gravity).map(|(&a, &g)| a - g).collect(),
+        };
+        let ground_truth = match (ground_truth_position, ground_truth_orientation) {
+            (None, None) => None,
+            (Some(p), Some(q)) => Some(GroundTruth {
+                position: three(p, "ground_truth_position", n)?,
+                orientation: four(q, "ground_truth_orientation")?,
+            }),
+            _ => {
+                return Err(errors::value(
+                    "ground truth needs both `ground_truth_position` and \
+                     `ground_truth_orientation`",
+                ));
+            }
+        };
+        let orientation_source = orientation_source
+            .map(|key| {
+                let keys: Vec<(&str, OrientationSource)> = OrientationSource::ALL
+                    .iter()
+                    .map(|s| (s.key(), *s))
+                    .collect();
+                choice("orientation_source", key, &keys)
+            })
+            .transpose()?;
+        let device = match device {
+            None => None,
+            Some(model) => {
+                let d = DeviceInfo::new(model).map_err(|e| errors::value(e.to_string()))?;
+                Some(match device_imu_rate_hz {
+                    Some(rate) => d
+                        .with_imu_rate(rate)
+                        .map_err(|e| errors::value(e.to_string()))?,
+                    None => d,
+                })
+            }
+        };
+        let parts = SequenceParts {
+            time: time.as_array().to_vec(),
+            gyro,
+            acce,
+            linacce,
+            gravity,
+            magnet: magnet.map(|m| three(m, "magnet", n)).transpose()?,
+            orientation: four(orientation, "orientation")?,
+            orientation_source,
+            ground_truth,
+            steps: steps
+                .map(|s| vector(s, "steps", Some(n)).map(|s| s.as_array().to_vec()))
+                .transpose()?,
+            device,
+            placement,
+            name,
+        };
+        let name = parts.name.clone();
+        let inner = RidiSequence::new(parts)
+            .map_err(|e| errors::value(format!("sequence `{name}`: {e}")))?;
+        Ok(Self::of(inner, None))
+    }
+
+    /// The sequence's name (its folder or file name when read).
+    #[getter]
+    fn name(&self) -> &str {
+        self.inner.name()
+    }
+
+    /// Placement label (`Texting`, `hand`, ...), or None.
+    #[getter]
+    fn placement(&self) -> Option<&str> {
+        self.inner.placement()
+    }
+
+    /// The format it was read from (`ridi-csv`, `ridi-plain`, `ridi-raw`, `tyrex`, `ilc`, `ronin`) by
+    /// ``ridi.read``, or None (built from arrays, read from a list).
+    #[getter]
+    fn format(&self) -> Option<String> {
+        self.format.map(format_name)
+    }
+
+    /// Timestamps, seconds, shape (N,).
+    #[getter]
+    fn time<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        vector_out(py, self.inner.time().to_vec())
+    }
+
+    /// Gyroscope, rad/s, device frame, shape (N, 3).
+    #[getter]
+    fn gyro<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<f64>> {
+        vecs_out(py, self.inner.gyro())
+    }
+
+    /// Accelerometer including gravity, m/s², device frame, shape (N, 3).
+    #[getter]
+    fn acce<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<f64>> {
+        vecs_out(py, self.inner.acce())
+    }
+
+    /// Linear acceleration (accelerometer minus gravity), m/s², device frame, shape (N, 3).
+    #[getter]
+    fn linacce<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<f64>> {
+        vecs_out(py, self.inner.linacce())
+    }
+
+    /// Gravity, pointing up (about +9.8 along the upward axis at rest), m/s², device frame,
+    /// shape (N, 3).
+    #[getter]
+    fn gravity<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<f64>> {
+        vecs_out(py, self.inner.gravity())
+    }
+
+    /// Magnetometer, µT, device frame, shape (N, 3), or None.
+    #[getter]
+    fn magnet<'py>(&self, py: Python<'py>) -> Option<Bound<'py, PyArray2<f64>>> {
+        self.inner.magnet().map(|m| vecs_out(py, m))
+    }
+
+    /// Device orientation, world-from-device quaternions `[w, x, y, z]`, shape (N, 4).
+    #[getter]
+    fn orientation<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<f64>> {
+        rotations_out(py, self.inner.orientation())
+    }
+
+    /// Where the orientation comes from (`game-rotation-vector`, `rotation-vector`,
+    /// `core-motion-attitude`, `estimated`, `ground-truth`), or None.
+    #[getter]
+    fn orientation_source(&self) -> Option<&'static str> {
+        self.inner.orientation_source().map(|s| s.key())
+    }
+
+    /// Ground-truth device position, metres, shape (N, 3), or None.
+    #[getter]
+    fn ground_truth_position<'py>(&self, py: Python<'py>) -> Option<Bound<'py, PyArray2<f64>>> {
+        self.inner.ground_truth().map(|g| vecs_out(py, &g.position))
+    }
+
+    /// Ground-truth device orientation, `[w, x, y, z]`, shape (N, 4), or None.
+    #[getter]
+    fn ground_truth_orientation<'py>(&self, py: Python<'py>) -> Option<Bound<'py, PyArray2<f64>>> {
+        self.inner
+            .ground_truth()
+            .map(|g| rotations_out(py, &g.orientation))
+    }
+
+    /// Step counter (steps since the start), shape (N,), or None.
+    #[getter]
+    fn steps<'py>(&self, py: Python<'py>) -> Option<Bound<'py, PyArray1<f64>>> {
+        self.inner.steps().map(|s| vector_out(py, s.to_vec()))
+    }
+
+    /// The phone model it was recorded with (`Nexus 5`), or None.
+    #[getter]
+    fn device(&self) -> Option<&str> {
+        self.inner.device().map(|d| d.model())
+    }
+
+    /// The rate the phone's IMU sampled at before any resampling, Hz, or None.
+    #[getter]
+    fn device_imu_rate_hz(&self) -> Option<f64> {
+        self.inner.device().and_then(|d| d.imu_rate_hz())
+    }
+
+    /// Duration, seconds (last timestamp minus first).
+    #[getter]
+    fn duration(&self) -> f64 {
+        self.inner.duration()
+    }
+
+    /// Mean rate, Hz (frames over duration).
+    #[getter]
+    fn rate_hz(&self) -> f64 {
+        self.inner.rate_hz()
+    }
+
+    /// Rate, Hz, one over the median frame interval (what tracking checks: 200 Hz ± 10 %).
+    #[getter]
+    fn median_rate_hz(&self) -> f64 {
+        self.inner.median_rate_hz()
+    }
+
+    /// A copy with the placement label `placement` (None removes it): what training needs
+    /// of a sequence read without a list file.
+    #[pyo3(signature = (placement))]
+    fn with_placement(&self, placement: Option<String>) -> Self {
+        let mut inner = self.inner.clone();
+        inner.set_placement(placement);
+        Self::of(inner, self.format)
+    }
+
+    fn __len__(&self) -> usize {
+        self.inner.len()
+    }
+
+    fn __repr__(&self) -> String {
+        format!(
+            "Sequence('{}', {} frames, {:.2} s, placement={}, ground truth: {})",
+            self.inner.name(),
+            self.inner.len(),
+            self.inner.duration(),
+            self.inner
+                .placement()
+                .map_or("None".to_string(), |p| format!("'{p}'")),
+            if self.inner.ground_truth().is_some() {
+                "yes"
+            } else {
+                "no"
+            }
+        )
+    }
+}
+
+/// Emits the readers' warnings as Python `UserWarning`s, as the command line prints them.
+fn warn(py: Python<'_>, warnings: &[String]) -> PyResult<()> {
+    let category = py.get_type::<PyUserWarning>();
+    for w in warnings {
+        let text = std::ffi::CString::new(w.replace('\0', " ")).expect("no NUL left");
+        PyErr::warn(py, &category, &text, 1)?;
+    }
+    Ok(())
+}
+
+/// Every sequence at `path` (several for a Tyrex run split at a long motion-capture loss).
+fn read_sequences(
+    py: Python<'_>,
+    path: &std::path::Path,
+    format: Option<&str>,
+) -> PyResult<Vec<Sequence>> {
+    let from = format.map(|f| choice("format", f, &FORMATS)).transpose()?;
+    let loaded = py
+        .detach(|| ridi::read_any(path, from, &options::read_options()))
+        .map_err(errors::data)?;
+    warn(py, &loaded.warnings)?;
+    let format = loaded.format;
+    Ok(loaded
+        .sequences
+        .into_iter()
+        .map(|s| Sequence::of(s, Some(format)))
+        .collect())
+}
+
+/// Reads the recording at `path`: a RIDI ``data.csv`` (or ``.csv.gz``), ``data_plain.txt``,
+/// RIDI raw recorder folder, Tyrex run folder or Indoor Location Competition path file, as
+/// ``ridi track`` reads it. ``format`` forces one (``ridi-csv``, ``ridi-plain``, ``ridi-raw``,
+/// ``tyrex``, ``ilc``, ``ronin``) instead of detecting it. The readers' warnings are ``UserWarning``\ s.
+///
+/// Raises ``OSError`` when the file cannot be read, ``ValueError`` naming the file, line and
+/// field when its content is wrong, and ``ValueError`` when the source holds several
+/// sequences (read those with ``ridi.read_any``).
+///
+/// >>> seq = ridi.read("datasets/sample/Jakob_Nexus5_NoDist_Texting")  # doctest: +SKIP
+/// >>> seq.gyro.shape                                                    # doctest: +SKIP
+/// (4801, 3)
+#[pyfunction]
+#[pyo3(signature = (path, format=None))]
+pub(crate) fn read(py: Python<'_>, path: PathBuf, format: Option<&str>) -> PyResult<Sequence> {
+    let mut seqs = read_sequences(py, &path, format)?;
+    if seqs.len() != 1 {
+        return Err(errors::value(format!(
+            "{} holds {} sequences; read them with `ridi.read_any`, or convert it with `ridi \
+             convert`",
+            path.display(),
+            seqs.len()
+        )));
+    }
+    Ok(seqs.remove(0))
+}
+
+/// Reads every sequence at `path` (``ridi.read`` for sources that hold several, such as a
+/// Tyrex run split at a long motion-capture loss), in order.
+#[pyfunction]
+#[pyo3(signature = (path, format=None))]
+pub(crate) fn read_any(
+    py: Python<'_>,
+    path: PathBuf,
+    format: Option<&str>,
+) -> PyResult<Vec<Sequence>> {
+    read_sequences(py, &path, format)
+}
+
+/// Reads the sequences of list files (``path,placement`` per line, ``#`` comments, paths
+/// relative to the list), in order, several lists as one, as ``ridi train --list`` and
+/// ``ridi eval --list`` do.
+///
+/// ``placement_map`` (``"tyrex4"`` or a file of ``label,class`` lines) relabels the
+/// placements; ``purpose`` (``"training"`` or ``"evaluation"``) checks what that needs of each
+/// sequence (ground truth; a placement label for training). Every error names the list file and
+/// line.
+///
+/// >>> seqs = ridi.read_list("datasets/sample/list_test.txt", placement_map="tyrex4")  # doctest: +SKIP
+/// >>> [s.placement for s in seqs][:2]                                               # doctest: +SKIP
+/// ['hand', 'pocket']
+#[pyfunction]
+#[pyo3(signature = (lists, *, placement_map=None, purpose=None))]
+pub(crate) fn read_list(
+    py: Python<'_>,
+    lists: &Bound<'_, PyAny>,
+    placement_map: Option<PathBuf>,
+    purpose: Option<&str>,
+) -> PyResult<Vec<Sequence>> {
+    let options::Inputs::Lists(lists) = options::Inputs::extract(lists)? else {
+        return Err(pyo3::exceptions::PyTypeError::new_err(
+            "`lists` must be a list file (str or os.PathLike) or a list of them",
+        ));
+    };
+    let map = options::placement_map(placement_map)?;
+    let purpose = purpose
+        .map(|p| {
+            choice(
+                "purpose",
+                p,
+                &[
+                    ("training", Purpose::Training),
+                    ("evaluation", Purpose::Evaluation),
+                ],
+            )
+        })
+        .transpose()?;
+    let listed = py
+        .detach(|| -> ridi::Result<Listed> {
+            let entries = ListEntry::read(&lists)?;
+            let read = options::read_options();
+            match purpose {
+                Some(purpose) => load_listed(entries, map.as_ref(), purpose, &read),
+                None => {
+                    // The labels written in the lists, checked as `load_listed` checks them.
+                    if let Some(map) = &map {
+                        for e in &entries {
+                            if let Some(label) = &e.placement {
+                                map.class_at(label, e.location())?;
+                            }
+                        }
+                    }
+                    let mut listed = Listed::load(entries, &read)?;
+                    if let Some(map) = &map {
+                        map.apply(listed.sequences_mut());
+                    }
+                    Ok(listed)
+                }
+            }
+        })
+        .map_err(errors::pipeline)?;
+    Ok(listed
+        .into_sequences()
+        .into_iter()
+        .map(|s| Sequence::of(s, None))
+        .collect())
+}

@@ -1,0 +1,225 @@
+//! `ridi.track`, `ridi.regress`, `ridi.Track` and `ridi.Regressions`.
+
+use std::path::PathBuf;
+
+use numpy::{IntoPyArray, PyArray1, PyArray2};
+use pyo3::prelude::*;
+use ridi::correct::FrameVelocity;
+use ridi::{PipelineError, oriented};
+
+use crate::arrays::{rows_out, vecs_out, vector_out};
+use crate::errors;
+use crate::model::Model;
+use crate::options::{self, MAX_FRAMES_APART};
+use crate::sequence::Sequence;
+
+/// The regressed velocities a correction follows: one per regression, at its frame.
+///
+/// ``velocity`` is ``[S-x, S-z]`` in m/s (S: the gravity-stabilized device frame, +y up;
+/// forward is -z), ``placement`` the placement class each was regressed for.
+#[pyclass(frozen, module = "ridi")]
+pub(crate) struct Regressions {
+    frame: Vec<usize>,
+    velocity: Vec<[f64; 2]>,
+    placement: Vec<String>,
+}
+
+impl Regressions {
+    pub(crate) fn of(
+        regressions: &[FrameVelocity],
+        placements: &[usize],
+        names: &[String],
+    ) -> Self {
+        Self {
+            frame: regressions.iter().map(|r| r.frame).collect(),
+            velocity: regressions.iter().map(|r| r.velocity.to_array()).collect(),
+            placement: placements
+                .iter()
+                .map(|&p| names.get(p).cloned().unwrap_or_default())
+                .collect(),
+        }
+    }
+}
+
+#[pymethods]
+impl Regressions {
+    /// Frame index of each regression, shape (M,), int64.
+    #[getter]
+    fn frame<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<i64>> {
+        let frames: Vec<i64> = self.frame.iter().map(|&f| f as i64).collect();
+        frames.into_pyarray(py)
+    }
+
+    /// Regressed velocity ``[S-x, S-z]``, m/s, shape (M, 2).
+    #[getter]
+    fn velocity<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<f64>> {
+        rows_out(py, self.velocity.iter().copied())
+    }
+
+    /// Placement class of each regression.
+    #[getter]
+    fn placement(&self) -> Vec<String> {
+        self.placement.clone()
+    }
+
+    fn __len__(&self) -> usize {
+        self.frame.len()
+    }
+
+    fn __repr__(&self) -> String {
+        format!("Regressions({} velocities)", self.frame.len())
+    }
+}
+
+/// A tracked sequence: one pose per frame, in the world frame of the device orientation
+/// (z up), metres from the start; what ``ridi track`` writes as its CSV.
+#[pyclass(frozen, module = "ridi")]
+pub(crate) struct Track {
+    inner: ridi::Track,
+}
+
+#[pymethods]
+impl Track {
+    /// Timestamps, seconds, shape (N,).
+    #[getter]
+    fn time<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        vector_out(py, self.inner.time.clone())
+    }
+
+    /// Position, metres, world frame, shape (N, 3).
+    #[getter]
+    fn position<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<f64>> {
+        vecs_out(py, &self.inner.position)
+    }
+
+    /// Velocity, m/s, world frame, shape (N, 3).
+    #[getter]
+    fn velocity<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<f64>> {
+        vecs_out(py, &self.inner.velocity)
+    }
+
+    /// Estimated accelerometer bias, m/s², device frame, shape (N, 3).
+    #[getter]
+    fn bias<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<f64>> {
+        vecs_out(py, &self.inner.bias)
+    }
+
+    /// The regressed velocities the correction followed.
+    #[getter]
+    fn regressions(&self) -> Regressions {
+        Regressions::of(
+            &self.inner.regressions,
+            &self.inner.placements,
+            &self.inner.placement_names,
+        )
+    }
+
+    /// The model's placement classes.
+    #[getter]
+    fn placement_names(&self) -> Vec<String> {
+        self.inner.placement_names.clone()
+    }
+
+    /// Writes the trajectory CSV of ``ridi track``:
+    /// ``time,pos_x,pos_y,pos_z,vel_x,vel_y,vel_z,placement,bias_x,bias_y,bias_z``.
+    fn write_csv(&self, py: Python<'_>, path: PathBuf) -> PyResult<()> {
+        let track = &self.inner;
+        py.detach(|| track.write_csv(&path))
+            .map_err(|e| errors::pipeline_in(e, Some(format!("cannot write {}", path.display()))))
+    }
+
+    fn __len__(&self) -> usize {
+        self.inner.time.len()
+    }
+
+    fn __repr__(&self) -> String {
+        let end = self
+            .inner
+            .position
+            .last()
+            .map_or([0.0; 3], |p| p.to_array());
+        format!(
+            "Track({} frames, {} regressions, ends at ({:.2}, {:.2}) m)",
+            self.inner.time.len(),
+            self.inner.regressions.len(),
+            end[0],
+            end[1]
+        )
+    }
+}
+
+/// Tracks `sequence` with `model`, as ``ridi track`` does: velocities regressed every
+/// ``regress_every`` frames, the accelerometer bias corrected so that the integrated velocity
+/// follows them, and integrated twice. ``online=True`` is ``ridi track --online`` (a
+/// correction every 200 frames over the latest 1,000; the poses a ``LiveTracker`` gives).
+/// ``lambda_`` (``--lambda``), ``estimate_initial_velocity`` and ``placement_window``
+/// (seconds, 0 for each window's own label) are the command's options, with its defaults.
+///
+/// Raises ``ValueError`` naming the sequence for one at another rate than 200 Hz, shorter than
+/// the model's window or with a gap longer than 0.1 s.
+///
+/// >>> track = ridi.track(seq, model)          # doctest: +SKIP
+/// >>> track.position[-1]                     # doctest: +SKIP
+/// array([ 3.1, -12.4,  0.2])
+#[pyfunction]
+#[pyo3(signature = (
+    sequence, model, online=false, *, regress_every=50, lambda_=0.1,
+    estimate_initial_velocity=false, placement_window=10.0,
+))]
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn track(
+    py: Python<'_>,
+    sequence: &Bound<'_, Sequence>,
+    model: &Bound<'_, Model>,
+    online: bool,
+    regress_every: usize,
+    lambda_: f64,
+    estimate_initial_velocity: bool,
+    placement_window: f64,
+) -> PyResult<Track> {
+    let opts = options::track_options(
+        online,
+        regress_every,
+        lambda_,
+        estimate_initial_velocity,
+        placement_window,
+    )?;
+    let (seq, model) = (&sequence.get().inner, &model.get().inner);
+    py.detach(|| -> ridi::Result<ridi::Track> {
+        // The model's orientation first, as `ridi track` gives it to the recording it read.
+        let seq = oriented(seq, model.feature_config().orientation)?;
+        ridi::track(&seq, model, &opts)
+    })
+    .map(|inner| Track { inner })
+    .map_err(|e| errors::pipeline_in(e, Some(format!("cannot track {}", seq.name()))))
+}
+
+/// The velocities `model` regresses for `sequence` every ``regress_every`` frames from the
+/// first whole window, each with the majority placement within ``placement_window`` seconds:
+/// what ``ridi.track`` corrects with, without the correction.
+#[pyfunction]
+#[pyo3(signature = (sequence, model, *, regress_every=50, placement_window=10.0))]
+pub(crate) fn regress(
+    py: Python<'_>,
+    sequence: &Bound<'_, Sequence>,
+    model: &Bound<'_, Model>,
+    regress_every: usize,
+    placement_window: f64,
+) -> PyResult<Regressions> {
+    let opts = ridi::TrackOptions {
+        regress_every: options::count("regress_every", regress_every, 1, MAX_FRAMES_APART)?,
+        placement_smoothing: options::placement_smoothing(placement_window)?,
+        ..ridi::TrackOptions::default()
+    };
+    let (seq, model) = (&sequence.get().inner, &model.get().inner);
+    let (velocities, placements) = py
+        .detach(|| ridi::track::regress(seq, model, &opts))
+        .map_err(|e: PipelineError| {
+            errors::pipeline_in(e, Some(format!("cannot regress {}", seq.name())))
+        })?;
+    Ok(Regressions::of(
+        &velocities,
+        &placements,
+        model.placements(),
+    ))
+}

@@ -1,0 +1,74 @@
+"""ridi.evaluate: the dict of `ridi eval`'s report.json, from list files or sequences, and its
+options and refusals."""
+
+import json
+import math
+
+import pytest
+
+import ridi
+from conftest import SAMPLE
+
+RUNS = ["Thibaud_Nexus5_NoDist_Texting", "Thibaud_Nexus5_NoDist_FrontPocket"]
+
+
+@pytest.fixture()
+def test_list(tmp_path):
+    listed = tmp_path / "test.txt"
+    listed.write_text("".join(f"{SAMPLE / r},{r.rsplit('_', 1)[1]}\n" for r in RUNS))
+    return listed
+
+
+def same(a, b):
+    """Equal, NaN (None in JSON) included, floats to the last bit."""
+    if isinstance(a, dict):
+        return a.keys() == b.keys() and all(same(a[k], b[k]) for k in a)
+    if isinstance(a, list):
+        return len(a) == len(b) and all(same(x, y) for x, y in zip(a, b))
+    if isinstance(a, float) and isinstance(b, float) and math.isnan(a) and math.isnan(b):
+        return True
+    return a == b
+
+
+def test_evaluate_equals_report_json(model, model_file, ridi_bin, test_list, tmp_path):
+    ridi_bin("eval", "--list", test_list, "--model", model_file, "--out", tmp_path / "out",
+             "--placement-map", "tyrex4", "--plots", "none")
+    expected = json.loads((tmp_path / "out" / "report.json").read_text())
+    report = ridi.evaluate(test_list, model, placement_map="tyrex4")
+    assert same(report, expected), (report, expected)
+    assert report["methods"] == list(ridi.METHODS)
+    assert [s["name"] for s in report["sequences"]] == RUNS
+
+
+def test_evaluate_options_reach_the_cli_flags(model, model_file, ridi_bin, test_list, tmp_path):
+    ridi_bin("eval", "--list", test_list, "--model", model_file, "--out", tmp_path / "out",
+             "--placement-map", "tyrex4", "--plots", "none", "--methods", "ridi,pdr",
+             "--align", "all", "--placement-window", "0", "--jobs", "1")
+    expected = json.loads((tmp_path / "out" / "report.json").read_text())
+    report = ridi.evaluate([test_list], model, placement_map="tyrex4", methods=["ridi", "pdr"],
+                           align="all", placement_window=0, jobs=1)
+    assert same(report, expected)
+    assert report["methods"] == ["ridi", "pdr"]
+
+
+def test_evaluate_sequences_equals_the_list(model, test_list):
+    seqs = ridi.read_list(test_list, placement_map="tyrex4", purpose="evaluation")
+    assert same(ridi.evaluate(seqs, model, methods=["ridi"]),
+                ridi.evaluate(test_list, model, placement_map="tyrex4", methods=["ridi"]))
+
+
+def test_bad_evaluations_are_refused(model, test_list, tmp_path):
+    with pytest.raises(ValueError, match="unknown method"):
+        ridi.evaluate(test_list, model, methods=["ridi", "magic"])
+    with pytest.raises(ValueError, match=r"`align` is 'half'"):
+        ridi.evaluate(test_list, model, align="half")
+    with pytest.raises(ValueError, match=r"`align` is -1"):
+        ridi.evaluate(test_list, model, align=-1.0)
+    twice = tmp_path / "twice.txt"
+    twice.write_text(test_list.read_text() + f"{SAMPLE / RUNS[0]},Texting\n")
+    with pytest.raises(ValueError, match=r"twice.txt:3"):
+        ridi.evaluate(twice, model)
+    no_truth = ridi.read(SAMPLE / RUNS[0])
+    args = {k: getattr(no_truth, k) for k in ("time", "gyro", "acce", "gravity", "orientation")}
+    with pytest.raises(ValueError, match="ground truth"):
+        ridi.evaluate([ridi.Sequence(**args, name="bare")], model)

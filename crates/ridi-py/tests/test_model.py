@@ -1,0 +1,109 @@
+"""ridi.train, ridi.load, Model.save and the model's description: the same model file as
+`ridi train` with the same options, progress, cancellation, and bad options and inputs."""
+
+import json
+import pickle
+
+import pytest
+
+import ridi
+from conftest import SAMPLE
+
+GUILLAUME = SAMPLE / "list_Guillaume.txt"
+
+
+def test_train_gives_the_cli_model_bytes(model, ridi_bin, tmp_path):
+    out = tmp_path / "cli.ridi"
+    ridi_bin("train", "--list", GUILLAUME, "--out", out, "--grid", "none",
+             "--placement-map", "tyrex4")
+    assert model.to_bytes() == out.read_bytes()
+    assert model.placements == ["hand", "pocket", "running", "swing"]
+    assert (model.window, model.orientation, model.up_axis) == (200, "recorded", "plus-or-minus-y")
+
+
+def test_save_load_pickle_and_describe(model, model_file, ridi_bin):
+    loaded = ridi.load(model_file)
+    assert loaded.to_bytes() == model.to_bytes() == model_file.read_bytes()
+    assert pickle.loads(pickle.dumps(model)).to_bytes() == model.to_bytes()
+    assert model.describe() == json.loads(ridi_bin("inspect", model_file, "--json"))
+    assert str(model).strip() in ridi_bin("inspect", model_file)
+    assert "hand" in repr(model)
+
+
+def test_train_on_sequences_equals_train_on_the_list(model):
+    seqs = ridi.read_list(GUILLAUME, placement_map="tyrex4", purpose="training")
+    assert ridi.train(seqs, grid="none").to_bytes() == model.to_bytes()
+
+
+def test_progress_reports_each_stage_and_can_cancel():
+    seqs = ridi.read_list(GUILLAUME, placement_map="tyrex4")[:4]
+    events = []
+    ridi.train(seqs, grid="none", progress=lambda *e: events.append(e), jobs=1)
+    stages = [s for s, done, total in events]
+    assert stages[0] == "placement classifier"
+    assert any(s.startswith("regressors ") for s in stages)
+    assert all(0 <= done <= total for _, done, total in events)
+    with pytest.raises(RuntimeError, match="cancelled"):
+        ridi.train(seqs, grid="none", progress=lambda *e: False)
+
+    def fail(*_):
+        raise KeyError("stop here")
+
+    with pytest.raises(KeyError, match="stop here"):
+        ridi.train(seqs, grid="none", progress=fail)
+
+
+@pytest.mark.parametrize(
+    "options, message",
+    [
+        (dict(grid="huge"), r"`grid` is 'huge'; expected one of 'paper', 'small', 'none'"),
+        (dict(turned_copies=33), r"`turned_copies` is 33; expected a whole number from 0 to 32"),
+        (dict(window=10), r"`window` is 10; expected a whole number from 20 to 600"),
+        (dict(step=0), r"`step` is 0"),
+        (dict(classifier_c=0.0), r"`classifier_c` is 0"),
+        (dict(solver="nystrom", landmarks=1), r"`landmarks` is 1"),
+        (dict(storage="full"), r"`storage` is 'full'"),
+        (dict(orientation="magnetic"), r"`orientation` is 'magnetic'"),
+        (dict(up_axis="z"), r"`up_axis` is 'z'"),
+        (dict(jobs=0), r"`jobs` is 0"),
+        (dict(placement_map="no-such-map.txt"), r"no-such-map.txt"),
+    ],
+)
+def test_bad_training_options_are_refused(options, message):
+    error = OSError if "placement_map" in options else ValueError
+    with pytest.raises(error, match=message):
+        ridi.train(GUILLAUME, **options)
+
+
+def test_training_lists_are_checked_at_their_line(tmp_path):
+    run = SAMPLE / "Guillaume_Nexus5_NoDist_AR"
+    listed = tmp_path / "train.txt"
+    listed.write_text(f"{run},AR\n{SAMPLE / 'Guillaume_Nexus5_NoDist_Texting'}\n")
+    # A processed file carries no label of its own: training needs it in the list.
+    with pytest.raises(ValueError, match=r"train.txt:2: field `placement`"):
+        ridi.train(listed, grid="none")
+    with pytest.raises(ValueError, match=r"no placement label"):
+        ridi.train([ridi.read(run)], grid="none")
+    with pytest.raises(TypeError, match="list file"):
+        ridi.train(3.5)
+    with pytest.raises(ValueError, match="no list file and no sequence"):
+        ridi.train([])
+
+
+def test_grid_search_with_too_few_sequences_says_how_to_train_without(tmp_path):
+    seqs = ridi.read_list(GUILLAUME, placement_map="tyrex4")[:2]
+    with pytest.raises(ValueError, match=r"grid=\"none\"` trains without it"):
+        ridi.train(seqs, grid="small")
+
+
+def test_model_files(tmp_path, model):
+    with pytest.raises(FileNotFoundError, match=r"cannot load model .*nowhere.ridi"):
+        ridi.load(tmp_path / "nowhere.ridi")
+    junk = tmp_path / "junk.ridi"
+    junk.write_bytes(b"not a model at all, but long enough for a header")
+    with pytest.raises(ValueError, match=r"cannot load model .*junk.ridi"):
+        ridi.load(junk)
+    with pytest.raises(ValueError, match="cannot load model"):
+        ridi.Model.from_bytes(b"\0" * 10)
+    with pytest.raises(OSError, match=r"cannot write .*missing"):
+        model.save(tmp_path / "missing" / "m.ridi")

@@ -1,0 +1,184 @@
+"""ridi.read, ridi.read_any, ridi.read_list and ridi.Sequence: arrays, metadata, and every
+bad input refused with a message naming the file, line and field, or the array and frame."""
+
+import gzip
+import json
+import shutil
+
+import numpy as np
+import pytest
+
+import ridi
+from conftest import SAMPLE, arrays_of
+
+RUN = SAMPLE / "Thibaud_Nexus5_NoDist_Texting"
+
+
+def test_read_gives_numpy_arrays_and_metadata(seq, ridi_bin):
+    n = len(seq)
+    assert seq.name == "Thibaud_Nexus5_NoDist_Texting"
+    assert seq.format == "ridi-csv"
+    assert seq.time.shape == (n,) and seq.time.dtype == np.float64
+    for a in (seq.gyro, seq.acce, seq.linacce, seq.gravity, seq.ground_truth_position):
+        assert a.shape == (n, 3) and a.dtype == np.float64
+    for q in (seq.orientation, seq.ground_truth_orientation):
+        assert q.shape == (n, 4)
+        np.testing.assert_allclose(np.linalg.norm(q, axis=1), 1.0, atol=1e-9)
+    # What `ridi inspect` says of the same recording.
+    inspected = json.loads(ridi_bin("inspect", RUN, "--json"))
+    assert inspected["frames"] == n
+    assert inspected["duration_s"] == pytest.approx(seq.duration)
+    assert inspected["rate_hz"] == pytest.approx(seq.rate_hz)
+    assert abs(seq.median_rate_hz - 200.0) < 20.0
+    assert (seq.device, seq.device_imu_rate_hz) == (inspected["device"], inspected["device_imu_rate_hz"])
+    assert seq.orientation_source == "game-rotation-vector"
+    assert (seq.magnet, seq.steps) == (None, None)
+    assert "Thibaud_Nexus5_NoDist_Texting" in repr(seq)
+
+
+def test_read_any_and_a_forced_format(seq):
+    [same] = ridi.read_any(RUN, format="ridi-csv")
+    np.testing.assert_array_equal(same.gyro, seq.gyro)
+    with pytest.raises(ValueError, match="not an Indoor Location Competition path file"):
+        ridi.read(RUN, format="ilc")
+    with pytest.raises(ValueError, match="`format` is 'csv'; expected one of"):
+        ridi.read(RUN, format="csv")
+
+
+def test_read_list_labels_and_checks(tmp_path):
+    seqs = ridi.read_list(SAMPLE / "list_test.txt", placement_map="tyrex4", purpose="evaluation")
+    assert len(seqs) == 8
+    assert {s.placement for s in seqs} == {"hand", "pocket", "running", "swing"}
+    raw = ridi.read_list([SAMPLE / "list_test.txt"])
+    assert [s.placement for s in raw][:2] == ["AR", "BackPocket"]
+    bad = tmp_path / "list.txt"
+    bad.write_text(f"{RUN},Texting\n{RUN},Swingin\n")
+    with pytest.raises(ValueError, match=r"list.txt:2: field `placement`: placement `Swingin`"):
+        ridi.read_list(bad, placement_map="tyrex4")
+    bad.write_text(f"# runs\n{tmp_path / 'nowhere'},Texting\n")
+    with pytest.raises(ValueError, match=r"list.txt:2: field `path`: .*nowhere` does not exist"):
+        ridi.read_list(bad)
+    with pytest.raises(ValueError, match="`purpose` is 'testing'"):
+        ridi.read_list(bad, purpose="testing")
+    with pytest.raises(TypeError):
+        ridi.read_list(42)
+
+
+def test_a_missing_file_is_an_os_error(tmp_path):
+    with pytest.raises(FileNotFoundError, match="nowhere"):
+        ridi.read(tmp_path / "nowhere" / "data.csv")
+
+
+def test_a_corrupt_cell_is_named_by_file_line_and_field(tmp_path):
+    folder = tmp_path / "run" / "processed"
+    folder.mkdir(parents=True)
+    with gzip.open(RUN / "processed" / "data.csv.gz", "rt") as f:
+        lines = f.read().splitlines()
+    cells = lines[5].split(",")
+    header = lines[0].split(",")
+    column = header.index("gyro_x")
+    cells[column] = "abc"
+    lines[5] = ",".join(cells)
+    (folder / "data.csv").write_text("\n".join(lines) + "\n")
+    with pytest.raises(ValueError, match=r"data.csv:6: field `gyro_x`"):
+        ridi.read(folder / "data.csv")
+
+
+def test_sequence_from_arrays_equals_the_one_read(seq, model):
+    built = ridi.Sequence(**arrays_of(seq))
+    for name in ("time", "gyro", "acce", "linacce", "gravity", "orientation",
+                 "ground_truth_position", "ground_truth_orientation"):
+        np.testing.assert_array_equal(getattr(built, name), getattr(seq, name))
+    assert (built.name, built.placement, built.format) == (seq.name, seq.placement, None)
+    a = ridi.track(seq, model)
+    b = ridi.track(built, model)
+    np.testing.assert_array_equal(a.position, b.position)
+
+
+def test_any_layout_is_read_in_place(seq):
+    n = len(seq)
+    args = arrays_of(seq)
+    # Fortran order, a strided view of a wider array, and a reversed-stride view.
+    args["gyro"] = np.asfortranarray(seq.gyro)
+    wide = np.zeros((n, 6))
+    wide[:, ::2] = seq.acce
+    args["acce"] = wide[:, ::2]
+    assert not args["acce"].flags.c_contiguous
+    flipped = np.ascontiguousarray(seq.gravity[::-1])
+    args["gravity"] = flipped[::-1]
+    sparse_time = np.zeros(2 * n)
+    sparse_time[::2] = seq.time
+    args["time"] = sparse_time[::2]
+    built = ridi.Sequence(**args)
+    np.testing.assert_array_equal(built.gyro, seq.gyro)
+    np.testing.assert_array_equal(built.acce, seq.acce)
+    np.testing.assert_array_equal(built.gravity, seq.gravity)
+    np.testing.assert_array_equal(built.time, seq.time)
+
+
+def test_linacce_defaults_to_acce_minus_gravity(seq):
+    args = arrays_of(seq)
+    del args["linacce"]
+    built = ridi.Sequence(**args)
+    np.testing.assert_allclose(built.linacce, seq.acce - seq.gravity)
+
+
+@pytest.mark.parametrize(
+    "change, error, message",
+    [
+        (lambda a: a.update(gyro=a["gyro"].astype(np.float32)), TypeError,
+         r"`gyro` has dtype float32; ridi takes float64"),
+        (lambda a: a.update(acce=a["acce"].tolist()), TypeError,
+         r"`acce` must be a numpy array of float64, not list"),
+        (lambda a: a.update(gyro=a["gyro"][:, :2]), ValueError,
+         r"`gyro` must have shape \(\d+, one row per frame of `time`, 3\); it has shape \(\d+, 2\)"),
+        (lambda a: a.update(gravity=a["gravity"][:-1]), ValueError,
+         r"`gravity` must have shape"),
+        (lambda a: a.update(time=a["time"][:, None]), ValueError,
+         r"`time` must have shape \(N,\); it has shape \(\d+, 1\)"),
+        (lambda a: a["gyro"].__setitem__((7, 1), np.nan), ValueError,
+         r"sequence `Thibaud_Nexus5_NoDist_Texting`: `gyro` is not finite at frame 7"),
+        (lambda a: a["time"].__setitem__(9, np.inf), ValueError,
+         r"`time` is not finite at frame 9"),
+        (lambda a: a["orientation"].__setitem__(3, [2.0, 0.0, 0.0, 0.0]), ValueError,
+         r"`orientation` at frame 3"),
+        (lambda a: a["time"].__setitem__(4, a["time"][2]), ValueError,
+         r"time does not increase at frame 4"),
+        (lambda a: a.update(ground_truth_orientation=None), ValueError,
+         r"ground truth needs both"),
+        (lambda a: a.update(acce=a["acce"] / 9.81, linacce=None), ValueError,
+         r"accelerometer in g"),
+        (lambda a: a.update(orientation_source="compass"), ValueError,
+         r"`orientation_source` is 'compass'"),
+    ],
+)
+def test_bad_arrays_are_refused_by_name(seq, change, error, message):
+    args = {k: (v.copy() if isinstance(v, np.ndarray) else v) for k, v in arrays_of(seq).items()}
+    change(args)
+    with pytest.raises(error, match=message):
+        ridi.Sequence(**args)
+
+
+def test_with_placement_and_len(seq):
+    other = seq.with_placement("hand")
+    assert other.placement == "hand" and seq.placement != "hand"
+    assert len(other) == len(seq)
+    assert other.with_placement(None).placement is None
+
+
+def test_a_copied_folder_reads_the_same(seq, tmp_path):
+    copy = tmp_path / seq.name
+    shutil.copytree(RUN, copy)
+    again = ridi.read(str(copy))
+    np.testing.assert_array_equal(again.orientation, seq.orientation)
+
+
+def test_the_docstring_examples_run():
+    import doctest
+
+    runner = doctest.DocTestRunner(optionflags=doctest.ELLIPSIS)
+    finder = doctest.DocTestFinder(exclude_empty=True)
+    for obj in (ridi.Sequence,):
+        for test in finder.find(obj, obj.__name__, module=False, globs={"ridi": ridi}):
+            runner.run(test)
+    assert runner.tries > 0 and runner.failures == 0

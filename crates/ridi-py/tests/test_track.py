@@ -1,0 +1,148 @@
+"""ridi.track, ridi.regress and ridi.LiveTracker: the trajectory of `ridi track` (batch and
+online) within 1e-9, the live tracker's poses equal to online tracking, the GIL released, and
+refused inputs."""
+
+import threading
+
+import numpy as np
+import pytest
+
+import ridi
+from conftest import SAMPLE, arrays_of
+
+RUN = SAMPLE / "Thibaud_Nexus5_NoDist_Texting"
+COLUMNS = "time,pos_x,pos_y,pos_z,vel_x,vel_y,vel_z,placement,bias_x,bias_y,bias_z"
+
+
+def cli_track(ridi_bin, model_file, out, *flags):
+    ridi_bin("track", RUN, "--model", model_file, "--out", out, *flags)
+    text = out.read_text().splitlines()
+    assert text[0] == COLUMNS
+    rows = [line.split(",") for line in text[1:]]
+    numbers = np.array([[float(c) for i, c in enumerate(r) if i != 7] for r in rows])
+    return numbers, [r[7] for r in rows]
+
+
+@pytest.mark.parametrize("online", [False, True])
+def test_track_equals_the_cli_trajectory(seq, model, model_file, ridi_bin, tmp_path, online):
+    numbers, placements = cli_track(
+        ridi_bin, model_file, tmp_path / "cli.csv", *(["--online"] if online else [])
+    )
+    track = ridi.track(seq, model, online=online)
+    assert len(track) == len(seq) == len(numbers)
+    mine = np.column_stack([track.time, track.position, track.velocity, track.bias])
+    np.testing.assert_allclose(mine, numbers, rtol=0, atol=1e-9)
+    # The CSV's placement column: the latest regression's, empty before the first.
+    regs = track.regressions
+    expected = [""] * len(seq)
+    for frame, label in zip(regs.frame, regs.placement):
+        expected[frame:] = [label] * (len(seq) - frame)
+    assert placements == expected
+    # And the same file, byte for byte.
+    track.write_csv(tmp_path / "py.csv")
+    assert (tmp_path / "py.csv").read_bytes() == (tmp_path / "cli.csv").read_bytes()
+
+
+def test_track_options_reach_the_cli_flags(seq, model, model_file, ridi_bin, tmp_path):
+    numbers, _ = cli_track(
+        ridi_bin, model_file, tmp_path / "cli.csv", "--regress-every", "25", "--lambda", "0.5",
+        "--estimate-initial-velocity", "--placement-window", "0",
+    )
+    track = ridi.track(seq, model, regress_every=25, lambda_=0.5,
+                       estimate_initial_velocity=True, placement_window=0)
+    np.testing.assert_allclose(track.position, numbers[:, 1:4], rtol=0, atol=1e-9)
+
+
+def test_regress_is_what_track_corrects_with(seq, model):
+    track = ridi.track(seq, model)
+    regs = ridi.regress(seq, model)
+    np.testing.assert_array_equal(regs.frame, track.regressions.frame)
+    np.testing.assert_array_equal(regs.velocity, track.regressions.velocity)
+    assert regs.placement == track.regressions.placement
+    assert regs.velocity.shape == (len(regs), 2) and regs.frame.dtype == np.int64
+    assert set(regs.placement) <= set(model.placements)
+    assert track.placement_names == model.placements
+    assert "frames" in repr(track)
+
+
+def test_live_tracker_gives_the_online_poses(seq, model):
+    online = ridi.track(seq, model, online=True)
+    live = ridi.LiveTracker(model)
+    t, g, a = seq.time, seq.gyro, seq.acce
+    q, grav, lin = seq.orientation, seq.gravity, seq.linacce
+    updates = []
+    for i in range(len(seq)):
+        updates += live.push(t[i], g[i], a[i], orientation=q[i], gravity=grav[i], linacce=lin[i])
+    updates += live.finish()
+    assert [u.frame for u in updates] == list(range(len(seq)))
+    np.testing.assert_array_equal(np.array([u.position for u in updates]), online.position)
+    np.testing.assert_array_equal(np.array([u.bias for u in updates]), online.bias)
+    assert not any(u.restarted for u in updates)
+    np.testing.assert_array_equal(live.regressions.velocity, online.regressions.velocity)
+    assert "Update(frame=0" in repr(updates[0])
+
+
+def test_live_tracker_refuses_bad_samples_and_stays_usable(seq, model):
+    live = ridi.LiveTracker(model)
+    recorded = dict(orientation=seq.orientation[0], gravity=seq.gravity[0],
+                    linacce=seq.linacce[0])
+    with pytest.raises(ValueError, match="trained on the recorded orientation"):
+        live.push(seq.time[0], seq.gyro[0], seq.acce[0])
+    with pytest.raises(ValueError, match="together"):
+        live.push(seq.time[0], seq.gyro[0], seq.acce[0], orientation=seq.orientation[0])
+    with pytest.raises(ValueError, match=r"`orientation` at t = "):
+        live.push(seq.time[0], seq.gyro[0], seq.acce[0], orientation=[2.0, 0, 0, 0],
+                  gravity=seq.gravity[0], linacce=seq.linacce[0])
+    with pytest.raises(ValueError, match=r"gyro"):
+        live.push(seq.time[0], [1e6, 0.0, 0.0], seq.acce[0], **recorded)
+    [first] = live.push(seq.time[0], seq.gyro[0], seq.acce[0], **recorded)
+    assert first.frame == 0 and first.time == seq.time[0]
+    with pytest.raises(ValueError, match="tracking"):
+        live.push(seq.time[0], seq.gyro[0], seq.acce[0], **recorded)
+    [second] = live.push(seq.time[1], seq.gyro[1], seq.acce[1], orientation=seq.orientation[1],
+                         gravity=seq.gravity[1], linacce=seq.linacce[1])
+    assert second.frame == 1
+    with pytest.raises(ValueError, match="`regress_every` is 0"):
+        ridi.LiveTracker(model, regress_every=0)
+
+
+def test_untrackable_sequences_are_named(seq, model):
+    args = arrays_of(seq)
+    short = {k: (v[:150] if isinstance(v, np.ndarray) else v) for k, v in args.items()}
+    with pytest.raises(ValueError, match=r"cannot track .*Texting.*no velocity can be regressed"):
+        ridi.track(ridi.Sequence(**short), model)
+    slow = {k: (v[::2] if isinstance(v, np.ndarray) else v) for k, v in args.items()}
+    with pytest.raises(ValueError, match=r"rate of 100.0 Hz"):
+        ridi.track(ridi.Sequence(**slow), model)
+
+
+@pytest.mark.parametrize(
+    "options, message",
+    [
+        (dict(regress_every=0), r"`regress_every` is 0; expected a whole number from 1 to 12000"),
+        (dict(lambda_=-1.0), r"`lambda_` is -1"),
+        (dict(placement_window=-2.0), r"`placement_window` is -2"),
+        (dict(placement_window=float("nan")), r"`placement_window` is NaN"),
+    ],
+)
+def test_bad_tracking_options_are_refused(seq, model, options, message):
+    with pytest.raises(ValueError, match=message):
+        ridi.track(seq, model, **options)
+
+
+def test_tracking_releases_the_gil(seq, model):
+    done = threading.Event()
+    result = []
+
+    def work():
+        result.append(ridi.track(seq, model))
+        done.set()
+
+    worker = threading.Thread(target=work)
+    spins = 0
+    worker.start()
+    while not done.is_set():
+        spins += 1
+    worker.join()
+    # Held by the tracking, the GIL would let this loop run only before and after it.
+    assert spins > 10_000 and len(result[0]) == len(seq)
