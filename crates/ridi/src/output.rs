@@ -18,7 +18,9 @@
 
 use std::path::{Path, PathBuf};
 
-use ridi_data::{Sequence, write_pending};
+use ridi_data::{
+    Sequence, TEMPORARY_FILE_PREFIX, register_temporary, temporary_prefix, write_pending,
+};
 use ridi_regress::Cascade;
 
 use crate::error::{PipelineError, Result};
@@ -236,10 +238,18 @@ pub fn check_output_folder(dir: &Path) -> Result<(), OutputError> {
 }
 
 /// Whether new entries can be made in the folder `dir`: makes and removes an empty temporary
-/// folder there. The error is its kind alone, since the error's own text names the temporary
-/// entry, not the output.
+/// folder there, named and registered as the outputs' temporaries are, so that a signal
+/// between the two removes it too. The error is its kind alone, since the error's own text
+/// names the temporary entry, not the output.
 fn probe(dir: &Path) -> std::result::Result<(), std::io::ErrorKind> {
-    tempfile::tempdir_in(dir).map(drop).map_err(|e| e.kind())
+    let prefix = temporary_prefix(TEMPORARY_FILE_PREFIX);
+    let (made, _registered) = register_temporary(|| {
+        let made = tempfile::Builder::new().prefix(&prefix).tempdir_in(dir)?;
+        let path = made.path().to_path_buf();
+        Ok((made, path))
+    })
+    .map_err(|e| e.kind())?;
+    made.close().map_err(|e| e.kind())
 }
 
 /// Refuses an output that would replace what the command reads (`inputs`) or another of its
