@@ -238,7 +238,7 @@ impl Callback {
 /// >>> model.save("model.ridi")                                      # doctest: +SKIP
 #[pyfunction]
 #[pyo3(signature = (
-    data, *, grid="paper", placement_map=None, orientation="recorded", storage="projected",
+    data, *, grid="paper", placement_map=None, orientation="estimated", storage="projected",
     solver="exact", landmarks=Nystrom::DEFAULT_LANDMARKS, turned_copies=1, step=None,
     window=None, speed=true, up_axis="plus-or-minus-y", standardize=true, classifier_c=10.0,
     jobs=None, progress=None,

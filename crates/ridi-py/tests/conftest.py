@@ -42,6 +42,13 @@ def model():
 
 
 @pytest.fixture(scope="session")
+def recorded_model():
+    """As `model`, on the recorded orientation: its live tracker takes the phone's own."""
+    return ridi.train(SAMPLE / "list_Guillaume.txt", grid="none", placement_map="tyrex4",
+                      orientation="recorded")
+
+
+@pytest.fixture(scope="session")
 def model_file(model, tmp_path_factory):
     path = tmp_path_factory.mktemp("model") / "model.ridi"
     model.save(path)

@@ -16,15 +16,19 @@ def test_train_gives_the_cli_model_bytes(model, ridi_bin, tmp_path):
     out = tmp_path / "cli.ridi"
     ridi_bin("train", "--list", GUILLAUME, "--out", out, "--grid", "none",
              "--placement-map", "tyrex4")
-    assert model.to_bytes() == out.read_bytes()
+    # A bool, not the bytes: pytest's explanation of two differing models takes minutes.
+    same = model.to_bytes() == out.read_bytes()
+    assert same, "the model differs from the one `ridi train` writes"
     assert model.placements == ["hand", "pocket", "running", "swing"]
-    assert (model.window, model.orientation, model.up_axis) == (200, "recorded", "plus-or-minus-y")
+    assert (model.window, model.orientation, model.up_axis) == (200, "estimated", "plus-or-minus-y")
 
 
 def test_save_load_pickle_and_describe(model, model_file, ridi_bin):
     loaded = ridi.load(model_file)
-    assert loaded.to_bytes() == model.to_bytes() == model_file.read_bytes()
-    assert pickle.loads(pickle.dumps(model)).to_bytes() == model.to_bytes()
+    same = loaded.to_bytes() == model.to_bytes() == model_file.read_bytes()
+    assert same, "a saved and loaded model differs"
+    same = pickle.loads(pickle.dumps(model)).to_bytes() == model.to_bytes()
+    assert same, "a pickled model differs"
     assert model.describe() == json.loads(ridi_bin("inspect", model_file, "--json"))
     assert str(model).strip() in ridi_bin("inspect", model_file)
     assert "hand" in repr(model)
@@ -32,7 +36,8 @@ def test_save_load_pickle_and_describe(model, model_file, ridi_bin):
 
 def test_train_on_sequences_equals_train_on_the_list(model):
     seqs = ridi.read_list(GUILLAUME, placement_map="tyrex4", purpose="training")
-    assert ridi.train(seqs, grid="none").to_bytes() == model.to_bytes()
+    same = ridi.train(seqs, grid="none").to_bytes() == model.to_bytes()
+    assert same, "training on the sequences differs from training on the list"
 
 
 def test_progress_reports_each_stage_and_can_cancel():

@@ -40,7 +40,8 @@ def test_track_equals_the_cli_trajectory(seq, model, model_file, ridi_bin, tmp_p
     assert placements == expected
     # And the same file, byte for byte.
     track.write_csv(tmp_path / "py.csv")
-    assert (tmp_path / "py.csv").read_bytes() == (tmp_path / "cli.csv").read_bytes()
+    same = (tmp_path / "py.csv").read_bytes() == (tmp_path / "cli.csv").read_bytes()
+    assert same, "write_csv differs from `ridi track`'s CSV"
 
 
 def test_track_options_reach_the_cli_flags(seq, model, model_file, ridi_bin, tmp_path):
@@ -82,8 +83,8 @@ def test_live_tracker_gives_the_online_poses(seq, model):
     assert "Update(frame=0" in repr(updates[0])
 
 
-def test_live_tracker_refuses_bad_samples_and_stays_usable(seq, model):
-    live = ridi.LiveTracker(model)
+def test_live_tracker_refuses_bad_samples_and_stays_usable(seq, recorded_model):
+    live = ridi.LiveTracker(recorded_model)
     recorded = dict(orientation=seq.orientation[0], gravity=seq.gravity[0],
                     linacce=seq.linacce[0])
     with pytest.raises(ValueError, match="trained on the recorded orientation"):
@@ -103,7 +104,7 @@ def test_live_tracker_refuses_bad_samples_and_stays_usable(seq, model):
                          gravity=seq.gravity[1], linacce=seq.linacce[1])
     assert second.frame == 1
     with pytest.raises(ValueError, match="`regress_every` is 0"):
-        ridi.LiveTracker(model, regress_every=0)
+        ridi.LiveTracker(recorded_model, regress_every=0)
 
 
 def test_untrackable_sequences_are_named(seq, model):

@@ -211,7 +211,7 @@ def train(
     *,
     grid: Literal["paper", "small", "none"] = "paper",
     placement_map: Optional[StrPath] = None,
-    orientation: Literal["recorded", "estimated"] = "recorded",
+    orientation: Literal["recorded", "estimated"] = "estimated",
     storage: Literal["projected", "half"] = "projected",
     solver: Literal["exact", "nystrom"] = "exact",
     landmarks: int = 1024,
