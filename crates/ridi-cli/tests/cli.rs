@@ -7,16 +7,9 @@ use std::process::{Command, Output};
 use ridi::frames::UpAxis;
 use ridi_test_support::{assert_names_file, file_names, sample_dataset, stderr};
 
-fn ridi(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_ridi"))
-        .args(args)
-        .output()
-        .expect("run ridi")
-}
+mod common;
 
-fn s(p: &Path) -> &str {
-    p.to_str().unwrap()
-}
+use common::{ridi, s};
 
 #[test]
 fn inspect_prints_text_and_json() {

@@ -12,16 +12,9 @@ use std::time::{Duration, Instant};
 
 use ridi_test_support::{file_names, sample_dataset, stderr};
 
-fn ridi(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_ridi"))
-        .args(args)
-        .output()
-        .expect("run ridi")
-}
+mod common;
 
-fn s(p: &Path) -> &str {
-    p.to_str().unwrap()
-}
+use common::{ridi, s};
 
 fn has_strace() -> bool {
     let found = Command::new("strace")

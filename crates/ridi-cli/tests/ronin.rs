@@ -2,20 +2,12 @@
 //! (`crates/ridi-data/tests/ronin`, written by h5py).
 
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
 
 use ridi_test_support::{assert_names_file, stderr};
 
-fn ridi(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_ridi"))
-        .args(args)
-        .output()
-        .expect("run ridi")
-}
+mod common;
 
-fn s(p: &Path) -> &str {
-    p.to_str().unwrap()
-}
+use common::{ridi, s};
 
 fn fixtures() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("../ridi-data/tests/ronin")

@@ -312,8 +312,9 @@ impl Hdf5File {
     /// The messages of the object header at `addr`, continuation blocks included.
     fn messages(&self, addr: u64) -> Found<Vec<Message<'_>>> {
         let mut c = self.at_addr(addr, "object header")?;
-        let mut out = Vec::new();
-        if c.bytes.starts_with(b"OHDR") {
+        // The first block and how its messages are laid out: version 2 (an OHDR signature)
+        // or version 1.
+        let (first, v2_creation_order) = if c.bytes.starts_with(b"OHDR") {
             c.take(4)?;
             let version = c.u8()?;
             if version != 2 {
@@ -329,46 +330,7 @@ impl Hdf5File {
             let size = c.uint(1 << (flags & 3))?;
             let at = c.at();
             let n = usize::try_from(size).map_err(|_| "object header too large".to_owned())?;
-            let block = c.take(n)?;
-            let mut blocks = vec![(block, at)];
-            let creation_order = flags & 0x04 != 0;
-            let mut i = 0;
-            while i < blocks.len() {
-                if i >= MAX_BLOCKS || out.len() >= MAX_MESSAGES {
-                    return Err(
-                        "too many object header continuation blocks or messages (a cycle?)".into(),
-                    );
-                }
-                let (block, at) = blocks[i];
-                i += 1;
-                let mut m = Cursor::new(block, at);
-                let head = if creation_order { 6 } else { 4 };
-                while m.remaining() >= head {
-                    let kind = u16::from(m.u8()?);
-                    let len = usize::from(m.u16()?);
-                    let mflags = m.u8()?;
-                    if creation_order {
-                        m.u16()?;
-                    }
-                    let at = m.at();
-                    let body = m.take(len)?;
-                    if kind == MSG_CONTINUATION {
-                        let (b, a) = self.continuation(body)?;
-                        if !b.starts_with(b"OCHK") || b.len() < 8 {
-                            return Err(format!(
-                                "object header continuation at byte {a} lacks its OCHK signature"
-                            ));
-                        }
-                        blocks.push((&b[4..b.len() - 4], a + 4));
-                    }
-                    out.push(Message {
-                        kind,
-                        flags: mflags,
-                        body,
-                        at,
-                    });
-                }
-            }
+            ((c.take(n)?, at), Some(flags & 0x04 != 0))
         } else {
             let version = c.u8()?;
             if version != 1 {
@@ -383,35 +345,64 @@ impl Hdf5File {
             let size = c.u32()?;
             c.take(4)?; // alignment
             let at = c.at();
-            let block = c.take(size as usize)?;
-            let mut blocks = vec![(block, at)];
-            let mut i = 0;
-            while i < blocks.len() {
-                if i >= MAX_BLOCKS || out.len() >= MAX_MESSAGES {
-                    return Err(
-                        "too many object header continuation blocks or messages (a cycle?)".into(),
-                    );
-                }
-                let (block, at) = blocks[i];
-                i += 1;
-                let mut m = Cursor::new(block, at);
-                while m.remaining() >= 8 {
-                    let kind = m.u16()?;
-                    let len = usize::from(m.u16()?);
-                    let mflags = m.u8()?;
-                    m.take(3)?;
-                    let at = m.at();
-                    let body = m.take(len)?;
-                    if kind == MSG_CONTINUATION {
-                        blocks.push(self.continuation(body)?);
+            ((c.take(size as usize)?, at), None)
+        };
+        let head = match v2_creation_order {
+            Some(true) => 6,
+            Some(false) => 4,
+            None => 8,
+        };
+        let mut out = Vec::new();
+        let mut blocks = vec![first];
+        let mut i = 0;
+        while i < blocks.len() {
+            if i >= MAX_BLOCKS || out.len() >= MAX_MESSAGES {
+                return Err(
+                    "too many object header continuation blocks or messages (a cycle?)".into(),
+                );
+            }
+            let (block, at) = blocks[i];
+            i += 1;
+            let mut m = Cursor::new(block, at);
+            while m.remaining() >= head {
+                let (kind, len, flags) = match v2_creation_order {
+                    Some(creation_order) => {
+                        let kind = u16::from(m.u8()?);
+                        let len = usize::from(m.u16()?);
+                        let flags = m.u8()?;
+                        if creation_order {
+                            m.u16()?;
+                        }
+                        (kind, len, flags)
                     }
-                    out.push(Message {
-                        kind,
-                        flags: mflags,
-                        body,
-                        at,
-                    });
+                    None => {
+                        let kind = m.u16()?;
+                        let len = usize::from(m.u16()?);
+                        let flags = m.u8()?;
+                        m.take(3)?;
+                        (kind, len, flags)
+                    }
+                };
+                let at = m.at();
+                let body = m.take(len)?;
+                if kind == MSG_CONTINUATION {
+                    let (b, a) = self.continuation(body)?;
+                    if v2_creation_order.is_none() {
+                        blocks.push((b, a));
+                    } else if !b.starts_with(b"OCHK") || b.len() < 8 {
+                        return Err(format!(
+                            "object header continuation at byte {a} lacks its OCHK signature"
+                        ));
+                    } else {
+                        blocks.push((&b[4..b.len() - 4], a + 4));
+                    }
                 }
+                out.push(Message {
+                    kind,
+                    flags,
+                    body,
+                    at,
+                });
             }
         }
         Ok(out)

@@ -4,8 +4,8 @@ use std::path::PathBuf;
 
 use numpy::{IntoPyArray, PyArray1, PyArray2};
 use pyo3::prelude::*;
+use ridi::PipelineError;
 use ridi::correct::FrameVelocity;
-use ridi::{PipelineError, oriented};
 
 use crate::arrays::{rows_out, vecs_out, vector_out};
 use crate::errors;
@@ -185,13 +185,10 @@ pub(crate) fn track(
         placement_window,
     )?;
     let (seq, model) = (&sequence.get().inner, &model.get().inner);
-    py.detach(|| -> ridi::Result<ridi::Track> {
-        // The model's orientation first, as `ridi track` gives it to the recording it read.
-        let seq = oriented(seq, model.feature_config().orientation)?;
-        ridi::track(&seq, model, &opts)
-    })
-    .map(|inner| Track { inner })
-    .map_err(|e| errors::pipeline_in(e, Some(format!("cannot track {}", seq.name()))))
+    // `ridi::track` gives the sequence the model's orientation itself.
+    py.detach(|| ridi::track(seq, model, &opts))
+        .map(|inner| Track { inner })
+        .map_err(|e| errors::pipeline_in(e, Some(format!("cannot track {}", seq.name()))))
 }
 
 /// The velocities `model` regresses for `sequence` every ``regress_every`` frames from the
