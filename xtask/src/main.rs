@@ -9,6 +9,7 @@ mod bootstrap;
 mod eval_devices;
 mod eval_orientation;
 mod eval_tyrex;
+mod model;
 mod sample;
 
 use xtask::checksum;
@@ -76,6 +77,18 @@ enum Task {
         data: Option<PathBuf>,
         /// Output folder [default: <workspace>/datasets/sample].
         #[arg(long, value_name = "DIR")]
+        out: Option<PathBuf>,
+    },
+    /// Rebuild the model bundled in the ridi crate (crates/ridi/model/ridi-tyrex.ridi) from
+    /// every run of datasets/protocols/tyrex-runs.txt: both phones, three people, the Nyström
+    /// solver; docs/model-card.md has its figures.
+    Model {
+        /// Tyrex root [default: <workspace>/../shared/data/raw/tyrex-attitude-smartphones, else
+        /// <workspace>/datasets/tyrex from `cargo xtask fetch tyrex`].
+        #[arg(long, value_name = "DIR")]
+        data: Option<PathBuf>,
+        /// Model file to write [default: <workspace>/crates/ridi/model/ridi-tyrex.ridi].
+        #[arg(long, value_name = "FILE")]
         out: Option<PathBuf>,
     },
     /// Run the benchmark set (criterion benches, correction latency, `ridi demo`), write a JSON
@@ -147,6 +160,11 @@ struct TyrexArgs {
     /// Train with the Nyström solver on this many landmarks instead of the exact SMO.
     #[arg(long, value_name = "N", conflicts_with = "variants")]
     landmarks: Option<usize>,
+    /// Regressor parameters: `none` fixes C = 10, epsilon = 0.01; `paper` searches the paper's
+    /// grid by cross-validation on the training people (cheap with --landmarks, 48 times the
+    /// training without).
+    #[arg(long, value_name = "GRID", default_value = "none", value_parser = ["none", "paper"], conflicts_with = "variants")]
+    grid: String,
 }
 
 #[derive(Args)]
@@ -253,6 +271,7 @@ fn run(cli: Cli) -> Result<()> {
                         _ => ridi::features::Orientation::Recorded,
                     },
                     landmarks: args.landmarks,
+                    grid: args.grid == "paper",
                 })?
             };
             println!("wrote {}", out.display());
@@ -262,6 +281,10 @@ fn run(cli: Cli) -> Result<()> {
         }
         Task::Eval(Eval::Orientation(args)) | Task::EvalOrientation(args) => {
             let out = eval_orientation::run(args.data, args.out)?;
+            println!("wrote {}", out.display());
+        }
+        Task::Model { data, out } => {
+            let out = model::run(data, out)?;
             println!("wrote {}", out.display());
         }
         Task::Sample { data, out } => {

@@ -20,9 +20,10 @@ pub(crate) struct Args {
     /// List files of the sequences to evaluate (ground truth required).
     #[arg(long, required = true, num_args = 1..)]
     list: Vec<PathBuf>,
-    /// Model file from `ridi train`.
+    /// Model file from `ridi train` [default: the bundled model, trained on every shared
+    /// Tyrex run; docs/model-card.md].
     #[arg(long)]
-    model: PathBuf,
+    model: Option<PathBuf>,
     /// Output folder.
     #[arg(long)]
     out: PathBuf,
@@ -63,14 +64,14 @@ pub(crate) fn run(args: Args) -> Result<()> {
             methods.push(m);
         }
     }
-    let model = crate::load_model(&args.model)?;
+    let model = crate::model_or_bundled(args.model.as_deref())?;
     let listed = crate::load_listed(
         ListEntry::read(&args.list)?,
         args.placement_map.as_deref(),
         Purpose::Evaluation,
     )?;
     let mut read = args.list.clone();
-    read.push(args.model.clone());
+    read.extend(args.model.clone());
     read.extend(args.placement_map.iter().map(PathBuf::from));
     read.extend(listed.entries().iter().map(|e| e.path.clone()));
     let folder = folder.reading(ReadFiles::of(&read));

@@ -214,6 +214,17 @@ fn load_model(path: &Path) -> Result<Cascade> {
     Cascade::load(path).with_context(|| format!("cannot load model {}", shown(path)))
 }
 
+/// The model at `path`, or without one the bundled model, saying so in one line on stderr.
+fn model_or_bundled(path: Option<&Path>) -> Result<Cascade> {
+    match path {
+        Some(p) => load_model(p),
+        None => {
+            eprintln!("no --model: using {}", ridi::BUNDLED_MODEL_SUMMARY);
+            ridi::bundled_model().context("cannot decode the bundled model")
+        }
+    }
+}
+
 /// One line: the outermost context and every cause, as users asked for. Errors that already
 /// print their source in their own message are not repeated.
 fn one_line(e: &anyhow::Error) -> String {

@@ -15,9 +15,10 @@ pub(crate) struct Args {
     /// A RIDI data.csv, data_plain.txt, raw folder, Tyrex run, or Indoor Location
     /// Competition path file.
     sequence: PathBuf,
-    /// Model file from `ridi train`.
+    /// Model file from `ridi train` [default: the bundled model, trained on every shared
+    /// Tyrex run; docs/model-card.md].
     #[arg(long)]
-    model: PathBuf,
+    model: Option<PathBuf>,
     /// Trajectory CSV to write.
     #[arg(long)]
     out: PathBuf,
@@ -46,12 +47,16 @@ pub(crate) struct Args {
 pub(crate) fn run(args: Args) -> Result<()> {
     // Every output is checked before any work, so that a bad --plot cannot leave the
     // trajectory written and the command failed.
-    let inputs = ReadFiles::of([&args.sequence, &args.model]);
+    let inputs = ReadFiles::of(
+        [Some(&args.sequence), args.model.as_ref()]
+            .into_iter()
+            .flatten(),
+    );
     let mut output = TrackOutput::new(&args.out, &inputs)?;
     if let Some(plot) = &args.plot {
         output = output.with_plot(plot, &inputs)?;
     }
-    let model = crate::load_model(&args.model)?;
+    let model = crate::model_or_bundled(args.model.as_deref())?;
     let opts = track_options(&args);
     // Online without a plot, a recording that streams is tracked as it is read, in memory that
     // does not grow with its length; a plot needs the whole trajectory.

@@ -50,15 +50,16 @@ pub(crate) struct Args {
     #[arg(long, value_enum, default_value = "projected")]
     storage: StorageArg,
     /// How the kernel machines are trained: `exact` (SMO, the paper's), or `nystrom`, which
-    /// approximates the RBF kernel on --landmarks training rows and trains linear machines
-    /// on those features: less training time and memory, a model and a query that do not
-    /// grow with the rows, velocities somewhat off the exact ones (measured in the
-    /// ridi-regress crate documentation).
+    /// approximates the RBF kernel on --landmarks rows per machine, with a linear classifier
+    /// and kernel ridge regressors on those features: training time and memory linear in the
+    /// rows, a model and a query that do not grow with them, velocities somewhat off the
+    /// exact ones (docs/benchmarks.md).
     #[arg(long, value_enum, default_value = "exact")]
     solver: SolverArg,
-    /// Landmarks of `--solver nystrom` (rows drawn at random, seed 0), 2 to 16384: more
-    /// approximate the exact kernel machines more closely, at a cost per query and in
-    /// training linear in them.
+    /// Landmarks per machine of `--solver nystrom` (rows drawn at random, seed 0: the
+    /// classifier's from all rows, each placement's regressors' from its own), 2 to 16384:
+    /// more approximate the kernel machines more closely, at a cost per query linear in them
+    /// and in training quadratic.
     #[arg(long, value_name = "N", default_value_t = Nystrom::DEFAULT_LANDMARKS,
           value_parser = |s: &str| count(s, 2, Nystrom::MAX_LANDMARKS))]
     landmarks: usize,

@@ -1088,3 +1088,46 @@ fn demo_writes_model_reports_and_plots_all_or_nothing() {
         ],
     );
 }
+
+#[test]
+fn track_and_eval_without_a_model_use_the_bundled_one_and_say_so() {
+    let dir = tempfile::tempdir().unwrap();
+    let seq = sample_dataset().join("Thibaud_Nexus5_NoDist_Texting");
+    let csv = dir.path().join("t.csv");
+    let out = ridi(&["track", s(&seq), "--out", s(&csv)]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let said = stderr(&out);
+    assert_eq!(
+        said.lines().filter(|l| l.contains("bundled model")).count(),
+        1,
+        "{said}"
+    );
+    assert!(said.contains("no --model"), "{said}");
+    // The same trajectory as with the bundled model's bytes written to a file.
+    let file = dir.path().join("bundled.ridi");
+    ridi::bundled_model().unwrap().save(&file).unwrap();
+    let csv2 = dir.path().join("t2.csv");
+    let out = ridi(&["track", s(&seq), "--model", s(&file), "--out", s(&csv2)]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert!(!stderr(&out).contains("bundled"));
+    assert!(std::fs::read(&csv).unwrap() == std::fs::read(&csv2).unwrap());
+    // `ridi eval` likewise.
+    let list = sample_dataset().join("list_test.txt");
+    let eval = dir.path().join("eval");
+    let out = ridi(&[
+        "eval",
+        "--list",
+        s(&list),
+        "--out",
+        s(&eval),
+        "--placement-map",
+        "tyrex4",
+        "--plots",
+        "none",
+        "--methods",
+        "ridi",
+    ]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert!(stderr(&out).contains("no --model: using the bundled model"));
+    assert!(eval.join("report.json").is_file());
+}

@@ -33,6 +33,7 @@ fn _ridi(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(sequence::read_any, m)?)?;
     m.add_function(wrap_pyfunction!(sequence::read_list, m)?)?;
     m.add_function(wrap_pyfunction!(model::load, m)?)?;
+    m.add_function(wrap_pyfunction!(model::bundled_model, m)?)?;
     m.add_function(wrap_pyfunction!(model::train, m)?)?;
     m.add_function(wrap_pyfunction!(track::regress, m)?)?;
     m.add_function(wrap_pyfunction!(track::track, m)?)?;

@@ -146,6 +146,16 @@ pub(crate) fn load(py: Python<'_>, path: PathBuf) -> PyResult<Model> {
         .map_err(|e| errors::model_file(e, "cannot load model", &path))
 }
 
+/// The model bundled with ridi-rs: trained on every shared Tyrex run (a Nexus 5 and an iPhone
+/// 4S, three people), for phones of your own without training (its card:
+/// ``docs/model-card.md``); what ``ridi track`` uses without ``--model``.
+#[pyfunction]
+pub(crate) fn bundled_model() -> PyResult<Model> {
+    ridi::bundled_model()
+        .map(Model::of)
+        .map_err(|e| errors::value(format!("cannot decode the bundled model: {e}")))
+}
+
 /// A progress callback, and what it did: the first exception it raised (or a
 /// `KeyboardInterrupt` caught between its calls), or whether it asked to stop.
 struct Callback {

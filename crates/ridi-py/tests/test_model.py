@@ -112,3 +112,15 @@ def test_model_files(tmp_path, model):
         ridi.Model.from_bytes(b"\0" * 10)
     with pytest.raises(OSError, match=r"cannot write .*missing"):
         model.save(tmp_path / "missing" / "m.ridi")
+
+
+def test_the_bundled_model_is_the_one_ridi_track_uses_without_a_model(ridi_bin, tmp_path):
+    model = ridi.bundled_model()
+    assert model.placements == ["hand", "pocket", "running", "swing"]
+    assert model.describe()["landmarks"] is not None
+    seq = ridi.read(SAMPLE / "Thibaud_Nexus5_NoDist_Texting")
+    out = tmp_path / "t.csv"
+    ridi_bin("track", SAMPLE / "Thibaud_Nexus5_NoDist_Texting", "--out", out)
+    ridi.track(seq, model).write_csv(tmp_path / "py.csv")
+    same = (tmp_path / "py.csv").read_bytes() == out.read_bytes()
+    assert same, "the bundled model tracks otherwise than `ridi track` without --model"

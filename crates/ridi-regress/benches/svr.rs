@@ -79,10 +79,10 @@ fn benches(c: &mut Criterion) {
     g.bench_function("cascade_predict_batch_2000", |b| {
         b.iter(|| model.predict(x).unwrap())
     });
-    // The Nyström solver on the same rows: training (landmarks, features, linear machines)
-    // and one query against 1024 landmarks.
+    // The Nyström solver on the same rows: training (landmarks, features, the linear
+    // classifier, the ridge regressors) and one query, on up to 1024 landmarks per machine.
     let nystrom = CascadeParams {
-        method: Solver::Nystrom(Nystrom::default()),
+        method: Solver::Nystrom(Nystrom::new(1024, 0).unwrap()),
         ..params.clone()
     };
     g.bench_function("cascade_train_nystrom_2000_1024", |b| {

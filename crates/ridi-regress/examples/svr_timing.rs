@@ -9,7 +9,7 @@
 //!            --storage half|projected (grid, cascade, query; default projected)
 //!            --queries Q (load-query: held-out queries, default 2000)
 //!            --solver exact|nystrom --landmarks M --seed S (grid, cascade, query; default
-//!            exact, 1024 landmarks, seed 0)
+//!            exact, 2048 landmarks, seed 0)
 //! ```
 //! `query <n> --save <path>` trains the cascade with fixed `C`/epsilon (no grid) and saves it;
 //! `load-query <n> <path>` loads it and times prediction on one core and batched, on the

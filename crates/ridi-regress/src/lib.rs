@@ -44,39 +44,50 @@
 //!
 //! # Nyström solver
 //!
-//! [`CascadeParams::method`] = [`Solver::Nystrom`] trains the same cascade approximately:
-//! `m` landmarks (default 1024) drawn uniformly from all training rows with a fixed seed,
-//! the RBF kernel (same widths) projected on the span of their feature maps,
+//! [`CascadeParams::method`] = [`Solver::Nystrom`] trains the same cascade approximately, in
+//! time and memory linear in the rows, with a model whose size does not grow with them. Each
+//! machine keeps `m` landmarks (default 2048) drawn uniformly with a fixed seed: the
+//! classifier's from all training rows, each placement's regressors' from that placement's
+//! rows. The RBF kernel (same widths) is projected on the span of the landmarks' feature maps,
 //! `φ(x) = Λ^{-1/2} Uᵀ k(L, x)` with `K(L, L) = UΛUᵀ` (eigenvalues below `1e-6` of the largest
-//! dropped), and every machine linear on `φ`: the one-vs-one classifier (same pairs, `C` and
-//! votes) by the dual coordinate descent of Hsieh et al. (2008), each epsilon-SVR (same `C`,
-//! epsilon and grid) by that of Ho & Lin (2012), with LIBLINEAR's stopping rules
-//! ([`Nystrom::DEFAULT_TOL`]). What is approximated: the kernel beyond the landmarks' span,
-//! and the offset, which a constant feature carries and so is regularized (the regressors fit
-//! targets centred on their mean). Training is the landmarks' fixed cost (`O(m²·dim + m³)`)
-//! plus `O(rows·m·(dim + m))` for the features and `O(rows·m)` per epoch (the epochs to
-//! LIBLINEAR's tolerance grew with the rows in the measurement below); the model keeps
-//! the landmarks (in the same [`Storage`]) and one weight per landmark and machine, `W^{-1/2}`
-//! folded in; a query is one kernel row against the landmarks. With every training row a
-//! landmark it reproduces the exact cascade to within 1 cm/s (tested); with fewer it
-//! approximates it (tested bounds).
+//! dropped), and every machine is linear on `φ`:
+//!
+//! - the one-vs-one classifier (same pairs, `C` and votes) by the dual coordinate descent of
+//!   Hsieh et al. (2008) with LIBLINEAR's stopping rule ([`Nystrom::DEFAULT_TOL`]); its offset
+//!   is a constant feature and so regularized;
+//! - each regressor is kernel ridge regression, `½‖f‖² + (C/2) Σ (f(xᵢ) − yᵢ)²` with a free
+//!   offset, solved in closed form (one `m × m` Cholesky factorization per placement and `C`):
+//!   the squared loss replaces the exact path's epsilon-insensitive one (epsilon is unused,
+//!   0 in the grid table), and the grid's cross-validation over `C` costs a factorization per
+//!   fold and value from sums kept per fold, without another pass over the rows.
+//!
+//! What is approximated, then: the kernel beyond the landmarks' span, the classifier's offset,
+//! and the regressors' loss. Training is `O(rows·m·(dim + m))` (the features and the sums,
+//! GEMMs) plus `O(m³)` per placement; the model keeps the landmarks (in the same [`Storage`],
+//! a placement's as its samples) with one weight per landmark and machine, `W^{-1/2}` folded
+//! in; a query is one kernel row against the classifier's landmarks and one against its
+//! placement's. With every row a landmark the regressors are exact kernel ridge regression and
+//! the classifier the exact machine (tested against a dense solve and the SMO); with fewer
+//! they approach it as the landmarks grow (tested bounds).
 //!
 //! Measured once on synthetic IMU-like features (`benches/synth.rs`, 1200 values, 4
-//! placements, `C` = 10, epsilon = 0.01, no grid; 2 shared cores of an Intel Xeon, load
-//! average about 5 from another job), `cargo run --release -p ridi-regress --example
-//! svr_timing -- query N --solver exact|nystrom --save F`, then `load-query N F`:
+//! placements, `C` = 10, epsilon = 0.01 for the exact solver, no grid; 2 cores of an Intel
+//! Xeon, quiet), `cargo run --release -p ridi-regress --example svr_timing -- query N --solver
+//! exact|nystrom --save F`, then `load-query N F`:
 //!
 //! | rows | solver | train | peak RSS | model | one query | held-out RMSE | placement |
 //! | --- | --- | --- | --- | --- | --- | --- | --- |
-//! | 20,000 | exact | 23.0 s | 510 MB | 15.0 MB | 0.34 ms | 0.180 m/s | 0.953 |
-//! | 20,000 | Nyström 1024 | 18.8 s | 378 MB | 3.9 MB | 0.19 ms | 0.282 m/s | 0.943 |
-//! | 40,000 | exact | 94.1 s | 1466 MB | 25.9 MB | 0.61 ms | 0.279 m/s | 0.962 |
-//! | 40,000 | Nyström 1024 | 71.3 s | 632 MB | 3.9 MB | 0.18 ms | 0.378 m/s | 0.970 |
+//! | 20,000 | exact | 9.5 s | 552 MB | 15.0 MB | 0.30 ms | 0.180 m/s | 0.953 |
+//! | 20,000 | Nyström 2048 | 14.2 s | 602 MB | 14.7 MB | 0.29 ms | 0.187 m/s | 0.936 |
+//! | 40,000 | exact | 29.1 s | 1466 MB | 25.9 MB | 0.44 ms | 0.279 m/s | 0.962 |
+//! | 40,000 | Nyström 2048 | 23.1 s | 1021 MB | 14.7 MB | 0.28 ms | 0.262 m/s | 0.954 |
 //!
-//! (one query: CPU time on one thread; held-out: 2000 windows of later sequences.) The
-//! model and the query no longer grow with the rows; on these features 1024 landmarks cost
-//! about 0.1 m/s of RMSE, and the query is bound by projecting it (544 principal directions
-//! here) and streaming the landmarks, above the 50 µs aimed for.
+//! (one query: CPU time on one thread; held-out: 2000 windows of later sequences; these
+//! features need 607 principal directions, so both models store half precision.) The model
+//! and the query no longer grow with the rows, and the held-out error stays the exact
+//! solver's. On the real Tyrex features, whose exact models keep nearly every row as a support
+//! vector, the difference in speed is larger: `docs/benchmarks.md` ("Training at scale") has
+//! the figures on up to 430,000 rows, and the device protocol's accuracy.
 //!
 //! # Small or degenerate placements
 //!
@@ -172,6 +183,7 @@ mod model_file;
 mod nystrom;
 mod progress;
 mod projection;
+mod ridge;
 #[cfg(target_arch = "x86_64")]
 mod simd;
 mod smo;

@@ -1,19 +1,17 @@
-//! Linear SVMs by dual coordinate descent, the solvers of the Nyström path
-//! ([`crate::Solver::Nystrom`]): the L1-loss C-SVC of Hsieh et al. (ICML 2008) and the
-//! L1-loss epsilon-SVR of Ho & Lin (JMLR 2012), both as LIBLINEAR implements them (random
-//! order each epoch, shrinking of variables at a bound whose gradient points outwards).
+//! The linear SVM of the Nyström path's classifier ([`crate::Solver::Nystrom`]): the L1-loss
+//! C-SVC of Hsieh et al. (ICML 2008) by dual coordinate descent, as LIBLINEAR implements it
+//! (random order each epoch, shrinking of variables at a bound whose gradient points
+//! outwards).
 //!
 //! Each epoch costs `O(rows × dim)`, against SMO's `O(rows²)` kernel: the Nyström features
-//! turn the kernel machines into linear ones. The offset is a constant feature [`BIAS`]
+//! turn the kernel machine into a linear one. The offset is a constant feature [`BIAS`]
 //! appended to every row (LIBLINEAR's `-B 1`), so it is regularized, unlike the exact
-//! solver's `rho`; the regressors are fitted to targets centred on their mean, so only the
-//! deviation from the mean offset is regularized.
+//! solver's `rho`.
 //!
-//! Stopping is LIBLINEAR's ([`Stop`]): on the spread of the projected gradients (C-SVC) or
-//! the relative decrease of the summed violation (SVR), at most [`MAX_EPOCHS`] epochs (or
-//! [`SmoSettings::max_iter`]). SMO's absolute gap of 1e-3 takes cyclic coordinate descent
-//! thousands of epochs on RBF features, whose Gram matrix is close to singular, for no gain
-//! on held-out data (measured in the crate documentation).
+//! Stopping is LIBLINEAR's ([`Stop`]): on the spread of the projected gradients, at most
+//! [`MAX_EPOCHS`] epochs (or [`SmoSettings::max_iter`]). SMO's absolute gap of 1e-3 takes
+//! cyclic coordinate descent thousands of epochs on RBF features, whose Gram matrix is close
+//! to singular, for no gain on held-out data.
 
 use crate::smo::SmoSettings;
 
@@ -26,8 +24,7 @@ pub(crate) const MAX_EPOCHS: usize = 1000;
 /// When to stop.
 #[derive(Debug, Clone, Copy)]
 pub(crate) struct Stop {
-    /// C-SVC: largest minus smallest projected gradient of an epoch at most `tol`; SVR: the
-    /// summed violation of an epoch at most `tol` times that of the first.
+    /// Largest minus smallest projected gradient of an epoch at most `tol`.
     pub tol: f64,
     /// Shrinking (LIBLINEAR's; [`SmoSettings::shrinking`]).
     pub shrinking: bool,
@@ -65,7 +62,7 @@ impl Rows<'_> {
 pub(crate) struct LinearFit {
     pub w: Vec<f64>,
     pub bias: f64,
-    /// Dual variables: `α` (C-SVC, in `[0, C]`) or `β` (SVR, in `[-C, C]`), per row.
+    /// Dual variables `α` (in `[0, C]`), per row.
     pub dual: Vec<f64>,
     pub epochs: usize,
     pub converged: bool,
@@ -224,125 +221,6 @@ pub(crate) fn svc(x: Rows<'_>, positive: &[bool], c: f64, settings: &Stop) -> Li
     }
 }
 
-/// L1-loss epsilon-SVR: `min_β ½ βᵀQβ − Σ y_s β_s + ε Σ|β_s|`, `−C ≤ β ≤ C`,
-/// `Q_st = x_s·x_t + BIAS²`. `beta0` warm-starts (any point of the box is feasible).
-pub(crate) fn svr(
-    x: Rows<'_>,
-    y: &[f64],
-    c: f64,
-    eps: f64,
-    beta0: Option<Vec<f64>>,
-    settings: &Stop,
-) -> LinearFit {
-    let n = x.idx.len();
-    let mut beta = beta0
-        .filter(|b| b.len() == n)
-        .map(|b| b.into_iter().map(|v| v.clamp(-c, c)).collect())
-        .unwrap_or_else(|| vec![0.0f64; n]);
-    let (mut w, mut b, qd) = primal(x, &beta);
-    let mut index: Vec<usize> = (0..n).collect();
-    let mut active = n;
-    let mut g_max_old = f64::INFINITY;
-    let mut g_norm1_init = 0.0f64;
-    let mut rng = SplitMix64(0);
-    let mut epochs = 0;
-    let mut converged = false;
-    while epochs < settings.max_epochs {
-        epochs += 1;
-        let mut g_max = 0.0f64;
-        let mut g_norm1 = 0.0f64;
-        rng.shuffle(&mut index[..active]);
-        let mut s = 0;
-        while s < active {
-            let i = index[s];
-            let r = x.row(i);
-            let g = dot(&w, r) + b * BIAS - y[i];
-            let h = qd[i];
-            let (gp, gn) = (g + eps, g - eps);
-            let shrink = settings.shrinking;
-            let violation = if beta[i] == 0.0 {
-                if gp < 0.0 {
-                    -gp
-                } else if gn > 0.0 {
-                    gn
-                } else if shrink && gp > g_max_old && gn < -g_max_old {
-                    active -= 1;
-                    index.swap(s, active);
-                    continue;
-                } else {
-                    0.0
-                }
-            } else if beta[i] >= c {
-                if gp > 0.0 {
-                    gp
-                } else if shrink && gp < -g_max_old {
-                    active -= 1;
-                    index.swap(s, active);
-                    continue;
-                } else {
-                    0.0
-                }
-            } else if beta[i] <= -c {
-                if gn < 0.0 {
-                    -gn
-                } else if shrink && gn > g_max_old {
-                    active -= 1;
-                    index.swap(s, active);
-                    continue;
-                } else {
-                    0.0
-                }
-            } else if beta[i] > 0.0 {
-                gp.abs()
-            } else {
-                gn.abs()
-            };
-            g_max = g_max.max(violation);
-            g_norm1 += violation;
-            // Newton step on the piecewise quadratic, then the box.
-            let d = if gp < h * beta[i] {
-                -gp / h
-            } else if gn > h * beta[i] {
-                -gn / h
-            } else {
-                -beta[i]
-            };
-            if d.abs() >= 1e-12 {
-                let old = beta[i];
-                beta[i] = (old + d).clamp(-c, c);
-                let d = beta[i] - old;
-                axpy(&mut w, d, r);
-                b += d * BIAS;
-            }
-            s += 1;
-        }
-        if epochs == 1 {
-            g_norm1_init = g_norm1;
-        }
-        if g_norm1 <= settings.tol * g_norm1_init {
-            if active == n {
-                converged = true;
-                break;
-            }
-            active = n;
-            g_max_old = f64::INFINITY;
-            continue;
-        }
-        g_max_old = g_max;
-    }
-    let objective = 0.5 * (w.iter().map(|v| v * v).sum::<f64>() + b * b)
-        - beta.iter().zip(y).map(|(b, y)| b * y).sum::<f64>()
-        + eps * beta.iter().map(|b| b.abs()).sum::<f64>();
-    LinearFit {
-        w,
-        bias: b * BIAS,
-        dual: beta,
-        epochs,
-        converged,
-        objective,
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -418,41 +296,6 @@ mod tests {
     }
 
     #[test]
-    fn svr_matches_a_dense_solve_of_its_dual() {
-        let (n, d) = (24, 3);
-        let (x, y) = problem(n, d);
-        let idx: Vec<usize> = (0..n).collect();
-        let rows = Rows {
-            data: &x,
-            dim: d,
-            idx: &idx,
-        };
-        let (c, eps) = (2.0, 0.05);
-        let fit = svr(rows, &y, c, eps, None, &tight());
-        assert!(fit.converged);
-        let ones = vec![1.0; n];
-        let beta = reference(&x, d, &y, eps, &vec![-c; n], &vec![c; n], &ones);
-        // The primal (w, offset) is unique (strongly convex); the dual need not be.
-        let (w, b) = primal_of(&x, d, &beta);
-        for (a, r) in fit.w.iter().zip(&w) {
-            assert!((a - r).abs() < 1e-5, "{:?} vs {w:?}", fit.w);
-        }
-        assert!((fit.bias - b).abs() < 1e-5, "{} vs {b}", fit.bias);
-        // A warm start from another tube ends at the same model.
-        let warm = svr(
-            rows,
-            &y,
-            c,
-            eps,
-            Some(svr(rows, &y, c, 0.2, None, &tight()).dual),
-            &tight(),
-        );
-        for (a, r) in warm.w.iter().zip(&fit.w) {
-            assert!((a - r).abs() < 1e-6);
-        }
-    }
-
-    #[test]
     fn svc_matches_a_dense_solve_of_its_dual_and_separates() {
         let (n, d) = (30, 3);
         let (x, y) = problem(n, d);
@@ -498,8 +341,9 @@ mod tests {
             idx: &idx,
         };
         let stop = Stop::new(0.1, &SmoSettings::default());
-        let a = svr(rows, &y, 1.0, 0.01, None, &stop);
-        let b = svr(rows, &y, 1.0, 0.01, None, &stop);
+        let positive: Vec<bool> = y.iter().map(|&v| v > 0.3).collect();
+        let a = svc(rows, &positive, 1.0, &stop);
+        let b = svc(rows, &positive, 1.0, &stop);
         assert_eq!(a.w, b.w);
         assert_eq!(a.dual, b.dual);
     }

@@ -18,10 +18,12 @@
 //! an optional speed regressor per placement ([`crate::CascadeParams::speed`]); the feature
 //! configuration with its definition of S (`up_axis`) and the orientation its inputs come from
 //! (`orientation`).
-//! Version 8 is a Nyström model ([`crate::Solver::Nystrom`]): a kind tag (1), the cascade
-//! exactly as version 7 lays it out (its placements without samples), then the landmarks in
-//! the same storage and one weight per landmark and machine. An exact model is still written
-//! as version 7, so its bytes did not change; both are read. An unknown kind is a decode
+//! Version 8 is a Nyström model ([`crate::Solver::Nystrom`]): a kind tag (2), the cascade
+//! exactly as version 7 lays it out (each placement's samples are its regressors' landmarks,
+//! its coefficients their weights), then the classifier's landmarks in the same storage and
+//! one weight per landmark and pair. An exact model is still written as version 7, so its
+//! bytes did not change; both are read. Kind 1 (Nyström models whose regressors shared the
+//! classifier's landmarks) is refused with a message to retrain; an unknown kind is a decode
 //! error.
 //!
 //! Older files are refused with [`RegressError::UnsupportedVersion`] (retrain the model):
@@ -53,7 +55,9 @@ pub(crate) const EXACT_VERSION: u32 = 7;
 pub(crate) const NYSTROM_VERSION: u32 = 8;
 /// The kind tag of a version-8 payload that is a Nyström model (the tag leaves room for
 /// other approximate kinds without another version).
-const NYSTROM_KIND: u32 = 1;
+const NYSTROM_KIND: u32 = 2;
+/// The kind of the first Nyström models: regressors on the classifier's landmarks.
+const SHARED_NYSTROM_KIND: u32 = 1;
 const HEADER: usize = 8 + 4 + 8 + 4;
 /// Refuses to allocate for absurd payload lengths from a corrupt header.
 const MAX_PAYLOAD: u64 = 1 << 40;
@@ -201,6 +205,13 @@ fn decode(bytes: &[u8]) -> Result<Cascade, RegressError> {
     if version == NYSTROM_VERSION {
         let (kind, used): (u32, usize) =
             bincode::serde::decode_from_slice(rest, bincode_config()).map_err(decode_err)?;
+        if kind == SHARED_NYSTROM_KIND {
+            return Err(RegressError::Decode(
+                "a Nyström model of an earlier ridi-rs (kind 1: regressors on shared \
+                 landmarks), which this build no longer reads: retrain it"
+                    .into(),
+            ));
+        }
         if kind != NYSTROM_KIND {
             return Err(RegressError::Decode(format!(
                 "unknown model kind {kind} in a version {version} file (this build knows kind \

@@ -1,14 +1,15 @@
 //! Nyström features: the approximate solver of the cascade ([`Solver::Nystrom`]).
 //!
-//! `m` landmarks `L` are drawn uniformly (without replacement, fixed seed) from all training
-//! rows, `W = K(L, L)` with the model's RBF width, and a row `x` maps to
+//! `m` landmarks `L` are drawn uniformly (without replacement, fixed seed) from the rows a
+//! machine trains on (all rows for the classifier, a placement's for its regressors),
+//! `W = K(L, L)` with the model's RBF width, and a row `x` maps to
 //! `φ(x) = Λ^{-1/2} Uᵀ k(L, x)` (`W = UΛUᵀ`, eigenvalues below [`EIGEN_FLOOR`] times the
 //! largest dropped), so that `φ(a)·φ(b) = k(L, a)ᵀ W⁺ k(L, b)`: the kernel projected on the
 //! span of the landmarks' feature maps, exact when `a` or `b` is a landmark. Every kernel
-//! machine of the cascade is then a linear one in `φ`-space (crate::linear), and its weights
-//! fold back into one weight per landmark, `w' = UΛ^{-1/2} w`, so that a query is
-//! `k(L, x)·w' + b`: one kernel row against the shared landmarks, then a dot product per
-//! classifier pair and per regressor channel.
+//! machine of the cascade is then a linear one in `φ`-space (crate::linear for the
+//! classifier, crate::ridge for the regressors), and its weights fold back into one weight per
+//! landmark, `w' = UΛ^{-1/2} w`, so that a query is `k(L, x)·w' + b`: one kernel row against
+//! the landmarks, then a dot product per classifier pair or regressor channel.
 //!
 //! Kernel values are those a query sees: the landmarks in the model's stored form (half
 //! precision, or principal coordinates, [`crate::Storage`]) and each row as the query path
@@ -35,12 +36,13 @@ pub enum Solver {
     /// every support vector.
     #[default]
     Exact,
-    /// Nyström features on shared landmarks, then linear SVMs by dual coordinate descent:
-    /// training time linear in the rows beyond the landmarks' fixed cost, a model of the
-    /// landmarks and one weight per landmark and machine, a query of one kernel row against
-    /// the landmarks. Approximates the exact kernel machines by those on the span of the
-    /// landmarks' feature maps, with a regularized offset; how closely is measured in the
-    /// crate documentation.
+    /// Nyström features on landmarks per machine, then a linear SVM by dual coordinate
+    /// descent for the classifier and kernel ridge regression in closed form for the
+    /// regressors: training time and memory linear in the rows beyond the landmarks' fixed
+    /// cost, a model of the landmarks and one weight per landmark and machine, a query of one
+    /// kernel row against the classifier's landmarks and one against its placement's.
+    /// Approximates kernel machines on the span of the landmarks' feature maps (the
+    /// regressors with a squared loss); how closely is measured in the crate documentation.
     Nystrom(Nystrom),
 }
 
@@ -69,13 +71,13 @@ impl TryFrom<NystromRepr> for Nystrom {
 
 impl Nystrom {
     /// Landmarks by default: see the crate documentation for what fewer or more change.
-    pub const DEFAULT_LANDMARKS: usize = 1024;
+    pub const DEFAULT_LANDMARKS: usize = 2048;
     /// Most landmarks: `W` is `m × m` and its eigendecomposition `O(m³)`.
     pub const MAX_LANDMARKS: usize = 16_384;
-    /// LIBLINEAR's default stopping tolerance of both dual solvers: the C-SVC stops when the
-    /// projected gradients of an epoch span at most this, the SVR when an epoch's summed
-    /// violation fell to this share of the first epoch's. Tighter costs epochs for no
+    /// LIBLINEAR's default stopping tolerance of the classifier's dual solver: it stops when
+    /// the projected gradients of an epoch span at most this. Tighter costs epochs for no
     /// measured gain on held-out data (the approximation, not the optimization, limits it).
+    /// The regressors are solved in closed form.
     pub const DEFAULT_TOL: f64 = 0.1;
 
     /// `landmarks` rows drawn with `seed` (a training set with fewer rows uses them all).
@@ -105,7 +107,7 @@ impl Nystrom {
         Ok(Self { tol, ..self })
     }
 
-    /// Stopping tolerance of the dual solvers.
+    /// Stopping tolerance of the classifier's dual solver.
     pub fn tol(&self) -> f64 {
         self.tol
     }

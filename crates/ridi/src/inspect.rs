@@ -408,8 +408,9 @@ impl std::fmt::Display for Inspection {
 pub struct ModelInspection {
     /// Model file format version ([`Cascade::format_version`]: 7 exact, 8 Nyström).
     pub format_version: u32,
-    /// Landmarks of a Nyström model (`None`: exact kernel machines,
-    /// [`ridi_regress::Solver`]); every placement shares them.
+    /// Most landmarks one machine of a Nyström model holds (`None`: exact kernel machines,
+    /// [`ridi_regress::Solver`]): the classifier's are drawn from all rows, each placement's
+    /// regressors' from its own (its samples).
     pub landmarks: Option<usize>,
     /// Frames per feature window.
     pub window: usize,
@@ -445,7 +446,9 @@ pub struct ModelInspection {
 pub struct PlacementModel {
     /// Placement name.
     pub name: String,
-    /// Training samples the model keeps for it.
+    /// Training windows it was trained on (turned copies included).
+    pub windows: usize,
+    /// Training samples the model keeps for it (a Nyström model: its regressors' landmarks).
     pub samples: usize,
     /// The S-x regressor.
     pub s_x: Regressor,
@@ -491,6 +494,7 @@ pub fn inspect_model(model: &Cascade) -> ModelInspection {
             let [x, z] = model.regressor_params(p).unwrap_or_default();
             PlacementModel {
                 name: name.clone(),
+                windows: model.training_windows(p),
                 samples: model.stored_samples(p),
                 s_x: x.into(),
                 s_z: z.into(),
@@ -552,7 +556,9 @@ impl std::fmt::Display for ModelInspection {
         if let Some(m) = self.landmarks {
             writeln!(
                 f,
-                "solver: Nyström, {m} landmarks shared by every placement (their samples below)"
+                "solver: Nyström, up to {m} landmarks per machine (the classifier's from all \
+                 rows; each placement's regressors', by kernel ridge, from its rows: its samples \
+                 below)"
             )?;
         }
         match self.projected_components {
@@ -569,8 +575,8 @@ impl std::fmt::Display for ModelInspection {
             let speed = p.speed.map_or(String::new(), |s| format!("  speed: {s}"));
             writeln!(
                 f,
-                "  {:<12} {:>6} samples  S-x: {}  S-z: {}{speed}",
-                p.name, p.samples, p.s_x, p.s_z
+                "  {:<12} {:>6} samples of {:>7} windows  S-x: {}  S-z: {}{speed}",
+                p.name, p.samples, p.windows, p.s_x, p.s_z
             )?;
         }
         if !self.grid.is_empty() {

@@ -37,6 +37,9 @@
 //!   progress and exit codes, and a program using the library writes as it does.
 //! - **Plots are optional.** The `plot` feature (on by default) brings plotters and an embedded
 //!   font; an embedded tracker leaves it out with `default-features = false`.
+//! - **A model ships with the crate.** The `bundled-model` feature (on by default) embeds a
+//!   compact model trained on every shared Tyrex run ([`bundled_model`]), which the command
+//!   line uses when no model is given.
 //!
 //! # Example
 //!
@@ -73,6 +76,8 @@ pub use ridi_frames as frames;
 pub use ridi_regress as regress;
 
 pub mod baselines;
+#[cfg(feature = "bundled-model")]
+mod bundled;
 pub mod convert;
 mod demo;
 mod error;
@@ -92,6 +97,8 @@ mod track_options;
 pub mod train;
 
 pub use baselines::Method;
+#[cfg(feature = "bundled-model")]
+pub use bundled::{BUNDLED_MODEL_SUMMARY, bundled_model, bundled_model_size};
 pub use demo::Demo;
 pub use error::{PipelineError, Result};
 pub use evaluate::{EvalOptions, Report, evaluate};

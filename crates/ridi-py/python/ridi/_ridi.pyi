@@ -206,6 +206,9 @@ def read_list(
 def load(path: StrPath) -> Model:
     """A model file written by ``ridi train`` or ``Model.save``."""
 
+def bundled_model() -> Model:
+    """The model bundled with ridi-rs, trained on every shared Tyrex run."""
+
 def train(
     data: Inputs,
     *,
@@ -214,7 +217,7 @@ def train(
     orientation: Literal["recorded", "estimated"] = "estimated",
     storage: Literal["projected", "half"] = "projected",
     solver: Literal["exact", "nystrom"] = "exact",
-    landmarks: int = 1024,
+    landmarks: int = 2048,
     turned_copies: int = 1,
     step: Optional[int] = None,
     window: Optional[int] = None,

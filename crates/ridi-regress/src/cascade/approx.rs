@@ -1,8 +1,11 @@
-//! Training by the Nyström solver ([`Solver::Nystrom`](crate::Solver::Nystrom)): landmarks
-//! shared by every machine, Nyström features of all rows once (crate::nystrom), then the
-//! one-vs-one classifier and each placement's regressors, grid search included, as linear
-//! machines by dual coordinate descent (crate::linear) with the exact path's `C`, epsilon,
-//! pairs and votes. Only the weights folded back onto the landmarks are kept.
+//! Training by the Nyström solver ([`Solver::Nystrom`](crate::Solver::Nystrom)): the
+//! placement classifier on landmarks drawn from all rows, as linear one-vs-one machines by
+//! dual coordinate descent (crate::linear) with the exact path's `C`, pairs and votes; each
+//! placement's regressors on landmarks drawn from its own rows, as kernel ridge regressions
+//! in closed form (crate::ridge), `C` chosen by the grid's cross-validation when it searches.
+//! Only the weights folded back onto the landmarks are kept: the classifier's with the
+//! shared landmarks, each placement's with its own (stored as its samples, so that its
+//! regression is the exact model's arithmetic on fewer rows).
 
 use rayon::prelude::*;
 
@@ -10,12 +13,13 @@ use super::train::{TrainingSet, channel_targets, in_placement, report};
 use super::{Cascade, ClassModel, ClassifierHead, NystromParts, SpeedRegressor};
 use super::{CascadeParams, RegressorChoice};
 use crate::error::RegressError;
-use crate::grid::{self, ChainPoint, GridSpec};
+use crate::grid::{self, ChainPoint};
 use crate::linear::{self, LinearFit, Rows, Stop};
-use crate::nystrom::{self, Map, Nystrom, Whitening};
+use crate::matrix::View as _;
+use crate::nystrom::{self, Map, Nystrom};
 use crate::progress::{Progress, Stage};
 use crate::projection::Projection;
-use crate::store::SampleRows;
+use crate::ridge::{Moments, RidgeFit};
 use crate::svr::FitInfo;
 
 /// Widths and storage the exact path resolved, shared by both solvers.
@@ -33,98 +37,6 @@ fn info(fit: &LinearFit) -> FitInfo {
         converged: fit.converged,
         n_support: fit.n_support(),
     }
-}
-
-/// Linear epsilon-SVR on targets centred on their mean (the offset is regularized, its
-/// deviation from the mean less so); the fit's bias includes the mean.
-fn svr_centred(
-    x: Rows<'_>,
-    y: &[f64],
-    c: f64,
-    eps: f64,
-    beta0: Option<Vec<f64>>,
-    stop: &Stop,
-) -> LinearFit {
-    let mean = y.iter().sum::<f64>() / y.len().max(1) as f64;
-    let yc: Vec<f64> = y.iter().map(|v| v - mean).collect();
-    let mut fit = linear::svr(x, &yc, c, eps, beta0, stop);
-    fit.bias += mean;
-    fit
-}
-
-/// Cross-validated grid search of one placement on its Nyström features, as `grid::search`
-/// does on its kernel: the same folds, chains (epsilon descending at each `C`, warm started)
-/// and table.
-#[allow(clippy::too_many_arguments)]
-fn grid_search(
-    phi: &[f32],
-    rank: usize,
-    idx: &[usize],
-    targets: &[Vec<f64>],
-    groups: &[u64],
-    spec: &GridSpec,
-    stop: &Stop,
-    placement: &str,
-    progress: &mut dyn Progress,
-) -> Result<Vec<grid::GridRow>, RegressError> {
-    let (fold, k, cs, eps) = grid::prepare(groups, spec, placement)?;
-    let channels = targets.len();
-    let total = k * channels * eps.len() * cs.len();
-    let stage = Stage::Grid { placement };
-    report(progress, stage, 0, total)?;
-    // Per fold: training rows (local and global), validation rows (local and global).
-    let split: Vec<[Vec<usize>; 4]> = (0..k)
-        .map(|f| {
-            let tl: Vec<usize> = (0..fold.len()).filter(|&s| fold[s] != f).collect();
-            let vl: Vec<usize> = (0..fold.len()).filter(|&s| fold[s] == f).collect();
-            let tg = tl.iter().map(|&s| idx[s]).collect();
-            let vg = vl.iter().map(|&s| idx[s]).collect();
-            [tl, tg, vl, vg]
-        })
-        .collect();
-    let chains = grid::chains(&cs, &eps);
-    let nh = chains.len();
-    let tasks: Vec<(usize, usize, usize)> = (0..k)
-        .flat_map(|f| (0..channels).flat_map(move |ch| (0..nh).map(move |h| (f, ch, h))))
-        .collect();
-    let progress = grid::GridProgress::new(progress, stage, total);
-    // Every task is a sequential chain of its own: the results do not depend on the threads.
-    let results: Vec<(usize, usize, Vec<ChainPoint>)> = tasks
-        .par_iter()
-        .map(|&(f, ch, h)| {
-            let [tl, tg, vl, vg] = &split[f];
-            let y: Vec<f64> = tl.iter().map(|&s| targets[ch][s]).collect();
-            let rows = Rows {
-                data: phi,
-                dim: rank,
-                idx: tg,
-            };
-            let mut prev: Option<Vec<f64>> = None;
-            let mut out = Vec::with_capacity(chains[h].len());
-            for &(ci, e) in &chains[h] {
-                if progress.cancelled() {
-                    break;
-                }
-                let fit = svr_centred(rows, &y, cs[ci], eps[e], prev.take(), stop);
-                let sse: f64 = vl
-                    .iter()
-                    .zip(vg)
-                    .map(|(&s, &g)| {
-                        let f = linear::dot(&fit.w, &phi[g * rank..(g + 1) * rank]) + fit.bias;
-                        (targets[ch][s] - f).powi(2)
-                    })
-                    .sum();
-                out.push((ci, e, sse / vl.len().max(1) as f64, fit.epochs));
-                prev = Some(fit.dual);
-                progress.step();
-            }
-            (f, ch, out)
-        })
-        .collect();
-    if progress.cancelled() {
-        return Err(RegressError::Cancelled);
-    }
-    Ok(grid::tabulate(placement, &cs, &eps, channels, k, &results))
 }
 
 impl Cascade {
@@ -145,26 +57,17 @@ impl Cascade {
         let x = data.features;
         let k = members.len();
         let stop = Stop::new(cfg.tol(), &params.solver.smo);
-        let picked = nystrom::pick(x.rows(), cfg.landmarks(), cfg.seed());
-        let map = Map::new(x, &picked, projection.as_ref())?;
-        let m = map.m();
-        let wr = map.whitening(x, &picked, gamma_r)?;
-        // A classifier of another width needs its own `W`; of the same width, it shares.
-        let wc_own = if k >= 2 && gamma_c != gamma_r {
-            Some(map.whitening(x, &picked, gamma_c)?)
+        // The classifier's landmarks, from all rows; none without a classifier.
+        let picked = if k >= 2 {
+            nystrom::pick(x.rows(), cfg.landmarks(), cfg.seed())
         } else {
-            None
+            Vec::new()
         };
-        let mut widths: Vec<(f32, &Whitening)> = vec![(gamma_r, &wr)];
-        if let Some(w) = &wc_own {
-            widths.push((gamma_c, w));
-        }
-        let phis = map.features(x, &widths);
-        let (phi_r, rank_r) = (&phis[0], wr.rank);
-        let wc = wc_own.as_ref().unwrap_or(&wr);
-        let (phi_c, rank_c) = (phis.get(1).unwrap_or(&phis[0]), wc.rank);
-
+        let map = Map::new(x, &picked, projection.as_ref())?;
         let (classifier, clf_weights) = if k >= 2 {
+            let wc = map.whitening(x, &picked, gamma_c)?;
+            let phi_c = map.features(x, &[(gamma_c, &wc)]).swap_remove(0);
+            let rank_c = wc.rank;
             let pairs: Vec<(usize, usize)> = (0..k)
                 .flat_map(|a| (a + 1..k).map(move |b| (a, b)))
                 .collect();
@@ -178,7 +81,7 @@ impl Cascade {
                     let positive: Vec<bool> =
                         rows.iter().map(|&i| data.placements[i] == a).collect();
                     let x = Rows {
-                        data: phi_c,
+                        data: &phi_c,
                         dim: rank_c,
                         idx: &rows,
                     };
@@ -187,9 +90,10 @@ impl Cascade {
                 .collect();
             report(progress, Stage::Classifier, pairs.len(), pairs.len())?;
             let np = pairs.len();
+            let m = map.m();
             let mut weights = vec![0.0f64; m * np];
             for (p, fit) in fits.iter().enumerate() {
-                for (j, v) in nystrom::fold(wc, &fit.w).into_iter().enumerate() {
+                for (j, v) in nystrom::fold(&wc, &fit.w).into_iter().enumerate() {
                     weights[j * np + p] = v;
                 }
             }
@@ -207,61 +111,48 @@ impl Cascade {
 
         let channels = 2 + usize::from(params.speed);
         let mut classes = Vec::with_capacity(k);
-        let mut reg_weights = Vec::with_capacity(k);
         let mut grid_rows = Vec::new();
         for (c, idx) in members.iter().enumerate() {
             let name = data.placement_names[c].as_str();
             let targets = channel_targets(data, idx, channels);
-            let chosen: Vec<(f64, f64)> = match &params.regressors {
-                RegressorChoice::Fixed { c, epsilon } => vec![(*c, *epsilon); channels],
-                RegressorChoice::Grid(spec) => {
-                    let groups: Vec<u64> = idx.iter().map(|&i| data.groups[i]).collect();
-                    let table = grid_search(
-                        phi_r, rank_r, idx, &targets, &groups, spec, &stop, name, progress,
-                    )
+            // The placement's own landmarks and its rows' features on them.
+            let xp = x.select(idx);
+            let own = nystrom::pick(idx.len(), cfg.landmarks(), placement_seed(cfg.seed(), c));
+            let pmap = Map::new(xp.view(), &own, projection.as_ref())?;
+            let wr = pmap.whitening(xp.view(), &own, gamma_r)?;
+            let phi = pmap.features(xp.view(), &[(gamma_r, &wr)]).swap_remove(0);
+            drop(xp);
+            let (fits, chosen, table) =
+                ridge_fits(&phi, wr.rank, &targets, data, idx, params, name, progress)
                     .map_err(in_placement(name))?;
-                    let best = grid::best(&table, channels);
-                    grid_rows.extend(table);
-                    best
-                }
-            };
-            report(progress, Stage::Regressors { placement: name }, 0, channels)?;
-            let rows = Rows {
-                data: phi_r,
-                dim: rank_r,
-                idx,
-            };
-            let fits: Vec<LinearFit> = (0..channels)
-                .into_par_iter()
-                .map(|ch| svr_centred(rows, &targets[ch], chosen[ch].0, chosen[ch].1, None, &stop))
-                .collect();
-            report(
-                progress,
-                Stage::Regressors { placement: name },
-                channels,
-                channels,
-            )?;
-            let mut weights = vec![0.0f64; m * channels];
+            grid_rows.extend(table);
+            let m = pmap.m();
+            let mut reg_coef = vec![0.0f64; m * channels];
             for (ch, fit) in fits.iter().enumerate() {
                 for (j, v) in nystrom::fold(&wr, &fit.w).into_iter().enumerate() {
-                    weights[j * channels + ch] = v;
+                    reg_coef[j * channels + ch] = v;
                 }
             }
-            reg_weights.push(weights);
+            let rinfo = || FitInfo {
+                iterations: 0,
+                objective: 0.0,
+                converged: true,
+                n_support: idx.len(),
+            };
             classes.push(ClassModel {
-                samples: SampleRows::from_rows(x, &[], projection.as_ref())?,
-                norms: Vec::new(),
+                norms: pmap.landmarks.norms(),
+                samples: pmap.landmarks,
                 n_classifier: 0,
                 clf_pairs: Vec::new(),
                 clf_coef: Vec::new(),
-                reg_coef: Vec::new(),
+                reg_coef,
                 reg_rho: [-fits[0].bias, -fits[1].bias],
                 reg_params: [chosen[0], chosen[1]],
-                reg_info: [info(&fits[0]), info(&fits[1])],
+                reg_info: [rinfo(), rinfo()],
                 speed: fits.get(2).map(|f| SpeedRegressor {
                     rho: -f.bias,
                     params: chosen[2],
-                    info: info(f),
+                    info: rinfo(),
                 }),
                 n_train: idx.len(),
             });
@@ -281,10 +172,89 @@ impl Cascade {
                 config: cfg,
                 landmarks,
                 norms,
-                rank: [rank_r as u32, rank_c as u32],
                 clf_weights,
-                reg_weights,
             })),
         })
+    }
+}
+
+/// Seed of placement `c`'s landmark draw: distinct per placement, fixed by the model's seed.
+fn placement_seed(seed: u64, c: usize) -> u64 {
+    seed ^ (c as u64 + 1).wrapping_mul(0x9E37_79B9_7F4A_7C15)
+}
+
+/// A placement's ridge fits, the `(C, epsilon)` of each channel and the grid's table.
+type Fitted = (Vec<RidgeFit>, Vec<(f64, f64)>, Vec<grid::GridRow>);
+
+/// Ridge fits of one placement's channels on its features `phi` (`rank` values per row, in
+/// the order of `idx`), `C` by the grid's cross-validation over sequences when it searches:
+/// the fits, the `(C, 0)` chosen per channel (no epsilon: the loss is squared) and the grid's
+/// table.
+#[allow(clippy::too_many_arguments)]
+fn ridge_fits(
+    phi: &[f32],
+    rank: usize,
+    targets: &[Vec<f64>],
+    data: &TrainingSet<'_>,
+    idx: &[usize],
+    params: &CascadeParams,
+    name: &str,
+    progress: &mut dyn Progress,
+) -> Result<Fitted, RegressError> {
+    let channels = targets.len();
+    let local = |rows: &[usize]| -> Moments {
+        let ys: Vec<Vec<f64>> = targets
+            .iter()
+            .map(|t| rows.iter().map(|&s| t[s]).collect())
+            .collect();
+        let yr: Vec<&[f64]> = ys.iter().map(Vec::as_slice).collect();
+        Moments::of(phi, rank, rows, &yr)
+    };
+    match &params.regressors {
+        RegressorChoice::Fixed { c, .. } => {
+            let stage = Stage::Regressors { placement: name };
+            report(progress, stage, 0, channels)?;
+            let all: Vec<usize> = (0..idx.len()).collect();
+            let fits = local(&all).solve(*c)?;
+            report(progress, stage, channels, channels)?;
+            Ok((fits, vec![(*c, 0.0); channels], Vec::new()))
+        }
+        RegressorChoice::Grid(spec) => {
+            let groups: Vec<u64> = idx.iter().map(|&i| data.groups[i]).collect();
+            let (fold, k, cs, _) = grid::prepare(&groups, spec, name)?;
+            let stage = Stage::Grid { placement: name };
+            report(progress, stage, 0, k * cs.len())?;
+            let folds: Vec<Moments> = (0..k)
+                .map(|f| {
+                    local(
+                        &(0..fold.len())
+                            .filter(|&s| fold[s] == f)
+                            .collect::<Vec<_>>(),
+                    )
+                })
+                .collect();
+            let all = folds[1..].iter().fold(folds[0].clone(), |a, b| a.plus(b));
+            let mut results: Vec<(usize, usize, Vec<ChainPoint>)> = Vec::new();
+            for (f, own) in folds.iter().enumerate() {
+                let train = all.minus(own);
+                let mut per_ch: Vec<Vec<ChainPoint>> = vec![Vec::new(); channels];
+                for (ci, &c) in cs.iter().enumerate() {
+                    for (ch, fit) in train.solve(c)?.iter().enumerate() {
+                        let mse = own.sse(ch, fit) / own.rows().max(1) as f64;
+                        per_ch[ch].push((ci, 0, mse, 0));
+                    }
+                    report(progress, stage, f * cs.len() + ci + 1, k * cs.len())?;
+                }
+                results.extend(per_ch.into_iter().enumerate().map(|(ch, r)| (f, ch, r)));
+            }
+            let table = grid::tabulate(name, &cs, &[0.0], channels, k, &results);
+            let best = grid::best(&table, channels);
+            // Channels may choose different `C`: one factorization per distinct value.
+            let mut fits = Vec::with_capacity(channels);
+            for (ch, &(c, _)) in best.iter().enumerate() {
+                fits.push(all.solve(c)?.swap_remove(ch));
+            }
+            Ok((fits, best, table))
+        }
     }
 }

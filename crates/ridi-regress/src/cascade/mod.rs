@@ -58,23 +58,22 @@ pub struct Cascade {
     nystrom: Option<Box<NystromParts>>,
 }
 
-/// What a Nyström model adds to the cascade: the landmarks shared by every machine and one
-/// weight per landmark and machine (`W^{-1/2}` folded in); the offsets stay where the exact
-/// model keeps them (`ClassifierHead::rho`, `ClassModel::reg_rho`, `SpeedRegressor::rho`).
+/// What a Nyström model adds to the cascade: the classifier's landmarks, drawn from all
+/// rows, and one weight per landmark and classifier pair (`W^{-1/2}` folded in). Each
+/// placement keeps its regressors' own landmarks as its samples and their folded weights as
+/// its coefficients, as an exact model keeps support vectors; the offsets stay where the
+/// exact model keeps them (`ClassifierHead::rho`, `ClassModel::reg_rho`, `SpeedRegressor::rho`).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub(crate) struct NystromParts {
     /// Landmark draw (the landmarks asked for and the seed).
     config: Nystrom,
+    /// The classifier's landmarks (none without a classifier).
     landmarks: SampleRows,
     /// Squared norms of the stored landmarks: recomputed on load, not stored.
     #[serde(skip)]
     norms: Vec<f32>,
-    /// Rank of `W` kept per width: regressors, classifier.
-    rank: [u32; 2],
     /// `landmarks × pairs` row-major: classifier weights.
     clf_weights: Vec<f64>,
-    /// Per placement, `landmarks × channels` row-major: regressor weights.
-    reg_weights: Vec<Vec<f64>>,
 }
 
 /// How a trained model stores its samples ([`Cascade::stored_as`]).
@@ -187,25 +186,41 @@ impl Cascade {
         }
     }
 
-    /// Stored samples of placement `p` (shared by its classifier part and both regressors);
-    /// for a Nyström model, the landmarks, which every placement shares.
+    /// Stored samples of placement `p` (shared by its classifier part and its regressors);
+    /// for a Nyström model, its regressors' landmarks.
     pub fn stored_samples(&self, p: usize) -> usize {
-        match &self.nystrom {
-            Some(n) if p < self.classes.len() => n.landmarks.rows(),
-            _ => self.classes.get(p).map_or(0, |c| c.samples.rows()),
-        }
+        self.classes.get(p).map_or(0, |c| c.samples.rows())
     }
 
-    /// How the model was trained: [`Solver::Exact`], or [`Solver::Nystrom`] with the landmarks
-    /// it holds (fewer than asked for when the training set had fewer rows) and their seed.
+    /// Training windows of placement `p` (turned copies included).
+    pub fn training_windows(&self, p: usize) -> usize {
+        self.classes.get(p).map_or(0, |c| c.n_train)
+    }
+
+    /// Landmarks of the classifier of a Nyström model (0 for an exact one, or without a
+    /// classifier).
+    pub fn classifier_landmarks(&self) -> usize {
+        self.nystrom.as_ref().map_or(0, |n| n.landmarks.rows())
+    }
+
+    /// How the model was trained: [`Solver::Exact`], or [`Solver::Nystrom`] with the most
+    /// landmarks one machine holds (fewer than asked for when the training set had fewer
+    /// rows) and their seed.
     pub fn solver(&self) -> Solver {
         match &self.nystrom {
             None => Solver::Exact,
-            Some(n) => Solver::Nystrom(
-                Nystrom::new(n.landmarks.rows().max(2), n.config.seed())
-                    .and_then(|c| c.with_tol(n.config.tol()))
-                    .unwrap_or(n.config),
-            ),
+            Some(n) => {
+                let held = (0..self.classes.len())
+                    .map(|p| self.stored_samples(p))
+                    .chain([n.landmarks.rows()])
+                    .max()
+                    .unwrap_or(0);
+                Solver::Nystrom(
+                    Nystrom::new(held.max(2), n.config.seed())
+                        .and_then(|c| c.with_tol(n.config.tol()))
+                        .unwrap_or(n.config),
+                )
+            }
         }
     }
 

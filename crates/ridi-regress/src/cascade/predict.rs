@@ -162,8 +162,8 @@ impl Cascade {
         }
     }
 
-    /// The single-query path of a Nyström model: one pass over the landmarks, then a dot
-    /// product per classifier pair and per channel of the chosen placement.
+    /// The single-query path of a Nyström model: one pass over the classifier's landmarks
+    /// and a dot product per pair, then one over the chosen placement's own landmarks.
     fn predict_single_nystrom(
         &self,
         n: &NystromParts,
@@ -171,14 +171,14 @@ impl Cascade {
         qn: f32,
         s: &mut Scratch,
     ) -> Prediction {
-        let m = n.landmarks.rows();
-        s.dist.resize(m, 0.0);
-        s.kv.resize(m, 0.0);
-        n.landmarks.dots(q, 0, &mut s.dist);
-        kernel::dist_from_dots(&mut s.dist, qn, &n.norms);
         let placement = match &self.classifier {
             None => 0,
             Some(head) => {
+                let m = n.landmarks.rows();
+                s.dist.resize(m, 0.0);
+                s.kv.resize(m, 0.0);
+                n.landmarks.dots(q, 0, &mut s.dist);
+                kernel::dist_from_dots(&mut s.dist, qn, &n.norms);
                 kernel::exp_neg_scaled(&s.dist, head.gamma, &mut s.kv);
                 s.dec.resize(head.pairs.len(), 0.0);
                 weighted_sum(&s.kv, &n.clf_weights, &mut s.dec);
@@ -187,69 +187,44 @@ impl Cascade {
                 svc::vote(&s.dec, &head.pairs, self.classes.len(), &mut s.votes)
             }
         };
-        if self
-            .classifier
-            .as_ref()
-            .is_none_or(|h| h.gamma != self.regressor_gamma)
-        {
-            kernel::exp_neg_scaled(&s.dist, self.regressor_gamma, &mut s.kv);
-        }
         let cl = &self.classes[placement];
+        s.kv.resize(cl.samples.rows(), 0.0);
+        cl.samples.dots(q, 0, &mut s.kv);
+        kernel::rbf_from_dots(&mut s.kv, qn, &cl.norms, self.regressor_gamma);
         let mut v = [0.0f64; 3];
         let v = &mut v[..cl.channels()];
-        weighted_sum(&s.kv, &n.reg_weights[placement], v);
+        weighted_sum(&s.kv, &cl.reg_coef, v);
         Prediction {
             placement,
             velocity: cl.velocity(v),
         }
     }
 
-    /// The batched path of a Nyström model: one distance block from the queries to the
-    /// landmarks (as training computed the features), then weighted sums.
-    fn predict_block_nystrom(
+    /// The placements of a block of queries by a Nyström model's classifier: one distance
+    /// block from the queries (stored form) to its landmarks, then weighted sums.
+    fn classify_block_nystrom(
         &self,
         n: &NystromParts,
         q: FeatureMatrixRef<'_>,
-        forced: Option<usize>,
+        qn: &[f32],
         out: &mut [Prediction],
     ) {
-        let (rows, m) = (q.rows(), n.landmarks.rows());
-        let (projected, qn) = match &self.projection {
-            Some(p) => {
-                let (z, n) = p.project(q);
-                (Some(z), n)
-            }
-            None => (None, kernel::sq_norms(q)),
+        let Some(head) = &self.classifier else {
+            return out.iter_mut().for_each(|o| o.placement = 0);
         };
-        let qv = projected.as_ref().map_or(q, FeatureMatrix::view);
+        let (rows, m) = (q.rows(), n.landmarks.rows());
         let mut wide = Vec::new();
         n.landmarks.rows_f32(0, m, &mut wide);
         let lv = FeatureMatrixRef::trusted(&wide, n.landmarks.dim());
-        let mut d = vec![0.0f32; rows * m];
-        kernel::cross_sq_dist(qv, &qn, lv, &n.norms, &mut d);
-        let mut kv = vec![0.0f32; d.len()];
-        match (forced, &self.classifier) {
-            (Some(p), _) => out.iter_mut().for_each(|o| o.placement = p),
-            (None, None) => out.iter_mut().for_each(|o| o.placement = 0),
-            (None, Some(head)) => {
-                let np = head.pairs.len();
-                kernel::exp_neg_scaled(&d, head.gamma, &mut kv);
-                let mut dec = vec![0.0f64; rows * np];
-                weighted_sums(&kv, &n.clf_weights, np, &mut dec);
-                let mut votes = vec![0u32; self.classes.len()];
-                for (o, row) in out.iter_mut().zip(dec.chunks_exact_mut(np)) {
-                    row.iter_mut().zip(&head.rho).for_each(|(v, r)| *v -= r);
-                    o.placement = svc::vote(row, &head.pairs, self.classes.len(), &mut votes);
-                }
-            }
-        }
-        kernel::exp_neg_scaled(&d, self.regressor_gamma, &mut kv);
-        let mut v = [0.0f64; 3];
-        for (o, k) in out.iter_mut().zip(kv.chunks_exact(m)) {
-            let cl = &self.classes[o.placement];
-            let v = &mut v[..cl.channels()];
-            weighted_sum(k, &n.reg_weights[o.placement], v);
-            o.velocity = cl.velocity(v);
+        let mut kv = vec![0.0f32; rows * m];
+        kernel::cross_kernel(q, qn, lv, &n.norms, head.gamma, &mut kv);
+        let np = head.pairs.len();
+        let mut dec = vec![0.0f64; rows * np];
+        weighted_sums(&kv, &n.clf_weights, np, &mut dec);
+        let mut votes = vec![0u32; self.classes.len()];
+        for (o, row) in out.iter_mut().zip(dec.chunks_exact_mut(np)) {
+            row.iter_mut().zip(&head.rho).for_each(|(v, r)| *v -= r);
+            o.placement = svc::vote(row, &head.pairs, self.classes.len(), &mut votes);
         }
     }
 
@@ -364,9 +339,6 @@ impl Cascade {
         forced: Option<usize>,
         out: &mut [Prediction],
     ) {
-        if let Some(n) = &self.nystrom {
-            return self.predict_block_nystrom(n, q, forced, out);
-        }
         let m = q.rows();
         let (projected, qn) = match (rows, &self.projection) {
             (Rows::Stored, Some(p)) => {
@@ -376,6 +348,15 @@ impl Cascade {
             _ => (None, kernel::sq_norms(q)),
         };
         let q = projected.as_ref().map_or(q, FeatureMatrix::view);
+        if let Some(n) = &self.nystrom {
+            match forced {
+                Some(p) => out.iter_mut().for_each(|o| o.placement = p),
+                None => self.classify_block_nystrom(n, q, &qn, out),
+            }
+            // Its placements hold no classifier rows: the regressors see only their own.
+            let none = vec![Vec::new(); self.classes.len()];
+            return self.regress_block(rows, q, &qn, &none, forced, out);
+        }
         // Squared distances to the classifier part of each placement.
         let dists: Vec<Vec<f32>> = (0..self.classes.len())
             .map(|p| {
@@ -416,6 +397,22 @@ impl Cascade {
                 }
             }
         }
+        self.regress_block(rows, q, &qn, &dists, forced, out);
+    }
+
+    /// The regressions of a block of queries (in stored form, `qn` their squared norms) whose
+    /// placements are set, per placement: kernel values to its samples, reusing `dists` to
+    /// its classifier rows unless `forced`.
+    fn regress_block(
+        &self,
+        rows: Rows<'_>,
+        q: FeatureMatrixRef<'_>,
+        qn: &[f32],
+        dists: &[Vec<f32>],
+        forced: Option<usize>,
+        out: &mut [Prediction],
+    ) {
+        let m = q.rows();
         for (p, cl) in self.classes.iter().enumerate() {
             let sel: Vec<usize> = (0..m).filter(|&i| out[i].placement == p).collect();
             if sel.is_empty() {

@@ -18,8 +18,9 @@ impl Cascade {
         self.check_nystrom()
     }
 
-    /// The Nyström part: landmarks in the model's storage, one weight per landmark and
-    /// machine, finite; placements without samples of their own.
+    /// The Nyström part: the classifier's landmarks in the model's storage (some exactly when
+    /// there is a classifier), one finite weight per landmark and pair; the placements' own
+    /// landmarks are checked as any model's samples ([`Self::check`]).
     fn check_nystrom(&self) -> Result<(), RegressError> {
         let Some(n) = &self.nystrom else {
             return Ok(());
@@ -31,7 +32,7 @@ impl Cascade {
             .projection
             .as_ref()
             .map_or(self.dim, |p| p.stored_dim());
-        if m < 1
+        if (m > 0) != self.classifier.is_some()
             || n.landmarks.is_projected() != self.projection.is_some()
             || n.landmarks.dim() != stored_dim
             || n.norms.len() != m
@@ -39,31 +40,18 @@ impl Cascade {
             return bad("landmark sizes");
         }
         let np = self.classifier.as_ref().map_or(0, |h| h.pairs.len());
-        if n.clf_weights.len() != m * np || n.reg_weights.len() != self.classes.len() {
+        if n.clf_weights.len() != m * np {
             return bad("weight sizes");
         }
-        for (cl, w) in self.classes.iter().zip(&n.reg_weights) {
-            if cl.samples.rows() != 0 || w.len() != m * cl.channels() {
-                return bad("placement sizes");
-            }
-        }
-        let offsets = self.classes.iter().flat_map(|c| {
-            c.reg_rho
-                .iter()
-                .copied()
-                .chain(c.speed.as_ref().map(|s| s.rho))
-        });
-        let head = self.classifier.iter().flat_map(|h| h.rho.iter().copied());
-        if !n
-            .clf_weights
+        if self
+            .classes
             .iter()
-            .chain(n.reg_weights.iter().flatten())
-            .copied()
-            .chain(offsets)
-            .chain(head)
-            .all(f64::is_finite)
+            .any(|cl| cl.samples.rows() == 0 || cl.n_classifier != 0)
         {
-            return bad("non-finite weight or offset");
+            return bad("placement sizes");
+        }
+        if !n.clf_weights.iter().all(|v| v.is_finite()) {
+            return bad("non-finite weight");
         }
         Ok(())
     }

@@ -1,0 +1,34 @@
+//! The model that ships inside the crate (feature `bundled-model`, on by default), so that a
+//! phone can be tracked without training: `ridi track` and `ridi eval` use it when no
+//! `--model` is given.
+//!
+//! It is a Nyström cascade ([`ridi_regress::Solver::Nystrom`]) trained on every run of the
+//! committed Tyrex list (`datasets/protocols/tyrex-runs.txt`: a Nexus 5 with and without
+//! magnetic disturbance and an iPhone 4S, three people, 4 placement groups, about 2.2 hours),
+//! orientation estimated from gyro and accelerometer. `docs/model-card.md` in the repository
+//! has its figures on each device and placement (trained without the test person), and what
+//! it cannot be expected to do. `cargo xtask model` rebuilds it; the Tyrex data are CeCILL
+//! v2.1 (`model/PROVENANCE.md` and the licence beside the file).
+
+use ridi_regress::{Cascade, RegressError};
+
+/// The model file's bytes.
+const BYTES: &[u8] = include_bytes!("../model/ridi-tyrex.ridi");
+
+/// One line naming the bundled model, as the command line prints it when it uses it.
+pub const BUNDLED_MODEL_SUMMARY: &str = "the bundled model (Nyström, trained on 66 Tyrex runs \
+     of a Nexus 5 and an iPhone 4S, three people; its card: docs/model-card.md)";
+
+/// The bundled model, decoded (a few milliseconds; decode once and keep it).
+///
+/// # Errors
+/// Only if the bundled bytes do not decode, which a test of this crate rules out for every
+/// build: `cargo xtask model` rebuilds the file after a format change.
+pub fn bundled_model() -> Result<Cascade, RegressError> {
+    Cascade::from_bytes(BYTES)
+}
+
+/// Size of the bundled model file in bytes.
+pub fn bundled_model_size() -> usize {
+    BYTES.len()
+}
