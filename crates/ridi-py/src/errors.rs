@@ -12,7 +12,7 @@ use pyo3::exceptions::{
     PyFileExistsError, PyFileNotFoundError, PyIsADirectoryError, PyNotADirectoryError, PyOSError,
     PyPermissionError, PyValueError,
 };
-use ridi::PipelineError;
+use ridi::{OutputError, PipelineError};
 use ridi::data::DataError;
 use ridi::regress::RegressError;
 
@@ -51,6 +51,7 @@ fn file_kind(e: &PipelineError) -> Option<ErrorKind> {
     match e {
         PipelineError::Data(d) => data_kind(d),
         PipelineError::Regress(r) => regress_kind(r),
+        PipelineError::Output(OutputError::Io { error, .. }) => Some(error.kind()),
         PipelineError::Output(_) => Some(ErrorKind::Other),
         // Reports and placement maps: a file that is not there is a file error, one that does
         // not parse a data error.

@@ -227,9 +227,11 @@ impl<'p> Map<'p> {
         let w = Mat::<f64>::from_fn(m, m, |i, j| {
             0.5 * (k[i * m + j] as f64 + k[j * m + i] as f64)
         });
-        let eig = w
-            .self_adjoint_eigen(Side::Lower)
-            .map_err(|e| RegressError::InvalidParam(format!("landmark kernel: {e:?}")))?;
+        let eig = w.self_adjoint_eigen(Side::Lower).map_err(|_| {
+            RegressError::InvalidParam(
+                "the eigendecomposition of the landmarks' kernel did not converge".into(),
+            )
+        })?;
         let s = eig.S();
         let top = (0..m).map(|j| s[j]).fold(0.0f64, f64::max);
         // Ascending order: keep from the largest down to the floor.

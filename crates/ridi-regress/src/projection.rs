@@ -117,9 +117,11 @@ impl Projection {
             .reduce(|| Mat::<f64>::zeros(d, d), |a, b| a + b);
         // f32 is plenty for the leading directions and the energy sums, and 1.7x faster.
         let cov32 = Mat::<f32>::from_fn(d, d, |i, j| cov64[(i, j)] as f32);
-        let eig = cov32
-            .self_adjoint_eigen(Side::Lower)
-            .map_err(|e| RegressError::InvalidParam(format!("feature covariance: {e:?}")))?;
+        let eig = cov32.self_adjoint_eigen(Side::Lower).map_err(|_| {
+            RegressError::InvalidParam(
+                "the eigendecomposition of the feature covariance did not converge".into(),
+            )
+        })?;
         // Ascending order: the leading directions are at the end.
         let values: Vec<f64> = (0..d).rev().map(|j| (eig.S()[j] as f64).max(0.0)).collect();
         let total: f64 = values.iter().sum();

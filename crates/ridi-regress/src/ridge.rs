@@ -156,9 +156,10 @@ impl Moments {
         });
         // The centred Gram is positive semi-definite and `1/C > 0` is added, so the factor
         // exists unless rounding ate the ridge: then it is named, not hidden.
-        let llt = a.llt(Side::Lower).map_err(|e| {
+        let llt = a.llt(Side::Lower).map_err(|_| {
             RegressError::InvalidParam(format!(
-                "ridge system at C = {c} is not positive definite ({e:?}): use a smaller C"
+                "the ridge system at C = {c} is not positive definite in floating point: use \
+                 a smaller C"
             ))
         })?;
         let w = llt.solve(&rhs);

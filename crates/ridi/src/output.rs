@@ -133,6 +133,16 @@ pub enum OutputError {
     #[cfg(feature = "plot")]
     #[error(transparent)]
     PlotFormat(crate::plot::PlotError),
+    /// The file system refused to write an output file (full, read-only, gone): the error is
+    /// its own, without the path again.
+    #[error("cannot write {}", ridi_data::shown(path))]
+    Io {
+        /// The output file.
+        path: PathBuf,
+        /// What the file system said.
+        #[source]
+        error: std::io::Error,
+    },
     /// Writing an output file failed.
     #[error("cannot write {}", ridi_data::shown(path))]
     Write {
@@ -155,9 +165,16 @@ pub enum OutputError {
 
 impl OutputError {
     fn write(path: &Path, source: impl Into<PipelineError>) -> Self {
-        OutputError::Write {
-            path: path.to_path_buf(),
-            source: Box::new(source.into()),
+        match source.into() {
+            // An I/O error of this very file names it already: keep the cause only, so that
+            // the message does not name the file twice.
+            PipelineError::Data(ridi_data::DataError::Io { path: p, error }) if p == path => {
+                OutputError::Io { path: p, error }
+            }
+            source => OutputError::Write {
+                path: path.to_path_buf(),
+                source: Box::new(source),
+            },
         }
     }
 }
@@ -595,6 +612,35 @@ mod tests {
 
     use super::*;
     use crate::evaluate::SequenceResult;
+
+    /// The error and its causes on one line, as the command line prints them.
+    fn chain(e: &dyn std::error::Error) -> String {
+        let mut line = e.to_string();
+        let mut next = e.source();
+        while let Some(c) = next {
+            line = format!("{line}: {c}");
+            next = c.source();
+        }
+        line
+    }
+
+    #[test]
+    fn a_failed_write_names_its_file_once() {
+        // A full disk while writing t.csv: the I/O error of that file names it already.
+        let path = Path::new("out/t.csv");
+        let full = std::io::Error::from(std::io::ErrorKind::StorageFull);
+        let e = OutputError::write(path, ridi_data::DataError::io(path, full));
+        let line = chain(&e);
+        assert_eq!(line.matches("t.csv").count(), 1, "{line}");
+        assert!(line.starts_with("cannot write out/t.csv: "), "{line}");
+        // Another file's error, or a data error, keeps its own words after the output's.
+        let other = Path::new("in/model.ridi");
+        let e = OutputError::write(
+            path,
+            ridi_data::DataError::io(other, std::io::Error::other("x")),
+        );
+        assert_eq!(chain(&e), "cannot write out/t.csv: in/model.ridi: x");
+    }
 
     /// A report of sequences of these names, with what JSON cannot hold as a number (`NaN`,
     /// written as `null`), as an evaluation without regressions has.
