@@ -56,8 +56,8 @@ pub(crate) struct Args {
     /// exact ones (docs/benchmarks.md).
     #[arg(long, value_enum, default_value = "exact")]
     solver: SolverArg,
-    /// Landmarks per machine of `--solver nystrom` (rows drawn at random, seed 0: the
-    /// classifier's from all rows, each placement's regressors' from its own), 2 to 16384:
+    /// Landmarks per machine of `--solver nystrom` (rows drawn at random with fixed seeds:
+    /// the classifier's from all rows, each placement's regressors' from its own), 2 to 16384:
     /// more approximate the kernel machines more closely, at a cost per query linear in them
     /// and in training quadratic.
     #[arg(long, value_name = "N", default_value_t = Nystrom::DEFAULT_LANDMARKS,

@@ -66,9 +66,10 @@
 //! GEMMs) plus `O(m³)` per placement; the model keeps the landmarks (in the same [`Storage`],
 //! a placement's as its samples) with one weight per landmark and machine, `W^{-1/2}` folded
 //! in; a query is one kernel row against the classifier's landmarks and one against its
-//! placement's. With every row a landmark the regressors are exact kernel ridge regression and
-//! the classifier the exact machine (tested against a dense solve and the SMO); with fewer
-//! they approach it as the landmarks grow (tested bounds).
+//! placement's. With every row a landmark the regressors are exact kernel ridge regression
+//! (tested against a dense solve) and the classifier gives the exact machine's placements
+//! (tested against the SMO); with fewer landmarks the regressors approach kernel ridge
+//! regression as they grow (tested bounds).
 //!
 //! Measured once on synthetic IMU-like features (`benches/synth.rs`, 1200 values, 4
 //! placements, `C` = 10, epsilon = 0.01 for the exact solver, no grid; 2 cores of an Intel

@@ -20,6 +20,9 @@ use crate::error::RegressError;
 /// Rows gathered per GEMM block (bounds the `f64` copy to `BLOCK × rank`).
 const BLOCK: usize = 2048;
 
+/// Rows per parallel part of the sums (a multiple of [`BLOCK`]).
+const PART: usize = 4 * BLOCK;
+
 /// Sums over a set of rows: their count, `Σ φ`, `Σ φ φᵀ`, and per channel `Σ φ y`, `Σ y`,
 /// `Σ y²`; everything the normal equations and a validation error need.
 #[derive(Debug, Clone)]
@@ -38,22 +41,21 @@ impl Moments {
     /// The sums over rows `rows` (indices into `phi`, `rank` values each), with targets
     /// `targets[ch][s]` of the `s`-th of them.
     pub(crate) fn of(phi: &[f32], rank: usize, rows: &[usize], targets: &[&[f64]]) -> Self {
-        // One contiguous share of the rows per thread, each summed by sequential GEMMs.
-        let parts = rayon::current_num_threads().clamp(1, rows.len().div_ceil(BLOCK).max(1));
-        let len = rows.len().div_ceil(parts).max(1);
+        // Parts of a fixed number of rows, summed in parallel by sequential GEMMs and added in
+        // order: the sums, and so the model's bytes, do not depend on the number of threads.
+        let parts = rows.len().div_ceil(PART).max(1);
         let partial: Vec<Self> = (0..parts)
             .into_par_iter()
             .map(|p| {
-                let (a, b) = ((p * len).min(rows.len()), ((p + 1) * len).min(rows.len()));
+                let (a, b) = ((p * PART).min(rows.len()), ((p + 1) * PART).min(rows.len()));
                 let t: Vec<&[f64]> = targets.iter().map(|t| &t[a..b]).collect();
                 Self::of_seq(phi, rank, &rows[a..b], &t)
             })
             .collect();
-        let mut it = partial.into_iter();
-        let first = it
-            .next()
-            .unwrap_or_else(|| Self::of_seq(phi, rank, &[], &[]));
-        it.fold(first, |acc, p| acc.plus(&p))
+        partial
+            .into_iter()
+            .reduce(|acc, p| acc.plus(&p))
+            .expect("at least one part")
     }
 
     fn of_seq(phi: &[f32], rank: usize, rows: &[usize], targets: &[&[f64]]) -> Self {
@@ -211,7 +213,6 @@ mod tests {
     /// A dense solve of the same problem, row by row: the oracle.
     fn direct(phi: &[f32], rank: usize, rows: &[usize], y: &[f64], c: f64) -> RidgeFit {
         // Augmented least squares: [Φ 1] with ridge 1/C on w only.
-        let n = rows.len();
         let mut a = Mat::<f64>::zeros(rank + 1, rank + 1);
         let mut r = Mat::<f64>::zeros(rank + 1, 1);
         for (s, &i) in rows.iter().enumerate() {
@@ -231,7 +232,6 @@ mod tests {
             a[(p, p)] += 1.0 / c;
         }
         let sol = a.partial_piv_lu().solve(&r);
-        let _ = n;
         RidgeFit {
             w: (0..rank).map(|p| sol[(p, 0)]).collect(),
             bias: sol[(rank, 0)],
@@ -297,5 +297,24 @@ mod tests {
             assert!((x - z).abs() < 1e-6 * (1.0 + z.abs()));
         }
         assert_eq!(ma.plus(&mb).rows(), n);
+    }
+
+    #[test]
+    fn the_sums_do_not_depend_on_the_number_of_threads() {
+        // More rows than one part, so that parts run in parallel: a model's bytes must not
+        // change with --jobs.
+        let (rank, n) = (3, 3 * PART + 17);
+        let (phi, y) = data(n, rank);
+        let rows: Vec<usize> = (0..n).collect();
+        let sums = |threads: usize| {
+            let pool = rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .unwrap();
+            let m = pool.install(|| Moments::of(&phi, rank, &rows, &[&y]));
+            let fit = m.solve(10.0).unwrap().swap_remove(0);
+            (fit.w, fit.bias)
+        };
+        assert_eq!(sums(1), sums(3));
     }
 }

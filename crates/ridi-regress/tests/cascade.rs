@@ -696,7 +696,6 @@ fn nystrom_with_every_row_a_landmark_is_the_exact_classifier_and_kernel_ridge() 
     params.solver.smo.max_iter = Some(20_000);
     let nys = Cascade::train(&data.set(), &params, &mut NoProgress).unwrap();
     assert_eq!(nys.solver(), Solver::Nystrom(cfg));
-    assert_eq!(nys.classifier_landmarks(), 480);
     assert_eq!(nys.stored_samples(0), 160);
     let (pe, pn) = (exact.predict(xt).unwrap(), nys.predict(xt).unwrap());
     assert_eq!(compare(&pe, &pn).0, 1.0, "placements");
@@ -837,6 +836,23 @@ fn nystrom_classifier_separates_separable_placements_and_the_grid_runs() {
 }
 
 #[test]
+fn a_nystrom_model_of_one_placement_has_no_classifier_and_round_trips() {
+    let data = make(1, 4, 30, 21);
+    let cfg = Nystrom::new(32, 1).unwrap();
+    let params = fixed(Storage::DEFAULT, Solver::Nystrom(cfg));
+    let model = Cascade::train(&data.set(), &params, &mut NoProgress).unwrap();
+    assert_eq!(model.stored_samples(0), 32);
+    let back = Cascade::from_bytes(&model.to_bytes().unwrap()).unwrap();
+    assert_eq!(back, model);
+    let x = data.set().features;
+    for (i, b) in back.predict(x).unwrap().iter().enumerate() {
+        let one = back.predict_one(x.row(i)).unwrap();
+        assert_eq!((one.placement, b.placement), (0, 0));
+        assert!((one.velocity - b.velocity).norm() < 1e-4, "row {i}");
+    }
+}
+
+#[test]
 fn nystrom_models_are_deterministic_compact_and_round_trip() {
     let data = make(2, 3, 30, 5);
     let cfg = Nystrom::new(32, 9).unwrap();
@@ -893,6 +909,15 @@ fn nystrom_models_are_deterministic_compact_and_round_trip() {
     kind[20..24].copy_from_slice(&crc.to_le_bytes());
     match Cascade::from_bytes(&kind) {
         Err(RegressError::Decode(m)) => assert!(m.contains("unknown model kind 7"), "{m}"),
+        other => panic!("expected a decode error, got {other:?}"),
+    }
+    // Kind 1, the first Nyström models' layout, is refused with what to do.
+    let mut old = bytes.clone();
+    old[24] = 1;
+    let crc = crc32fast::hash(&old[24..]);
+    old[20..24].copy_from_slice(&crc.to_le_bytes());
+    match Cascade::from_bytes(&old) {
+        Err(RegressError::Decode(m)) => assert!(m.contains("retrain it"), "{m}"),
         other => panic!("expected a decode error, got {other:?}"),
     }
     // A corrupt Nyström part (a weight made NaN, checksum fixed) is refused.

@@ -27,8 +27,3 @@ pub const BUNDLED_MODEL_SUMMARY: &str = "the bundled model (Nyström, trained on
 pub fn bundled_model() -> Result<Cascade, RegressError> {
     Cascade::from_bytes(BYTES)
 }
-
-/// Size of the bundled model file in bytes.
-pub fn bundled_model_size() -> usize {
-    BYTES.len()
-}

@@ -98,7 +98,7 @@ pub mod train;
 
 pub use baselines::Method;
 #[cfg(feature = "bundled-model")]
-pub use bundled::{BUNDLED_MODEL_SUMMARY, bundled_model, bundled_model_size};
+pub use bundled::{BUNDLED_MODEL_SUMMARY, bundled_model};
 pub use demo::Demo;
 pub use error::{PipelineError, Result};
 pub use evaluate::{EvalOptions, Report, evaluate};

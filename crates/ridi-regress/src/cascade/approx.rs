@@ -115,13 +115,18 @@ impl Cascade {
         for (c, idx) in members.iter().enumerate() {
             let name = data.placement_names[c].as_str();
             let targets = channel_targets(data, idx, channels);
-            // The placement's own landmarks and its rows' features on them.
-            let xp = x.select(idx);
-            let own = nystrom::pick(idx.len(), cfg.landmarks(), placement_seed(cfg.seed(), c));
-            let pmap = Map::new(xp.view(), &own, projection.as_ref())?;
-            let wr = pmap.whitening(xp.view(), &own, gamma_r)?;
-            let phi = pmap.features(xp.view(), &[(gamma_r, &wr)]).swap_remove(0);
-            drop(xp);
+            // The placement's own landmarks (training rows, so that an error names the row)
+            // and its rows' features on them.
+            let own: Vec<usize> =
+                nystrom::pick(idx.len(), cfg.landmarks(), placement_seed(cfg.seed(), c))
+                    .into_iter()
+                    .map(|j| idx[j])
+                    .collect();
+            let pmap = Map::new(x, &own, projection.as_ref())?;
+            let wr = pmap.whitening(x, &own, gamma_r)?;
+            let phi = pmap
+                .features(x.select(idx).view(), &[(gamma_r, &wr)])
+                .swap_remove(0);
             let (fits, chosen, table) =
                 ridge_fits(&phi, wr.rank, &targets, data, idx, params, name, progress)
                     .map_err(in_placement(name))?;
@@ -133,6 +138,7 @@ impl Cascade {
                     reg_coef[j * channels + ch] = v;
                 }
             }
+            // A closed-form fit: no iterations, every row takes part.
             let rinfo = || FitInfo {
                 iterations: 0,
                 objective: 0.0,
@@ -249,11 +255,22 @@ fn ridge_fits(
             }
             let table = grid::tabulate(name, &cs, &[0.0], channels, k, &results);
             let best = grid::best(&table, channels);
+            let stage = Stage::Regressors { placement: name };
+            report(progress, stage, 0, channels)?;
             // Channels may choose different `C`: one factorization per distinct value.
-            let mut fits = Vec::with_capacity(channels);
-            for (ch, &(c, _)) in best.iter().enumerate() {
-                fits.push(all.solve(c)?.swap_remove(ch));
+            let mut fits: Vec<Option<RidgeFit>> = vec![None; channels];
+            for &(c, _) in &best {
+                if fits.iter().zip(&best).any(|(f, b)| f.is_some() && b.0 == c) {
+                    continue;
+                }
+                for (ch, fit) in all.solve(c)?.into_iter().enumerate() {
+                    if best[ch].0 == c {
+                        fits[ch] = Some(fit);
+                    }
+                }
             }
+            report(progress, stage, channels, channels)?;
+            let fits = fits.into_iter().flatten().collect();
             Ok((fits, best, table))
         }
     }

@@ -197,12 +197,6 @@ impl Cascade {
         self.classes.get(p).map_or(0, |c| c.n_train)
     }
 
-    /// Landmarks of the classifier of a Nyström model (0 for an exact one, or without a
-    /// classifier).
-    pub fn classifier_landmarks(&self) -> usize {
-        self.nystrom.as_ref().map_or(0, |n| n.landmarks.rows())
-    }
-
     /// How the model was trained: [`Solver::Exact`], or [`Solver::Nystrom`] with the most
     /// landmarks one machine holds (fewer than asked for when the training set had fewer
     /// rows) and their seed.

@@ -353,9 +353,8 @@ impl Cascade {
                 Some(p) => out.iter_mut().for_each(|o| o.placement = p),
                 None => self.classify_block_nystrom(n, q, &qn, out),
             }
-            // Its placements hold no classifier rows: the regressors see only their own.
-            let none = vec![Vec::new(); self.classes.len()];
-            return self.regress_block(rows, q, &qn, &none, forced, out);
+            // Its placements hold no classifier rows (validated): no distances to reuse.
+            return self.regress_block(rows, q, &qn, &[], forced, out);
         }
         // Squared distances to the classifier part of each placement.
         let dists: Vec<Vec<f32>> = (0..self.classes.len())

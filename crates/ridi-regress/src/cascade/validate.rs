@@ -50,8 +50,25 @@ impl Cascade {
         {
             return bad("placement sizes");
         }
-        if !n.clf_weights.iter().all(|v| v.is_finite()) {
-            return bad("non-finite weight");
+        // Every number a query multiplies or adds: a non-finite one would give NaN velocities.
+        let offsets = self.classes.iter().flat_map(|c| {
+            c.reg_rho
+                .iter()
+                .copied()
+                .chain(c.speed.as_ref().map(|s| s.rho))
+        });
+        let head = self.classifier.iter().flat_map(|h| h.rho.iter().copied());
+        let coef = self.classes.iter().flat_map(|c| c.reg_coef.iter().copied());
+        if !n
+            .clf_weights
+            .iter()
+            .copied()
+            .chain(coef)
+            .chain(offsets)
+            .chain(head)
+            .all(f64::is_finite)
+        {
+            return bad("non-finite weight or offset");
         }
         Ok(())
     }
