@@ -86,7 +86,7 @@ pub(crate) fn run(
         outln!(
             "{}  {}",
             shown(&c.path),
-            c.placement.as_deref().unwrap_or("-")
+            c.placement.as_deref().map_or("-".into(), shown)
         );
     }
     for l in &summary.lists {

@@ -4,7 +4,7 @@ use std::path::{Path, PathBuf};
 
 use anyhow::Result;
 
-use ridi::data::ReadOptions;
+use ridi::data::{ReadOptions, shown};
 use ridi::regress::MODEL_MAGIC;
 
 #[derive(clap::Args)]
@@ -23,7 +23,7 @@ pub(crate) fn run(Args { sequence, json }: Args) -> Result<()> {
         let model = crate::load_model(&sequence)?;
         let report = ridi::inspect::inspect_model(&model);
         if json {
-            outln!("{}", serde_json::to_string_pretty(&report)?);
+            outln!("{}", escaped(serde_json::to_string_pretty(&report)?));
         } else {
             out!("{report}");
         }
@@ -35,7 +35,7 @@ pub(crate) fn run(Args { sequence, json }: Args) -> Result<()> {
         let rows = ridi::data::RowReader::open(&sequence, &ReadOptions::default())?;
         let report = ridi::inspect::inspect_stream(rows)?;
         if json {
-            outln!("{}", serde_json::to_string_pretty(&report)?);
+            outln!("{}", escaped(serde_json::to_string_pretty(&report)?));
         } else {
             out!("{report}");
         }
@@ -59,7 +59,7 @@ pub(crate) fn run(Args { sequence, json }: Args) -> Result<()> {
             [one] => serde_json::to_string_pretty(one)?,
             parts => serde_json::to_string_pretty(parts)?,
         };
-        outln!("{text}");
+        outln!("{}", escaped(text));
     } else {
         for (i, report) in reports.iter().enumerate() {
             if i > 0 {
@@ -69,7 +69,7 @@ pub(crate) fn run(Args { sequence, json }: Args) -> Result<()> {
         }
         // Once for the recording, not once per part.
         for w in &loaded.warnings {
-            outln!("warning:      {w}");
+            outln!("warning:      {}", shown(w));
         }
     }
     Ok(())
@@ -77,13 +77,19 @@ pub(crate) fn run(Args { sequence, json }: Args) -> Result<()> {
 
 /// `true` for a `.ridi` file, or a file that starts like a model file or is a model file's
 /// first bytes cut short (recordings never are): loading it then says what is wrong with it.
+/// Only a regular file is opened, as every reader does: opening a FIFO waits for a writer for
+/// ever, and a device can hand out bytes for ever. What is none is left to the readers, which
+/// refuse it.
 fn is_model_file(path: &Path) -> bool {
     use std::io::Read;
+    // `metadata` does not open the file.
+    if !std::fs::metadata(path).is_ok_and(|m| m.is_file()) {
+        return false;
+    }
     // A `.ridi` file is meant as a model: if it is none, say so, not which data it is not.
     if path
         .extension()
         .is_some_and(|e| e.eq_ignore_ascii_case("ridi"))
-        && path.is_file()
     {
         return true;
     }
@@ -95,4 +101,41 @@ fn is_model_file(path: &Path) -> bool {
     file.take(magic.len() as u64).read_to_end(&mut head).is_ok()
         && !head.is_empty()
         && magic.starts_with(&head)
+}
+
+/// serde_json's `json` with DEL and the C1 controls (U+007F-U+009F) escaped too (`\u009b`), as
+/// it escapes U+0000-U+001F: they are valid JSON raw, but a terminal may obey them (U+009B
+/// starts an escape sequence on some). They can only be inside strings (JSON's own syntax is
+/// ASCII), where the escape stands for the same character.
+fn escaped(json: String) -> String {
+    let raw = |c: char| ('\u{7f}'..='\u{9f}').contains(&c);
+    if !json.contains(raw) {
+        return json;
+    }
+    let mut out = String::with_capacity(json.len() + 16);
+    for c in json.chars() {
+        if raw(c) {
+            out.push_str(&format!("\\u{:04x}", u32::from(c)));
+        } else {
+            out.push(c);
+        }
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::escaped;
+
+    #[test]
+    fn json_escapes_del_and_c1_as_it_escapes_c0() {
+        let json = serde_json::to_string(&["a\u{1b}b\u{7f}c\u{9b}d\u{a0}é"]).unwrap();
+        let text = escaped(json);
+        assert_eq!(text, "[\"a\\u001bb\\u007fc\\u009bd\u{a0}é\"]");
+        assert!(!text.chars().any(char::is_control), "{text:?}");
+        // The same strings, read back.
+        let back: Vec<String> = serde_json::from_str(&text).unwrap();
+        assert_eq!(back, ["a\u{1b}b\u{7f}c\u{9b}d\u{a0}é"]);
+        assert_eq!(escaped("{\"a\": 1}".into()), "{\"a\": 1}");
+    }
 }

@@ -70,15 +70,15 @@ pub(crate) fn run(args: Args) -> Result<()> {
             .map_err(|e| match e {
                 e @ (PipelineError::Data(_) | PipelineError::Output(_)) => anyhow::Error::from(e),
                 e => anyhow::Error::from(e)
-                    .context(format!("cannot track {}", args.sequence.display())),
+                    .context(format!("cannot track {}", shown(&args.sequence))),
             })?;
         let n = track.regressions;
         outln!(
             "{}: {} frames, {n} regression{} -> {}",
-            track.name,
+            shown(&track.name),
             track.frames,
             if n == 1 { "" } else { "s" },
-            args.out.display()
+            shown(&args.out)
         );
         return Ok(());
     }
@@ -101,7 +101,7 @@ pub(crate) fn run(args: Args) -> Result<()> {
     let n = track.regressions.len();
     outln!(
         "{}: {} frames, {n} regression{} -> {}",
-        seq.name(),
+        shown(seq.name()),
         track.time.len(),
         if n == 1 { "" } else { "s" },
         shown(&args.out)

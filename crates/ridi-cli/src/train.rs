@@ -233,8 +233,8 @@ pub(crate) fn with_progress(
     let mut progress = |e: &ProgressEvent<'_>| {
         let stage = match e.stage {
             Stage::Classifier => "placement classifier".to_string(),
-            Stage::Grid { placement } => format!("grid {placement}"),
-            Stage::Regressors { placement } => format!("regressors {placement}"),
+            Stage::Grid { placement } => format!("grid {}", shown(placement)),
+            Stage::Regressors { placement } => format!("regressors {}", shown(placement)),
         };
         bar.set_prefix(stage);
         bar.set_length(e.total as u64);

@@ -43,7 +43,8 @@ impl Location {
 }
 
 /// `text` (a path, a sequence name, a message) for a message, with control characters escaped
-/// (`\n`, `\u{1b}`): a file or sequence name may hold a line break or a terminal escape
+/// (`\n`, `\u{1b}`; DEL and the C1 controls U+0080-U+009F too, `\u{9b}` being a CSI to some
+/// terminals): a file or sequence name may hold a line break or a terminal escape
 /// sequence, which printed raw would split the one-line error or retitle and clear the user's
 /// terminal. The one escaping of ridi-rs: its messages and the `ridi` command's output go
 /// through it. Bytes that are not UTF-8 are shown as U+FFFD, as `Path::display` shows them.
@@ -157,5 +158,22 @@ mod escaping_tests {
             Location::file(Path::new("a b/ü.csv")).to_string(),
             "a b/ü.csv"
         );
+    }
+
+    #[test]
+    fn shown_escapes_every_control_character_del_and_c1_included() {
+        // C0, DEL (U+007F) and C1 (U+0080-U+009F: U+009B is a one-character CSI that some
+        // terminals obey) alike; the characters around them, and `\` itself, unchanged (so
+        // that escaping twice changes nothing).
+        assert_eq!(shown("del\u{7f}"), "del\\u{7f}");
+        assert_eq!(shown("csi\u{9b}31m"), "csi\\u{9b}31m");
+        assert_eq!(shown("c1\u{80}\u{9f}"), "c1\\u{80}\\u{9f}");
+        assert_eq!(shown("tab\tline\nbell\u{7}"), "tab\\tline\\nbell\\u{7}");
+        assert_eq!(shown("\u{a0}é\u{ff}"), "\u{a0}é\u{ff}");
+        for text in ["esc\u{1b}[31m\u{7f}\u{85}\u{9b}", "a\\b"] {
+            let once = shown(text);
+            assert!(!once.chars().any(char::is_control), "{once:?}");
+            assert_eq!(shown(&once), once);
+        }
     }
 }

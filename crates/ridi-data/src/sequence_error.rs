@@ -88,7 +88,10 @@ pub enum SequenceError {
         next: f64,
     },
     /// Two frames are too far apart.
-    #[error("gap of {gap_s:.3} s before frame {index} (at {time} s) exceeds {max_gap_s} s")]
+    #[error(
+        "gap of {gap_s:.3} s before frame {index} (at {time} s) exceeds {} s",
+        short(*max_gap_s)
+    )]
     Gap {
         /// 0-based index of the frame after the gap.
         index: usize,

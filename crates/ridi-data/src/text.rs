@@ -4,7 +4,7 @@
 use std::path::Path;
 
 use crate::error::{DataError, Location, Result};
-use crate::sequence_error::{AXES, beyond, jump};
+use crate::sequence_error::{AXES, beyond, jump, short};
 use crate::{Channel, SequenceError, Validation};
 
 /// Reads a whole file; the readers parse from memory because one pass over a byte slice is much
@@ -287,8 +287,9 @@ pub(crate) fn check_step(
         return Err(DataError::format(
             at(),
             format!(
-                "gap of {:.3} s since line {prev_line} exceeds the limit of {max_gap_s} s",
-                next - prev
+                "gap of {:.3} s since line {prev_line} exceeds the limit of {} s",
+                next - prev,
+                short(max_gap_s)
             ),
         ));
     }

@@ -12,9 +12,9 @@ use pyo3::exceptions::{
     PyFileExistsError, PyFileNotFoundError, PyIsADirectoryError, PyNotADirectoryError, PyOSError,
     PyPermissionError, PyValueError,
 };
-use ridi::{OutputError, PipelineError};
 use ridi::data::DataError;
 use ridi::regress::RegressError;
+use ridi::{OutputError, PipelineError};
 
 /// The error and its causes on one line, each cause once: the command line's `one_line`.
 pub(crate) fn one_line(e: &(dyn Error + 'static)) -> String {
@@ -105,7 +105,13 @@ pub(crate) fn data(e: DataError) -> PyErr {
 
 /// A model file's error (loading or saving `path`), worded as the command line words it.
 pub(crate) fn model_file(e: RegressError, doing: &str, path: &Path) -> PyErr {
-    let message = format!("{doing} {}: {}", path.display(), one_line(&e));
+    let cause = match &e {
+        // An I/O error of this very file names it already: its cause only, so that the
+        // message names the file once (as the command line says it).
+        RegressError::Io { path: p, error } if p == path => error.to_string(),
+        e => one_line(e),
+    };
+    let message = format!("{doing} {}: {cause}", path.display());
     match regress_kind(&e) {
         Some(kind) => os_error(kind, message),
         None => PyValueError::new_err(message),

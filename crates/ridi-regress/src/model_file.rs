@@ -162,9 +162,10 @@ fn check_header(bytes: &[u8], size: u64) -> Result<Header, RegressError> {
         });
     }
     if size > expected {
+        let extra = size - expected;
         return Err(RegressError::Decode(format!(
-            "{} trailing bytes after the payload",
-            size - expected
+            "{extra} trailing byte{} after the payload",
+            if extra == 1 { "" } else { "s" }
         )));
     }
     Ok(Header { version, len, crc })
@@ -237,18 +238,30 @@ fn decode(bytes: &[u8]) -> Result<Cascade, RegressError> {
 }
 
 /// The bytes of the model file `path`, read only as far as its header allows: what is not a
-/// regular file, or whose header is not a model's or declares another size than the file's,
-/// is refused after the header.
+/// regular file is refused before it is opened, a file whose header is not a model's or
+/// declares another size than the file's after the header.
 fn read_bounded(path: &Path) -> Result<Vec<u8>, RegressError> {
     use std::io::Read as _;
-    let mut file = std::fs::File::open(path).map_err(io_err(path))?;
-    let meta = file.metadata().map_err(io_err(path))?;
-    if !meta.is_file() {
-        return Err(io_err(path)(std::io::Error::new(
+    // The metadata first, which does not open the file: opening a FIFO waits for a writer for
+    // ever. Worded as ridi-data's readers word it.
+    let regular = |meta: std::fs::Metadata| {
+        if meta.is_file() {
+            return Ok(meta);
+        }
+        Err(io_err(path)(std::io::Error::new(
             std::io::ErrorKind::InvalidInput,
-            "not a regular file (a folder, a device or a pipe): a model is a file",
-        )));
-    }
+            if meta.is_dir() {
+                "is a folder: it is not a regular file"
+            } else {
+                "is a device, a pipe or a socket: it is not a regular file"
+            },
+        )))
+    };
+    regular(std::fs::metadata(path).map_err(io_err(path))?)?;
+    let mut file = std::fs::File::open(path).map_err(io_err(path))?;
+    // Again of the file opened, whose size the header must match (the path may name another
+    // file by now).
+    let meta = regular(file.metadata().map_err(io_err(path))?)?;
     let mut bytes = Vec::with_capacity(HEADER);
     (&mut file)
         .take(HEADER as u64)

@@ -323,7 +323,12 @@ fn training_is_deterministic_and_model_files_round_trip() {
         assert_names_file(&e, zero);
         assert!(e.to_string().contains("not a regular file"), "{e}");
     }
-    assert!(Cascade::load(&dir).is_err());
+    let e = Cascade::load(&dir).unwrap_err();
+    assert!(
+        e.to_string()
+            .ends_with("is a folder: it is not a regular file"),
+        "{e}"
+    );
     let huge = dir.join("huge.ridi");
     std::fs::File::create(&huge)
         .unwrap()
@@ -336,6 +341,14 @@ fn training_is_deterministic_and_model_files_round_trip() {
     f.set_len(3 << 30).unwrap();
     let e = Cascade::load(&padded).unwrap_err();
     assert!(e.to_string().contains("trailing bytes"), "{e}");
+    let one_more = dir.join("one-more.ridi");
+    std::fs::write(&one_more, [&bytes[..], b"\n"].concat()).unwrap();
+    let e = Cascade::load(&one_more).unwrap_err();
+    assert!(
+        e.to_string()
+            .ends_with(": 1 trailing byte after the payload"),
+        "{e}"
+    );
     let cut = dir.join("cut.ridi");
     std::fs::write(&cut, &bytes[..bytes.len() - 1]).unwrap();
     assert!(matches!(

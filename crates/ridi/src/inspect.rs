@@ -1,6 +1,6 @@
 //! What `ridi inspect` reports about a sequence or a model.
 
-use ridi_data::{Format, Sequence};
+use ridi_data::{Format, Sequence, shown};
 use ridi_features::FeatureChannel;
 use ridi_frames::UpAxis;
 use ridi_regress::{Cascade, GridRow, Solver, StoredAs};
@@ -333,21 +333,23 @@ fn report(s: Summary) -> Inspection {
 
 impl std::fmt::Display for Inspection {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        writeln!(f, "name:         {}", self.name)?;
+        // Names come from file names and list lines: escaped, as every name `ridi` prints.
+        writeln!(f, "name:         {}", shown(&self.name))?;
         writeln!(f, "format:       {}", self.format)?;
         match (&self.device, self.device_imu_rate_hz) {
             (Some(d), Some(r)) => writeln!(
                 f,
-                "device:       {d}, IMU at {r:.1} Hz (this sequence: {:.0} Hz)",
+                "device:       {}, IMU at {r:.1} Hz (this sequence: {:.0} Hz)",
+                shown(d),
                 self.rate_hz
             )?,
-            (Some(d), None) => writeln!(f, "device:       {d}")?,
+            (Some(d), None) => writeln!(f, "device:       {}", shown(d))?,
             (None, _) => writeln!(f, "device:       (unknown)")?,
         }
         writeln!(
             f,
             "placement:    {}",
-            self.placement.as_deref().unwrap_or("(none)")
+            self.placement.as_deref().map_or("(none)".into(), shown)
         )?;
         writeln!(
             f,
@@ -396,7 +398,7 @@ impl std::fmt::Display for Inspection {
             None => writeln!(f, "ground truth: none")?,
         }
         for w in &self.warnings {
-            writeln!(f, "warning:      {w}")?;
+            writeln!(f, "warning:      {}", shown(w))?;
         }
         Ok(())
     }
@@ -526,7 +528,8 @@ pub fn inspect_model(model: &Cascade) -> ModelInspection {
 
 impl std::fmt::Display for ModelInspection {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        let names: Vec<&str> = self.placements.iter().map(|p| p.name.as_str()).collect();
+        // Placement labels come from list lines, which may hold any character but a space.
+        let names: Vec<String> = self.placements.iter().map(|p| shown(&p.name)).collect();
         writeln!(f, "placements: {}", names.join(", "))?;
         writeln!(
             f,
@@ -576,7 +579,11 @@ impl std::fmt::Display for ModelInspection {
             writeln!(
                 f,
                 "  {:<12} {:>6} samples of {:>7} windows  S-x: {}  S-z: {}{speed}",
-                p.name, p.samples, p.windows, p.s_x, p.s_z
+                shown(&p.name),
+                p.samples,
+                p.windows,
+                p.s_x,
+                p.s_z
             )?;
         }
         if !self.grid.is_empty() {
@@ -590,7 +597,7 @@ impl std::fmt::Display for ModelInspection {
                 writeln!(
                     f,
                     "  {:<12} {:>7} {:>8} {:>8} {:>10.5}",
-                    r.placement,
+                    shown(&r.placement),
                     ["S-x", "S-z", "speed"][usize::from(r.channel.min(2))],
                     r.c,
                     r.epsilon,

@@ -111,11 +111,16 @@ pub enum OutputError {
         /// Why, as the system said it.
         kind: std::io::ErrorKind,
     },
-    /// An output would replace a file the command reads.
+    /// An output would replace a file the command reads. The input is named when it is given
+    /// by another path (a link, `..`, a hard link), not again when it is the output's.
     #[error(
-        "cannot write {}: the command reads it ({}); choose another output",
+        "cannot write {}: the command reads it{}; choose another output",
         ridi_data::shown(path),
-        ridi_data::shown(input)
+        if path == input {
+            String::new()
+        } else {
+            format!(" as {}", ridi_data::shown(input))
+        }
     )]
     Input {
         /// The output.
@@ -754,7 +759,14 @@ mod tests {
 
         let inputs = ReadFiles::of([&file]);
         let e = message(check_not_input(&file, &inputs, &[]).unwrap_err());
-        assert!(e.contains("the command reads it"), "{e}");
+        // The input is the output, by the same path: named once.
+        assert_eq!(
+            e,
+            format!(
+                "cannot write {}: the command reads it; choose another output",
+                file.display()
+            )
+        );
         let out = dir.path().join("out.csv");
         assert!(check_not_input(&out, &inputs, &[]).is_ok());
         let e =
@@ -766,7 +778,13 @@ mod tests {
         let second = dir.path().join("second-name.csv");
         std::fs::hard_link(&file, &second).unwrap();
         let e = message(check_not_input(&second, &inputs, &[]).unwrap_err());
-        assert!(e.contains("the command reads it"), "{e}");
+        assert!(
+            e.ends_with(&format!(
+                "second-name.csv: the command reads it as {}; choose another output",
+                file.display()
+            )),
+            "{e}"
+        );
     }
 
     /// An evaluation whose input (here its model) lies at a name it writes inside `--out`
