@@ -418,16 +418,14 @@ pub fn read_all_runs(data: &Path) -> Result<Vec<Sequence>> {
     let runs = read_run_list(&xtask::workspace_root().join(RUN_LIST))?;
     let mut seqs = Vec::new();
     for run in &runs {
-        seqs.extend(read_run(data, run)?.sequences);
+        seqs.extend(read_folder(&run_folder(data, run)?)?.sequences);
     }
     Ok(seqs)
 }
 
-/// The folder of `run` under the Tyrex root `data`, read as the protocols read it.
-fn read_run(data: &Path, run: &Run) -> Result<tyrex::TyrexRead> {
-    let dir = run_folder(data, run)?;
-    tyrex::read(&dir, &TyrexOptions::default())
-        .with_context(|| format!("reading {}", dir.display()))
+/// A run's folder, read as the protocols read it.
+fn read_folder(dir: &Path) -> Result<tyrex::TyrexRead> {
+    tyrex::read(dir, &TyrexOptions::default()).with_context(|| format!("reading {}", dir.display()))
 }
 
 /// The folder of `run` under the Tyrex root `data`; a run of the list must be there.
@@ -480,7 +478,7 @@ pub fn run(opts: Options) -> Result<PathBuf> {
     let (mut seqs, mut run_of_seq, mut bridged) = (Vec::new(), Vec::new(), Vec::new());
     for (i, run) in runs.iter().enumerate().filter(|(_, r)| needed(r)) {
         let dir = run_folder(&data, run)?;
-        let read = read_run(&data, run)?;
+        let read = read_folder(&dir)?;
         let other = if compare_jumps {
             tyrex::read(&dir, &bridging)?.sequences
         } else {

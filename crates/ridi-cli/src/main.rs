@@ -11,7 +11,7 @@ use clap::{Parser, Subcommand, ValueEnum};
 use ridi::correct::PlacementSmoother;
 use ridi::data::{ListEntry, Listed, ReadOptions, shown};
 use ridi::eval::AlignWindow;
-use ridi::regress::{Cascade, RegressError};
+use ridi::regress::Cascade;
 use ridi::{EvalPlots, GridChoice, PlacementMap, Purpose};
 
 /// `println!` that ignores a closed stdout (`ridi train ... | head`): the command's results are
@@ -211,14 +211,9 @@ fn load_listed(entries: Vec<ListEntry>, map: Option<&str>, purpose: Purpose) -> 
 }
 
 fn load_model(path: &Path) -> Result<Cascade> {
-    let context = || format!("cannot load model {}", shown(path));
-    Cascade::load(path).map_err(|e| match e {
-        // An I/O error of this very file names it already: keep the cause only, so that the
-        // message names the file once (as `ridi::OutputError` does for a write).
-        RegressError::Io { path: p, error } if p == path => {
-            anyhow::Error::new(error).context(context())
-        }
-        e => anyhow::Error::new(e).context(context()),
+    Cascade::load(path).map_err(|e| {
+        anyhow::Error::from_boxed(e.under(path))
+            .context(format!("cannot load model {}", shown(path)))
     })
 }
 

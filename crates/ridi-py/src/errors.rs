@@ -105,14 +105,10 @@ pub(crate) fn data(e: DataError) -> PyErr {
 
 /// A model file's error (loading or saving `path`), worded as the command line words it.
 pub(crate) fn model_file(e: RegressError, doing: &str, path: &Path) -> PyErr {
-    let cause = match &e {
-        // An I/O error of this very file names it already: its cause only, so that the
-        // message names the file once (as the command line says it).
-        RegressError::Io { path: p, error } if p == path => error.to_string(),
-        e => one_line(e),
-    };
-    let message = format!("{doing} {}: {cause}", path.display());
-    match regress_kind(&e) {
+    let kind = regress_kind(&e);
+    // Named once, as the command line names it.
+    let message = format!("{doing} {}: {}", path.display(), one_line(&*e.under(path)));
+    match kind {
         Some(kind) => os_error(kind, message),
         None => PyValueError::new_err(message),
     }

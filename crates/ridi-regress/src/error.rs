@@ -132,3 +132,15 @@ pub enum RegressError {
         error: std::io::Error,
     },
 }
+
+impl RegressError {
+    /// This error as the cause of a message that names `path` already ("cannot load model
+    /// `path`"): an I/O error of `path` itself becomes the system's error alone, since its own
+    /// message would name the file again; any other error stays as it is.
+    pub fn under(self, path: &std::path::Path) -> Box<dyn std::error::Error + Send + Sync> {
+        match self {
+            RegressError::Io { path: p, error } if p == path => Box::new(error),
+            e => Box::new(e),
+        }
+    }
+}
