@@ -22,10 +22,10 @@ use std::time::Instant;
 use anyhow::{Context, Result, bail, ensure};
 use ridi::data::tyrex::{self, TyrexOptions};
 use ridi::data::{Sequence, write_atomically};
-use ridi::evaluate::{SequenceResult, check_evaluable};
 use ridi::features::Orientation;
 use ridi::regress::{NoProgress, Nystrom, Solver};
 use ridi::{EvalOptions, GridChoice, PlacementMap, TrainOptions, apply_orientation};
+use ridi::{SequenceResult, check_evaluable};
 
 use crate::bootstrap::{self, Interval};
 use crate::eval_tyrex::{PEOPLE, interval_cell};

@@ -17,20 +17,20 @@ use std::time::Instant;
 
 use crate::bootstrap::{self, Interval};
 use anyhow::{Context, Result};
-use ridi::baselines::{Method, trajectory};
 use ridi::correct::{CorrectionConfig, FrameVelocity, InitialVelocity, PlacementSmoother};
 use ridi::data::tyrex::{self, TyrexOptions};
 use ridi::data::{Sequence, write_atomically};
 use ridi::eval::{AlignWindow, EvalConfig, evaluate_trajectory};
-use ridi::evaluate::{SequenceResult, Traces};
 use ridi::features::{SampleSchedule, compute_targets};
 use ridi::frames::UpAxis;
+use ridi::ground_truth_view;
 use ridi::regress::{Cascade, Gamma, NoProgress};
-use ridi::train::ground_truth_view;
 use ridi::{
     EvalOptions, GridChoice, Orientation, PlacementMap, TrackOptions, TrainOptions,
     apply_orientation,
 };
+use ridi::{Method, baseline_trajectory};
+use ridi::{SequenceResult, Traces};
 
 pub(crate) const PEOPLE: [&str; 3] = ["Guillaume", "Jakob", "Thibaud"];
 
@@ -111,7 +111,7 @@ const DEFAULTS: Variant = Variant {
     name: "turned copy + speed regressor + majority + S on -y upside down, step 20 (ridi's defaults)",
     turned_copies: 1,
     speed: true,
-    step: ridi::train::default_step(1),
+    step: ridi::default_step(1),
     up_axis: UpAxis::PlusOrMinusY,
     smoothing: true,
     ..PAPER
@@ -298,7 +298,7 @@ fn swapped_rte(
             }
         })
         .collect();
-    let est = trajectory(Method::Ridi, seq, &regs, correction)?;
+    let est = baseline_trajectory(Method::Ridi, seq, &regs, correction)?;
     Ok(evaluate_trajectory(
         seq.time(),
         &est,
@@ -357,7 +357,7 @@ fn oracle_rte(seq: &Sequence, window: usize, opts: &EvalOptions) -> Result<f64> 
             velocity: *v,
         })
         .collect();
-    let est = trajectory(Method::Ridi, seq, &regs, opts.track.correction)?;
+    let est = baseline_trajectory(Method::Ridi, seq, &regs, opts.track.correction)?;
     let gt = seq.ground_truth().context("no ground truth")?.horizontal();
     Ok(
         evaluate_trajectory(seq.time(), &est, &gt, &EvalConfig::default())?

@@ -50,10 +50,10 @@ impl From<FromFormat> for Format {
     }
 }
 
-/// `--rate`: within [`ridi::convert::RATE_HZ`], the rates whose frames the readers accept
+/// `--rate`: within [`ridi::CONVERT_RATE_HZ`], the rates whose frames the readers accept
 /// (less than 1 s apart, at least 0.1 ms in the median); phone sensors deliver 5-500 Hz.
 fn rate_hz(text: &str) -> std::result::Result<f64, String> {
-    let (min, max) = ridi::convert::RATE_HZ;
+    let (min, max) = ridi::CONVERT_RATE_HZ;
     match text.parse::<f64>() {
         Ok(x) if (min..=max).contains(&x) => Ok(x),
         _ => Err(format!(
@@ -72,13 +72,13 @@ pub(crate) fn run(
         rate,
     }: Args,
 ) -> Result<()> {
-    let opts = ridi::convert::ConvertOptions {
+    let opts = ridi::ConvertOptions {
         from: from.map(Format::from),
         read: ReadOptions::default(),
         rate_hz: rate,
     };
     ridi::check_output_folder(&out)?;
-    let summary = ridi::convert::convert(&source, &out, &opts)?;
+    let summary = ridi::convert(&source, &out, &opts)?;
     for w in &summary.warnings {
         eprintln!("warning: {}", shown(w));
     }

@@ -6,9 +6,9 @@ use std::path::PathBuf;
 use anyhow::Result;
 use indicatif::ProgressBar;
 
+use ridi::ReadFiles;
 use ridi::data::{ListEntry, shown};
 use ridi::eval::{AlignWindow, EvalConfig};
-use ridi::source::ReadFiles;
 use ridi::{
     EvalFolder, EvalOptions, EvalPlots, EvalWritten, Method, Purpose, Report, TrackOptions,
 };

@@ -22,7 +22,7 @@ pub(crate) struct Args {
 pub(crate) fn run(Args { sequence, json }: Args) -> Result<()> {
     if is_model_file(&sequence) {
         let model = crate::load_model(&sequence)?;
-        let report = ridi::inspect::inspect_model(&model);
+        let report = ridi::inspect_model(&model);
         if json {
             outln!("{}", escaped(serde_json::to_string_pretty(&report)?));
         } else {
@@ -34,7 +34,7 @@ pub(crate) fn run(Args { sequence, json }: Args) -> Result<()> {
     // its length.
     if ridi::data::detect(&sequence).is_ok_and(|f| f.streams()) {
         let rows = ridi::data::RowReader::open(&sequence, &ReadOptions::default())?;
-        let report = ridi::inspect::inspect_stream(rows)?;
+        let report = ridi::inspect_stream(rows)?;
         if json {
             outln!("{}", escaped(serde_json::to_string_pretty(&report)?));
         } else {
@@ -45,7 +45,7 @@ pub(crate) fn run(Args { sequence, json }: Args) -> Result<()> {
     let loaded = ridi::read_any(&sequence, None, &ReadOptions::default())?;
     let mut reports = Vec::new();
     for seq in &loaded.sequences {
-        let mut report = ridi::inspect::inspect(seq, loaded.format);
+        let mut report = ridi::inspect(seq, loaded.format);
         if json {
             // The reader's warnings (gaps, splits, dropped parts) belong to every part.
             report

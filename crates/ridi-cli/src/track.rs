@@ -4,8 +4,8 @@ use std::path::PathBuf;
 
 use anyhow::{Context, Result, bail};
 
+use ridi::ReadFiles;
 use ridi::data::{ReadOptions, shown};
-use ridi::source::ReadFiles;
 use ridi::{PipelineError, TrackOptions, TrackOutput, apply_orientation};
 
 use crate::{MAX_FRAMES_APART, count, non_negative, placement_smoothing, positive};

@@ -6,11 +6,11 @@ use anyhow::{Context, Result};
 use clap::ValueEnum;
 use indicatif::{ProgressBar, ProgressStyle};
 
+use ridi::ReadFiles;
 use ridi::data::{ListEntry, shown};
 use ridi::features::FeatureConfig;
 use ridi::frames::UpAxis;
 use ridi::regress::{Cascade, Nystrom, ProgressEvent, RegressError, Solver, Stage, Storage};
-use ridi::source::ReadFiles;
 use ridi::{
     GridChoice, Orientation, PipelineError, Purpose, TrainOptions, check_not_input,
     check_output_file,
@@ -179,9 +179,7 @@ pub(crate) fn run(args: Args) -> Result<()> {
         standardize: !args.no_standardize,
         turned_copies: args.turned_copies,
         features: FeatureConfig {
-            step: args
-                .step
-                .unwrap_or(ridi::train::default_step(args.turned_copies)),
+            step: args.step.unwrap_or(ridi::default_step(args.turned_copies)),
             window: args.window.unwrap_or(defaults.features.window),
             up_axis: args.up_axis.into(),
             orientation: args.orientation.into(),
@@ -248,5 +246,5 @@ pub(crate) fn with_progress(
 
 /// What the trained model is, as `ridi inspect` says it.
 pub(crate) fn print_training(model: &Cascade) {
-    out!("{}", ridi::inspect::inspect_model(model));
+    out!("{}", ridi::inspect_model(model));
 }

@@ -2,6 +2,16 @@
 
 use thiserror::Error;
 
+/// `v` to four significant digits, for a message: a step between two timestamps is
+/// `0.505` s, not `0.5050000000000008`.
+pub(crate) fn rounded(v: f64) -> f64 {
+    if v == 0.0 || !v.is_finite() {
+        return v;
+    }
+    let scale = 10f64.powi(3 - v.abs().log10().floor() as i32);
+    (v * scale).round() / scale
+}
+
 /// Why a batch correction (or an integration) was refused.
 ///
 /// Every check happens before any arithmetic, so an error never leaves a partly written result.
@@ -43,7 +53,7 @@ pub enum CorrectError {
         frame: usize,
     },
     /// The time step before `frame` exceeds the configured maximum.
-    #[error("gap of {dt} s before frame {frame} exceeds max_dt = {max_dt} s")]
+    #[error("gap of {} s before frame {frame} exceeds max_dt = {max_dt} s", rounded(*dt))]
     Gap {
         /// First frame after the gap.
         frame: usize,
@@ -114,5 +124,26 @@ impl From<ridi_frames::ImuError> for CorrectError {
             expected,
             found,
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_gap_is_printed_rounded() {
+        let e = CorrectError::Gap {
+            frame: 120,
+            dt: 0.5050000000000008,
+            max_dt: 0.1,
+        };
+        assert_eq!(
+            e.to_string(),
+            "gap of 0.505 s before frame 120 exceeds max_dt = 0.1 s"
+        );
+        assert_eq!(rounded(0.000123456), 0.0001235);
+        assert_eq!(rounded(1234.5678), 1235.0);
+        assert_eq!(rounded(0.0), 0.0);
     }
 }

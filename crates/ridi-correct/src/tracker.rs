@@ -120,7 +120,7 @@ pub enum TrackError {
         previous: f64,
     },
     /// The time step exceeds `max_dt` and the gap policy is [`GapPolicy::Reject`].
-    #[error("gap of {dt} s exceeds max_dt = {max_dt} s")]
+    #[error("gap of {} s exceeds max_dt = {max_dt} s", crate::error::rounded(*dt))]
     Gap {
         /// The step, seconds.
         dt: f64,

@@ -21,6 +21,10 @@
 //! | RoNIN sequence folder (`data.hdf5`, `info.json`) | [`ronin::read`] | |
 //! | dataset list file (`path,placement` per line) | [`ListEntry::read`], [`Listed`] | |
 //!
+//! Each format is a public module, the one kind of public module here: every format has its
+//! own `read` (and most a `parse` of bytes), so the module is the name (`tyrex::read`,
+//! `ronin::read`). Everything else is re-exported at the crate root from private modules.
+//!
 //! [`detect`] tells the format of a file or folder and [`read_sequence`] reads any of them
 //! (a Tyrex run only when it is not split into parts; it drops the reader's warnings, which
 //! [`tyrex::read`] returns). [`ReadOptions`] holds the validation limits and the

@@ -1,5 +1,5 @@
 //! The building blocks of an evaluation report: per-sequence metrics (serde, as `report.json`
-//! holds them), per-method means and markdown tables. `ridi::evaluate::Report` assembles them
+//! holds them), per-method means and markdown tables. `ridi::Report` assembles them
 //! into `report.json` and `report.md`. Method and sequence order is kept as given, so tables
 //! read in the order the pipeline ran things.
 

@@ -40,7 +40,7 @@ fn _ridi(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(evaluate::evaluate, m)?)?;
     let methods: Vec<&str> = ridi::Method::ALL.iter().map(|m| m.key()).collect();
     m.add("METHODS", pyo3::types::PyTuple::new(m.py(), methods)?)?;
-    m.add("RATE_HZ", ridi::track::RATE_HZ)?;
+    m.add("RATE_HZ", ridi::TRACK_RATE_HZ)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     Ok(())
 }

@@ -93,7 +93,7 @@ impl Model {
     /// What ``ridi inspect --json`` says of the model: placements, window, S, orientation,
     /// regressors, stored samples, cross-validation table.
     fn describe<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
-        let json = serde_json::to_string(&ridi::inspect::inspect_model(&self.inner))
+        let json = serde_json::to_string(&ridi::inspect_model(&self.inner))
             .map_err(|e| errors::value(e.to_string()))?;
         py.import("json")?.call_method1("loads", (json,))
     }
@@ -123,7 +123,7 @@ impl Model {
     }
 
     fn __str__(&self) -> String {
-        ridi::inspect::inspect_model(&self.inner).to_string()
+        ridi::inspect_model(&self.inner).to_string()
     }
 
     fn __repr__(&self) -> String {
@@ -291,7 +291,7 @@ pub(crate) fn train(
         features: FeatureConfig {
             step: match step {
                 Some(s) => options::count("step", s, 1, MAX_FRAMES_APART)?,
-                None => ridi::train::default_step(turned_copies),
+                None => ridi::default_step(turned_copies),
             },
             window: match window {
                 Some(w) => options::count("window", w, WINDOW_RANGE.0, WINDOW_RANGE.1)?,

@@ -210,7 +210,7 @@ pub(crate) fn regress(
     };
     let (seq, model) = (&sequence.get().inner, &model.get().inner);
     let (velocities, placements) = py
-        .detach(|| ridi::track::regress(seq, model, &opts))
+        .detach(|| ridi::regress_sequence(seq, model, &opts))
         .map_err(|e: PipelineError| {
             errors::pipeline_in(e, Some(format!("cannot regress {}", seq.name())))
         })?;

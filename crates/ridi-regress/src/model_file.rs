@@ -257,7 +257,12 @@ fn read_bounded(path: &Path) -> Result<Vec<u8>, RegressError> {
             },
         )))
     };
-    regular(std::fs::metadata(path).map_err(io_err(path))?)?;
+    let meta = std::fs::metadata(path).map_err(|e| match e.kind() {
+        // The kind kept (Python maps it to FileNotFoundError), the words the readers use.
+        std::io::ErrorKind::NotFound => std::io::Error::new(e.kind(), "no such file or folder"),
+        _ => e,
+    });
+    regular(meta.map_err(io_err(path))?)?;
     let mut file = std::fs::File::open(path).map_err(io_err(path))?;
     // Again of the file opened, whose size the header must match (the path may name another
     // file by now).

@@ -33,7 +33,7 @@ fn features(model: &Cascade, lists: &[PathBuf]) -> Result<Vec<f32>, Error> {
         seqs.extend(Listed::read(&[l], &ReadOptions::default())?.into_sequences());
     }
     let config = model.feature_config();
-    let mut data = ridi::train::training_data(&seqs, config)?;
+    let mut data = ridi::training_data(&seqs, config)?;
     if let Some(s) = &config.standardization {
         s.apply(&mut data.features)?;
     }

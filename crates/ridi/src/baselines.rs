@@ -124,7 +124,7 @@ fn mean_speed(seq: &Sequence) -> Result<f64> {
 /// The horizontal trajectory of `method` on `seq`, starting at the origin. `regressions` are
 /// the cascade's velocities at their frames (needed by the model-based methods); `config` is
 /// RIDI's correction.
-pub fn trajectory(
+pub fn baseline_trajectory(
     method: Method,
     seq: &Sequence,
     regressions: &[FrameVelocity],

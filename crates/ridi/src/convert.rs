@@ -48,7 +48,7 @@ pub struct ConvertOptions {
     /// How to read (validation limits).
     pub read: ReadOptions,
     /// Resample every sequence to this rate, Hz ([`Sequence::resampled`]), within
-    /// [`RATE_HZ`]; `None` keeps each sequence's timeline.
+    /// [`CONVERT_RATE_HZ`]; `None` keeps each sequence's timeline.
     ///
     /// [`Sequence::resampled`]: ridi_data::Sequence::resampled
     pub rate_hz: Option<f64>,
@@ -59,7 +59,7 @@ pub struct ConvertOptions {
 /// median step under 0.1 ms (`time_step_range`); a uniform timeline at exactly 1 Hz or
 /// 10 kHz lands on either side of those bounds once its times are added up in floating point
 /// and written as whole nanoseconds, so the range keeps 0.1 % from each.
-pub const RATE_HZ: (f64, f64) = (1.001, 9990.0);
+pub const CONVERT_RATE_HZ: (f64, f64) = (1.001, 9990.0);
 
 /// Longest gap `--rate` interpolates across, in frame intervals of the source: longer ones
 /// would be filled with invented frames, so the recording has to be split there first.

@@ -24,10 +24,11 @@ use ridi_features::{FeatureConfig, compute_targets};
 use ridi_regress::Cascade;
 use serde::{Deserialize, Deserializer, Serialize};
 
-use crate::baselines::{Method, trajectory};
+use crate::baselines::{Method, baseline_trajectory};
 use crate::error::{PipelineError, Result};
 use crate::orientation::oriented;
-use crate::track::{TrackOptions, check_trackable, regress};
+use crate::track::{check_trackable, regress_sequence};
+use crate::track_options::TrackOptions;
 use crate::train::ground_truth_view;
 
 /// What to evaluate and how.
@@ -144,7 +145,7 @@ fn evaluate_one(seq: &Sequence, model: &Cascade, opts: &EvalOptions) -> Result<E
         .ok_or_else(|| PipelineError::sequence(seq.name(), "has no ground truth to evaluate"))?;
     let gt2 = gt.horizontal();
     let (regressions, placements) = if opts.methods.iter().any(|m| m.needs_model()) {
-        regress(seq, model, &opts.track)?
+        regress_sequence(seq, model, &opts.track)?
     } else {
         Default::default()
     };
@@ -170,7 +171,7 @@ fn evaluate_one(seq: &Sequence, model: &Cascade, opts: &EvalOptions) -> Result<E
     let mut methods = BTreeMap::new();
     let mut traced = Vec::new();
     for &m in &opts.methods {
-        let est = trajectory(m, seq, &regressions, opts.track.correction_for(model))?;
+        let est = baseline_trajectory(m, seq, &regressions, opts.track.correction_for(model))?;
         let e = evaluate_trajectory(seq.time(), &est, &gt2, &opts.metrics)?;
         methods.insert(m.key().to_string(), e.metrics);
         traced.push((m, e.aligned));
@@ -368,7 +369,8 @@ type GroupKey = fn(&SequenceResult) -> Option<&str>;
 
 impl Report {
     /// The markdown report: overall summary, per placement, per device (when the sequences
-    /// name theirs), per sequence, velocity and placement results.
+    /// name theirs), per sequence, velocity and placement results. Control characters in names
+    /// are escaped (`\u{1b}`), as in messages.
     pub fn to_markdown(&self) -> String {
         let mut out = String::new();
         let _ = writeln!(out, "# RIDI evaluation\n");
@@ -501,7 +503,13 @@ impl Report {
             let _ = writeln!(out, "\n## Placement confusion (rows: truth)\n");
             out.push_str(&markdown_confusion(cm));
         }
-        out
+        // Names come from folders and list files: a control character in one (a terminal
+        // escape) is written escaped, as every message shows it, so that `cat report.md` cannot
+        // retitle or clear the terminal.
+        out.split('\n')
+            .map(ridi_data::shown)
+            .collect::<Vec<_>>()
+            .join("\n")
     }
 
     /// Reads a `report.json` that [`Report::write`] wrote.
@@ -666,5 +674,20 @@ mod tests {
         let json = serde_json::to_string(&r).unwrap();
         let back: Report = serde_json::from_str(&json).unwrap();
         assert_eq!(back.sequences[1].device.as_deref(), Some("iPhone 4S"));
+    }
+
+    #[test]
+    fn control_characters_of_names_are_escaped_in_the_markdown() {
+        let mut r = report(vec![result(
+            "esc\x1b]0;title\x07",
+            Some("dev\u{9b}2J"),
+            1.0,
+        )]);
+        r.warnings.push("placement of esc\x1b[2J".into());
+        let md = r.to_markdown();
+        assert!(!md.chars().any(|c| c.is_control() && c != '\n'), "{md:?}");
+        assert!(md.contains("esc\\u{1b}]0;title\\u{7}"), "{md}");
+        assert!(md.contains("dev\\u{9b}2J"), "{md}");
+        assert!(md.contains("esc\\u{1b}[2J"), "{md}");
     }
 }

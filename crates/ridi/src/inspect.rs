@@ -7,11 +7,11 @@ use ridi_regress::{Cascade, GridRow, Solver, StoredAs};
 use serde::Serialize;
 
 use crate::orientation::Orientation;
-use crate::track::{RATE_HZ, RATE_TOLERANCE};
+use crate::track::{TRACK_RATE_HZ, TRACK_RATE_TOLERANCE};
 
 /// Summary statistics of a scalar series.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
-pub struct Stats {
+pub struct SeriesStats {
     /// Mean.
     pub mean: f64,
     /// Standard deviation (population).
@@ -22,17 +22,17 @@ pub struct Stats {
     pub max: f64,
 }
 
-impl Stats {
+impl SeriesStats {
     /// Statistics of `values` (all zero when empty), in one pass (the sum, the extremes, and the sums of the
     /// differences from the first value and of their squares).
-    pub fn of(values: impl Iterator<Item = f64>) -> Stats {
+    pub fn of(values: impl Iterator<Item = f64>) -> SeriesStats {
         let mut sum = StatsSum::default();
         values.for_each(|v| sum.push(v));
         sum.stats()
     }
 }
 
-/// [`Stats`] summed one value at a time, so that a stream too long to hold has them: the sum,
+/// [`SeriesStats`] summed one value at a time, so that a stream too long to hold has them: the sum,
 /// the extremes, and the sums of the values' differences from the first and of their squares
 /// (shifted so that a small spread about a large mean keeps its digits).
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
@@ -60,9 +60,9 @@ impl StatsSum {
         self.dd += d * d;
     }
 
-    fn stats(&self) -> Stats {
+    fn stats(&self) -> SeriesStats {
         if self.n == 0 {
-            return Stats {
+            return SeriesStats {
                 mean: 0.0,
                 std: 0.0,
                 min: 0.0,
@@ -71,7 +71,7 @@ impl StatsSum {
         }
         let n = self.n as f64;
         let var = ((self.dd - self.d * self.d / n) / n).max(0.0);
-        Stats {
+        SeriesStats {
             mean: self.sum / n,
             std: var.sqrt(),
             min: self.min,
@@ -89,12 +89,12 @@ struct Summary {
     frames: usize,
     duration: f64,
     max_gap: f64,
-    /// The median rate, when it is off [`RATE_HZ`] by more than [`RATE_TOLERANCE`].
+    /// The median rate, when it is off [`TRACK_RATE_HZ`] by more than [`TRACK_RATE_TOLERANCE`].
     rate_off: Option<f64>,
     orientation_source: Option<ridi_data::OrientationSource>,
-    gravity_norm: Stats,
+    gravity_norm: SeriesStats,
     upside_down: usize,
-    acce_norm: Stats,
+    acce_norm: SeriesStats,
     has_magnet: bool,
     has_steps: bool,
     has_ground_truth: bool,
@@ -192,12 +192,12 @@ pub struct Inspection {
     /// Where the device orientation comes from.
     pub orientation_source: Option<String>,
     /// Gravity magnitude, m/s^2.
-    pub gravity_norm: Stats,
+    pub gravity_norm: SeriesStats,
     /// Fraction of frames with the phone upside down ([`UpAxis::is_upside_down`]), where the
     /// paper's S is ill-conditioned.
     pub upside_down_fraction: f64,
     /// Accelerometer magnitude, m/s^2.
-    pub acce_norm: Stats,
+    pub acce_norm: SeriesStats,
     /// Whether a magnetometer stream is present.
     pub has_magnet: bool,
     /// Whether a step counter is present.
@@ -214,7 +214,7 @@ pub struct Inspection {
 /// Inspects `seq`, read as `format`.
 pub fn inspect(seq: &Sequence, format: Format) -> Inspection {
     let median_rate = seq.median_rate_hz();
-    let off = (median_rate - RATE_HZ).abs() > RATE_TOLERANCE * RATE_HZ;
+    let off = (median_rate - TRACK_RATE_HZ).abs() > TRACK_RATE_TOLERANCE * TRACK_RATE_HZ;
     report(Summary {
         format,
         name: seq.name().to_string(),
@@ -225,13 +225,13 @@ pub fn inspect(seq: &Sequence, format: Format) -> Inspection {
         max_gap: seq.max_gap(),
         rate_off: (seq.len() >= 2 && off).then_some(median_rate),
         orientation_source: seq.orientation_source(),
-        gravity_norm: Stats::of(seq.gravity().iter().map(|g| g.norm())),
+        gravity_norm: SeriesStats::of(seq.gravity().iter().map(|g| g.norm())),
         upside_down: seq
             .gravity()
             .iter()
             .filter(|&&g| UpAxis::is_upside_down(g))
             .count(),
-        acce_norm: Stats::of(seq.acce().iter().map(|a| a.norm())),
+        acce_norm: SeriesStats::of(seq.acce().iter().map(|a| a.norm())),
         has_magnet: seq.magnet().is_some(),
         has_steps: seq.steps().is_some(),
         has_ground_truth: seq.ground_truth().is_some(),
@@ -258,8 +258,8 @@ fn report(s: Summary) -> Inspection {
     } else if let Some(median_rate) = s.rate_off {
         warnings.push(format!(
             "rate {median_rate:.1} Hz (median frame interval): train, track and eval need \
-             {RATE_HZ} Hz (within {:.0} %)",
-            RATE_TOLERANCE * 100.0
+             {TRACK_RATE_HZ} Hz (within {:.0} %)",
+            TRACK_RATE_TOLERANCE * 100.0
         ));
     }
     if (2..=window).contains(&s.frames) {
@@ -453,29 +453,29 @@ pub struct PlacementModel {
     /// Training samples the model keeps for it (a Nyström model: its regressors' landmarks).
     pub samples: usize,
     /// The S-x regressor.
-    pub s_x: Regressor,
+    pub s_x: RegressorSummary,
     /// The S-z regressor.
-    pub s_z: Regressor,
+    pub s_z: RegressorSummary,
     /// The speed regressor, if the model has one.
-    pub speed: Option<Regressor>,
+    pub speed: Option<RegressorSummary>,
 }
 
 /// Hyper-parameters of one epsilon-SVR ([`PlacementModel`]).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
-pub struct Regressor {
+pub struct RegressorSummary {
     /// `C`.
     pub c: f64,
     /// Epsilon, m/s.
     pub epsilon: f64,
 }
 
-impl From<(f64, f64)> for Regressor {
+impl From<(f64, f64)> for RegressorSummary {
     fn from((c, epsilon): (f64, f64)) -> Self {
-        Regressor { c, epsilon }
+        RegressorSummary { c, epsilon }
     }
 }
 
-impl std::fmt::Display for Regressor {
+impl std::fmt::Display for RegressorSummary {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         write!(f, "C={} eps={}", self.c, self.epsilon)
     }
@@ -500,7 +500,7 @@ pub fn inspect_model(model: &Cascade) -> ModelInspection {
                 samples: model.stored_samples(p),
                 s_x: x.into(),
                 s_z: z.into(),
-                speed: model.speed_params(p).map(Regressor::from),
+                speed: model.speed_params(p).map(RegressorSummary::from),
             }
         })
         .collect();

@@ -11,12 +11,16 @@
 //! | [`correct`] | `ridi-correct` | bias correction, integration, streaming tracker |
 //! | [`eval`] | `ridi-eval` | alignment, MPE/ATE/RTE, reports |
 //!
-//! Pipeline modules: [`source`] reads any supported layout, [`convert`] writes the RIDI
-//! layout with list files (all or nothing, through [`Staging`]), [`load_listed`] reads the
-//! sequences of list files for training and evaluation with the labels they need, [`inspect`]
-//! summarizes a recording or a model, [`orientation`] swaps in an orientation estimated from gyro and accelerometer, [`live`]
-//! tracks a stream sample by sample, [`Demo`] is `ridi demo` (train on a sample, evaluate on
-//! its held-out runs, write both).
+//! The pipeline, every item at the crate root (its modules are private, so each item has one
+//! path): [`read_any`] reads any supported layout, [`convert()`] writes the RIDI layout with
+//! list files (all or nothing, through [`Staging`]), [`load_listed`] reads the sequences of
+//! list files for training and evaluation with the labels they need, [`inspect()`] and
+//! [`inspect_model`] summarize a recording or a model, [`oriented`] swaps in an orientation
+//! estimated from gyro and accelerometer, [`train()`], [`track()`] and [`evaluate()`] are the
+//! three stages, [`LiveTracker`] tracks a stream sample by sample, [`Demo`] is `ridi demo`
+//! (train on a sample, evaluate on its held-out runs, write both). The one public module is
+//! `plot` (feature `plot`, on by default): figures are an optional sub-API with its own
+//! error type.
 //!
 //! # Design decisions
 //!
@@ -75,45 +79,57 @@ pub use ridi_features as features;
 pub use ridi_frames as frames;
 pub use ridi_regress as regress;
 
-pub mod baselines;
+mod baselines;
 #[cfg(feature = "bundled-model")]
 mod bundled;
-pub mod convert;
+mod convert;
 mod demo;
 mod error;
-pub mod evaluate;
-pub mod inspect;
+mod evaluate;
+mod inspect;
 mod lists;
-pub mod live;
-pub mod orientation;
+mod live;
+mod orientation;
 mod output;
-pub mod placement;
+mod placement;
 #[cfg(feature = "plot")]
 pub mod plot;
-pub mod source;
+mod source;
 mod staging;
-pub mod track;
+mod track;
 mod track_options;
-pub mod train;
+mod train;
 
-pub use baselines::Method;
+pub use baselines::{Method, baseline_trajectory, device_heading};
 #[cfg(feature = "bundled-model")]
 pub use bundled::{BUNDLED_MODEL_SUMMARY, bundled_model};
+pub use convert::{CONVERT_RATE_HZ, ConvertOptions, ConvertSummary, Converted, convert};
 pub use demo::Demo;
 pub use error::{PipelineError, Result};
-pub use evaluate::{EvalOptions, Report, evaluate};
+pub use evaluate::{
+    EvalOptions, Report, SequenceResult, Traces, check_evaluable, evaluate, placement_warnings,
+};
+pub use inspect::{
+    Inspection, ModelInspection, PlacementModel, RegressorSummary, SeriesStats, inspect,
+    inspect_model, inspect_stream,
+};
 pub use lists::{Purpose, load_listed};
-pub use live::{LiveTracker, Recorded, SensorReading};
-pub use orientation::{Orientation, apply_orientation, oriented};
+pub use live::{CascadeRegressor, LiveTracker, Recorded, SensorReading};
+pub use orientation::{Orientation, apply_orientation, oriented, with_estimated_orientation};
 pub use output::{
     EvalFolder, EvalPlots, EvalWritten, OutputError, TrackOutput, check_not_input,
     check_output_file, check_output_folder, save_model,
 };
 pub use placement::PlacementMap;
-pub use source::{Loaded, read_any};
+pub use source::{Loaded, ReadFiles, read_any};
 pub use staging::Staging;
-pub use track::{Track, TrackOptions, track};
-pub use train::{GridChoice, TrainOptions, train};
+pub use track::{
+    StreamedTrack, TRACK_RATE_HZ, TRACK_RATE_TOLERANCE, Track, regress_sequence, track,
+};
+pub use track_options::TrackOptions;
+pub use train::{
+    GridChoice, TrainOptions, TrainingData, default_step, ground_truth_view, train, training_data,
+};
 
 /// The README's Rust example, compiled by `cargo test --doc` so that it cannot drift from the API.
 #[cfg(doctest)]

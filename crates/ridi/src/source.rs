@@ -132,7 +132,7 @@ impl ReadFiles {
 
 /// `path` with its folder resolved (links, `..`), whether or not the file exists yet; `None`
 /// when its folder does not exist.
-pub fn resolved(path: &Path) -> Option<PathBuf> {
+pub(crate) fn resolved(path: &Path) -> Option<PathBuf> {
     if let Ok(p) = path.canonicalize() {
         return Some(p);
     }
@@ -140,7 +140,7 @@ pub fn resolved(path: &Path) -> Option<PathBuf> {
 }
 
 /// The folder a file path is in (`.` for a bare file name).
-pub fn folder_of(path: &Path) -> &Path {
+pub(crate) fn folder_of(path: &Path) -> &Path {
     match path.parent() {
         Some(p) if !p.as_os_str().is_empty() => p,
         _ => Path::new("."),

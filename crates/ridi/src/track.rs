@@ -14,7 +14,7 @@ use crate::error::{PipelineError, Result};
 use crate::live::{LiveTracker, SensorReading};
 use crate::orientation::oriented;
 
-pub use crate::track_options::TrackOptions;
+use crate::track_options::TrackOptions;
 
 /// A tracked sequence: one pose per frame, plus what produced it.
 #[derive(Debug, Clone, PartialEq)]
@@ -144,7 +144,7 @@ fn csv_row(
 /// the placement it was regressed for: a cascade [`Prediction`](ridi_regress::Prediction) at a
 /// frame, kept as the two things its users take apart ([`Track::regressions`] and
 /// [`Track::placements`]).
-pub fn regress(
+pub fn regress_sequence(
     seq: &Sequence,
     model: &Cascade,
     opts: &TrackOptions,
@@ -245,15 +245,15 @@ fn gap_error(name: &str, i: usize, t: (f64, f64), t0: f64, max_dt: f64) -> Pipel
 
 /// The IMU rate every model assumes: feature windows, sample steps, regressions and
 /// correction knots are all counted in frames of a 200 Hz stream.
-pub const RATE_HZ: f64 = 200.0;
+pub const TRACK_RATE_HZ: f64 = 200.0;
 
-/// How far a sequence's mean rate may be from [`RATE_HZ`], as a fraction, for training,
+/// How far a sequence's mean rate may be from [`TRACK_RATE_HZ`], as a fraction, for training,
 /// tracking and evaluation (Android's fastest sensor rate varies by a few percent between
 /// phones; half or twice the rate would make a one-second window half or two seconds long).
-pub const RATE_TOLERANCE: f64 = 0.1;
+pub const TRACK_RATE_TOLERANCE: f64 = 0.1;
 
 /// Refuses a sequence whose frames do not fit the model's frame counts: a rate (one over the
-/// median frame interval, so that gaps do not count) outside [`RATE_HZ`] ± [`RATE_TOLERANCE`],
+/// median frame interval, so that gaps do not count) outside [`TRACK_RATE_HZ`] ± [`TRACK_RATE_TOLERANCE`],
 /// or no frame with a whole feature window before it (the trajectory would be plain double
 /// integration, and its metrics meaningless).
 pub(crate) fn check_frames(seq: &Sequence, config: &FeatureConfig) -> Result<()> {
@@ -262,7 +262,7 @@ pub(crate) fn check_frames(seq: &Sequence, config: &FeatureConfig) -> Result<()>
         return Err(too_short(seq.name(), n, seq.duration(), config));
     }
     let rate = seq.median_rate_hz();
-    if (rate - RATE_HZ).abs() > RATE_TOLERANCE * RATE_HZ {
+    if (rate - TRACK_RATE_HZ).abs() > TRACK_RATE_TOLERANCE * TRACK_RATE_HZ {
         return Err(wrong_rate(seq.name(), rate));
     }
     Ok(())
@@ -274,9 +274,9 @@ fn too_short(name: &str, n: usize, duration: f64, config: &FeatureConfig) -> Pip
         name,
         format!(
             "has {n} frames ({duration:.2} s): no velocity can be regressed before a whole \
-             feature window of {} frames ({:.1} s at {RATE_HZ} Hz)",
+             feature window of {} frames ({:.1} s at {TRACK_RATE_HZ} Hz)",
             config.window,
-            config.window as f64 / RATE_HZ
+            config.window as f64 / TRACK_RATE_HZ
         ),
     )
 }
@@ -287,19 +287,19 @@ fn wrong_rate(name: &str, rate: f64) -> PipelineError {
         name,
         format!(
             "has a rate of {rate:.1} Hz (median frame interval); models count windows and \
-             knots in frames of a {RATE_HZ} Hz stream (within {:.0} %): resample it with \
-             `ridi convert <recording> --out <folder> --rate {RATE_HZ}`",
-            RATE_TOLERANCE * 100.0
+             knots in frames of a {TRACK_RATE_HZ} Hz stream (within {:.0} %): resample it with \
+             `ridi convert <recording> --out <folder> --rate {TRACK_RATE_HZ}`",
+            TRACK_RATE_TOLERANCE * 100.0
         ),
     )
 }
 
 /// Counts a frame `interval` (seconds) towards the median rate [`check_frames`] judges:
-/// `low`, a rate above [`RATE_HZ`] beyond the tolerance, holds for short intervals, `high` for
+/// `low`, a rate above [`TRACK_RATE_HZ`] beyond the tolerance, holds for short intervals, `high` for
 /// long ones.
 pub(crate) fn count_rate(test: &mut ridi_data::MedianTest, interval: f64) {
-    let off = 1.0 / interval - RATE_HZ;
-    let tolerance = RATE_TOLERANCE * RATE_HZ;
+    let off = 1.0 / interval - TRACK_RATE_HZ;
+    let tolerance = TRACK_RATE_TOLERANCE * TRACK_RATE_HZ;
     test.push(off > tolerance, -off > tolerance);
 }
 
@@ -324,7 +324,7 @@ pub(crate) fn check_trackable(seq: &Sequence, config: &FeatureConfig, max_dt: f6
 /// Tracks `seq` with `model`, in the orientation the model was trained with ([`oriented`]).
 ///
 /// # Errors
-/// Besides the stages' own: a sequence at another rate than [`RATE_HZ`] (± [`RATE_TOLERANCE`]),
+/// Besides the stages' own: a sequence at another rate than [`TRACK_RATE_HZ`] (± [`TRACK_RATE_TOLERANCE`]),
 /// shorter than one feature window, or with a gap longer than the correction's `max_dt`.
 pub fn track(seq: &Sequence, model: &Cascade, opts: &TrackOptions) -> Result<Track> {
     check_trackable(seq, model.feature_config(), opts.correction.max_dt)?;
@@ -338,7 +338,7 @@ pub fn track(seq: &Sequence, model: &Cascade, opts: &TrackOptions) -> Result<Tra
     }
     let seq = oriented(seq, model.feature_config().orientation)?;
     let seq = seq.as_ref();
-    let (regressions, placements) = regress(seq, model, opts)?;
+    let (regressions, placements) = regress_sequence(seq, model, opts)?;
     correct_with(
         seq,
         regressions,

@@ -3,11 +3,11 @@
 
 use std::path::{Path, PathBuf};
 
-use ridi::convert::{ConvertOptions, convert};
 use ridi::data::{
     Format, GroundTruth, ReadOptions, Sequence, SequenceError, SequenceParts, read_sequence,
     write_ridi_csv, write_ridi_plain,
 };
+use ridi::{ConvertOptions, convert};
 use ridi_test_support::{file_names, sample_dataset};
 
 fn seq(name: &str) -> PathBuf {
@@ -419,7 +419,7 @@ fn devices_are_kept_with_one_list_per_device() {
     assert_eq!(c.device.as_ref().unwrap().model(), "Nexus 5");
 
     // `ridi inspect` names the device and its rate.
-    let report = ridi::inspect::inspect(&back, Format::RidiCsv);
+    let report = ridi::inspect(&back, Format::RidiCsv);
     assert_eq!(report.device.as_deref(), Some("iPhone 4S"));
     assert_eq!(report.device_imu_rate_hz, Some(90.2));
     let text = report.to_string();
@@ -427,7 +427,7 @@ fn devices_are_kept_with_one_list_per_device() {
         text.contains("device:       iPhone 4S, IMU at 90.2 Hz (this sequence: 200 Hz)\n"),
         "{text}"
     );
-    let text = ridi::inspect::inspect(&walk, Format::RidiCsv).to_string();
+    let text = ridi::inspect(&walk, Format::RidiCsv).to_string();
     assert!(text.contains("device:       (unknown)\n"), "{text}");
 
     // Converted again without its device, a sequence loses the old sidecar with its old data.
@@ -489,11 +489,11 @@ fn tyrex_runs_without_motion_capture_are_skipped_or_converted_with_a_warning() {
     tyrex_run(&android.join("Ann_Nexus5_NoDist_AR"), 12.0);
     for from in [None, Some(ridi::data::Format::Tyrex)] {
         let out = tmp.path().join(format!("out-{}", from.is_some()));
-        let opts = ridi::convert::ConvertOptions {
+        let opts = ridi::ConvertOptions {
             from,
             ..Default::default()
         };
-        let summary = ridi::convert::convert(&tmp.path().join("tyrex"), &out, &opts).unwrap();
+        let summary = ridi::convert(&tmp.path().join("tyrex"), &out, &opts).unwrap();
         assert_eq!(summary.sequences.len(), 2, "{from:?}");
         assert!(
             summary

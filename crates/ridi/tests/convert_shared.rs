@@ -15,11 +15,11 @@ fn the_whole_tyrex_root_converts_with_one_list_per_person_and_device() {
     let out = tempfile::tempdir().unwrap();
     let started = std::time::Instant::now();
     // As `ridi convert --from tyrex <root>`.
-    let opts = ridi::convert::ConvertOptions {
+    let opts = ridi::ConvertOptions {
         from: Some(ridi::data::Format::Tyrex),
         ..Default::default()
     };
-    let summary = ridi::convert::convert(&root, out.path(), &opts).unwrap();
+    let summary = ridi::convert(&root, out.path(), &opts).unwrap();
     eprintln!(
         "{} sequences converted in {:.1?}",
         summary.sequences.len(),
@@ -119,7 +119,7 @@ fn the_whole_tyrex_root_converts_with_one_list_per_person_and_device() {
 fn indoor_location_competition_paths_convert_with_the_hand_placement() {
     let root = shared_dataset("indoor-location-competition-20", "data");
     let out = tempfile::tempdir().unwrap();
-    let summary = ridi::convert::convert(&root, out.path(), &Default::default()).unwrap();
+    let summary = ridi::convert(&root, out.path(), &Default::default()).unwrap();
     assert_eq!(summary.sequences.len(), 12);
     assert!(summary.warnings.is_empty(), "{:?}", summary.warnings);
     let all = ListEntry::read(&[out.path().join("list_all.txt")]).unwrap();

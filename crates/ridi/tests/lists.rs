@@ -255,7 +255,7 @@ fn labels_the_model_does_not_know_are_a_warning_in_the_report() {
     let test = load(&[&t], Some(&tyrex4), Purpose::Evaluation).unwrap();
     let want = "placement `swing` of Thibaud_Nexus5_NoDist_Swinging is not one of the model's \
                 classes (hand, pocket): its placement accuracy is 0";
-    assert_eq!(ridi::evaluate::placement_warnings(&test, &model), [want]);
+    assert_eq!(ridi::placement_warnings(&test, &model), [want]);
     let opts = EvalOptions {
         methods: vec![Method::Ridi],
         ..EvalOptions::default()

@@ -1,11 +1,11 @@
 //! End to end on the bundled sample: train, track (batch and online), evaluate.
 
+use ridi::CascadeRegressor;
 use ridi::correct::{Tracker, TrackerConfig};
 use ridi::data::{Listed, ReadOptions, Sequence};
 use ridi::frames::ImuSample;
 use ridi::frames::nalgebra::Vector3;
 use ridi::frames::{DeviceVec, Rot, UpAxis};
-use ridi::live::CascadeRegressor;
 use ridi::regress::{Cascade, NoProgress};
 use ridi::{
     EvalOptions, GridChoice, LiveTracker, Method, Orientation, PlacementMap, SensorReading,
@@ -208,8 +208,8 @@ fn placement_smoothing_takes_the_window_majority_and_its_regressors() {
         };
         let on = TrackOptions::default();
         let smoother = on.placement_smoothing.unwrap();
-        let (raw, raw_p) = ridi::track::regress(seq, &model, &off).unwrap();
-        let (smoothed, smoothed_p) = ridi::track::regress(seq, &model, &on).unwrap();
+        let (raw, raw_p) = ridi::regress_sequence(seq, &model, &off).unwrap();
+        let (smoothed, smoothed_p) = ridi::regress_sequence(seq, &model, &on).unwrap();
         let times: Vec<f64> = raw.iter().map(|r| seq.time()[r.frame]).collect();
         let want = smoother.smooth(&times, &raw_p, model.placements().len());
         assert_eq!(raw.len(), smoothed.len());
@@ -330,7 +330,7 @@ fn training_without_labels_or_ground_truth_names_the_sequence() {
 fn turned_copies_repeat_labels_and_groups_and_keep_speeds() {
     let seqs = load("list_train.txt");
     let config = ridi::features::FeatureConfig::default();
-    let data = ridi::train::training_data(&seqs[..3], &config).unwrap();
+    let data = ridi::training_data(&seqs[..3], &config).unwrap();
     let n = data.targets.len();
     let turned = data.clone().with_turned_copies(2).unwrap();
     assert_eq!(turned.features.rows(), 3 * n);
@@ -394,8 +394,8 @@ fn a_phone_carried_top_down_is_tracked_like_the_upright_one() {
     );
     // PDR's heading too.
     let (a, b) = (
-        ridi::baselines::device_heading(&upright),
-        ridi::baselines::device_heading(&top_down),
+        ridi::device_heading(&upright),
+        ridi::device_heading(&top_down),
     );
     for (x, y) in a.iter().zip(&b) {
         let d =
@@ -698,7 +698,7 @@ fn another_rate_or_less_than_a_window_is_refused_by_name() {
     let gappy = Sequence::new(p).unwrap();
     assert!(gappy.rate_hz() < 170.0 && (gappy.median_rate_hz() - 200.0).abs() < 0.1);
     let features = TrainOptions::default().features;
-    assert!(ridi::train::training_data(std::slice::from_ref(&gappy), &features).is_ok());
+    assert!(ridi::training_data(std::slice::from_ref(&gappy), &features).is_ok());
     let err = ridi::track(&gappy, &model, &opts).unwrap_err().to_string();
     assert!(err.contains("a gap of 0.905 s"), "{err}");
 
