@@ -71,7 +71,8 @@ fn time_ns(seq: &Sequence, i: usize) -> i64 {
 /// trajectories, the models the `ridi` library and command write, and every file of a staged
 /// output folder. [`write_pending`] is the same write in two steps, for a file that is to be
 /// renamed into place only once another is written too. (`ridi_regress::Cascade::save`, for
-/// users of that crate alone, which cannot depend on this one, writes its own temporary file.)
+/// users of that crate alone, which cannot depend on this one, writes its own temporary file,
+/// with the same mode.)
 ///
 /// # Permissions
 ///

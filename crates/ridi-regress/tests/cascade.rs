@@ -255,6 +255,14 @@ fn training_is_deterministic_and_model_files_round_trip() {
     let path = dir.join("model.ridi");
     a.save(&path).unwrap();
     assert_eq!(Cascade::load(&path).unwrap(), a);
+    // The mode every file of the project gets (0644 less the umask, which is at most 022 here).
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::PermissionsExt as _;
+        let mode = std::fs::metadata(&path).unwrap().permissions().mode() & 0o777;
+        assert_eq!(mode & !0o022, 0o644 & !0o022, "mode {mode:o}");
+        assert_eq!(mode & 0o133, 0, "mode {mode:o}: nothing beyond 0644");
+    }
     assert_eq!(
         std::fs::read_dir(&dir).unwrap().count(),
         1,
