@@ -1,9 +1,10 @@
 #!/bin/sh
-# Peak resident memory of `ridi track --online` and `ridi inspect` on long synthetic
-# recordings (docs/benchmarks.md, "Memory of long recordings").
+# Peak resident memory of `ridi track --online` (with and without a plot) and `ridi inspect` on
+# long synthetic recordings, a RIDI data.csv and a raw folder (docs/benchmarks.md, "Memory of
+# long recordings").
 # Usage: benchmarks/memory.sh [RIDI_BINARY] [ROWS...]
 # Defaults: target/release/ridi (cargo build --release -p ridi-cli), 1000000 and 10000000 rows.
-# Needs python3 and GNU time (/usr/bin/time); writes up to 1.2 GB into a temporary folder.
+# Needs python3 and GNU time (/usr/bin/time); writes up to 3.1 GB into a temporary folder.
 set -eu
 here=$(cd "$(dirname "$0")" && pwd)
 ridi=${1:-$here/../target/release/ridi}
@@ -18,8 +19,16 @@ printf '%s,Swinging\n%s,Texting\n' "$sample/Jakob_Nexus5_NoDist_Swinging" \
 "$ridi" train --list "$tmp/list.txt" --out "$tmp/m.ridi" --grid none > /dev/null
 for n in $rows; do
     python3 "$here/long_recording.py" "$n" "$tmp/long.csv"
-    /usr/bin/time -f "$n rows: inspect peak %M KiB, %e s" "$ridi" inspect "$tmp/long.csv" > /dev/null
-    /usr/bin/time -f "$n rows: track --online peak %M KiB, %e s" \
-        "$ridi" track "$tmp/long.csv" --model "$tmp/m.ridi" --online --out "$tmp/t.csv" > /dev/null
-    rm -f "$tmp/long.csv" "$tmp/t.csv"
+    python3 "$here/long_recording.py" --raw "$n" "$tmp/raw"
+    for source in long.csv raw; do
+        /usr/bin/time -f "$n rows, $source: inspect peak %M KiB, %e s" \
+            "$ridi" inspect "$tmp/$source" > /dev/null
+        /usr/bin/time -f "$n rows, $source: track --online peak %M KiB, %e s" \
+            "$ridi" track "$tmp/$source" --model "$tmp/m.ridi" --online --out "$tmp/t.csv" \
+            > /dev/null
+        /usr/bin/time -f "$n rows, $source: track --online --plot peak %M KiB, %e s" \
+            "$ridi" track "$tmp/$source" --model "$tmp/m.ridi" --online --out "$tmp/t.csv" \
+            --plot "$tmp/t.png" > /dev/null
+    done
+    rm -rf "$tmp/long.csv" "$tmp/raw" "$tmp/t.csv" "$tmp/t.png"
 done

@@ -58,12 +58,9 @@ pub(crate) fn run(args: Args) -> Result<()> {
     }
     let model = crate::model_or_bundled(args.model.as_deref())?;
     let opts = track_options(&args);
-    // Online without a plot, a recording that streams is tracked as it is read, in memory that
-    // does not grow with its length; a plot needs the whole trajectory.
-    if args.online
-        && args.plot.is_none()
-        && ridi::data::detect(&args.sequence).is_ok_and(|f| f.streams())
-    {
+    // Online, a recording that streams is tracked as it is read, in memory that does not grow
+    // with its length but for a plot's points.
+    if args.online && ridi::data::detect(&args.sequence).is_ok_and(|f| f.streams()) {
         let rows = ridi::data::RowReader::open(&args.sequence, &ReadOptions::default())?;
         let track = output
             .write_stream(rows, &model, &opts)
@@ -72,14 +69,7 @@ pub(crate) fn run(args: Args) -> Result<()> {
                 e => anyhow::Error::from(e)
                     .context(format!("cannot track {}", shown(&args.sequence))),
             })?;
-        let n = track.regressions;
-        outln!(
-            "{}: {} frames, {n} regression{} -> {}",
-            shown(&track.name),
-            track.frames,
-            if n == 1 { "" } else { "s" },
-            shown(&args.out)
-        );
+        print_tracked(&args, &track.name, track.frames, track.regressions);
         return Ok(());
     }
     let mut loaded = ridi::read_any(&args.sequence, None, &ReadOptions::default())?;
@@ -98,18 +88,21 @@ pub(crate) fn run(args: Args) -> Result<()> {
     let track = ridi::track(seq, &model, &opts)
         .with_context(|| format!("cannot track {}", shown(&args.sequence)))?;
     output.write(seq, &track)?;
-    let n = track.regressions.len();
+    print_tracked(&args, seq.name(), track.time.len(), track.regressions.len());
+    Ok(())
+}
+
+/// Prints what was tracked, `frames` frames of `name` with `n` regressions, and where it went.
+fn print_tracked(args: &Args, name: &str, frames: usize, n: usize) {
     outln!(
-        "{}: {} frames, {n} regression{} -> {}",
-        shown(seq.name()),
-        track.time.len(),
+        "{}: {frames} frames, {n} regression{} -> {}",
+        shown(name),
         if n == 1 { "" } else { "s" },
         shown(&args.out)
     );
     if let Some(plot) = &args.plot {
         outln!("plot: {}", shown(plot));
     }
-    Ok(())
 }
 
 /// The tracking options `args` ask for.

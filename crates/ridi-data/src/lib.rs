@@ -30,9 +30,9 @@
 //! [`tyrex::read`] returns). [`ReadOptions`] holds the validation limits and the
 //! raw synchronization settings.
 //!
-//! [`RowReader`] reads a RIDI `data.csv` or `data_plain.txt` row by row, in memory that does not
-//! grow with the recording, with the same checks and errors as the whole-file readers
-//! ([`Format::streams`] says which formats stream).
+//! [`RowReader`] reads a RIDI `data.csv`, `data_plain.txt` or raw folder row by row, in memory
+//! that does not grow with the recording, with the same rows, checks and errors as the
+//! whole-file readers ([`Format::streams`] says which formats stream).
 //!
 //! Conventions at the file edges: time is nanoseconds in files and seconds (absolute, `f64`)
 //! in a [`Sequence`]; quaternions are `w, x, y, z` in processed files and `x, y, z, w` in raw

@@ -1,10 +1,79 @@
 //! Resampling onto a timeline: linear interpolation for vectors and scalars, slerp for
-//! rotations. Outside the source span values are held at the nearest end.
+//! rotations. Outside the source span values are held at the nearest end. [`Interpolator`]
+//! does it on a stream of samples (a raw folder read row by row); the slice functions are it
+//! on samples in memory, so that both give the same bits.
+
+use std::convert::Infallible;
 
 use ridi_frames::{Frame, Rot, Vec3};
 
+/// Interpolates a stream of samples (strictly increasing times) at non-decreasing times,
+/// blending the two neighbours of a time with a `mix(a, b, t)` ([`lerp_scalar`],
+/// [`lerp_vec3`], [`slerp`]); before the first sample the first is held, from the last on
+/// the last. Holds two samples: memory does not grow with the stream. `E` is the error a
+/// sample of the stream may be instead.
+pub(crate) struct Interpolator<T, I> {
+    samples: I,
+    /// The first sample.
+    first: (f64, T),
+    /// Time of the last sample.
+    last_time: f64,
+    /// The latest sample before the latest time asked for, and the one after it (none once
+    /// the stream ended).
+    before: (f64, T),
+    after: Option<(f64, T)>,
+}
+
+impl<T: Clone, E, I: Iterator<Item = Result<(f64, T), E>>> Interpolator<T, I> {
+    /// The interpolator of the sample `first` and the `rest` after it; the last sample is at
+    /// `last_time`.
+    pub(crate) fn new(first: (f64, T), mut rest: I, last_time: f64) -> Result<Self, E> {
+        let after = rest.next().transpose()?;
+        Ok(Self {
+            samples: rest,
+            first: first.clone(),
+            last_time,
+            before: first,
+            after,
+        })
+    }
+
+    /// Moves on by one sample.
+    fn advance(&mut self) -> Result<(), E> {
+        if let Some(next) = self.after.take() {
+            self.before = next;
+            self.after = self.samples.next().transpose()?;
+        }
+        Ok(())
+    }
+
+    /// The value at `t`, not before the time of the previous call.
+    pub(crate) fn at(&mut self, t: f64, mix: impl Fn(&T, &T, f64) -> T) -> Result<T, E> {
+        if t <= self.first.0 {
+            return Ok(self.first.1.clone());
+        }
+        if t >= self.last_time {
+            while self.after.is_some() {
+                self.advance()?;
+            }
+            return Ok(self.before.1.clone());
+        }
+        while self.after.as_ref().is_some_and(|a| a.0 < t) {
+            self.advance()?;
+        }
+        let (t0, a) = &self.before;
+        Ok(match &self.after {
+            Some((t1, b)) => mix(a, b, (t - t0) / (t1 - t0)),
+            // The stream ended before `last_time` said it would (a file that changed since it
+            // was first read): its last sample is held.
+            None => a.clone(),
+        })
+    }
+}
+
 /// Interpolates `src` (sampled at strictly increasing `src_t`) at each time of `dst_t`
-/// (non-decreasing), blending neighbours with `mix(a, b, t)`. Linear in `src.len() + dst_t.len()`.
+/// (non-decreasing), blending neighbours with `mix(a, b, t)`: an [`Interpolator`] over the
+/// slices. Linear in `src.len() + dst_t.len()`.
 ///
 /// # Panics
 /// When `src` is empty or its length differs from `src_t`'s.
@@ -16,29 +85,38 @@ pub(crate) fn interpolate_with<T: Clone>(
 ) -> Vec<T> {
     assert_eq!(src_t.len(), src.len(), "times and values differ in length");
     assert!(!src.is_empty(), "nothing to interpolate from");
-    let last = src.len() - 1;
-    let mut j = 0;
+    let mut samples = src_t.iter().copied().zip(src.iter().cloned());
+    let first = (src_t[0], src[0].clone());
+    samples.next();
+    let last_time = src_t[src.len() - 1];
+    let Ok(mut at) = Interpolator::new(first, samples.map(Ok::<_, Infallible>), last_time);
     dst_t
         .iter()
         .map(|&t| {
-            if t <= src_t[0] {
-                return src[0].clone();
-            }
-            if t >= src_t[last] {
-                return src[last].clone();
-            }
-            while src_t[j + 1] < t {
-                j += 1;
-            }
-            let (t0, t1) = (src_t[j], src_t[j + 1]);
-            mix(&src[j], &src[j + 1], (t - t0) / (t1 - t0))
+            let Ok(v) = at.at(t, &mix);
+            v
         })
         .collect()
 }
 
+/// Linear interpolation between two scalars.
+pub(crate) fn lerp_scalar(a: &f64, b: &f64, t: f64) -> f64 {
+    a + (b - a) * t
+}
+
+/// Linear interpolation between two vectors.
+pub(crate) fn lerp_vec3<F: Frame>(a: &Vec3<F>, b: &Vec3<F>, t: f64) -> Vec3<F> {
+    a.lerp(*b, t)
+}
+
+/// Spherical linear interpolation between two rotations (shortest path).
+pub(crate) fn slerp<A: Frame, B: Frame>(a: &Rot<A, B>, b: &Rot<A, B>, t: f64) -> Rot<A, B> {
+    a.slerp(b, t)
+}
+
 /// Linear interpolation of scalars.
 pub(crate) fn interpolate_scalar(src_t: &[f64], src: &[f64], dst_t: &[f64]) -> Vec<f64> {
-    interpolate_with(src_t, src, dst_t, |a, b, t| a + (b - a) * t)
+    interpolate_with(src_t, src, dst_t, lerp_scalar)
 }
 
 /// Linear interpolation of vectors.
@@ -47,7 +125,7 @@ pub(crate) fn interpolate_vec3<F: Frame>(
     src: &[Vec3<F>],
     dst_t: &[f64],
 ) -> Vec<Vec3<F>> {
-    interpolate_with(src_t, src, dst_t, |a, b, t| a.lerp(*b, t))
+    interpolate_with(src_t, src, dst_t, lerp_vec3)
 }
 
 /// Spherical linear interpolation of rotations (shortest path).
@@ -56,16 +134,30 @@ pub(crate) fn interpolate_rot<A: Frame, B: Frame>(
     src: &[Rot<A, B>],
     dst_t: &[f64],
 ) -> Vec<Rot<A, B>> {
-    interpolate_with(src_t, src, dst_t, |a, b, t| a.slerp(b, t))
+    interpolate_with(src_t, src, dst_t, slerp)
 }
 
-/// A uniform timeline from `start` to at most `end` at `rate_hz`.
-pub(crate) fn uniform_timeline(start: f64, end: f64, rate_hz: f64) -> Vec<f64> {
-    if !(end >= start && rate_hz > 0.0 && start.is_finite() && end.is_finite()) {
-        return Vec::new();
+/// How many times a uniform timeline from `start` to at most `end` at `rate_hz` has (none
+/// when the span or the rate is not finite, or the rate not positive).
+pub(crate) fn uniform_len(start: f64, end: f64, rate_hz: f64) -> usize {
+    let finite = start.is_finite() && end.is_finite() && rate_hz.is_finite();
+    if !(finite && end >= start && rate_hz > 0.0) {
+        return 0;
     }
-    let n = ((end - start) * rate_hz + 1e-9).floor() as usize + 1;
-    (0..n).map(|i| start + i as f64 / rate_hz).collect()
+    // Saturating: a span of petaseconds has no end either way.
+    (((end - start) * rate_hz + 1e-9).floor() as usize).saturating_add(1)
+}
+
+/// Time `i` of the uniform timeline from `start` at `rate_hz`.
+pub(crate) fn uniform_time(start: f64, rate_hz: f64, i: usize) -> f64 {
+    start + i as f64 / rate_hz
+}
+
+/// A uniform timeline from `start` to at most `end` at `rate_hz` ([`uniform_len`] times).
+pub(crate) fn uniform_timeline(start: f64, end: f64, rate_hz: f64) -> Vec<f64> {
+    (0..uniform_len(start, end, rate_hz))
+        .map(|i| uniform_time(start, rate_hz, i))
+        .collect()
 }
 
 #[cfg(test)]

@@ -230,22 +230,34 @@ fn check_len(field: &'static str, expected: usize, found: usize) -> Result<(), S
 /// `time` strictly increasing, with no step longer than `max_gap_s`.
 fn check_steps(time: &[f64], max_gap_s: f64) -> Result<(), SequenceError> {
     for (i, w) in time.windows(2).enumerate() {
-        let gap = w[1] - w[0];
-        if gap <= 0.0 {
-            return Err(SequenceError::TimeNotIncreasing {
-                index: i + 1,
-                previous: w[0],
-                next: w[1],
-            });
-        }
-        if gap > max_gap_s {
-            return Err(SequenceError::Gap {
-                index: i + 1,
-                time: w[1],
-                gap_s: gap,
-                max_gap_s,
-            });
-        }
+        check_step(i + 1, w[0], w[1], max_gap_s)?;
+    }
+    Ok(())
+}
+
+/// [`check_steps`] of the step from `previous` to frame `index` at `next` (for a timeline
+/// built as it is read).
+pub(crate) fn check_step(
+    index: usize,
+    previous: f64,
+    next: f64,
+    max_gap_s: f64,
+) -> Result<(), SequenceError> {
+    let gap = next - previous;
+    if gap <= 0.0 {
+        return Err(SequenceError::TimeNotIncreasing {
+            index,
+            previous,
+            next,
+        });
+    }
+    if gap > max_gap_s {
+        return Err(SequenceError::Gap {
+            index,
+            time: next,
+            gap_s: gap,
+            max_gap_s,
+        });
     }
     Ok(())
 }

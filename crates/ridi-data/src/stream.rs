@@ -1,4 +1,4 @@
-//! Reading a RIDI processed recording row by row, in memory that does not grow with its length.
+//! Reading a RIDI recording row by row, in memory that does not grow with its length.
 //!
 //! [`RowReader`] reads a `data.csv` or `data_plain.txt` (either gzip-compressed) line by line
 //! with the parsers of [`ridi_csv`](crate::ridi_csv) and [`ridi_plain`](crate::ridi_plain),
@@ -10,9 +10,14 @@
 //! is judged exactly from counts; only when one is out of range is the file read again, in a
 //! few passes of bounded memory, to name it.
 //!
-//! The other formats cannot stream: a RIDI raw folder, a Tyrex run and an Indoor Location
-//! Competition path file interpolate several streams onto one timeline (and a Tyrex run splits
-//! at gaps), so their readers take the whole recording ([`Format::streams`]).
+//! A RIDI raw folder streams too: a first pass over each of its files makes the checks the
+//! whole-folder reader makes on that file and finds the span every sensor covers, a second
+//! reads the files side by side and interpolates them onto the pose timeline
+//! ([`ridi_raw`](crate::ridi_raw)'s module `stream`); the rows so made go through the same
+//! checks as a processed file's. The other formats cannot stream: a Tyrex run and an Indoor
+//! Location Competition path file interpolate streams whose clocks must first be aligned (and
+//! a Tyrex run splits at gaps), RoNIN and MAT files are read by random access, so their
+//! readers take the whole recording ([`Format::streams`]).
 
 use std::io::{BufRead, BufReader, Read};
 use std::path::{Path, PathBuf};
@@ -27,13 +32,13 @@ use crate::processed::{
 use crate::sequence::norm;
 use crate::sequence_error::SequenceError;
 use crate::{Channel, DeviceInfo, Format, OrientationSource, Validation, sidecar, text};
-use crate::{ridi_csv, ridi_plain};
+use crate::{ridi_csv, ridi_plain, ridi_raw};
 
 impl Format {
-    /// Whether [`RowReader`] reads this format as a stream: RIDI `data.csv` and
-    /// `data_plain.txt`. The others interpolate several files onto one timeline.
+    /// Whether [`RowReader`] reads this format as a stream: RIDI `data.csv`, `data_plain.txt`
+    /// and raw folders. The others are read whole.
     pub fn streams(self) -> bool {
-        matches!(self, Format::RidiCsv | Format::RidiPlain)
+        matches!(self, Format::RidiCsv | Format::RidiPlain | Format::RidiRaw)
     }
 }
 
@@ -58,6 +63,9 @@ pub struct Row {
     pub orientation: WorldFromDevice,
     /// Ground-truth position and orientation, when the recording has ground truth.
     pub ground_truth: Option<(WorldVec, WorldFromDevice)>,
+    /// The step counter (steps since start), when the recording has one (a raw folder's
+    /// `step.txt`).
+    pub steps: Option<f64>,
 }
 
 /// Whether the median of a stream of values has a property, decided exactly from two counts
@@ -129,7 +137,10 @@ impl Quantity {
 /// The `k`-th smallest (from 0) of the values `pass` hands out, which must be the same in
 /// every call, non-negative and not NaN: a radix selection on their bits, 16 at a time, in at
 /// most four passes of 512 KiB.
-fn select(k: usize, mut pass: impl FnMut(&mut dyn FnMut(f64)) -> Result<()>) -> Result<f64> {
+pub(crate) fn select(
+    k: usize,
+    mut pass: impl FnMut(&mut dyn FnMut(f64)) -> Result<()>,
+) -> Result<f64> {
     let (mut prefix, mut k) = (0u64, k);
     for level in 0..4u32 {
         let shift = 48 - 16 * level;
@@ -185,7 +196,7 @@ impl<R: Read> Read for Bounded<R> {
 }
 
 /// The non-blank lines of a file, numbered as [`text::lines`] numbers them.
-struct Lines {
+pub(crate) struct Lines {
     input: Box<dyn BufRead>,
     path: PathBuf,
     /// `(limit, compressed size)` of a gzip file.
@@ -194,11 +205,12 @@ struct Lines {
     /// Number of the last line read.
     line: usize,
     /// Whether the file so far ends in a line break (trailing spaces, tabs and `\r` aside).
-    ends_in_break: bool,
+    pub(crate) ends_in_break: bool,
 }
 
 impl Lines {
-    fn open(path: &Path) -> Result<Self> {
+    /// Opens the file at `path`, gzip-compressed or not.
+    pub(crate) fn open(path: &Path) -> Result<Self> {
         let meta = text::regular_file(path)?;
         let file = std::fs::File::open(path).map_err(|e| DataError::io(path, e))?;
         let mut raw = BufReader::with_capacity(1 << 16, file);
@@ -245,7 +257,16 @@ impl Lines {
     }
 
     /// The next non-blank line and its number, without its line ending.
-    fn next(&mut self) -> Result<Option<(usize, &str)>> {
+    pub(crate) fn next(&mut self) -> Result<Option<(usize, &str)>> {
+        match self.next_text()? {
+            Some((line, text)) => Ok(Some((line, text?))),
+            None => Ok(None),
+        }
+    }
+
+    /// [`Self::next`], with a line that is not UTF-8 text as an error of its own (the inner
+    /// one), after which the lines can be read on; the outer error is a failed read.
+    pub(crate) fn next_text(&mut self) -> Result<Option<(usize, Result<&str>)>> {
         let (start, end) = loop {
             self.buf.clear();
             let n = match self.input.read_until(b'\n', &mut self.buf) {
@@ -267,10 +288,13 @@ impl Lines {
                 end -= 1;
             }
             let Ok(text) = std::str::from_utf8(&self.buf[..end]) else {
-                return Err(DataError::format(
-                    Location::line(&self.path, self.line),
-                    "is not UTF-8 text",
-                ));
+                return Ok(Some((
+                    self.line,
+                    Err(DataError::format(
+                        Location::line(&self.path, self.line),
+                        "is not UTF-8 text",
+                    )),
+                )));
             };
             let start = if self.line == 1 && text.starts_with('\u{feff}') {
                 '\u{feff}'.len_utf8()
@@ -283,7 +307,7 @@ impl Lines {
         };
         // Valid UTF-8 from `start`, a character boundary: checked above.
         let text = std::str::from_utf8(&self.buf[start..end]).unwrap_or_default();
-        Ok(Some((self.line, text)))
+        Ok(Some((self.line, Ok(text))))
     }
 }
 
@@ -302,6 +326,40 @@ struct GroundTruthState {
     given: bool,
 }
 
+/// A processed file read line by line.
+struct Processed {
+    lines: Lines,
+    header: Header,
+    ground_truth: GroundTruthState,
+    /// Line of the previous row.
+    last_line: Option<usize>,
+}
+
+/// Where the rows come from (each boxed: a raw folder's readers take a few kilobytes).
+enum Source {
+    Processed(Box<Processed>),
+    /// A raw folder, its files merged onto one timeline.
+    Raw(Box<ridi_raw::stream::Rows>),
+}
+
+impl Source {
+    /// A validation failure of the recording read from `path`, naming the file and the
+    /// field; when it is about frame `index` of the pair `at`, on that frame's line (if it has
+    /// one).
+    fn error(
+        &self,
+        path: &Path,
+        e: SequenceError,
+        at: Option<(usize, Option<usize>)>,
+    ) -> DataError {
+        let line_of = |i: usize| at.and_then(|(index, line)| line.filter(|_| i == index));
+        match self {
+            Source::Processed(_) => text::sequence_error_at(path, line_of, &ProcessedFields, e),
+            Source::Raw(raw) => raw.error(e, line_of),
+        }
+    }
+}
+
 /// The first error of each kind [`Sequence::new`](crate::Sequence::new) checks one frame at a
 /// time, kept until the end so that the whole-recording checks it makes first come first.
 #[derive(Debug, Default)]
@@ -312,6 +370,9 @@ struct Deferred {
     gravity: Option<DataError>,
     magnet: Option<DataError>,
     position: Option<DataError>,
+    /// A step count that is not finite (a raw folder's, interpolated; the other channels are
+    /// parsed finite, or interpolated between values their files' checks bound).
+    steps: Option<DataError>,
 }
 
 /// What [`RowReader::finish`] needs of the whole recording, summed as the rows come.
@@ -328,9 +389,9 @@ struct Sums {
     /// later step (from frame 2 on) is too fast.
     jump: Option<(usize, [f64; 3], f64)>,
     later_jump: bool,
-    /// Lines of frame 0 and of the first too fast step.
-    first_line: usize,
-    jump_line: usize,
+    /// Lines of frame 0 and of the first too fast step, when rows have lines.
+    first_line: Option<usize>,
+    jump_line: Option<usize>,
     gravity_norms: f64,
     acce_norms: f64,
     /// Gyro scale sums of every step and of the steps that are no orientation jump.
@@ -343,19 +404,24 @@ struct Sums {
     magnet_seen: bool,
 }
 
-/// Reads a RIDI `data.csv` or `data_plain.txt` (either gzip-compressed) row by row, in memory
-/// that does not grow with its length: iterate it for the rows, then
-/// [`finish`](Self::finish) it for the checks that need the whole recording.
+/// Reads a RIDI `data.csv` or `data_plain.txt` (either gzip-compressed), or a RIDI raw
+/// folder, row by row, in memory that does not grow with its length: iterate it for the rows,
+/// then [`finish`](Self::finish) it for the checks that need the whole recording.
 ///
-/// Each row is parsed by the whole-file readers' parsers and checked as it comes (numbers,
-/// time order and gaps, rotations, ground truth); what needs the whole recording (the median
-/// interval, the units of every channel, gravity, the ground truth's speed) is summed as the
-/// rows come and judged by `finish`, which refuses what
+/// Each row of a processed file is parsed by the whole-file readers' parsers and checked as it
+/// comes (numbers, time order and gaps, rotations, ground truth). A raw folder is read twice:
+/// [`open`](Self::open) reads each file once for the checks the whole-folder reader makes on
+/// it (numbers, time order and gaps, its median time step and values, rotations) and for the
+/// span every sensor covers, then the rows are made by reading the files side by side and
+/// interpolating them onto the pose timeline, with the whole reader's arithmetic. What needs
+/// the whole recording (the median interval, the units of every channel, gravity, the ground
+/// truth's speed) is summed as the rows come and judged by `finish`, which refuses what
 /// [`Sequence::new`](crate::Sequence::new) would refuse: a recording with one fault gets the
 /// error the whole-file reader gives (file, line, field, message). A median is judged exactly
-/// from counts ([`MedianTest`]); only one out of range is named after reading the file again,
-/// in a few passes of bounded memory. Formats that interpolate several files onto one
-/// timeline do not stream ([`Format::streams`]).
+/// from counts ([`MedianTest`]); only one out of range is named after reading the file (or
+/// folder) again, in a few passes of bounded memory. Formats whose streams must be aligned
+/// before they can be interpolated, or that are read by random access, do not stream
+/// ([`Format::streams`]).
 ///
 /// After an error the iteration ends. A row refused by a check of the whole recording's
 /// channels (a value beyond its channel's bound) is still handed out, so that the checks can
@@ -396,12 +462,10 @@ pub struct RowReader {
     name: String,
     device: Option<DeviceInfo>,
     orientation_source: Option<OrientationSource>,
-    lines: Lines,
-    header: Header,
+    source: Source,
     /// Whether the whole-recording checks run (not while re-reading for a median).
     checked: bool,
-    previous: Option<(Row, usize)>,
-    ground_truth: GroundTruthState,
+    previous: Option<Row>,
     deferred: Deferred,
     sums: Sums,
     done: bool,
@@ -419,11 +483,13 @@ impl std::fmt::Debug for RowReader {
 
 impl RowReader {
     /// Opens the recording at `path` (a file, or a folder holding one, as
-    /// [`detect`](crate::detect) finds it) and reads its header and its sidecar.
+    /// [`detect`](crate::detect) finds it) and reads its header and its sidecar; a raw folder
+    /// is read once through (see above).
     ///
     /// # Errors
     /// A source of a format that does not stream ([`Format::streams`]), and what the
-    /// whole-file reader refuses in the header, the sidecar or the file itself.
+    /// whole-file reader refuses in the header, the sidecar or the file itself; for a raw
+    /// folder, what the whole-folder reader refuses before it synchronizes the files.
     pub fn open(path: impl AsRef<Path>, opts: &ReadOptions) -> Result<Self> {
         Self::open_checked(path.as_ref(), opts, true)
     }
@@ -434,41 +500,64 @@ impl RowReader {
             return Err(DataError::format(
                 Location::file(path),
                 format!(
-                    "{format} cannot be read as a stream of rows (only a RIDI data.csv or \
-                     data_plain.txt can)"
+                    "{format} cannot be read as a stream of rows (only a RIDI data.csv, \
+                     data_plain.txt or raw folder can)"
                 ),
             ));
         }
-        let mut lines = Lines::open(&file)?;
-        let header = match (format, lines.next()?) {
-            (Format::RidiPlain, Some((line, content))) => {
-                Header::Plain(ridi_plain::parse_header(line, content, &file)?)
-            }
-            (Format::RidiPlain, None) => return Err(ridi_plain::empty_file(&file)),
-            (_, Some((line, content))) => {
-                Header::Csv(ridi_csv::parse_header(line, content, &file)?)
-            }
-            (_, None) => return Err(ridi_csv::empty_file(&file)),
+        let (name, device, orientation_source, source) = if format == Format::RidiRaw {
+            let raw = ridi_raw::stream::Rows::open(&file, opts)?;
+            let name = raw.name();
+            let source = Some(OrientationSource::GameRotationVector);
+            (name, None, source, Source::Raw(Box::new(raw)))
+        } else {
+            let (processed, side) = Self::open_processed(format, &file)?;
+            let source = side
+                .orientation_source
+                .or(Some(OrientationSource::GameRotationVector));
+            let name = processed::name_from_path(&file);
+            (
+                name,
+                side.device,
+                source,
+                Source::Processed(Box::new(processed)),
+            )
         };
-        let side = sidecar::read(&file)?;
         Ok(Self {
-            name: processed::name_from_path(&file),
+            name,
             path: file,
             format,
             opts: opts.clone(),
-            device: side.device,
-            orientation_source: side
-                .orientation_source
-                .or(Some(OrientationSource::GameRotationVector)),
-            lines,
-            header,
+            device,
+            orientation_source,
+            source,
             checked,
             previous: None,
-            ground_truth: GroundTruthState::default(),
             deferred: Deferred::default(),
             sums: Sums::default(),
             done: false,
         })
+    }
+
+    /// The processed `file` of `format`, its header read, and its sidecar.
+    fn open_processed(format: Format, file: &Path) -> Result<(Processed, sidecar::Sidecar)> {
+        let mut lines = Lines::open(file)?;
+        let header = match (format, lines.next()?) {
+            (Format::RidiPlain, Some((line, content))) => {
+                Header::Plain(ridi_plain::parse_header(line, content, file)?)
+            }
+            (Format::RidiPlain, None) => return Err(ridi_plain::empty_file(file)),
+            (_, Some((line, content))) => Header::Csv(ridi_csv::parse_header(line, content, file)?),
+            (_, None) => return Err(ridi_csv::empty_file(file)),
+        };
+        let side = sidecar::read(file)?;
+        let processed = Processed {
+            lines,
+            header,
+            ground_truth: GroundTruthState::default(),
+            last_line: None,
+        };
+        Ok((processed, side))
     }
 
     /// The options the rows are read with.
@@ -476,12 +565,12 @@ impl RowReader {
         &self.opts
     }
 
-    /// The file read (a folder's `processed/data.csv`, say).
+    /// The file read (a folder's `processed/data.csv`, say), or the raw folder.
     pub fn path(&self) -> &Path {
         &self.path
     }
 
-    /// The format: [`Format::RidiCsv`] or [`Format::RidiPlain`].
+    /// The format: [`Format::RidiCsv`], [`Format::RidiPlain`] or [`Format::RidiRaw`].
     pub fn format(&self) -> Format {
         self.format
     }
@@ -506,10 +595,23 @@ impl RowReader {
         self.sums.rows
     }
 
-    /// Whether a magnetometer was recorded: a row so far had a magnetometer reading other
-    /// than zero (all zeros mean none).
+    /// Whether a magnetometer was recorded: in a processed file, a row so far had a
+    /// magnetometer reading other than zero (all zeros mean none); in a raw folder,
+    /// `magnet.txt` has records.
     pub fn has_magnet(&self) -> bool {
-        self.sums.magnet_seen
+        match &self.source {
+            Source::Processed(_) => self.sums.magnet_seen,
+            Source::Raw(raw) => raw.has_magnet(),
+        }
+    }
+
+    /// Whether a step counter was recorded (a raw folder's `step.txt` has records): the rows
+    /// then have [`Row::steps`].
+    pub fn has_steps(&self) -> bool {
+        match &self.source {
+            Source::Processed(_) => false,
+            Source::Raw(raw) => raw.has_steps(),
+        }
     }
 
     /// Whether a row so far refused a check that [`finish`](Self::finish) reports (a value
@@ -522,6 +624,7 @@ impl RowReader {
             || d.gravity.is_some()
             || d.position.is_some()
             || d.magnet.is_some()
+            || d.steps.is_some()
     }
 
     /// Reads the rest of the file, then checks what needs the whole recording, in the order
@@ -535,22 +638,8 @@ impl RowReader {
         for row in self.by_ref() {
             row?;
         }
-        let path = self.path.clone();
-        let last_line = self.previous.as_ref().map(|p| p.1);
-        match &self.header {
-            Header::Csv(h) if self.sums.rows == 0 => return Err(ridi_csv::no_rows(&path, h.line)),
-            Header::Plain(h) => {
-                let last = last_line.unwrap_or(h.line);
-                if let Some(e) = h.too_few(&path, self.sums.rows, last) {
-                    return Err(e);
-                }
-            }
-            Header::Csv(_) => {}
-        }
-        if let Some(line) = last_line
-            && !self.lines.ends_in_break
-        {
-            return Err(text::cut_off(Location::line(&path, line), ""));
+        if let Source::Processed(p) = &self.source {
+            p.check_end(&self.path, self.sums.rows)?;
         }
         if self.checked {
             self.check_whole()?;
@@ -561,6 +650,9 @@ impl RowReader {
     /// The checks of [`Sequence::with_validation`](crate::Sequence::with_validation) that need
     /// every frame, in its order.
     fn check_whole(&mut self) -> Result<()> {
+        if let Some(e) = self.deferred.steps.take() {
+            return Err(e);
+        }
         let limits = self.opts.validation.clone();
         let s = &self.sums;
         let (min, max) = limits.time_step_range;
@@ -576,8 +668,8 @@ impl RowReader {
             }));
         }
         let d = std::mem::take(&mut self.deferred);
-        let has_magnet = self.sums.magnet_seen;
-        let has_ground_truth = self.ground_truth.given;
+        let has_magnet = self.has_magnet();
+        let has_ground_truth = self.ground_truth_given();
         let first = [
             d.gyro,
             d.acce,
@@ -636,19 +728,22 @@ impl RowReader {
         checks.map_err(|e| self.error(e))
     }
 
-    /// A whole-recording error, naming the file and the field.
-    fn error(&self, e: SequenceError) -> DataError {
-        text::sequence_error_at(&self.path, |_| None, &ProcessedFields, e)
+    /// Whether the recording has ground truth (a row so far had it).
+    fn ground_truth_given(&self) -> bool {
+        match &self.source {
+            Source::Processed(p) => p.ground_truth.given,
+            Source::Raw(raw) => raw.has_ground_truth(),
+        }
     }
 
-    /// An error about frame `index`, on `line`.
-    fn error_at(&self, e: SequenceError, index: usize, line: usize) -> DataError {
-        text::sequence_error_at(
-            &self.path,
-            |i| (i == index).then_some(line),
-            &ProcessedFields,
-            e,
-        )
+    /// A whole-recording error, naming the file and the field.
+    fn error(&self, e: SequenceError) -> DataError {
+        self.source.error(&self.path, e, None)
+    }
+
+    /// An error about frame `index`, on `line` when it has one.
+    fn error_at(&self, e: SequenceError, index: usize, line: Option<usize>) -> DataError {
+        self.source.error(&self.path, e, Some((index, line)))
     }
 
     /// The median of `quantity` over the `count` values of the file, read again.
@@ -667,29 +762,147 @@ impl RowReader {
         })
     }
 
-    /// Parses and checks the next row.
+    /// Reads and checks the next row.
     fn read_row(&mut self) -> Result<Option<Row>> {
-        let path = &self.path;
+        let next = match &mut self.source {
+            Source::Processed(p) => {
+                let max_gap_s = self.opts.validation.max_gap_s;
+                let rows = self.sums.rows;
+                p.read_row(&self.path, max_gap_s, rows, self.previous.as_ref())?
+                    .map(|(row, line)| (row, Some(line)))
+            }
+            Source::Raw(raw) => raw.next_row()?,
+        };
+        let Some((row, line)) = next else {
+            return Ok(None);
+        };
+        if self.checked {
+            self.sum(&row, line);
+        }
+        self.sums.rows += 1;
+        self.previous = Some(row);
+        Ok(Some(row))
+    }
+
+    /// Adds `row`, read from `line` (when it has one), to the whole-recording checks.
+    fn sum(&mut self, row: &Row, line: Option<usize>) {
+        let limits = &self.opts.validation;
+        let index = self.sums.rows;
+        let previous = self.previous.as_ref();
+        let s = &mut self.sums;
+        let d = &mut self.deferred;
+        if index == 0 {
+            s.first_line = line;
+        }
+        if let Some(p) = previous {
+            let dt = row.time - p.time;
+            let (min, max) = limits.time_step_range;
+            s.interval.push(dt < min, dt > max);
+            let (time, gyro) = ([p.time, row.time], [p.gyro, row.gyro]);
+            let orientation = [p.orientation, row.orientation];
+            for (_, _, w, g) in crate::validation::step_rates(&time, &gyro, &orientation) {
+                s.rates += 1;
+                s.all = (s.all.0 + g * w, s.all.1 + w * w, s.all.2 + 1);
+                if w - g > crate::ORIENTATION_JUMP_RATE {
+                    s.jumps += 1;
+                } else {
+                    s.kept = (s.kept.0 + g * w, s.kept.1 + w * w, s.kept.2 + 1);
+                }
+            }
+            if let (Some((pp, _)), Some((rp, _))) = (p.ground_truth, row.ground_truth) {
+                let speed = Validation::step_speed(rp - pp, dt);
+                s.speed.push(false, speed > limits.max_median_speed);
+                if limits.too_fast(speed) {
+                    match s.jump {
+                        None => {
+                            s.jump = Some((index, (rp - pp).to_array(), dt));
+                            s.jump_line = line;
+                        }
+                        Some(_) => s.later_jump |= index >= 2,
+                    }
+                }
+            }
+        }
+        let gyro = row.gyro.to_array();
+        s.gyro.push(false, norm(gyro) > limits.max_median_gyro);
+        let (source, path) = (&self.source, &self.path);
+        let at = Some((index, line));
+        let first = |slot: &mut Option<DataError>, channel: Channel, v: [f64; 3]| {
+            if slot.is_none()
+                && let Err(e) = limits.check_value(channel, index, v)
+            {
+                *slot = Some(source.error(path, e, at));
+            }
+        };
+        first(&mut d.gyro, Channel::Gyro, gyro);
+        first(&mut d.acce, Channel::Acce, row.acce.to_array());
+        first(&mut d.linacce, Channel::Linacce, row.linacce.to_array());
+        first(&mut d.gravity, Channel::Gravity, row.gravity.to_array());
+        if let Some(m) = row.magnet {
+            first(&mut d.magnet, Channel::Magnet, m.to_array());
+            s.magnet_seen |= m != DeviceVec::ZERO;
+        }
+        if let Some((p, _)) = row.ground_truth {
+            first(&mut d.position, Channel::Position, p.to_array());
+        }
+        if let Some(steps) = row.steps
+            && !steps.is_finite()
+            && d.steps.is_none()
+        {
+            let e = SequenceError::NonFinite {
+                what: "steps",
+                index,
+            };
+            d.steps = Some(source.error(path, e, at));
+        }
+        s.gravity_norms += norm(row.gravity.to_array());
+        s.acce_norms += norm(row.acce.to_array());
+        let (a, g, l) = (
+            row.acce.to_array(),
+            row.gravity.to_array(),
+            row.linacce.to_array(),
+        );
+        let (dl, ll, dd, n) = &mut s.linacce;
+        for k in 0..3 {
+            let diff = a[k] - g[k];
+            *dl += diff * l[k];
+            *ll += l[k] * l[k];
+            *dd += diff * diff;
+        }
+        *n += 1;
+    }
+}
+
+impl Processed {
+    /// Parses and checks the next row of the file at `path`, the `rows`-th, after `previous`;
+    /// with its line.
+    fn read_row(
+        &mut self,
+        path: &Path,
+        max_gap_s: f64,
+        rows: usize,
+        previous: Option<&Row>,
+    ) -> Result<Option<(Row, usize)>> {
         let Some((line, content)) = self.lines.next()? else {
             return Ok(None);
         };
         let r = match &self.header {
             Header::Csv(h) => h.parse_row(line, content, path)?,
             Header::Plain(h) => {
-                if self.sums.rows == h.rows {
+                if rows == h.rows {
                     return Err(h.too_many(path, line));
                 }
                 h.parse_row(line, content, path)?
             }
         };
         let time = r[TIME] / 1e9;
-        if let Some((p, p_line)) = &self.previous {
+        if let (Some(p), Some(p_line)) = (previous, self.last_line) {
             text::check_step(
-                (p.time, *p_line),
+                (p.time, p_line),
                 (time, line),
                 path,
                 PROCESSED_COLUMNS[TIME],
-                self.opts.validation.max_gap_s,
+                max_gap_s,
             )?;
         }
         let orientation = processed::rotation_at(&r, RV, path, line)?;
@@ -731,95 +944,31 @@ impl RowReader {
             magnet: has_magnet.then(|| v(MAGNET)),
             orientation,
             ground_truth,
+            steps: None,
         };
-        if self.checked {
-            self.sum(&row, line);
-        }
-        self.sums.rows += 1;
-        self.previous = Some((row, line));
-        Ok(Some(row))
+        self.last_line = Some(line);
+        Ok(Some((row, line)))
     }
 
-    /// Adds `row`, read from `line`, to the whole-recording checks.
-    fn sum(&mut self, row: &Row, line: usize) {
-        let limits = &self.opts.validation;
-        let index = self.sums.rows;
-        let previous = self.previous.as_ref().map(|p| &p.0);
-        let s = &mut self.sums;
-        let d = &mut self.deferred;
-        if index == 0 {
-            s.first_line = line;
-        }
-        if let Some(p) = previous {
-            let dt = row.time - p.time;
-            let (min, max) = limits.time_step_range;
-            s.interval.push(dt < min, dt > max);
-            let (time, gyro) = ([p.time, row.time], [p.gyro, row.gyro]);
-            let orientation = [p.orientation, row.orientation];
-            for (_, _, w, g) in crate::validation::step_rates(&time, &gyro, &orientation) {
-                s.rates += 1;
-                s.all = (s.all.0 + g * w, s.all.1 + w * w, s.all.2 + 1);
-                if w - g > crate::ORIENTATION_JUMP_RATE {
-                    s.jumps += 1;
-                } else {
-                    s.kept = (s.kept.0 + g * w, s.kept.1 + w * w, s.kept.2 + 1);
+    /// What the end of the file at `path`, after `rows` rows, refuses: no rows, fewer than a
+    /// `data_plain.txt` announces, or a last row without a line break.
+    fn check_end(&self, path: &Path, rows: usize) -> Result<()> {
+        match &self.header {
+            Header::Csv(h) if rows == 0 => return Err(ridi_csv::no_rows(path, h.line)),
+            Header::Plain(h) => {
+                let last = self.last_line.unwrap_or(h.line);
+                if let Some(e) = h.too_few(path, rows, last) {
+                    return Err(e);
                 }
             }
-            if let (Some((pp, _)), Some((rp, _))) = (p.ground_truth, row.ground_truth) {
-                let speed = Validation::step_speed(rp - pp, dt);
-                s.speed.push(false, speed > limits.max_median_speed);
-                if limits.too_fast(speed) {
-                    match s.jump {
-                        None => {
-                            s.jump = Some((index, (rp - pp).to_array(), dt));
-                            s.jump_line = line;
-                        }
-                        Some(_) => s.later_jump |= index >= 2,
-                    }
-                }
+            Header::Csv(_) => {}
+        }
+        match self.last_line {
+            Some(line) if !self.lines.ends_in_break => {
+                Err(text::cut_off(Location::line(path, line), ""))
             }
+            _ => Ok(()),
         }
-        let gyro = row.gyro.to_array();
-        s.gyro.push(false, norm(gyro) > limits.max_median_gyro);
-        let path = &self.path;
-        let first = |slot: &mut Option<DataError>, channel: Channel, v: [f64; 3]| {
-            if slot.is_none()
-                && let Err(e) = limits.check_value(channel, index, v)
-            {
-                *slot = Some(text::sequence_error_at(
-                    path,
-                    |i| (i == index).then_some(line),
-                    &ProcessedFields,
-                    e,
-                ));
-            }
-        };
-        first(&mut d.gyro, Channel::Gyro, gyro);
-        first(&mut d.acce, Channel::Acce, row.acce.to_array());
-        first(&mut d.linacce, Channel::Linacce, row.linacce.to_array());
-        first(&mut d.gravity, Channel::Gravity, row.gravity.to_array());
-        if let Some(m) = row.magnet {
-            first(&mut d.magnet, Channel::Magnet, m.to_array());
-            s.magnet_seen |= m != DeviceVec::ZERO;
-        }
-        if let Some((p, _)) = row.ground_truth {
-            first(&mut d.position, Channel::Position, p.to_array());
-        }
-        s.gravity_norms += norm(row.gravity.to_array());
-        s.acce_norms += norm(row.acce.to_array());
-        let (a, g, l) = (
-            row.acce.to_array(),
-            row.gravity.to_array(),
-            row.linacce.to_array(),
-        );
-        let (dl, ll, dd, n) = &mut s.linacce;
-        for k in 0..3 {
-            let diff = a[k] - g[k];
-            *dl += diff * l[k];
-            *ll += l[k] * l[k];
-            *dd += diff * diff;
-        }
-        *n += 1;
     }
 }
 

@@ -185,21 +185,30 @@ proptest! {
     #![proptest_config(config(48))]
 
     #[test]
-    fn raw_reader_survives_mutations(file in 0usize..8, edits in edits(), trim in 0usize..8) {
+    fn raw_reader_survives_mutations(
+        mutations in prop::collection::vec((0usize..8, edits()), 1..3),
+        trim in 0usize..8,
+    ) {
         let dir = tempfile::tempdir().unwrap();
-        let mut files = raw_files(30, true);
-        let content = mutate(files[file].1.as_bytes(), &edits);
-        files.remove(file);
+        let files = raw_files(30, true);
         write_files(dir.path(), &files);
-        std::fs::write(dir.path().join(raw_files(30, true)[file].0), content).unwrap();
+        // One or two files mutated (the same one twice, or two whose faults race).
+        for (file, edits) in &mutations {
+            let path = dir.path().join(files[*file].0);
+            let content = mutate(&std::fs::read(&path).unwrap(), edits);
+            std::fs::write(path, content).unwrap();
+        }
         let opts = ReadOptions { pose_trim: trim, ..ReadOptions::default() };
-        if let Err(e) = ridi_raw::read(dir.path(), &opts) {
+        let whole = ridi_raw::read(dir.path(), &opts);
+        if let Err(e) = &whole {
             // The folder, or one of its files (whose lines the error may name).
-            let blame = assert_names_file(&e, dir.path());
+            let blame = assert_names_file(e, dir.path());
             if blame.file != dir.path() {
                 blame.assert_line_in(&std::fs::read(&blame.file).unwrap());
             }
         }
+        // Read as a stream: the same rows, or the same error.
+        assert_streams_as_read(dir.path(), &opts, &whole);
     }
 }
 

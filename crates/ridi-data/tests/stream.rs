@@ -1,14 +1,19 @@
 //! The streaming reader against the whole-file one: the same rows, and for a recording with
-//! one fault the same error (file, line, field and message).
+//! one fault the same error (file, line, field and message). Raw folders are held to it here
+//! and wherever a test reads one through `common::raw_with`.
+
+mod common;
 
 use std::io::Write as _;
 use std::path::{Path, PathBuf};
 
+use common::{assert_streams_as_read, raw_files, raw_options, streamed};
 use ridi_data::ridi_frames::{DeviceVec, WorldFromDevice, WorldVec};
 use ridi_data::{
     GroundTruth, OrientationSource, ReadOptions, RowReader, Sequence, SequenceParts, read_sequence,
-    write_ridi_csv, write_ridi_plain,
+    ridi_raw, write_ridi_csv, write_ridi_plain,
 };
+use ridi_test_support::{edit_cells, edit_file, write_files};
 
 /// A valid walk of `n` frames at 200 Hz, turning slowly, with magnetometer and ground truth.
 fn walk(n: usize) -> Sequence {
@@ -52,17 +57,6 @@ fn walk(n: usize) -> Sequence {
     .unwrap()
 }
 
-/// The rows of `path` read as a stream, or its error.
-fn streamed(path: &Path) -> Result<Vec<ridi_data::Row>, String> {
-    let mut rows = RowReader::open(path, &ReadOptions::default()).map_err(|e| e.to_string())?;
-    let mut out = Vec::new();
-    for row in rows.by_ref() {
-        out.push(row.map_err(|e| e.to_string())?);
-    }
-    rows.finish().map_err(|e| e.to_string())?;
-    Ok(out)
-}
-
 /// Writes `text` as `name` in `dir`.
 fn file(dir: &Path, name: &str, text: &str) -> PathBuf {
     let p = dir.join(name);
@@ -85,7 +79,7 @@ fn a_valid_recording_streams_as_the_sequence_it_reads_as() {
     std::fs::write(&gz, enc.finish().unwrap()).unwrap();
     for path in [&csv, &plain, &gz] {
         let read = read_sequence(path, &ReadOptions::default()).unwrap();
-        let rows = streamed(path).unwrap();
+        let rows = streamed(path, &ReadOptions::default()).unwrap();
         assert_eq!(rows.len(), read.len(), "{}", path.display());
         let gt = read.ground_truth().unwrap();
         for (i, r) in rows.iter().enumerate() {
@@ -190,7 +184,7 @@ fn a_recording_with_one_fault_gets_the_whole_file_readers_error() {
         let whole = read_sequence(&path, &ReadOptions::default())
             .map(|_| ())
             .map_err(|e| e.to_string());
-        let stream = streamed(&path).map(|_| ());
+        let stream = streamed(&path, &ReadOptions::default()).map(|_| ());
         assert!(whole.is_err(), "{what}: the whole-file reader accepts it");
         assert_eq!(stream, whole, "{what}");
     }
@@ -201,19 +195,294 @@ fn a_recording_with_one_fault_gets_the_whole_file_readers_error() {
     let cut: Vec<&str> = text.lines().take(300).collect();
     let path = file(dir.path(), "q_plain.txt", &format!("{}\n", cut.join("\n")));
     let whole = read_sequence(&path, &ReadOptions::default()).map_err(|e| e.to_string());
-    assert_eq!(streamed(&path).map(|_| ()), whole.map(|_| ()));
+    assert_eq!(
+        streamed(&path, &ReadOptions::default()).map(|_| ()),
+        whole.map(|_| ())
+    );
 }
 
 #[test]
 fn formats_that_do_not_stream_are_named() {
     let dir = tempfile::tempdir().unwrap();
-    let raw = dir.path().join("raw");
-    std::fs::create_dir(&raw).unwrap();
-    std::fs::write(raw.join("gyro.txt"), "").unwrap();
-    let e = RowReader::open(&raw, &ReadOptions::default()).unwrap_err();
+    let run = dir.path().join("Ann_Nexus5_NoDist_Texting");
+    write_files(&run, &[("accelerometer.txt", "0 0 0 9.8\n".into())]);
+    let e = RowReader::open(&run, &ReadOptions::default()).unwrap_err();
     assert!(
-        e.to_string()
-            .contains("RIDI raw folder cannot be read as a stream"),
+        e.to_string().contains(
+            "Tyrex folder cannot be read as a stream of rows (only a RIDI data.csv, \
+             data_plain.txt or raw folder can)"
+        ),
         "{e}"
     );
+}
+
+/// Writes `files` as a raw folder `name` in `dir` and checks that it streams as it reads
+/// with `opts`; the whole read.
+fn raw_case(
+    dir: &Path,
+    name: &str,
+    files: &[(&'static str, String)],
+    opts: &ReadOptions,
+) -> ridi_data::Result<Sequence> {
+    let folder = dir.join(name);
+    write_files(&folder, files);
+    let whole = ridi_raw::read(&folder, opts);
+    assert_streams_as_read(&folder, opts, &whole);
+    whole
+}
+
+/// `text` with the data line `n` (from 1, header included) edited by `f` (cells split at
+/// spaces).
+fn edit_line(n: usize, f: impl Fn(&mut Vec<String>)) -> impl FnOnce(&str) -> String {
+    move |text| {
+        edit_cells(text, ' ', |i, cells| {
+            if i == n {
+                f(cells);
+            }
+        })
+    }
+}
+
+#[test]
+fn raw_folders_stream_as_they_read() {
+    let dir = tempfile::tempdir().unwrap();
+    let dir = dir.path();
+    let opts = raw_options();
+    // With the pose as the clock, and without (a uniform timeline), with every optional file
+    // and without.
+    let seq = raw_case(dir, "pose", &raw_files(100, true), &opts).unwrap();
+    assert!(seq.ground_truth().is_some() && seq.steps().is_some() && seq.magnet().is_some());
+    let seq = raw_case(dir, "uniform", &raw_files(50, false), &opts).unwrap();
+    assert!(seq.ground_truth().is_none());
+    let mut bare = raw_files(80, true);
+    bare.retain(|(n, _)| !["magnet.txt", "step.txt"].contains(n));
+    let seq = raw_case(dir, "bare", &bare, &opts).unwrap();
+    assert!(seq.magnet().is_none() && seq.steps().is_none());
+    // Repeated timestamps keep their first record; comments and blank lines anywhere; the
+    // pose reaching beyond the sensors (dropped) and trimmed differently.
+    let mut files = raw_files(120, true);
+    for (name, content) in &mut files {
+        let Some(dup) = content.lines().nth(7).map(str::to_owned) else {
+            continue;
+        };
+        *content = content.replacen(&format!("{dup}\n"), &format!("{dup}\n\n{dup}\n# note\n"), 1);
+        if *name == "pose.txt" {
+            let t0 = common::T0_NS - 50_000_000;
+            let early = format!("{t0} 0 0.5 1.5 0 0 0 1\n");
+            *content = content.replacen('\n', &format!("\n{early}"), 1);
+        }
+    }
+    raw_case(dir, "edited", &files, &opts).unwrap();
+    for trim in [0, 1, 7] {
+        let opts = ReadOptions {
+            pose_trim: trim,
+            ..raw_options()
+        };
+        raw_case(dir, &format!("trim{trim}"), &raw_files(60, true), &opts).unwrap();
+    }
+    // Gzip-compressed files, whatever their names.
+    let gz: Vec<(&'static str, String)> = raw_files(70, true);
+    let folder = dir.join("gz");
+    write_files(&folder, &gz);
+    for (name, content) in &gz {
+        let mut enc = flate2::write::GzEncoder::new(Vec::new(), flate2::Compression::fast());
+        enc.write_all(content.as_bytes()).unwrap();
+        std::fs::write(folder.join(name), enc.finish().unwrap()).unwrap();
+    }
+    let whole = ridi_raw::read(&folder, &opts);
+    assert!(whole.is_ok(), "{whole:?}");
+    assert_streams_as_read(&folder, &opts, &whole);
+    // A capture folder with processed/data.csv streams that, as it reads.
+    let seq = read_sequence(&folder, &opts).unwrap();
+    std::fs::create_dir_all(folder.join("processed")).unwrap();
+    write_ridi_csv(&seq, folder.join("processed/data.csv")).unwrap();
+    let rows = streamed(&folder, &opts).unwrap();
+    assert_eq!(rows.len(), seq.len());
+}
+
+#[test]
+fn a_raw_folder_with_one_fault_gets_the_whole_readers_error() {
+    let dir = tempfile::tempdir().unwrap();
+    let dir = dir.path();
+    let opts = raw_options();
+    type Edit = Box<dyn Fn(&mut Vec<(&'static str, String)>)>;
+    let on = |file: &'static str, line: usize, f: fn(&mut Vec<String>)| -> Edit {
+        Box::new(move |files| edit_file(files, file, edit_line(line, f)))
+    };
+    // `f` on every record of `file` (given its line).
+    let every = |file: &'static str, f: fn(usize, &mut Vec<String>)| -> Edit {
+        Box::new(move |files| {
+            edit_file(files, file, |t| {
+                edit_cells(t, ' ', |i, c| {
+                    if !c[0].starts_with('#') {
+                        f(i, c);
+                    }
+                })
+            })
+        })
+    };
+    let cases: Vec<(&str, Edit)> = vec![
+        ("not a number", on("gyro.txt", 9, |c| c[2] = "x".into())),
+        ("too few fields", on("linacce.txt", 4, |c| c.truncate(3))),
+        ("time going back", on("acce.txt", 12, |c| c[0] = "1".into())),
+        (
+            "no rotation",
+            on("orientation.txt", 30, |c| c[4] = "3".into()),
+        ),
+        (
+            "pose no rotation, kept",
+            on("pose.txt", 20, |c| c[7] = "2".into()),
+        ),
+        (
+            "pose no rotation, trimmed",
+            on("pose.txt", 3, |c| c[7] = "2".into()),
+        ),
+        (
+            "value beyond its bound",
+            on("gravity.txt", 8, |c| c[1] = "-30".into()),
+        ),
+        (
+            "pose beyond its bound",
+            on("pose.txt", 40, |c| c[2] = "2e6".into()),
+        ),
+        (
+            "ground truth jump",
+            on("pose.txt", 30, |c| c[1] = "40".into()),
+        ),
+        ("first pose off", on("pose.txt", 7, |c| c[2] = "-40".into())),
+        (
+            "a later file's parse error before an earlier file's check",
+            Box::new(|files| {
+                edit_file(files, "gyro.txt", edit_line(6, |c| c[1] = "500".into()));
+                edit_file(files, "step.txt", edit_line(2, |c| c[1] = "z".into()));
+            }),
+        ),
+        (
+            "a file's check before the rotations",
+            Box::new(|files| {
+                edit_file(
+                    files,
+                    "orientation.txt",
+                    edit_line(3, |c| c[4] = "3".into()),
+                );
+                edit_file(files, "pose.txt", edit_line(50, |c| c[3] = "-2e6".into()));
+            }),
+        ),
+        (
+            "the gyro's units before its values",
+            every("gyro.txt", |i, c| {
+                c[3] = if i == 5 { "300" } else { "30" }.into()
+            }),
+        ),
+        (
+            "gravity in g",
+            Box::new(|files| edit_file(files, "gravity.txt", |t| t.replace(" 9.8 ", " 1 "))),
+        ),
+        (
+            "steps beyond any number once interpolated",
+            Box::new(|files| {
+                edit_file(files, "step.txt", |_| {
+                    format!(
+                        "# t count\n{} 1e308\n{} -1e308\n",
+                        common::T0_NS,
+                        common::T0_NS + 400_000_000
+                    )
+                })
+            }),
+        ),
+        (
+            "pose in millimetres",
+            every("pose.txt", |i, c| c[1] = (i * 100).to_string()),
+        ),
+        (
+            "no overlap",
+            every("magnet.txt", |_, c| {
+                let ns: i64 = c[0].parse().unwrap();
+                c[0] = (ns + 10_000_000_000).to_string();
+            }),
+        ),
+        (
+            "empty",
+            Box::new(|files| edit_file(files, "acce.txt", |_| "# t x y z\n".into())),
+        ),
+        (
+            "missing",
+            Box::new(|files| files.retain(|(n, _)| *n != "gravity.txt")),
+        ),
+    ];
+    for (what, edit) in cases {
+        let mut files = raw_files(60, true);
+        edit(&mut files);
+        let whole = raw_case(dir, what, &files, &opts);
+        let trimmed_rotation = what == "pose no rotation, trimmed";
+        assert_eq!(whole.is_ok(), trimmed_rotation, "{what}: {whole:?}");
+    }
+    // Not UTF-8 after a line that does not parse, and then a gzip stream cut short: the
+    // whole reader decodes and checks the text before it parses any of it.
+    let mut files = raw_files(60, true);
+    edit_file(
+        &mut files,
+        "magnet.txt",
+        edit_line(5, |c| c[1] = "y".into()),
+    );
+    let folder = dir.join("bytes");
+    write_files(&folder, &files);
+    let magnet = folder.join("magnet.txt");
+    let mut bytes = std::fs::read(&magnet).unwrap();
+    let at = bytes.len() / 2;
+    bytes.insert(at, 0xff);
+    std::fs::write(&magnet, &bytes).unwrap();
+    let whole = ridi_raw::read(&folder, &opts);
+    assert!(
+        whole
+            .as_ref()
+            .unwrap_err()
+            .to_string()
+            .contains("is not UTF-8"),
+        "{whole:?}"
+    );
+    assert_streams_as_read(&folder, &opts, &whole);
+    let mut enc = flate2::write::GzEncoder::new(Vec::new(), flate2::Compression::fast());
+    enc.write_all(&bytes).unwrap();
+    let gz = enc.finish().unwrap();
+    std::fs::write(&magnet, &gz[..gz.len() - 10]).unwrap();
+    let whole = ridi_raw::read(&folder, &opts);
+    let e = whole.as_ref().unwrap_err().to_string();
+    assert!(
+        e.contains("magnet.txt: corrupt or truncated gzip data"),
+        "{e}"
+    );
+    assert_streams_as_read(&folder, &opts, &whole);
+    // A gap on the pose clock (the sequence's, after trimming; the pose file's own clock may
+    // have gaps).
+    let mut files = raw_files(60, true);
+    edit_file(&mut files, "pose.txt", |t| {
+        let lines: Vec<&str> = t.lines().collect();
+        [&lines[..30], &lines[40..]].concat().join("\n") + "\n"
+    });
+    let mut opts = raw_options();
+    opts.validation.max_gap_s = 0.02;
+    let e = raw_case(dir, "pose gap", &files, &opts).unwrap_err();
+    assert!(
+        e.to_string()
+            .contains("pose.txt:31: field `time`: gap of 0.055 s"),
+        "{e}"
+    );
+    // The pose trimmed away, and no pose at a rate without a frame or with gaps.
+    let e = raw_case(dir, "trim", &raw_files(60, true), &ReadOptions::default());
+    assert!(e.is_err());
+    for (rate, max_gap_s) in [
+        (0.0, 1.0),
+        (f64::INFINITY, 1.0),
+        (f64::NAN, 1.0),
+        (4.0, 0.1),
+    ] {
+        let mut opts = ReadOptions {
+            rate_without_pose_hz: rate,
+            ..raw_options()
+        };
+        opts.validation.max_gap_s = max_gap_s;
+        let e = raw_case(dir, &format!("rate{rate}"), &raw_files(60, false), &opts);
+        assert!(e.is_err(), "{rate} Hz");
+    }
 }

@@ -155,7 +155,7 @@ pub fn inspect_stream(mut rows: ridi_data::RowReader) -> crate::Result<Inspectio
         upside_down,
         acce_norm: acce.stats(),
         has_magnet: rows.has_magnet(),
-        has_steps: false,
+        has_steps: rows.has_steps(),
         has_ground_truth,
         path_length: has_ground_truth.then_some(path),
     };

@@ -358,20 +358,28 @@ impl TrackOutput {
     }
 
     /// Tracks the recording `rows` reads, online, writing the trajectory CSV as the poses come
-    /// (memory that does not grow with the recording; the same CSV as [`Self::write`] of an
-    /// online [`crate::track()`]) under a
-    /// temporary name beside it, renamed into place once the whole recording was tracked and
-    /// checked. A failure leaves the file as it was. No plot: drawing one needs the whole
-    /// trajectory.
+    /// (the same CSV as [`Self::write`] of an online [`crate::track()`]) under a temporary name
+    /// beside it, then the plot if there is one, then the CSV renamed into place once the
+    /// whole recording was tracked and checked. A failure leaves both files as they were.
+    /// Memory does not grow with the recording but for the plot's points: the time and
+    /// horizontal position of every frame and of its ground truth (40 bytes a frame), a
+    /// small part of what the recording holds.
     pub fn write_stream(
         &self,
         rows: ridi_data::RowReader,
         model: &Cascade,
         opts: &crate::TrackOptions,
     ) -> Result<crate::track::StreamedTrack> {
+        #[cfg(feature = "plot")]
+        let mut points = self
+            .plot
+            .as_ref()
+            .map(|_| crate::track::TrackPoints::default());
+        #[cfg(not(feature = "plot"))]
+        let mut points: Option<crate::track::TrackPoints> = None;
         let mut tracked = None;
         let pending = write_pending(&self.csv, |w| {
-            let t = crate::track::track_stream(rows, model, opts, w)?;
+            let t = crate::track::track_stream(rows, model, opts, w, points.as_mut())?;
             let failed = t.is_err();
             tracked = Some(t);
             match failed {
@@ -379,13 +387,22 @@ impl TrackOutput {
                 false => Ok(()),
             }
         });
-        if let Some(Err(e)) = tracked {
-            return Err(e);
-        }
+        let tracked = match tracked {
+            Some(Err(e)) => return Err(e),
+            Some(Ok(t)) => t,
+            // `write_pending` ran the content, which tracked, unless it failed before.
+            None => {
+                pending.map_err(|e| OutputError::write(&self.csv, e))?;
+                return Err(PipelineError::Live("the recording was not tracked".into()));
+            }
+        };
         let csv = pending.map_err(|e| OutputError::write(&self.csv, e))?;
+        #[cfg(feature = "plot")]
+        if let (Some(plot), Some(points)) = (&self.plot, &points) {
+            points.plot(&tracked.name, plot)?;
+        }
         csv.commit().map_err(|e| OutputError::write(&self.csv, e))?;
-        // `write_pending` ran the content, which tracked.
-        tracked.unwrap_or_else(|| Err(PipelineError::Live("the recording was not tracked".into())))
+        Ok(tracked)
     }
 }
 

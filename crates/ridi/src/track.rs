@@ -75,30 +75,70 @@ impl Track {
     /// first 10 s as evaluations do.
     #[cfg(feature = "plot")]
     pub fn plot(&self, seq: &Sequence, path: &Path) -> Result<()> {
-        use crate::plot::{Trajectory, TrajectoryOptions, TrajectoryPlot, plot_trajectories};
-        let est = self.horizontal();
         let gt = seq.ground_truth().map(|gt| gt.horizontal());
-        let shown = match &gt {
-            Some(gt) => ridi_eval::align_trajectory(seq.time(), &est, gt, Default::default())?.1,
-            None => est,
-        };
-        let estimates = [Trajectory {
-            name: "ridi",
-            points: &shown,
-        }];
-        plot_trajectories(
+        plot_track(
+            seq.name(),
+            seq.time(),
+            &self.horizontal(),
+            gt.as_deref(),
             path,
-            &TrajectoryPlot {
-                title: seq.name(),
-                ground_truth: gt.as_deref().map(|points| Trajectory {
-                    name: "ground truth",
-                    points,
-                }),
-                estimates: &estimates,
-            },
-            &TrajectoryOptions::default(),
-        )?;
-        Ok(())
+        )
+    }
+}
+
+/// [`Track::plot`] of the recording `title`: the horizontal positions `estimate` at `time`,
+/// and the ground truth's `gt` if any.
+#[cfg(feature = "plot")]
+fn plot_track(
+    title: &str,
+    time: &[f64],
+    estimate: &[[f64; 2]],
+    gt: Option<&[[f64; 2]]>,
+    path: &Path,
+) -> Result<()> {
+    use crate::plot::{Trajectory, TrajectoryOptions, TrajectoryPlot, plot_trajectories};
+    let aligned = match gt {
+        Some(gt) => Some(ridi_eval::align_trajectory(time, estimate, gt, Default::default())?.1),
+        None => None,
+    };
+    let estimates = [Trajectory {
+        name: "ridi",
+        points: aligned.as_deref().unwrap_or(estimate),
+    }];
+    plot_trajectories(
+        path,
+        &TrajectoryPlot {
+            title,
+            ground_truth: gt.map(|points| Trajectory {
+                name: "ground truth",
+                points,
+            }),
+            estimates: &estimates,
+        },
+        &TrajectoryOptions::default(),
+    )?;
+    Ok(())
+}
+
+/// What the plot of a track draws ([`Track::plot`]), a small part of what the recording
+/// holds: the time and horizontal position of each frame, and the ground truth's position
+/// when the recording has ground truth. A streamed track keeps these alone
+/// ([`crate::TrackOutput::write_stream`]).
+#[derive(Debug, Clone, Default, PartialEq)]
+#[cfg_attr(not(feature = "plot"), allow(dead_code))]
+pub(crate) struct TrackPoints {
+    time: Vec<f64>,
+    estimate: Vec<[f64; 2]>,
+    /// Empty without ground truth.
+    ground_truth: Vec<[f64; 2]>,
+}
+
+#[cfg(feature = "plot")]
+impl TrackPoints {
+    /// Draws them, the track of the recording `title`, to `path`, as [`Track::plot`] does.
+    pub(crate) fn plot(&self, title: &str, path: &Path) -> Result<()> {
+        let gt = Some(&self.ground_truth[..]).filter(|gt| !gt.is_empty());
+        plot_track(title, &self.time, &self.estimate, gt, path)
     }
 }
 
@@ -385,7 +425,8 @@ pub struct StreamedTrack {
 /// the recording. The rows and the checks are those of [`track`] with
 /// [`TrackOptions::online`] on the sequence the whole-file reader gives: the same CSV, bit for
 /// bit; an error (also one found at the end, such as a recording's rate) leaves `out` partly
-/// written, for the caller to discard ([`crate::TrackOutput::write_stream`]).
+/// written, for the caller to discard ([`crate::TrackOutput::write_stream`]). With `points`,
+/// what a plot of the track needs is kept there as the rows and poses come.
 ///
 /// The outer error is a failed write of `out`; the inner one what reading the recording
 /// refuses ([`RowReader`], [`RowReader::finish`]) and what [`track`] refuses of it.
@@ -394,9 +435,10 @@ pub(crate) fn track_stream(
     model: &Cascade,
     opts: &TrackOptions,
     out: &mut dyn std::io::Write,
+    points: Option<&mut TrackPoints>,
 ) -> std::io::Result<Result<StreamedTrack>> {
     let mut failed = None;
-    let tracked = track_rows(rows, model, opts, out, &mut failed);
+    let tracked = track_rows(rows, model, opts, out, points, &mut failed);
     match failed {
         Some(e) => Err(e),
         None => Ok(tracked),
@@ -409,6 +451,7 @@ fn track_rows(
     model: &Cascade,
     opts: &TrackOptions,
     out: &mut dyn std::io::Write,
+    mut points: Option<&mut TrackPoints>,
     failed: &mut Option<std::io::Error>,
 ) -> Result<StreamedTrack> {
     let name = rows.name().to_string();
@@ -436,6 +479,8 @@ fn track_rows(
     let mut updates = Vec::new();
     let (mut frames, mut regressions) = (0usize, 0usize);
     let (mut first, mut previous) = (None::<f64>, None::<f64>);
+    // The ground truth's points, for the plot, while `write` holds `points`.
+    let (mut truth, plotted) = (Vec::new(), points.is_some());
     let mut write = |updates: &mut Vec<ridi_correct::Update>,
                      live: &mut LiveTracker<'_>,
                      times: &mut std::collections::VecDeque<f64>|
@@ -450,6 +495,10 @@ fn track_rows(
                 placement = names.get(p).map(String::as_str);
             }
             let time = times.pop_front().unwrap_or(f64::NAN);
+            if let Some(p) = points.as_deref_mut() {
+                p.time.push(time);
+                p.estimate.push([u.pose.position.x(), u.pose.position.y()]);
+            }
             csv_row(
                 out,
                 time,
@@ -476,6 +525,9 @@ fn track_rows(
             count_rate(&mut rate, row.time - p);
         }
         previous = Some(row.time);
+        if let Some((p, _)) = row.ground_truth.filter(|_| plotted) {
+            truth.push([p.x(), p.y()]);
+        }
         let reading = SensorReading {
             time: row.time,
             gyro: row.gyro,
@@ -509,6 +561,9 @@ fn track_rows(
     live.finish(&mut updates)
         .map_err(|e| PipelineError::sequence(&name, e.to_string()))?;
     write(&mut updates, &mut live, &mut times).map_err(written)?;
+    if let Some(p) = points {
+        p.ground_truth = truth;
+    }
     Ok(StreamedTrack {
         name,
         frames,

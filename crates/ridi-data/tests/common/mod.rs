@@ -11,7 +11,9 @@ use ridi_data::ridi_frames::nalgebra::Vector3;
 use ridi_data::ridi_frames::{
     Device, DeviceVec, Rot, WorldFromDevice, WorldVec, gravity_in_device,
 };
-use ridi_data::{GroundTruth, OrientationSource, ReadOptions, Sequence, SequenceParts, ridi_raw};
+use ridi_data::{
+    GroundTruth, OrientationSource, ReadOptions, Row, RowReader, Sequence, SequenceParts, ridi_raw,
+};
 use ridi_test_support::write_files;
 
 /// First timestamp of the fixtures, ns (a plausible boot-clock value).
@@ -141,7 +143,8 @@ pub(crate) fn raw_files(n: usize, with_pose: bool) -> Vec<(&'static str, String)
     files
 }
 
-/// Reads a raw folder of `raw_files(60, true)` after `edit`.
+/// Reads a raw folder of `raw_files(60, true)` after `edit`, and checks that it streams as it
+/// reads ([`assert_streams_as_read`]).
 pub(crate) fn raw_with(
     edit: impl FnOnce(&mut Vec<(&'static str, String)>),
 ) -> (tempfile::TempDir, ridi_data::Result<Sequence>) {
@@ -150,5 +153,81 @@ pub(crate) fn raw_with(
     edit(&mut files);
     write_files(dir.path(), &files);
     let r = ridi_raw::read(dir.path(), &raw_options());
+    assert_streams_as_read(dir.path(), &raw_options(), &r);
     (dir, r)
+}
+
+/// The rows of the recording at `path` read as a stream, finished, or the error.
+pub(crate) fn streamed(path: &std::path::Path, opts: &ReadOptions) -> Result<Vec<Row>, String> {
+    let mut rows = RowReader::open(path, opts).map_err(|e| e.to_string())?;
+    let mut out = Vec::new();
+    for row in rows.by_ref() {
+        out.push(row.map_err(|e| e.to_string())?);
+    }
+    rows.finish().map_err(|e| e.to_string())?;
+    Ok(out)
+}
+
+/// The bits of every value of `row`, in one order.
+fn row_bits(row: &Row) -> Vec<u64> {
+    let mut v = vec![row.time];
+    for x in [row.gyro, row.acce, row.linacce, row.gravity] {
+        v.extend(x.to_array());
+    }
+    v.extend(row.magnet.map(|m| m.to_array()).into_iter().flatten());
+    v.extend(row.orientation.to_wxyz());
+    if let Some((p, o)) = row.ground_truth {
+        v.extend(p.to_array());
+        v.extend(o.to_wxyz());
+    }
+    v.extend(row.steps);
+    v.into_iter().map(f64::to_bits).collect()
+}
+
+/// Frame `i` of `seq` as the [`Row`] a stream of it gives.
+pub(crate) fn frame(seq: &Sequence, i: usize) -> Row {
+    Row {
+        time: seq.time()[i],
+        gyro: seq.gyro()[i],
+        acce: seq.acce()[i],
+        linacce: seq.linacce()[i],
+        gravity: seq.gravity()[i],
+        magnet: seq.magnet().map(|m| m[i]),
+        orientation: seq.orientation()[i],
+        ground_truth: seq
+            .ground_truth()
+            .map(|gt| (gt.position[i], gt.orientation[i])),
+        steps: seq.steps().map(|s| s[i]),
+    }
+}
+
+/// Asserts that the recording at `path` read as a stream ([`RowReader`]) gives the frames of
+/// `whole`, what the whole-file reader read, bit for bit, with its name and flags; or the
+/// same error (file, line, field, message).
+pub(crate) fn assert_streams_as_read(
+    path: &std::path::Path,
+    opts: &ReadOptions,
+    whole: &ridi_data::Result<Sequence>,
+) {
+    let stream = streamed(path, opts);
+    let seq = match (whole, stream) {
+        (Err(e), stream) => {
+            assert_eq!(stream.map(|_| ()), Err(e.to_string()), "{}", path.display());
+            return;
+        }
+        (Ok(_), Err(e)) => panic!("{}: streams as an error: {e}", path.display()),
+        (Ok(seq), Ok(rows)) => {
+            assert_eq!(rows.len(), seq.len(), "{}", path.display());
+            for (i, row) in rows.iter().enumerate() {
+                let expected = frame(seq, i);
+                assert_eq!(row_bits(row), row_bits(&expected), "frame {i}: {row:?}");
+            }
+            seq
+        }
+    };
+    let reader = RowReader::open(path, opts).unwrap();
+    assert_eq!(reader.name(), seq.name());
+    assert_eq!(reader.orientation_source(), seq.orientation_source());
+    assert_eq!(reader.has_magnet(), seq.magnet().is_some());
+    assert_eq!(reader.has_steps(), seq.steps().is_some());
 }
