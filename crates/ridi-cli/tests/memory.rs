@@ -3,8 +3,8 @@
 //! as a child whose peak resident memory (`wait4`) must stay far below what reading the whole
 //! recording takes. Before streaming, 1 M rows took 493 MB to inspect and 499 MB to track
 //! (500 k rows about half), a raw folder of 500 k records a file 289 MB to inspect and one of
-//! 250 k 146 MB to track with a plot; streamed, 6-16 MB, and with a plot what its points take
-//! (`docs/benchmarks.md`, "Memory of long recordings"). A child's peak counts its parent's
+//! 250 k 146 MB to track with a plot; streamed, 6-16 MB, and with a plot what its points take,
+//! at most 2^18 frames' (`docs/benchmarks.md`, "Memory of long recordings"). A child's peak counts its parent's
 //! (see [`count_lines`]): this process holds no long output.
 
 #![cfg(target_os = "linux")]
@@ -206,10 +206,12 @@ fn small_model(dir: &Path) -> std::path::PathBuf {
 fn online_track_of_half_a_million_rows_runs_in_bounded_memory() {
     let dir = tempfile::tempdir().unwrap();
     let model = small_model(dir.path());
-    // 500 k rows: 3 s in the dev profile; whole, the recording took about 250 MB.
+    // 500 k rows: 3 s in the dev profile; whole, the recording took about 250 MB. Twice the
+    // frames a plot keeps (ridi's PLOT_FRAMES): its points are thinned, not grown.
     let csv = dir.path().join("long.csv");
     long_recording(&csv, 500_000);
     let traj = dir.path().join("traj.csv");
+    let plot = dir.path().join("traj.svg");
     let args = [
         "track",
         csv.to_str().unwrap(),
@@ -218,10 +220,13 @@ fn online_track_of_half_a_million_rows_runs_in_bounded_memory() {
         "--online",
         "--out",
         traj.to_str().unwrap(),
+        "--plot",
+        plot.to_str().unwrap(),
     ];
     assert_bounded(&args, dir.path());
     // Every frame has its row, after the header.
     assert_eq!(count_lines(&traj), 500_001);
+    assert!(holds(&plot, b"<svg"), "no plot");
 }
 
 #[test]
@@ -229,7 +234,7 @@ fn online_track_of_a_raw_folder_with_a_plot_runs_in_bounded_memory() {
     let dir = tempfile::tempdir().unwrap();
     let model = small_model(dir.path());
     // 250 k records a file: 3 s in the dev profile; whole, the folder took about 145 MB. The
-    // plot keeps 40 bytes a frame (10 MB).
+    // plot keeps 40 bytes a frame, every frame of these (10 MB).
     let raw = dir.path().join("long");
     long_raw_folder(&raw, 250_000);
     let traj = dir.path().join("traj.csv");

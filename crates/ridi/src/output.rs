@@ -360,10 +360,11 @@ impl TrackOutput {
     /// Tracks the recording `rows` reads, online, writing the trajectory CSV as the poses come
     /// (the same CSV as [`Self::write`] of an online [`crate::track()`]) under a temporary name
     /// beside it, then the plot if there is one, then the CSV renamed into place once the
-    /// whole recording was tracked and checked. A failure leaves both files as they were.
-    /// Memory does not grow with the recording but for the plot's points: the time and
-    /// horizontal position of every frame and of its ground truth (40 bytes a frame), a
-    /// small part of what the recording holds.
+    /// whole recording was tracked and checked. A failed write leaves both files as they were;
+    /// only a failed rename, after the plot's, would not. Memory does not grow with the
+    /// recording: the plot keeps the time and horizontal position of at most 2^18 frames and
+    /// of their ground truth (40 bytes a frame), every frame of a shorter recording, every
+    /// second (fourth, ...) of a longer one.
     pub fn write_stream(
         &self,
         rows: ridi_data::RowReader,

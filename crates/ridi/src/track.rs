@@ -120,25 +120,79 @@ fn plot_track(
     Ok(())
 }
 
+/// The most frames a streamed track's plot keeps ([`TrackPoints`]): about 22 minutes at
+/// 200 Hz, far more than a figure's pixel columns.
+pub(crate) const PLOT_FRAMES: usize = 1 << 18;
+
+/// A per-frame series thinned to at most [`PLOT_FRAMES`] values: frame `i` is kept when `i`
+/// is a multiple of the stride, which doubles (every other value dropped) whenever one more
+/// would exceed the bound. What is kept depends only on how many frames were pushed, so
+/// series of the same frames, pushed at different times, keep the same frames.
+#[derive(Debug, Clone, PartialEq)]
+pub(crate) struct Thinned<T> {
+    kept: Vec<T>,
+    stride: usize,
+    seen: usize,
+}
+
+impl<T> Default for Thinned<T> {
+    fn default() -> Self {
+        Self {
+            kept: Vec::new(),
+            stride: 1,
+            seen: 0,
+        }
+    }
+}
+
+impl<T> Thinned<T> {
+    /// The value of the next frame.
+    pub(crate) fn push(&mut self, value: T) {
+        if self.seen.is_multiple_of(self.stride) {
+            if self.kept.len() == PLOT_FRAMES {
+                let mut i = 0;
+                self.kept.retain(|_| {
+                    i += 1;
+                    i % 2 == 1
+                });
+                self.stride *= 2;
+            }
+            if self.seen.is_multiple_of(self.stride) {
+                self.kept.push(value);
+            }
+        }
+        self.seen += 1;
+    }
+
+    /// The values kept.
+    #[cfg_attr(not(feature = "plot"), allow(dead_code))]
+    pub(crate) fn kept(&self) -> &[T] {
+        &self.kept
+    }
+}
+
 /// What the plot of a track draws ([`Track::plot`]), a small part of what the recording
 /// holds: the time and horizontal position of each frame, and the ground truth's position
 /// when the recording has ground truth. A streamed track keeps these alone
-/// ([`crate::TrackOutput::write_stream`]).
+/// ([`crate::TrackOutput::write_stream`]), thinned to at most [`PLOT_FRAMES`] frames so that
+/// memory does not grow with the recording: a recording of up to that many frames is plotted
+/// as [`Track::plot`] plots it, byte for byte; a longer one on every second (fourth, ...) frame,
+/// the alignment to the ground truth too.
 #[derive(Debug, Clone, Default, PartialEq)]
 #[cfg_attr(not(feature = "plot"), allow(dead_code))]
 pub(crate) struct TrackPoints {
-    time: Vec<f64>,
-    estimate: Vec<[f64; 2]>,
+    time: Thinned<f64>,
+    estimate: Thinned<[f64; 2]>,
     /// Empty without ground truth.
-    ground_truth: Vec<[f64; 2]>,
+    ground_truth: Thinned<[f64; 2]>,
 }
 
 #[cfg(feature = "plot")]
 impl TrackPoints {
     /// Draws them, the track of the recording `title`, to `path`, as [`Track::plot`] does.
     pub(crate) fn plot(&self, title: &str, path: &Path) -> Result<()> {
-        let gt = Some(&self.ground_truth[..]).filter(|gt| !gt.is_empty());
-        plot_track(title, &self.time, &self.estimate, gt, path)
+        let gt = Some(self.ground_truth.kept()).filter(|gt| !gt.is_empty());
+        plot_track(title, self.time.kept(), self.estimate.kept(), gt, path)
     }
 }
 
@@ -480,7 +534,7 @@ fn track_rows(
     let (mut frames, mut regressions) = (0usize, 0usize);
     let (mut first, mut previous) = (None::<f64>, None::<f64>);
     // The ground truth's points, for the plot, while `write` holds `points`.
-    let (mut truth, plotted) = (Vec::new(), points.is_some());
+    let (mut truth, plotted) = (Thinned::default(), points.is_some());
     let mut write = |updates: &mut Vec<ridi_correct::Update>,
                      live: &mut LiveTracker<'_>,
                      times: &mut std::collections::VecDeque<f64>|
@@ -569,4 +623,28 @@ fn track_rows(
         frames,
         regressions,
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::{PLOT_FRAMES, Thinned};
+
+    fn thinned(n: usize) -> Vec<usize> {
+        let mut t = Thinned::default();
+        (0..n).for_each(|i| t.push(i));
+        t.kept().to_vec()
+    }
+
+    #[test]
+    fn plot_points_are_every_frame_up_to_the_bound_then_every_other() {
+        assert_eq!(thinned(PLOT_FRAMES), (0..PLOT_FRAMES).collect::<Vec<_>>());
+        // One more frame halves them: every second frame, the new one included.
+        let kept = thinned(PLOT_FRAMES + 1);
+        assert_eq!(kept, (0..=PLOT_FRAMES).step_by(2).collect::<Vec<_>>());
+        // Far beyond: every fourth frame, never more than the bound.
+        let n = 3 * PLOT_FRAMES + 5;
+        let kept = thinned(n);
+        assert_eq!(kept, (0..n).step_by(4).collect::<Vec<_>>());
+        assert!(kept.len() <= PLOT_FRAMES);
+    }
 }
