@@ -26,7 +26,8 @@ pub(crate) struct Interpolator<T, I> {
 
 impl<T: Clone, E, I: Iterator<Item = Result<(f64, T), E>>> Interpolator<T, I> {
     /// The interpolator of the sample `first` and the `rest` after it; the last sample is at
-    /// `last_time`.
+    /// `last_time` (a stream that ends elsewhere is its source's to refuse: [`Self::at`] holds
+    /// whatever sample comes last).
     pub(crate) fn new(first: (f64, T), mut rest: I, last_time: f64) -> Result<Self, E> {
         let after = rest.next().transpose()?;
         Ok(Self {
@@ -53,10 +54,7 @@ impl<T: Clone, E, I: Iterator<Item = Result<(f64, T), E>>> Interpolator<T, I> {
             return Ok(self.first.1.clone());
         }
         if t >= self.last_time {
-            while self.after.is_some() {
-                self.advance()?;
-            }
-            return Ok(self.before.1.clone());
+            self.read_to_end()?;
         }
         while self.after.as_ref().is_some_and(|a| a.0 < t) {
             self.advance()?;
@@ -64,10 +62,17 @@ impl<T: Clone, E, I: Iterator<Item = Result<(f64, T), E>>> Interpolator<T, I> {
         let (t0, a) = &self.before;
         Ok(match &self.after {
             Some((t1, b)) => mix(a, b, (t - t0) / (t1 - t0)),
-            // The stream ended before `last_time` said it would (a file that changed since it
-            // was first read): its last sample is held.
+            // Read to its end: the last sample, held.
             None => a.clone(),
         })
+    }
+
+    /// Reads the rest of the stream, to its end.
+    pub(crate) fn read_to_end(&mut self) -> Result<(), E> {
+        while self.after.is_some() {
+            self.advance()?;
+        }
+        Ok(())
     }
 }
 

@@ -39,6 +39,7 @@ use ridi_frames::{DeviceVec, Vec3, WorldFromDevice, WorldVec};
 use crate::error::{DataError, Location, Result};
 use crate::options::ReadOptions;
 use crate::resample::{interpolate_rot, interpolate_scalar, interpolate_vec3, uniform_timeline};
+use crate::stream::Lines;
 use crate::text;
 use crate::{
     Channel, GroundTruth, OrientationSource, Sequence, SequenceError, SequenceParts, Validation,
@@ -64,12 +65,22 @@ pub const FILES: [(&str, &[&str]); 8] = [
     ("step.txt", STEP),
 ];
 
+/// The most values a record of any of the [`FILES`] has (the fields but `t`).
+const WIDTH: usize = {
+    let (mut width, mut i) = (0, 0);
+    while i < FILES.len() {
+        if FILES[i].1.len() - 1 > width {
+            width = FILES[i].1.len() - 1;
+        }
+        i += 1;
+    }
+    width
+};
+
 /// How the reader takes one file of a folder.
 struct Spec {
     name: &'static str,
     fields: &'static [&'static str],
-    /// One of [`REQUIRED`].
-    required: bool,
     /// Whether a gap longer than the validation's `max_gap_s` on the file's own clock is
     /// refused: in every file but `step.txt` (written only when a step is taken) and
     /// `pose.txt` (checked after trimming, on the sequence itself).
@@ -83,37 +94,47 @@ struct Spec {
 }
 
 impl Spec {
-    const fn sensor(name: &'static str, required: bool, channel: Channel) -> Spec {
+    const fn sensor(name: &'static str, channel: Channel) -> Spec {
         Spec {
             name,
             fields: XYZ,
-            required,
             gap: true,
             checked: true,
             channel: Some(channel),
             rotation_at: None,
         }
     }
+
+    /// Whether the file is one of [`REQUIRED`].
+    fn required(&self) -> bool {
+        REQUIRED.contains(&self.name)
+    }
+
+    /// The longest gap the file's own clock may have under `limits`: none unless [`Spec::gap`].
+    fn max_gap_s(&self, limits: &Validation) -> f64 {
+        match self.gap {
+            true => limits.max_gap_s,
+            false => f64::INFINITY,
+        }
+    }
 }
 
-const GYRO: Spec = Spec::sensor("gyro.txt", true, Channel::Gyro);
-const ACCE: Spec = Spec::sensor("acce.txt", true, Channel::Acce);
-const LINACCE: Spec = Spec::sensor("linacce.txt", true, Channel::Linacce);
-const GRAVITY: Spec = Spec::sensor("gravity.txt", true, Channel::Gravity);
+const GYRO: Spec = Spec::sensor("gyro.txt", Channel::Gyro);
+const ACCE: Spec = Spec::sensor("acce.txt", Channel::Acce);
+const LINACCE: Spec = Spec::sensor("linacce.txt", Channel::Linacce);
+const GRAVITY: Spec = Spec::sensor("gravity.txt", Channel::Gravity);
 const ROTATION: Spec = Spec {
     name: "orientation.txt",
     fields: QUAT,
-    required: true,
     gap: true,
     checked: true,
     channel: None,
     rotation_at: Some(RV_AT),
 };
-const MAGNET: Spec = Spec::sensor("magnet.txt", false, Channel::Magnet);
+const MAGNET: Spec = Spec::sensor("magnet.txt", Channel::Magnet);
 const POSE_FILE: Spec = Spec {
     name: "pose.txt",
     fields: POSE,
-    required: false,
     gap: false,
     checked: true,
     channel: Some(Channel::Position),
@@ -122,7 +143,6 @@ const POSE_FILE: Spec = Spec {
 const STEP_FILE: Spec = Spec {
     name: "step.txt",
     fields: STEP,
-    required: false,
     gap: false,
     checked: false,
     channel: None,
@@ -248,19 +268,36 @@ fn rotation(
     })
 }
 
-/// Parses the non-blank `content` of `line`: `None` for a `#` line, else the record's time in
-/// seconds, its values (`fields` but `t`) put into `row`.
+/// One record of a file: its time (seconds), its values (the fields but `t`, then zeros) and
+/// its line.
+#[derive(Debug, Clone, Copy)]
+struct Record {
+    time: f64,
+    values: [f64; WIDTH],
+    line: usize,
+}
+
+impl Record {
+    fn vec3<F: ridi_frames::Frame>(&self) -> Vec3<F> {
+        Vec3::new(self.values[0], self.values[1], self.values[2])
+    }
+
+    fn first3(&self) -> [f64; 3] {
+        [self.values[0], self.values[1], self.values[2]]
+    }
+}
+
+/// Parses the non-blank `content` of `line`: `None` for a `#` line, else the record (its time
+/// in seconds, its values `fields` but `t`).
 fn parse_record(
     content: &str,
     path: &Path,
     line: usize,
     fields: &[&str],
-    row: &mut Vec<f64>,
-) -> Result<Option<f64>> {
+) -> Result<Option<Record>> {
     if content.trim_start().starts_with('#') {
         return Ok(None);
     }
-    let width = fields.len() - 1;
     let mut cells = content.split_ascii_whitespace();
     let t = text::number(
         cells.next().unwrap_or(""),
@@ -269,80 +306,204 @@ fn parse_record(
         "t",
         text::Nan::Reject,
     )?;
-    row.clear();
+    let mut values = [0.0; WIDTH];
+    let mut parsed = 0;
     for (&field, cell) in fields[1..].iter().zip(cells.by_ref()) {
-        row.push(text::number(cell, path, line, field, text::Nan::Reject)?);
+        values[parsed] = text::number(cell, path, line, field, text::Nan::Reject)?;
+        parsed += 1;
     }
-    if row.len() < width {
+    if parsed < fields.len() - 1 {
         return Err(DataError::format(
-            Location::line(path, line).with_field(fields[row.len() + 1]),
+            Location::line(path, line).with_field(fields[parsed + 1]),
             format!(
                 "{} fields, expected {} (`{}`; truncated line?)",
-                row.len() + 1,
+                parsed + 1,
                 fields.len(),
                 fields.join(" ")
             ),
         ));
     }
-    // Division by the exact 1e9 rounds once; multiplying by the inexact 1e-9 would not, and
-    // times would then differ from the same nanoseconds read from a processed file.
-    Ok(Some(t / 1e9))
+    Ok(Some(Record {
+        // Division by the exact 1e9 rounds once; multiplying by the inexact 1e-9 would not,
+        // and times would then differ from the same nanoseconds read from a processed file.
+        time: t / 1e9,
+        values,
+        line,
+    }))
 }
 
-/// Parses one raw file. Records with a timestamp equal to the previous one are dropped.
-fn parse_records(
-    bytes: &[u8],
-    path: &Path,
+/// Where a [`RecordReader`] takes the lines of a file from: the file in memory
+/// ([`TextLines`]) or read as a stream ([`Lines`]).
+trait LineSource {
+    /// The next non-blank line and its number, without its line ending; the inner error is a
+    /// line that is not UTF-8 text, after which the lines can be read on, the outer one a
+    /// failed read.
+    fn next_text(&mut self) -> Result<Option<(usize, Result<&str>)>>;
+
+    /// Whether the file so far ends in a line break (trailing spaces, tabs and `\r` aside).
+    fn ends_in_break(&self) -> bool;
+}
+
+impl LineSource for Lines {
+    fn next_text(&mut self) -> Result<Option<(usize, Result<&str>)>> {
+        Lines::next_text(self)
+    }
+
+    fn ends_in_break(&self) -> bool {
+        self.ends_in_break
+    }
+}
+
+/// The lines of a file's `text` in memory, as [`text::lines`] numbers them.
+struct TextLines<'a, I> {
+    text: &'a str,
+    lines: I,
+}
+
+/// The lines of `text`.
+fn text_lines(text: &str) -> TextLines<'_, impl Iterator<Item = (usize, &str)>> {
+    TextLines {
+        text,
+        lines: text::lines(text),
+    }
+}
+
+impl<'a, I: Iterator<Item = (usize, &'a str)>> LineSource for TextLines<'a, I> {
+    fn next_text(&mut self) -> Result<Option<(usize, Result<&str>)>> {
+        Ok(self.lines.next().map(|(line, content)| (line, Ok(content))))
+    }
+
+    fn ends_in_break(&self) -> bool {
+        text::ends_in_break(self.text)
+    }
+}
+
+/// The records of one file as the whole reader takes them, one at a time: `#` lines skipped,
+/// a record with the time of the one before dropped, each step from the one before checked
+/// (time order, and gaps as the file's [`Spec`] says). The whole reader's errors, in its
+/// order: a failed read, a line that is not UTF-8 text, the first record that does not parse
+/// (from [`next`](Self::next), which reads the rest of the file for what comes before it),
+/// then a last record cut off and the first step refused (from [`finish`](Self::finish), at
+/// the end of the file; [`step`](Self::step) is that step's error as soon as it is read).
+struct RecordReader<S> {
+    lines: S,
+    path: PathBuf,
     fields: &'static [&'static str],
-    max_gap_s: Option<f64>,
-) -> Result<Records> {
+    max_gap_s: f64,
+    /// Time and line of the previous record.
+    previous: Option<(f64, usize)>,
+    /// The line of the last record, unless a `#` line follows it.
+    last_record: Option<usize>,
+    /// The error of the first step refused.
+    step: Option<DataError>,
+}
+
+impl<S: LineSource> RecordReader<S> {
+    /// The records of the file `spec` names, at `path`, from its `lines`, with gaps refused
+    /// beyond `limits`.
+    fn new(lines: S, path: &Path, spec: &Spec, limits: &Validation) -> Self {
+        Self {
+            lines,
+            path: path.to_path_buf(),
+            fields: spec.fields,
+            max_gap_s: spec.max_gap_s(limits),
+            previous: None,
+            last_record: None,
+            step: None,
+        }
+    }
+
+    /// The next record, `None` at the end of the file.
+    fn next(&mut self) -> Result<Option<Record>> {
+        while let Some((line, content)) = self.lines.next_text()? {
+            let content = match content {
+                Ok(content) => content,
+                Err(e) => return Err(self.first_fault(e, false)),
+            };
+            let record = match parse_record(content, &self.path, line, self.fields) {
+                Ok(Some(record)) => record,
+                Ok(None) => {
+                    self.last_record = None;
+                    continue;
+                }
+                Err(e) => return Err(self.first_fault(e, true)),
+            };
+            self.last_record = Some(line);
+            let next = (record.time, line);
+            if let Some(previous) = self.previous {
+                if previous.0 == record.time {
+                    continue;
+                }
+                if self.step.is_none() {
+                    let (path, gap) = (&self.path, self.max_gap_s);
+                    self.step = text::check_step(previous, next, path, "t", gap).err();
+                }
+            }
+            self.previous = Some(next);
+            return Ok(Some(record));
+        }
+        Ok(None)
+    }
+
+    /// The error the whole reader gives a file whose first fault is `fault`: a failed read in
+    /// the rest of the file comes first, and so, for a record that does not parse
+    /// (`parse_error`), does a line that is not UTF-8 text.
+    fn first_fault(&mut self, mut fault: DataError, mut parse_error: bool) -> DataError {
+        loop {
+            match self.lines.next_text() {
+                Err(e) => return e,
+                Ok(None) => return fault,
+                Ok(Some((_, Err(e)))) if parse_error => {
+                    fault = e;
+                    parse_error = false;
+                }
+                Ok(Some(_)) => {}
+            }
+        }
+    }
+
+    /// At the end of the file: refuses a last record cut off, then the first step refused.
+    fn finish(&mut self) -> Result<()> {
+        if let Some(line) = self.last_record
+            && !self.lines.ends_in_break()
+        {
+            return Err(text::cut_off(Location::line(&self.path, line), ""));
+        }
+        self.step.take().map_or(Ok(()), Err)
+    }
+}
+
+/// Parses one raw file, the one `spec` names, at `path`, with gaps refused beyond `limits`.
+fn parse_records(bytes: &[u8], path: &Path, spec: &Spec, limits: &Validation) -> Result<Records> {
     let mut rec = Records {
         path: path.to_path_buf(),
-        fields,
+        fields: spec.fields,
         time: Vec::new(),
         values: Vec::new(),
         lines: Vec::new(),
     };
-    let mut row = Vec::with_capacity(fields.len() - 1);
-    // The line of the last record, unless a `#` line follows it.
-    let mut last_record = None;
+    let width = rec.width();
     let text = text::as_text(bytes, path)?;
-    for (line, content) in text::lines(text) {
-        let Some(t) = parse_record(content, path, line, fields, &mut row)? else {
-            last_record = None;
-            continue;
-        };
-        last_record = Some(line);
-        if rec.time.last() == Some(&t) {
-            continue;
-        }
-        rec.time.push(t);
-        rec.values.extend_from_slice(&row);
-        rec.lines.push(line);
+    let mut records = RecordReader::new(text_lines(text), path, spec, limits);
+    while let Some(r) = records.next()? {
+        rec.time.push(r.time);
+        rec.values.extend_from_slice(&r.values[..width]);
+        rec.lines.push(r.line);
     }
-    text::check_line_break(text, last_record.map(|l| Location::line(path, l)), "")?;
-    // Duplicates are gone, so equal times cannot occur here; decreasing ones and gaps can.
-    text::check_time(
-        &rec.time,
-        &rec.lines,
-        path,
-        "t",
-        max_gap_s.unwrap_or(f64::INFINITY),
-    )?;
+    records.finish()?;
     Ok(rec)
 }
 
-/// Reads the file `spec` names in `folder`, refusing gaps longer than `max_gap_s` if it says
-/// so: `Ok(None)` when it is optional and absent or without rows.
-fn read_records(folder: &Path, spec: &Spec, max_gap_s: f64) -> Result<Option<Records>> {
+/// Reads the file `spec` names in `folder`, refusing gaps beyond `limits` if it says so:
+/// `Ok(None)` when it is optional and absent or without rows.
+fn read_records(folder: &Path, spec: &Spec, limits: &Validation) -> Result<Option<Records>> {
     let path = folder.join(spec.name);
-    if !spec.required && !path.exists() {
+    if !spec.required() && !path.exists() {
         return Ok(None);
     }
-    let gap = spec.gap.then_some(max_gap_s);
-    let rec = parse_records(&text::read_file(&path)?, &path, spec.fields, gap)?;
+    let rec = parse_records(&text::read_file(&path)?, &path, spec, limits)?;
     if rec.time.is_empty() {
-        if spec.required {
+        if spec.required() {
             return Err(no_rows(&path));
         }
         return Ok(None);
@@ -355,8 +516,8 @@ fn no_rows(path: &Path) -> DataError {
     DataError::format(Location::file(path), "has no data rows")
 }
 
-fn required(folder: &Path, spec: &Spec, max_gap_s: f64) -> Result<Records> {
-    read_records(folder, spec, max_gap_s)?.ok_or_else(|| no_rows(&folder.join(spec.name)))
+fn required(folder: &Path, spec: &Spec, limits: &Validation) -> Result<Records> {
+    read_records(folder, spec, limits)?.ok_or_else(|| no_rows(&folder.join(spec.name)))
 }
 
 /// Reads a RIDI raw recorder folder into a sequence named after the folder, with the game
@@ -365,15 +526,15 @@ fn required(folder: &Path, spec: &Spec, max_gap_s: f64) -> Result<Records> {
 pub fn read(folder: impl AsRef<Path>, opts: &ReadOptions) -> Result<Sequence> {
     let folder = folder.as_ref();
     check_required(folder)?;
-    let gap = opts.validation.max_gap_s;
-    let gyro = required(folder, &GYRO, gap)?;
-    let acce = required(folder, &ACCE, gap)?;
-    let linacce = required(folder, &LINACCE, gap)?;
-    let gravity = required(folder, &GRAVITY, gap)?;
-    let rv = required(folder, &ROTATION, gap)?;
-    let magnet = read_records(folder, &MAGNET, gap)?;
-    let pose = read_records(folder, &POSE_FILE, gap)?;
-    let step = read_records(folder, &STEP_FILE, gap)?;
+    let limits = &opts.validation;
+    let gyro = required(folder, &GYRO, limits)?;
+    let acce = required(folder, &ACCE, limits)?;
+    let linacce = required(folder, &LINACCE, limits)?;
+    let gravity = required(folder, &GRAVITY, limits)?;
+    let rv = required(folder, &ROTATION, limits)?;
+    let magnet = read_records(folder, &MAGNET, limits)?;
+    let pose = read_records(folder, &POSE_FILE, limits)?;
+    let step = read_records(folder, &STEP_FILE, limits)?;
     // Each file on its own lines, in the order read.
     let checked = [
         (Some(&gyro), &GYRO),

@@ -230,14 +230,14 @@ fn check_len(field: &'static str, expected: usize, found: usize) -> Result<(), S
 /// `time` strictly increasing, with no step longer than `max_gap_s`.
 fn check_steps(time: &[f64], max_gap_s: f64) -> Result<(), SequenceError> {
     for (i, w) in time.windows(2).enumerate() {
-        check_step(i + 1, w[0], w[1], max_gap_s)?;
+        check_frame_step(i + 1, w[0], w[1], max_gap_s)?;
     }
     Ok(())
 }
 
 /// [`check_steps`] of the step from `previous` to frame `index` at `next` (for a timeline
 /// built as it is read).
-pub(crate) fn check_step(
+pub(crate) fn check_frame_step(
     index: usize,
     previous: f64,
     next: f64,

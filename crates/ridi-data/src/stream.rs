@@ -746,10 +746,11 @@ impl RowReader {
         self.source.error(&self.path, e, Some((index, line)))
     }
 
-    /// The median of `quantity` over the `count` values of the file, read again.
+    /// The median of `quantity` over the `count` values of the file, read again in a few
+    /// passes ([`select`]); a raw folder's through its second pass only ([`Self::again`]).
     fn median(&self, quantity: Quantity, count: usize) -> Result<f64> {
         select(count / 2, |f| {
-            let mut again = Self::open_checked(&self.path, &self.opts, false)?;
+            let mut again = self.again()?;
             let mut previous: Option<Row> = None;
             for row in again.by_ref() {
                 let row = row?;
@@ -759,6 +760,30 @@ impl RowReader {
                 previous = Some(row);
             }
             Ok(())
+        })
+    }
+
+    /// The recording read again from its first row, without the whole-recording checks: a
+    /// processed file opened again, a raw folder's files opened for the rows as its first
+    /// pass found them, without that pass ([`Rows::again`](ridi_raw::stream::Rows::again)).
+    fn again(&self) -> Result<Self> {
+        let raw = match &self.source {
+            Source::Processed(_) => return Self::open_checked(&self.path, &self.opts, false),
+            Source::Raw(raw) => raw.again(&self.opts)?,
+        };
+        Ok(Self {
+            path: self.path.clone(),
+            format: self.format,
+            opts: self.opts.clone(),
+            name: self.name.clone(),
+            device: self.device.clone(),
+            orientation_source: self.orientation_source,
+            source: Source::Raw(Box::new(raw)),
+            checked: false,
+            previous: None,
+            deferred: Deferred::default(),
+            sums: Sums::default(),
+            done: false,
         })
     }
 

@@ -138,11 +138,14 @@ pub(crate) fn check_line_break(
     hint: &str,
 ) -> Result<()> {
     match last_record {
-        Some(at) if !content.trim_end_matches([' ', '\t', '\r']).ends_with('\n') => {
-            Err(cut_off(at, hint))
-        }
+        Some(at) if !ends_in_break(content) => Err(cut_off(at, hint)),
         _ => Ok(()),
     }
+}
+
+/// Whether `content` ends in a line break, trailing spaces, tabs and `\r` aside.
+pub(crate) fn ends_in_break(content: &str) -> bool {
+    content.trim_end_matches([' ', '\t', '\r']).ends_with('\n')
 }
 
 /// The error of [`check_line_break`] for the record at `at`.

@@ -486,3 +486,109 @@ fn a_raw_folder_with_one_fault_gets_the_whole_readers_error() {
         assert!(e.is_err(), "{rate} Hz");
     }
 }
+
+/// Asserts that the rows of a raw folder of 6000 records a file (`raw_files`, after `edit`)
+/// end in the error of a file changed since [`RowReader::open`] read it through, `at` that
+/// file (and line), when `change` changes the folder after that: every file is over 64 KiB,
+/// so that a change is not hidden by what the second pass buffered on opening.
+#[track_caller]
+fn refused_as_changed(
+    edit: impl FnOnce(&mut Vec<(&'static str, String)>),
+    change: impl FnOnce(&Path),
+    at: &str,
+) {
+    let dir = tempfile::tempdir().unwrap();
+    let mut files = raw_files(6000, true);
+    edit(&mut files);
+    write_files(dir.path(), &files);
+    let whole = ridi_raw::read(dir.path(), &raw_options());
+    assert!(whole.is_ok(), "{whole:?}");
+    let mut rows = RowReader::open(dir.path(), &raw_options()).unwrap();
+    change(dir.path());
+    let mut n = 0;
+    let e = loop {
+        match rows.next() {
+            Some(Ok(_)) => n += 1,
+            Some(Err(e)) => break e.to_string(),
+            None => panic!("{at}: {n} rows and no error"),
+        }
+    };
+    let changed = "changed while being read: its records are not those read before";
+    assert!(e.ends_with(&format!("/{at}: {changed}")), "{e}");
+}
+
+/// Cuts the file `name` in `folder` in place to its first `lines` lines.
+fn cut(folder: &Path, name: &str, lines: usize) {
+    let path = folder.join(name);
+    let text = std::fs::read_to_string(&path).unwrap();
+    let kept: String = text.lines().take(lines).map(|l| format!("{l}\n")).collect();
+    std::fs::write(&path, kept).unwrap();
+}
+
+/// Appends `records` records of `values` to the file `name` in `folder`, 5 ms apart from 5 ms
+/// after its last.
+fn append(folder: &Path, name: &str, records: usize, values: &str) {
+    let path = folder.join(name);
+    let text = std::fs::read_to_string(&path).unwrap();
+    let last: i64 = text
+        .lines()
+        .last()
+        .unwrap()
+        .split(' ')
+        .next()
+        .unwrap()
+        .parse()
+        .unwrap();
+    let mut file = std::fs::OpenOptions::new()
+        .append(true)
+        .open(&path)
+        .unwrap();
+    for i in 1..=records as i64 {
+        writeln!(file, "{} {values}", last + 5_000_000 * i).unwrap();
+    }
+}
+
+#[test]
+fn a_sensor_or_pose_file_that_loses_records_after_open_is_refused_as_changed() {
+    // A sensor cut in the middle of the timeline (its last value was held from there on) and
+    // beyond the last frame (the rows are the first pass's, the file is not); the pose cut in
+    // the records trimmed at its end (the kept ones are all there) and in the kept ones.
+    let cuts = [
+        ("gyro.txt", 3000),
+        ("acce.txt", 6015),
+        ("pose.txt", 5998),
+        ("pose.txt", 3000),
+    ];
+    for (name, lines) in cuts {
+        refused_as_changed(|_| {}, |dir| cut(dir, name, lines), name);
+    }
+}
+
+#[test]
+fn a_sensor_file_that_grows_after_open_is_refused_as_changed() {
+    // The gyro ends first, at a pose time: the last frame is at its last record, from where
+    // the interpolation read on to the end of the file.
+    let gyro_first = |files: &mut Vec<(&'static str, String)>| {
+        edit_file(files, "gyro.txt", |t| {
+            t.lines().take(5001).map(|l| format!("{l}\n")).collect()
+        });
+        edit_file(files, "pose.txt", |t| {
+            edit_cells(t, ' ', |_, c| {
+                if let Ok(ns) = c[0].parse::<i64>() {
+                    c[0] = (ns - 1_000_000).to_string();
+                }
+            })
+        });
+    };
+    let grow = |dir: &Path| append(dir, "gyro.txt", 3, "9 9 9");
+    refused_as_changed(gyro_first, grow, "gyro.txt:5002");
+    // A file whose end no frame reached.
+    let grow = |dir: &Path| append(dir, "magnet.txt", 1, "1 2 3");
+    refused_as_changed(|_| {}, grow, "magnet.txt:6022");
+}
+
+#[test]
+fn a_pose_file_that_grows_after_open_is_refused_as_changed() {
+    let grow = |dir: &Path| append(dir, "pose.txt", 2, "0 0.5 1.5 0 0 0 1");
+    refused_as_changed(|_| {}, grow, "pose.txt:6002");
+}

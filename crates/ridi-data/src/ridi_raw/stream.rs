@@ -3,9 +3,10 @@
 //!
 //! [`Rows::open`] reads each file once, in the whole-folder reader's order, and makes the
 //! checks [`read`](super::read) makes on it before it synchronizes anything, with the same
-//! errors in the same order: a failed read first, then a line that is not UTF-8, then the
-//! first record that does not parse, a last record cut off, the first time going back or gap;
-//! then, once every file is read, each file's median time step and values, the sensors'
+//! errors in the same order (the whole reader's [`RecordReader`] reads the records of both):
+//! a failed read first, then a line that is not UTF-8, then the first record that does not
+//! parse, a last record cut off, the first time going back or gap; then, once every file is
+//! read, each file's median time step and values, the sensors'
 //! common span, the pose timeline and the rotations. What the whole reader judges on all of a
 //! file's records (a median) is counted ([`MedianTest`]) and, only when out of range, named by
 //! reading that file again. The pose records kept are a range of indices, found from the
@@ -15,106 +16,97 @@
 //! each sensor at the next time of the timeline with the whole reader's arithmetic
 //! ([`Interpolator`]): the rows are the frames of the sequence [`read`](super::read) builds,
 //! bit for bit. The checks of that sequence are the [`RowReader`](crate::RowReader)'s, with
-//! [`Rows::error`] naming the file as the whole reader does.
+//! [`Rows::error`] naming the file as the whole reader does. Every file is read to its end,
+//! what the frames did not reach after the last: one that changed since the first pass is
+//! refused as changed ([`Reread`]) when it has more records than that pass counted or fewer,
+//! or its last is not at the time that pass read, on the record that says so (a step it now
+//! refuses is that step's error).
 
 use std::path::{Path, PathBuf};
 
-use ridi_frames::{DeviceVec, Frame, Vec3, WorldFromDevice};
+use ridi_frames::{DeviceVec, WorldFromDevice};
 
 use super::{
     ACCE, GRAVITY, GYRO, LINACCE, MAGNET, POSE_FILE, POSE_ROTATION_AT, ROTATION, RV_AT, RawFields,
-    STEP_FILE, Spec, check_required, common_span, kept_poses, name_of, no_frame, no_rows,
-    parse_record, rotation, synchronized_error,
+    Record, RecordReader, STEP_FILE, Spec, check_required, common_span, kept_poses, name_of,
+    no_frame, no_rows, rotation, synchronized_error,
 };
 use crate::error::{DataError, Location, Result};
 use crate::options::ReadOptions;
 use crate::resample::{Interpolator, lerp_scalar, lerp_vec3, slerp, uniform_len, uniform_time};
-use crate::sequence::{check_step, norm};
+use crate::sequence::{check_frame_step, norm};
 use crate::stream::{Lines, MedianTest, Row, select};
 use crate::{Channel, SequenceError, Validation, text};
 
-/// The most values a record has (`pose.txt`: position and rotation).
-const WIDTH: usize = 7;
-
-/// One record of a file: its time (seconds), its values (the fields but `t`) and its line.
-#[derive(Debug, Clone, Copy)]
-struct Record {
-    time: f64,
-    values: [f64; WIDTH],
-    line: usize,
-}
-
-impl Record {
-    fn vec3<F: Frame>(&self) -> Vec3<F> {
-        Vec3::new(self.values[0], self.values[1], self.values[2])
-    }
-
-    fn first3(&self) -> [f64; 3] {
-        [self.values[0], self.values[1], self.values[2]]
-    }
-}
-
-/// The records of one file, parsed as the whole reader parses them, repeated timestamps
-/// dropped, time order and gaps checked: for a file that the first pass found sound.
-struct RecordReader {
-    lines: Lines,
+/// A file as the first pass found it: what the second must find again.
+#[derive(Clone)]
+struct Found {
     path: PathBuf,
-    fields: &'static [&'static str],
-    max_gap_s: f64,
-    row: Vec<f64>,
-    /// Time and line of the previous record.
-    previous: Option<(f64, usize)>,
+    spec: &'static Spec,
+    /// Records kept (repeated timestamps dropped).
+    records: usize,
+    /// Times of the first and the last record.
+    span: (f64, f64),
 }
 
-impl RecordReader {
-    fn open(path: &Path, spec: &Spec, opts: &ReadOptions) -> Result<Self> {
+/// A file read again after the first pass found it sound, its records checked against what
+/// that pass found: refused as changed ([`changed`]) at a record beyond those it counted, at
+/// a last record not at the time it read, and at an end before it; a step refused is refused
+/// as soon as it is read.
+struct Reread {
+    records: RecordReader<Lines>,
+    /// Records the first pass found, and the time of the last.
+    expected: (usize, f64),
+    /// Records read so far.
+    read: usize,
+}
+
+impl Reread {
+    fn open(found: &Found, opts: &ReadOptions) -> Result<Self> {
+        let lines = Lines::open(&found.path)?;
         Ok(Self {
-            lines: Lines::open(path)?,
-            path: path.to_path_buf(),
-            fields: spec.fields,
-            max_gap_s: max_gap(spec, opts),
-            row: Vec::with_capacity(WIDTH),
-            previous: None,
+            records: RecordReader::new(lines, &found.path, found.spec, &opts.validation),
+            expected: (found.records, found.span.1),
+            read: 0,
         })
     }
 
-    fn next_record(&mut self) -> Result<Option<Record>> {
-        while let Some((line, content)) = self.lines.next()? {
-            let Some(t) = parse_record(content, &self.path, line, self.fields, &mut self.row)?
-            else {
-                continue;
-            };
-            if let Some(p) = self.previous {
-                if p.0 == t {
-                    continue;
-                }
-                text::check_step(p, (t, line), &self.path, "t", self.max_gap_s)?;
-            }
-            self.previous = Some((t, line));
-            let mut values = [0.0; WIDTH];
-            values[..self.row.len()].copy_from_slice(&self.row);
-            return Ok(Some(Record {
-                time: t,
-                values,
-                line,
-            }));
-        }
-        Ok(None)
+    fn path(&self) -> &Path {
+        &self.records.path
     }
 
-    /// The `k`-th smallest of `quantity` over the file's records (given the previous one),
-    /// read again in a few passes ([`select`]).
+    /// The next record, `None` at the end of the file.
+    fn next(&mut self) -> Result<Option<Record>> {
+        let (records, last_time) = self.expected;
+        let Some(r) = self.records.next()? else {
+            if self.read < records {
+                return Err(changed(self.path(), None));
+            }
+            self.records.finish()?;
+            return Ok(None);
+        };
+        self.read += 1;
+        if self.read > records || (self.read == records && r.time != last_time) {
+            return Err(changed(self.path(), Some(r.line)));
+        }
+        match self.records.step.take() {
+            Some(e) => Err(e),
+            None => Ok(Some(r)),
+        }
+    }
+
+    /// The `k`-th smallest of `quantity` over the records of the file `found`, given the
+    /// previous one, read again in a few passes ([`select`]).
     fn select(
-        path: &Path,
-        spec: &Spec,
+        found: &Found,
         opts: &ReadOptions,
         k: usize,
         quantity: impl Fn(Option<&Record>, &Record) -> Option<f64>,
     ) -> Result<f64> {
         select(k, |f| {
-            let mut records = Self::open(path, spec, opts)?;
+            let mut records = Self::open(found, opts)?;
             let mut previous = None;
-            while let Some(r) = records.next_record()? {
+            while let Some(r) = records.next()? {
                 if let Some(v) = quantity(previous.as_ref(), &r) {
                     f(v);
                 }
@@ -125,25 +117,30 @@ impl RecordReader {
     }
 }
 
-/// The gap a file's own clock may have.
-fn max_gap(spec: &Spec, opts: &ReadOptions) -> f64 {
-    match spec.gap {
-        true => opts.validation.max_gap_s,
-        false => f64::INFINITY,
-    }
+/// The error for a file whose records are not those the first pass read, at `line` when a
+/// record there says so.
+fn changed(path: &Path, line: Option<usize>) -> DataError {
+    let at = match line {
+        Some(line) => Location::line(path, line),
+        None => Location::file(path),
+    };
+    DataError::format(
+        at,
+        "changed while being read: its records are not those read before",
+    )
 }
 
 /// The records of a file as samples of an [`Interpolator`]: time and value.
 struct Samples<T> {
-    records: RecordReader,
-    value: fn(&RecordReader, &Record) -> Result<T>,
+    records: Reread,
+    value: fn(&Reread, &Record) -> Result<T>,
 }
 
 impl<T> Iterator for Samples<T> {
     type Item = Result<(f64, T)>;
 
     fn next(&mut self) -> Option<Result<(f64, T)>> {
-        match self.records.next_record() {
+        match self.records.next() {
             Ok(Some(r)) => Some((self.value)(&self.records, &r).map(|v| (r.time, v))),
             Ok(None) => None,
             Err(e) => Some(Err(e)),
@@ -151,28 +148,41 @@ impl<T> Iterator for Samples<T> {
     }
 }
 
-fn vec3_of(_: &RecordReader, r: &Record) -> Result<DeviceVec> {
+fn vec3_of(_: &Reread, r: &Record) -> Result<DeviceVec> {
     Ok(r.vec3())
 }
 
-fn rotation_of(records: &RecordReader, r: &Record) -> Result<WorldFromDevice> {
-    rotation(&r.values, RV_AT, &records.path, r.line, records.fields)
+fn rotation_of(records: &Reread, r: &Record) -> Result<WorldFromDevice> {
+    let (path, fields) = (records.path(), records.records.fields);
+    rotation(&r.values, RV_AT, path, r.line, fields)
 }
 
-fn scalar_of(_: &RecordReader, r: &Record) -> Result<f64> {
+fn scalar_of(_: &Reread, r: &Record) -> Result<f64> {
     Ok(r.values[0])
 }
 
 /// One sensor file interpolated onto the timeline.
 type Sensor<T> = Interpolator<T, Samples<T>>;
 
-/// What the first pass learns of one file: its span and what the whole reader checks on it.
+/// The file `found` interpolated onto the timeline, its `value` read from each record.
+fn sensor<T: Clone>(
+    found: &Found,
+    opts: &ReadOptions,
+    value: fn(&Reread, &Record) -> Result<T>,
+) -> Result<Sensor<T>> {
+    let records = Reread::open(found, opts)?;
+    let mut samples = Samples { records, value };
+    let first = samples
+        .next()
+        .transpose()?
+        .ok_or_else(|| changed(&found.path, None))?;
+    Interpolator::new(first, samples, found.span.1)
+}
+
+/// What the first pass learns of one file: what the second must find again, and what the
+/// whole reader checks on it.
 struct Scan {
-    path: PathBuf,
-    spec: &'static Spec,
-    records: usize,
-    /// Times of the first and the last record.
-    span: (f64, f64),
+    found: Found,
     /// Intervals below and above the validation's time step range.
     intervals: MedianTest,
     /// Magnitudes of the first three values above the gyro's median bound (`gyro.txt`).
@@ -205,98 +215,50 @@ impl Scan {
         keep: Option<Keep>,
     ) -> Result<Option<Scan>> {
         let path = folder.join(spec.name);
-        if !spec.required && !path.exists() {
+        if !spec.required() && !path.exists() {
             return Ok(None);
         }
         let limits = &opts.validation;
-        let max_gap_s = max_gap(spec, opts);
-        let mut lines = Lines::open(&path)?;
+        let mut records = RecordReader::new(Lines::open(&path)?, &path, spec, limits);
         let mut scan = Scan {
-            path: path.clone(),
-            spec,
-            records: 0,
-            span: (f64::NAN, f64::NAN),
+            found: Found {
+                path,
+                spec,
+                records: 0,
+                span: (f64::NAN, f64::NAN),
+            },
             intervals: MedianTest::default(),
             norms: MedianTest::default(),
             beyond: None,
             not_rotation: None,
             kept: (None, None),
         };
-        // The first error of each kind, reported in the whole reader's order.
-        let (mut not_text, mut not_parsed, mut time) = (None, None, None);
-        let mut row = Vec::with_capacity(WIDTH);
-        // The line of the last record, unless a `#` line follows it.
-        let mut last_record = None;
-        let mut previous: Option<(f64, usize)> = None;
-        while let Some((line, content)) = lines.next_text()? {
-            let content = match content {
-                Ok(c) if not_text.is_none() && not_parsed.is_none() => c,
-                // Past a fault that comes first, only a failed read can still come before it.
-                Ok(_) => continue,
-                Err(e) => {
-                    not_text.get_or_insert(e);
-                    continue;
-                }
-            };
-            let t = match parse_record(content, &path, line, spec.fields, &mut row) {
-                Ok(Some(t)) => t,
-                Ok(None) => {
-                    last_record = None;
-                    continue;
-                }
-                Err(e) => {
-                    not_parsed = Some(e);
-                    continue;
-                }
-            };
-            last_record = Some(line);
-            if previous.is_some_and(|p| p.0 == t) {
-                continue;
-            }
-            if let Some(p) = previous {
-                if time.is_none() {
-                    time = text::check_step(p, (t, line), &path, "t", max_gap_s).err();
-                }
-                let dt = t - p.0;
-                let (min, max) = limits.time_step_range;
-                scan.intervals.push(dt < min, dt > max);
-            }
-            let mut record = Record {
-                time: t,
-                values: [0.0; WIDTH],
-                line,
-            };
-            record.values[..row.len()].copy_from_slice(&row);
-            scan.record(&record, limits, keep);
-            previous = Some((t, line));
+        while let Some(r) = records.next()? {
+            scan.record(&r, limits, keep);
         }
-        if let Some(e) = not_text.or(not_parsed) {
-            return Err(e);
-        }
-        if let Some(line) = last_record
-            && !lines.ends_in_break
-        {
-            return Err(text::cut_off(Location::line(&path, line), ""));
-        }
-        if let Some(e) = time {
-            return Err(e);
-        }
-        match scan.records {
-            0 if spec.required => Err(no_rows(&path)),
+        records.finish()?;
+        match scan.found.records {
+            0 if spec.required() => Err(no_rows(&scan.found.path)),
             0 => Ok(None),
             _ => Ok(Some(scan)),
         }
     }
 
-    /// Counts `r`, the next record kept (the `self.records`-th).
+    /// Counts `r`, the next record (the `self.found.records`-th).
     fn record(&mut self, r: &Record, limits: &Validation, keep: Option<Keep>) {
-        let index = self.records;
-        self.records += 1;
+        let found = &mut self.found;
+        let index = found.records;
+        found.records += 1;
         if index == 0 {
-            self.span.0 = r.time;
+            found.span.0 = r.time;
+        } else {
+            let dt = r.time - found.span.1;
+            let (min, max) = limits.time_step_range;
+            self.intervals.push(dt < min, dt > max);
         }
-        self.span.1 = r.time;
-        if let Some(channel) = self.spec.channel {
+        found.span.1 = r.time;
+        let (path, spec) = (&found.path, found.spec);
+        if let Some(channel) = spec.channel {
             let v = r.first3();
             if channel == Channel::Gyro {
                 self.norms.push(false, norm(v) > limits.max_median_gyro);
@@ -305,7 +267,7 @@ impl Scan {
                 && let Err(e) = limits.check_value(channel, index, v)
             {
                 let line_of = |i: usize| (i == index).then_some(r.line);
-                self.beyond = Some(text::sequence_error_at(&self.path, line_of, &RawFields, e));
+                self.beyond = Some(text::sequence_error_at(path, line_of, &RawFields, e));
             }
         }
         let (start, end) = keep.map_or((f64::MIN, f64::MAX), |k| k.span);
@@ -318,11 +280,11 @@ impl Scan {
                 self.kept.1 = Some(index);
             }
         }
-        if let Some(at) = self.spec.rotation_at
+        if let Some(at) = spec.rotation_at
             && self.not_rotation.is_none()
             && from_trim
             && (start..=end).contains(&r.time)
-            && let Err(e) = rotation(&r.values, at, &self.path, r.line, self.spec.fields)
+            && let Err(e) = rotation(&r.values, at, path, r.line, spec.fields)
         {
             self.not_rotation = Some((index, e));
         }
@@ -332,21 +294,21 @@ impl Scan {
     /// with the whole reader's errors.
     fn check(&mut self, opts: &ReadOptions) -> Result<()> {
         let limits = &opts.validation;
-        if !self.spec.checked {
+        if !self.found.spec.checked {
             return Ok(());
         }
-        let whole = |e| text::sequence_error_at(&self.path, |_| None, &RawFields, e);
+        let whole = |e| text::sequence_error_at(&self.found.path, |_| None, &RawFields, e);
         let (min, max) = limits.time_step_range;
         if self.intervals.median_low() || self.intervals.median_high() {
             let interval = |p: Option<&Record>, r: &Record| p.map(|p| r.time - p.time);
             let k = self.intervals.len() / 2;
-            let median = RecordReader::select(&self.path, self.spec, opts, k, interval)?;
+            let median = Reread::select(&self.found, opts, k, interval)?;
             return Err(whole(SequenceError::TimeStep { median, min, max }));
         }
         if self.norms.median_high() {
             let magnitude = |_: Option<&Record>, r: &Record| Some(norm(r.first3()));
             let k = self.norms.len() / 2;
-            let median = RecordReader::select(&self.path, self.spec, opts, k, magnitude)?;
+            let median = Reread::select(&self.found, opts, k, magnitude)?;
             let max = limits.max_median_gyro;
             return Err(whole(SequenceError::GyroUnits { median, max }));
         }
@@ -355,35 +317,26 @@ impl Scan {
             None => Ok(()),
         }
     }
-
-    /// The file's sensor interpolated onto the timeline, its `value` read from each record.
-    fn sensor<T: Clone>(
-        &self,
-        opts: &ReadOptions,
-        value: fn(&RecordReader, &Record) -> Result<T>,
-    ) -> Result<Sensor<T>> {
-        let records = RecordReader::open(&self.path, self.spec, opts)?;
-        let mut samples = Samples { records, value };
-        let first = samples
-            .next()
-            .transpose()?
-            .ok_or_else(|| changed(&self.path))?;
-        Interpolator::new(first, samples, self.span.1)
-    }
 }
 
-/// The error for a file whose records are not those the first pass read.
-fn changed(path: &Path) -> DataError {
-    DataError::format(
-        Location::file(path),
-        "changed while being read: its records are not those read before",
-    )
+/// Where the frames' times come from, as the first pass found it.
+#[derive(Clone)]
+enum Clock {
+    /// The records of `pose.txt` from index `kept.0` to `kept.1`.
+    Pose { found: Found, kept: (usize, usize) },
+    /// `frames` times from `start` on, at `rate_hz`.
+    Uniform {
+        start: f64,
+        rate_hz: f64,
+        frames: usize,
+    },
 }
 
-/// The frames' times: the kept pose records, or a uniform timeline.
+/// The frames' times, as they come.
 enum Timeline {
     Pose {
-        records: RecordReader,
+        /// Boxed: far larger than the other variant.
+        records: Box<Reread>,
         /// The index of the next record, and the first and last kept.
         next: usize,
         kept: (usize, usize),
@@ -397,7 +350,27 @@ enum Timeline {
 }
 
 impl Timeline {
-    /// The next frame's time and pose record.
+    fn open(clock: &Clock, opts: &ReadOptions) -> Result<Self> {
+        Ok(match *clock {
+            Clock::Pose { ref found, kept } => Timeline::Pose {
+                records: Box::new(Reread::open(found, opts)?),
+                next: 0,
+                kept,
+            },
+            Clock::Uniform {
+                start,
+                rate_hz,
+                frames,
+            } => Timeline::Uniform {
+                start,
+                rate_hz,
+                frames,
+                next: 0,
+            },
+        })
+    }
+
+    /// The next frame's time and pose record. After the last, `pose.txt` is read to its end.
     fn next_frame(&mut self) -> Result<Option<(f64, Option<Record>)>> {
         match self {
             Timeline::Pose {
@@ -405,12 +378,10 @@ impl Timeline {
                 next,
                 kept,
             } => {
-                while *next <= kept.1 {
-                    let Some(r) = records.next_record()? else {
-                        return Err(changed(&records.path));
-                    };
+                while let Some(r) = records.next()? {
+                    let index = *next;
                     *next += 1;
-                    if *next > kept.0 {
+                    if (kept.0..=kept.1).contains(&index) {
                         return Ok(Some((r.time, Some(r))));
                     }
                 }
@@ -433,11 +404,23 @@ impl Timeline {
     }
 }
 
+/// What the second pass reads, as the first found it: each file and the clock.
+#[derive(Clone)]
+struct Plan {
+    folder: PathBuf,
+    clock: Clock,
+    gyro: Found,
+    acce: Found,
+    linacce: Found,
+    gravity: Found,
+    rotation: Found,
+    magnet: Option<Found>,
+    step: Option<Found>,
+}
+
 /// A raw folder's rows, made as they are asked for.
 pub(crate) struct Rows {
-    folder: PathBuf,
-    /// `pose.txt`, when it is the clock.
-    pose: Option<PathBuf>,
+    plan: Plan,
     max_gap_s: f64,
     timeline: Timeline,
     gyro: Sensor<DeviceVec>,
@@ -474,7 +457,7 @@ impl Rows {
         let spans = [&gyro, &acce, &linacce, &gravity, &rv]
             .into_iter()
             .chain(magnet.as_ref())
-            .map(|s| s.span);
+            .map(|s| s.found.span);
         let span = common_span(folder, spans);
         let keep = span.as_ref().ok().map(|&span| Keep {
             trim: opts.pose_trim,
@@ -491,14 +474,13 @@ impl Rows {
             scan.check(opts)?;
         }
         let (start, end) = span?;
-        let timeline = match &pose {
+        let clock = match &pose {
             Some(p) => {
-                let (first, last) =
-                    kept_poses(&p.path, p.records, opts.pose_trim, p.kept.0, p.kept.1)?;
-                Timeline::Pose {
-                    records: RecordReader::open(&p.path, p.spec, opts)?,
-                    next: 0,
-                    kept: (first, last),
+                let (found, trim) = (&p.found, opts.pose_trim);
+                let kept = kept_poses(&found.path, found.records, trim, p.kept.0, p.kept.1)?;
+                Clock::Pose {
+                    found: found.clone(),
+                    kept,
                 }
             }
             None => {
@@ -507,43 +489,67 @@ impl Rows {
                 if frames == 0 {
                     return Err(no_frame(folder, opts));
                 }
-                Timeline::Uniform {
+                Clock::Uniform {
                     start,
                     rate_hz,
                     frames,
-                    next: 0,
                 }
             }
         };
         if let Some((_, e)) = rv.not_rotation.take() {
             return Err(e);
         }
-        if let (Some(p), Timeline::Pose { kept, .. }) = (&mut pose, &timeline)
+        if let (Some(p), Clock::Pose { kept, .. }) = (&mut pose, &clock)
             && let Some((index, e)) = p.not_rotation.take()
             && index <= kept.1
         {
             return Err(e);
         }
-        Ok(Rows {
+        let plan = Plan {
             folder: folder.to_path_buf(),
-            pose: pose.map(|p| p.path),
+            clock,
+            gyro: gyro.found,
+            acce: acce.found,
+            linacce: linacce.found,
+            gravity: gravity.found,
+            rotation: rv.found,
+            magnet: magnet.map(|m| m.found),
+            step: step.map(|s| s.found),
+        };
+        Self::read(plan, opts)
+    }
+
+    /// The rows of the files `plan` holds: each opened for the second pass.
+    fn read(plan: Plan, opts: &ReadOptions) -> Result<Rows> {
+        let vec3 = |found: &Found| sensor(found, opts, vec3_of);
+        Ok(Rows {
             max_gap_s: opts.validation.max_gap_s,
-            timeline,
-            gyro: gyro.sensor(opts, vec3_of)?,
-            acce: acce.sensor(opts, vec3_of)?,
-            linacce: linacce.sensor(opts, vec3_of)?,
-            gravity: gravity.sensor(opts, vec3_of)?,
-            magnet: magnet.map(|m| m.sensor(opts, vec3_of)).transpose()?,
-            orientation: rv.sensor(opts, rotation_of)?,
-            steps: step.map(|s| s.sensor(opts, scalar_of)).transpose()?,
+            timeline: Timeline::open(&plan.clock, opts)?,
+            gyro: vec3(&plan.gyro)?,
+            acce: vec3(&plan.acce)?,
+            linacce: vec3(&plan.linacce)?,
+            gravity: vec3(&plan.gravity)?,
+            magnet: plan.magnet.as_ref().map(vec3).transpose()?,
+            orientation: sensor(&plan.rotation, opts, rotation_of)?,
+            steps: (plan.step.as_ref())
+                .map(|s| sensor(s, opts, scalar_of))
+                .transpose()?,
+            plan,
             frames: 0,
             previous: None,
         })
     }
 
+    /// The same rows again from the first, for another pass over them (a median to name):
+    /// the files are opened for the second pass as the first pass found them, without that
+    /// pass and its checks again; one changed since is refused as the second pass refuses it.
+    pub(crate) fn again(&self, opts: &ReadOptions) -> Result<Rows> {
+        Self::read(self.plan.clone(), opts)
+    }
+
     /// The sequence's name, as the whole reader names it.
     pub(crate) fn name(&self) -> String {
-        name_of(&self.folder)
+        name_of(&self.plan.folder)
     }
 
     /// Whether the rows have a magnetometer reading (`magnet.txt` has records).
@@ -556,9 +562,17 @@ impl Rows {
         self.steps.is_some()
     }
 
+    /// `pose.txt`, when it is the clock.
+    fn pose(&self) -> Option<&Path> {
+        match &self.plan.clock {
+            Clock::Pose { found, .. } => Some(&found.path),
+            Clock::Uniform { .. } => None,
+        }
+    }
+
     /// Whether the rows have ground truth (the pose is the clock).
     pub(crate) fn has_ground_truth(&self) -> bool {
-        self.pose.is_some()
+        self.pose().is_some()
     }
 
     /// A validation failure of the sequence, naming the file as the whole reader does; a
@@ -568,24 +582,25 @@ impl Rows {
         e: SequenceError,
         line_of: impl Fn(usize) -> Option<usize>,
     ) -> DataError {
-        synchronized_error(&self.folder, self.pose.as_deref(), line_of, e)
+        synchronized_error(&self.plan.folder, self.pose(), line_of, e)
     }
 
     /// The next frame, with its line of `pose.txt` when the pose is the clock. A step of the
     /// timeline that the sequence refuses (a gap) is an error here, the first the sequence
-    /// checks.
+    /// checks. After the last frame, every file is read to its end ([`Reread`]).
     pub(crate) fn next_row(&mut self) -> Result<Option<(Row, Option<usize>)>> {
         let Some((time, pose)) = self.timeline.next_frame()? else {
+            self.read_to_end()?;
             return Ok(None);
         };
         let index = self.frames;
         let line = pose.map(|r| r.line);
         if let Some(previous) = self.previous
-            && let Err(e) = check_step(index, previous, time, self.max_gap_s)
+            && let Err(e) = check_frame_step(index, previous, time, self.max_gap_s)
         {
             return Err(self.error(e, |i| line.filter(|_| i == index)));
         }
-        let ground_truth = match (pose, &self.pose) {
+        let ground_truth = match (pose, self.pose()) {
             (Some(r), Some(path)) => {
                 let at = POSE_ROTATION_AT;
                 Some((
@@ -617,5 +632,22 @@ impl Rows {
         self.frames += 1;
         self.previous = Some(time);
         Ok(Some((row, line)))
+    }
+
+    /// Reads every sensor file to its end: one changed since the first pass is refused,
+    /// whatever of it the frames reached.
+    fn read_to_end(&mut self) -> Result<()> {
+        self.gyro.read_to_end()?;
+        self.acce.read_to_end()?;
+        self.linacce.read_to_end()?;
+        self.gravity.read_to_end()?;
+        if let Some(magnet) = &mut self.magnet {
+            magnet.read_to_end()?;
+        }
+        self.orientation.read_to_end()?;
+        if let Some(steps) = &mut self.steps {
+            steps.read_to_end()?;
+        }
+        Ok(())
     }
 }
