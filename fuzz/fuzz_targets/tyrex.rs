@@ -1,6 +1,6 @@
-//! Tyrex reader: the input is split at NUL bytes into the contents of a run's files
-//! (accelerometer, calibrated gyroscope, rotation vector, time alignment, then the `.mat`
-//! ground truth), written into the benchmark's layout in a temp folder.
+//! Tyrex reader: the input is split at its first NUL bytes into the contents of a run's files
+//! (accelerometer, calibrated gyroscope, rotation vector, time alignment, then the rest: the
+//! `.mat` ground truth), written into the benchmark's layout in a temp folder.
 #![no_main]
 
 use libfuzzer_sys::fuzz_target;

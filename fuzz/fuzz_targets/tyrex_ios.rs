@@ -1,6 +1,7 @@
-//! Tyrex iOS reader: the input is split at NUL bytes into the contents of an iPhone run's files
-//! (accelerometer, gyroscope, attitude, description with its `BootTime`, time alignment, then
-//! the `.mat` ground truth), written into the dataset's layout in a temp folder.
+//! Tyrex iOS reader: the input is split at its first NUL bytes into the contents of an iPhone
+//! run's files (accelerometer, gyroscope, attitude, description with its `BootTime`, time
+//! alignment, then the rest: the `.mat` ground truth), written into the dataset's layout in a
+//! temp folder.
 #![no_main]
 
 use libfuzzer_sys::fuzz_target;

@@ -9,6 +9,7 @@ mod bootstrap;
 mod eval_devices;
 mod eval_orientation;
 mod eval_tyrex;
+mod fuzz;
 mod model;
 mod sample;
 
@@ -103,6 +104,29 @@ enum Task {
         /// Rewrite benchmarks/baseline.json from this run instead of comparing with it.
         #[arg(long)]
         update_baseline: bool,
+    },
+    /// Build a fuzz target of fuzz/ with a nightly toolchain and the flags of `cargo fuzz build`
+    /// (no cargo-fuzz needed), seed fuzz/corpus/<target> from the test fixtures and run
+    /// libFuzzer on it; failing inputs go to fuzz/artifacts/<target>.
+    Fuzz {
+        /// csv, plain, raw, list, mat, tyrex, tyrex_ios, ilc, ronin, or `all` for each in turn.
+        target: String,
+        /// Fuzzing time per target.
+        #[arg(long, value_name = "N", default_value_t = 60)]
+        seconds: u64,
+        /// Toolchain of the build (`rustup run <toolchain> cargo`); it must accept `-Z` flags.
+        #[arg(long, value_name = "NAME", default_value = "nightly")]
+        toolchain: String,
+        /// Build without AddressSanitizer (where its runtime does not work).
+        #[arg(long)]
+        no_asan: bool,
+        /// Run the target on these inputs (e.g. a crash from fuzz/artifacts) instead of fuzzing;
+        /// with `-- -minimize_crash=1 -runs=N` libFuzzer minimizes a crash.
+        #[arg(long, value_name = "FILE")]
+        input: Vec<PathBuf>,
+        /// More libFuzzer arguments, after `--` (e.g. `-- -max_len=4096`).
+        #[arg(last = true, value_name = "LIBFUZZER ARGS")]
+        libfuzzer: Vec<String>,
     },
 }
 
@@ -301,6 +325,21 @@ fn run(cli: Cli) -> Result<()> {
             quick,
             json,
             update_baseline,
+        })?,
+        Task::Fuzz {
+            target,
+            seconds,
+            toolchain,
+            no_asan,
+            input,
+            libfuzzer,
+        } => fuzz::run(&fuzz::Options {
+            target,
+            seconds,
+            toolchain,
+            asan: !no_asan,
+            inputs: input,
+            libfuzzer,
         })?,
     }
     Ok(())

@@ -1155,7 +1155,9 @@ fn chars(
     let rows = dims.first().copied().unwrap_or(1);
     // Multi-row char arrays are column-major; reorder when the count allows it, and keep the
     // raw order otherwise (multi-byte UTF-8 can make the count differ from the dimensions).
-    if rows > 1 && decoded.len() == numel {
+    // An empty array is an empty text: its row count, which costs nothing to declare (e.g.
+    // 2^31 - 1 by 0), must not become that many line breaks.
+    if rows > 1 && numel > 0 && decoded.len() == numel {
         let cols = numel / rows;
         let mut text = String::with_capacity(numel + rows);
         for r in 0..rows {

@@ -290,6 +290,32 @@ fn huge_declared_sizes_fail_fast_without_allocating() {
 }
 
 #[test]
+fn an_empty_char_array_of_many_rows_is_an_empty_text_at_once() {
+    // 2^31 - 1 rows of no characters cost 8 bytes to declare; found by `cargo xtask fuzz mat`
+    // (tests/fuzz_found/mat), which spent its 10 s writing that many line breaks.
+    let v = V::Typed {
+        dims: vec![i32::MAX as usize, 0],
+        class: mat_support::CLASS_CHAR,
+        mi_type: mat_support::MI_UTF16,
+        data: vec![],
+    };
+    let m = MatFile::from_bytes(&le().file(&[("c", v)], false), "c.mat").unwrap();
+    let c = m.get("c").unwrap();
+    assert_eq!(c.dims(), [i32::MAX as usize, 0]);
+    // The length only: a failure must not print two billion line breaks.
+    assert_eq!(c.as_str().map(str::len), Some(0));
+    // Rows with characters are still the rows of the text.
+    let v = V::Typed {
+        dims: vec![2, 2],
+        class: mat_support::CLASS_CHAR,
+        mi_type: mat_support::MI_UTF16,
+        data: "acbd".encode_utf16().flat_map(u16::to_le_bytes).collect(),
+    };
+    let m = MatFile::from_bytes(&le().file(&[("c", v)], false), "c.mat").unwrap();
+    assert_eq!(m.get("c").unwrap().as_str(), Some("ab\ncd"));
+}
+
+#[test]
 fn nesting_is_limited() {
     let mut v = V::Num(vec![1, 1], vec![1.0]);
     for _ in 0..MAX_DEPTH + 2 {
