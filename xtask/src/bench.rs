@@ -1,6 +1,7 @@
 //! `cargo xtask bench`: a fixed set of measurements (criterion benches, the correction latency
 //! harness and an end-to-end `ridi demo`) run as subprocesses, collected into a JSON report and
-//! `docs/bench-latest.md`, and compared with `benchmarks/baseline.json`.
+//! `docs/bench-latest.md`, and compared with the baseline of the CPU it runs on
+//! (`benchmarks/baseline.json`, or `benchmarks/baseline-<cpu model>.json`: [`baseline_for`]).
 //!
 //! The machine is shared with other builds, so the comparison uses CPU-time figures only, each
 //! divided by a reference figure measured in the same run (the naive feature extraction): a
@@ -202,7 +203,12 @@ pub fn run(opts: Options) -> Result<()> {
         started.elapsed().as_secs_f64()
     );
 
-    let baseline_path = root.join("benchmarks/baseline.json");
+    let baseline_path = baseline_for(&root, &report.machine.model, opts.update_baseline)?;
+    let shown = baseline_path
+        .strip_prefix(&root)
+        .unwrap_or(&baseline_path)
+        .display()
+        .to_string();
     let comparisons = if opts.update_baseline {
         let mut base = report.clone();
         base.note = Some(format!(
@@ -212,17 +218,18 @@ pub fn run(opts: Options) -> Result<()> {
             report.command
         ));
         write_json(&baseline_path, &base)?;
-        println!("wrote {}", baseline_path.display());
+        println!("wrote {shown}");
         Vec::new()
     } else {
         let text = std::fs::read_to_string(&baseline_path)
             .with_context(|| format!("reading {}", baseline_path.display()))?;
         let base: Report = serde_json::from_str(&text)
             .with_context(|| format!("parsing {}", baseline_path.display()))?;
+        println!("baseline: {shown} ({})", base.machine.model);
         compare(&base.figures, &report.figures, REFERENCE, TOLERANCE)?
     };
 
-    let md = markdown(&report, &comparisons);
+    let md = markdown(&report, &comparisons, &shown);
     let md_path = root.join("docs/bench-latest.md");
     ridi_data::write_atomically(&md_path, |w| w.write_all(md.as_bytes()))?;
     println!("wrote {}", md_path.display());
@@ -237,11 +244,56 @@ pub fn run(opts: Options) -> Result<()> {
             if c.regressed { "  REGRESSED" } else { "" }
         );
     }
-    check(&comparisons)
+    check(&comparisons, &shown)
 }
 
-/// Fails, naming each figure, when a comparison regressed.
-pub fn check(comparisons: &[Comparison]) -> Result<()> {
+/// The baseline for a CPU of model `model`: `benchmarks/baseline-<model>.json` when one was
+/// recorded on that model, else `benchmarks/baseline.json`, which a comparison uses whatever
+/// its CPU (`.ci/bench` then reports without failing). `--update-baseline` (`update`) writes
+/// `baseline.json` when it does not exist or was recorded on this model, else this model's
+/// own file. A normalized figure holds for the CPU it was measured on only
+/// (docs/benchmarks.md, "On another CPU").
+pub fn baseline_for(root: &Path, model: &str, update: bool) -> Result<PathBuf> {
+    let dir = root.join("benchmarks");
+    let own = dir.join(format!("baseline-{}.json", slug(model)));
+    let main = dir.join("baseline.json");
+    if own.is_file() || !update {
+        return Ok(if own.is_file() { own } else { main });
+    }
+    let Ok(text) = std::fs::read_to_string(&main) else {
+        return Ok(main);
+    };
+    let base: Report =
+        serde_json::from_str(&text).with_context(|| format!("parsing {}", main.display()))?;
+    // The recorded model may be a prefix of the full name ("AMD EPYC" of "AMD EPYC 7763").
+    Ok(if model.starts_with(base.machine.model.as_str()) {
+        main
+    } else {
+        own
+    })
+}
+
+/// `model` as a file name part: lowercase ASCII letters and digits, runs of anything else one
+/// `-` ("Intel(R) Xeon(R) Processor" -> "intel-r-xeon-r-processor").
+fn slug(model: &str) -> String {
+    let mut out = String::new();
+    for c in model.chars() {
+        if c.is_ascii_alphanumeric() {
+            out.push(c.to_ascii_lowercase());
+        } else if !out.is_empty() && !out.ends_with('-') {
+            out.push('-');
+        }
+    }
+    let out = out.trim_end_matches('-');
+    if out.is_empty() {
+        "unknown-cpu".into()
+    } else {
+        out.into()
+    }
+}
+
+/// Fails, naming each figure, when a comparison against the baseline `baseline` regressed.
+pub fn check(comparisons: &[Comparison], baseline: &str) -> Result<()> {
     let regressed: Vec<String> = comparisons
         .iter()
         .filter(|c| c.regressed)
@@ -249,7 +301,7 @@ pub fn check(comparisons: &[Comparison]) -> Result<()> {
         .collect();
     if !regressed.is_empty() {
         bail!(
-            "slower than benchmarks/baseline.json by more than {:.0} % (normalized by {REFERENCE}): {}",
+            "slower than {baseline} by more than {:.0} % (normalized by {REFERENCE}): {}",
             TOLERANCE * 100.0,
             regressed.join(", ")
         );
@@ -570,7 +622,7 @@ fn significant(v: f64) -> String {
     format!("{v:.decimals$}")
 }
 
-pub fn markdown(report: &Report, comparisons: &[Comparison]) -> String {
+pub fn markdown(report: &Report, comparisons: &[Comparison], baseline: &str) -> String {
     let m = &report.machine;
     let mut s = String::new();
     let _ = writeln!(s, "# Latest benchmark run\n");
@@ -583,7 +635,7 @@ pub fn markdown(report: &Report, comparisons: &[Comparison]) -> String {
     let _ = writeln!(
         s,
         "CPU-time figures are divided by `{}` from the same run and compared with \
-         `benchmarks/baseline.json` (fail above +{:.0} %); wall-clock figures are informational.\n",
+         `{baseline}` (fail above +{:.0} %); wall-clock figures are informational.\n",
         report.reference,
         TOLERANCE * 100.0
     );
@@ -721,10 +773,16 @@ mod tests {
         ];
         assert!(!compare(&base, &now19, REFERENCE, TOLERANCE).unwrap()[0].regressed);
         assert!(compare(&base, &now[1..], REFERENCE, TOLERANCE).is_err());
-        let err = check(&c).unwrap_err().to_string();
+        let err = check(&c, "benchmarks/baseline.json")
+            .unwrap_err()
+            .to_string();
         assert!(err.contains("b (+25 %)"), "{err}");
         assert!(!err.contains("a ("), "{err}");
-        assert!(check(&c[..1]).is_ok());
+        assert!(
+            err.contains("slower than benchmarks/baseline.json"),
+            "{err}"
+        );
+        assert!(check(&c[..1], "benchmarks/baseline.json").is_ok());
         let md = markdown(
             &Report {
                 note: None,
@@ -735,9 +793,54 @@ mod tests {
                 figures: now.clone(),
             },
             &c,
+            "benchmarks/baseline.json",
         );
         assert!(md.contains("| b | 25.00 | ms | 0.1250 | +25.0 % REGRESSED |"));
         assert_eq!(significant(0.000707), "0.0007070");
         assert_eq!(significant(291.66667), "291.7");
+    }
+
+    #[test]
+    fn each_cpu_model_has_its_own_baseline() {
+        assert_eq!(
+            slug("Intel(R) Xeon(R) Processor"),
+            "intel-r-xeon-r-processor"
+        );
+        assert_eq!(
+            slug("  AMD EPYC 7763 64-Core Processor "),
+            "amd-epyc-7763-64-core-processor"
+        );
+        assert_eq!(slug("()"), "unknown-cpu");
+        let dir = tempfile::tempdir().unwrap();
+        let root = dir.path();
+        std::fs::create_dir(root.join("benchmarks")).unwrap();
+        let main = root.join("benchmarks/baseline.json");
+        let intel = root.join("benchmarks/baseline-intel-r-xeon-r-processor.json");
+        // No baseline yet: the first one is the main one.
+        assert_eq!(
+            baseline_for(root, "Intel(R) Xeon(R) Processor", true).unwrap(),
+            main
+        );
+        let mut base = Report {
+            note: None,
+            machine: Machine::default(),
+            commit: "abc".into(),
+            command: "cargo xtask bench".into(),
+            reference: REFERENCE.into(),
+            figures: Vec::new(),
+        };
+        base.machine.model = "AMD EPYC".into();
+        write_json(&main, &base).unwrap();
+        // The main baseline's model, or a fuller name of it: the main one.
+        let epyc = "AMD EPYC 7763 64-Core Processor";
+        assert_eq!(baseline_for(root, epyc, true).unwrap(), main);
+        assert_eq!(baseline_for(root, epyc, false).unwrap(), main);
+        // Another model: recorded into its own; compared with the main one until it has one.
+        let xeon = "Intel(R) Xeon(R) Processor";
+        assert_eq!(baseline_for(root, xeon, true).unwrap(), intel);
+        assert_eq!(baseline_for(root, xeon, false).unwrap(), main);
+        write_json(&intel, &base).unwrap();
+        assert_eq!(baseline_for(root, xeon, false).unwrap(), intel);
+        assert_eq!(baseline_for(root, xeon, true).unwrap(), intel);
     }
 }

@@ -93,7 +93,8 @@ enum Task {
         out: Option<PathBuf>,
     },
     /// Run the benchmark set (criterion benches, correction latency, `ridi demo`), write a JSON
-    /// report and docs/bench-latest.md, and compare with benchmarks/baseline.json.
+    /// report and docs/bench-latest.md, and compare with the baseline of this CPU model
+    /// (benchmarks/baseline-<model>.json, else benchmarks/baseline.json).
     Bench {
         /// Short measurement times and a subset of the benches.
         #[arg(long)]
@@ -101,7 +102,8 @@ enum Task {
         /// Report to write [default: <target dir>/bench-report.json].
         #[arg(long, value_name = "FILE")]
         json: Option<PathBuf>,
-        /// Rewrite benchmarks/baseline.json from this run instead of comparing with it.
+        /// Record this run as the baseline of this CPU model instead of comparing with it
+        /// (benchmarks/baseline.json when that is this model's or absent, else its own file).
         #[arg(long)]
         update_baseline: bool,
     },
