@@ -260,17 +260,24 @@ pub fn baseline_for(root: &Path, model: &str, update: bool) -> Result<PathBuf> {
     if own.is_file() || !update {
         return Ok(if own.is_file() { own } else { main });
     }
-    let Ok(text) = std::fs::read_to_string(&main) else {
-        return Ok(main);
+    let text = match std::fs::read_to_string(&main) {
+        Ok(text) => text,
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(main),
+        // Never written over when it cannot be read: it may be another CPU's.
+        Err(e) => return Err(e).with_context(|| format!("reading {}", main.display())),
     };
     let base: Report =
         serde_json::from_str(&text).with_context(|| format!("parsing {}", main.display()))?;
-    // The recorded model may be a prefix of the full name ("AMD EPYC" of "AMD EPYC 7763").
-    Ok(if model.starts_with(base.machine.model.as_str()) {
-        main
-    } else {
-        own
-    })
+    // The recorded model may be a prefix of the full name ("AMD EPYC" of "AMD EPYC 7763"); an
+    // empty one (no "model name" in /proc/cpuinfo) is nobody's.
+    let recorded = base.machine.model.as_str();
+    Ok(
+        if !recorded.is_empty() && !model.is_empty() && model.starts_with(recorded) {
+            main
+        } else {
+            own
+        },
+    )
 }
 
 /// `model` as a file name part: lowercase ASCII letters and digits, runs of anything else one
@@ -842,5 +849,16 @@ mod tests {
         write_json(&intel, &base).unwrap();
         assert_eq!(baseline_for(root, xeon, false).unwrap(), intel);
         assert_eq!(baseline_for(root, xeon, true).unwrap(), intel);
+        // A main baseline without a model is no CPU's: never recorded over.
+        base.machine.model = String::new();
+        write_json(&main, &base).unwrap();
+        assert_eq!(
+            baseline_for(root, epyc, true).unwrap(),
+            root.join("benchmarks/baseline-amd-epyc-7763-64-core-processor.json")
+        );
+        // One that cannot be read is an error, not an absent one to write.
+        std::fs::remove_file(&main).unwrap();
+        std::fs::create_dir(&main).unwrap();
+        assert!(baseline_for(root, epyc, true).is_err());
     }
 }

@@ -206,8 +206,8 @@ fn small_model(dir: &Path) -> std::path::PathBuf {
 fn online_track_of_half_a_million_rows_runs_in_bounded_memory() {
     let dir = tempfile::tempdir().unwrap();
     let model = small_model(dir.path());
-    // 500 k rows: 3 s in the dev profile; whole, the recording took about 250 MB. Twice the
-    // frames a plot keeps (ridi's PLOT_FRAMES): its points are thinned, not grown.
+    // 500 k rows: 3 s in the dev profile; whole, the recording took about 250 MB. Nearly twice
+    // the frames a plot keeps (ridi's PLOT_FRAMES): its points are thinned, not grown.
     let csv = dir.path().join("long.csv");
     long_recording(&csv, 500_000);
     let traj = dir.path().join("traj.csv");

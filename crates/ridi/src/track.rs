@@ -647,4 +647,23 @@ mod tests {
         assert_eq!(kept, (0..n).step_by(4).collect::<Vec<_>>());
         assert!(kept.len() <= PLOT_FRAMES);
     }
+
+    #[test]
+    fn plot_series_pushed_at_different_times_keep_the_same_frames() {
+        // The ground truth is pushed as rows are read, the estimate as poses come out, a
+        // tracker's delay later; the recording may end between two halvings of either.
+        for n in [PLOT_FRAMES - 1, PLOT_FRAMES + 1, 2 * PLOT_FRAMES + 3] {
+            let (mut truth, mut estimate) = (Thinned::default(), Thinned::default());
+            let lag = 1000;
+            for i in 0..n + lag {
+                if i < n {
+                    truth.push(i);
+                }
+                if i >= lag {
+                    estimate.push(i - lag);
+                }
+            }
+            assert_eq!(truth.kept(), estimate.kept(), "{n} frames");
+        }
+    }
 }
