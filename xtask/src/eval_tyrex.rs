@@ -21,14 +21,11 @@ use ridi::correct::{CorrectionConfig, FrameVelocity, InitialVelocity, PlacementS
 use ridi::data::tyrex::{self, TyrexOptions};
 use ridi::data::{Sequence, write_atomically};
 use ridi::eval::{AlignWindow, EvalConfig, evaluate_trajectory};
-use ridi::features::{SampleSchedule, compute_targets};
+use ridi::features::{Orientation, SampleSchedule, compute_targets};
 use ridi::frames::UpAxis;
 use ridi::ground_truth_view;
 use ridi::regress::{Cascade, Gamma, NoProgress};
-use ridi::{
-    EvalOptions, GridChoice, Orientation, PlacementMap, TrackOptions, TrainOptions,
-    apply_orientation,
-};
+use ridi::{EvalOptions, GridChoice, PlacementMap, TrackOptions, TrainOptions, apply_orientation};
 use ridi::{Method, baseline_trajectory};
 use ridi::{SequenceResult, Traces};
 

@@ -8,13 +8,10 @@ use indicatif::{ProgressBar, ProgressStyle};
 
 use ridi::ReadFiles;
 use ridi::data::{ListEntry, shown};
-use ridi::features::FeatureConfig;
+use ridi::features::{FeatureConfig, Orientation};
 use ridi::frames::UpAxis;
 use ridi::regress::{Cascade, Nystrom, ProgressEvent, RegressError, Solver, Stage, Storage};
-use ridi::{
-    GridChoice, Orientation, PipelineError, Purpose, TrainOptions, check_not_input,
-    check_output_file,
-};
+use ridi::{GridChoice, PipelineError, Purpose, TrainOptions, check_not_input, check_output_file};
 
 use crate::{Grid, MAX_FRAMES_APART, count, positive};
 

@@ -4,9 +4,10 @@ use std::sync::{Arc, Mutex, MutexGuard};
 
 use pyo3::prelude::*;
 use ridi::correct::Update as RidiUpdate;
+use ridi::features::Orientation;
 use ridi::frames::DeviceVec;
 use ridi::regress::Cascade;
-use ridi::{Orientation, Recorded, SensorReading};
+use ridi::{Recorded, SensorReading};
 
 use crate::arrays::rotation;
 use crate::errors;

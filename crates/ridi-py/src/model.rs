@@ -8,9 +8,10 @@ use pyo3::prelude::*;
 use pyo3::types::{PyBytes, PyDict};
 use ridi::data::ListEntry;
 use ridi::features::FeatureConfig;
+use ridi::features::Orientation;
 use ridi::frames::UpAxis;
 use ridi::regress::{Cascade, Nystrom, ProgressEvent, RegressError, Solver, Stage, Storage};
-use ridi::{GridChoice, Orientation, PipelineError, Purpose, TrainOptions, load_listed};
+use ridi::{GridChoice, PipelineError, Purpose, TrainOptions, load_listed};
 
 use crate::errors;
 use crate::options::{self, Inputs, MAX_FRAMES_APART, MAX_TURNED_COPIES, WINDOW_RANGE, choice};

@@ -6,7 +6,7 @@ use ridi_frames::UpAxis;
 use ridi_regress::{Cascade, GridRow, Solver, StoredAs};
 use serde::Serialize;
 
-use crate::orientation::Orientation;
+use ridi_features::Orientation;
 use crate::track::{TRACK_RATE_HZ, TRACK_RATE_TOLERANCE};
 
 /// Summary statistics of a scalar series.

@@ -115,7 +115,7 @@ pub use inspect::{
 };
 pub use lists::{Purpose, load_listed};
 pub use live::{CascadeRegressor, LiveTracker, Recorded, SensorReading};
-pub use orientation::{Orientation, apply_orientation, oriented, with_estimated_orientation};
+pub use orientation::{apply_orientation, oriented, with_estimated_orientation};
 pub use output::{
     EvalFolder, EvalPlots, EvalWritten, OutputError, TrackOutput, check_not_input,
     check_output_file, check_output_folder, save_model,

@@ -14,7 +14,7 @@ use ridi_frames::{FilterConfig, estimate_orientation, gravity_and_linacce};
 
 use crate::error::{PipelineError, Result};
 
-pub use ridi_features::Orientation;
+use ridi_features::Orientation;
 
 /// `seq` with its orientation replaced by a gyro + accelerometer estimate, gravity by the
 /// estimate's gravity (standard magnitude) and linear acceleration by accelerometer minus that

@@ -3,13 +3,14 @@
 use ridi::CascadeRegressor;
 use ridi::correct::{Tracker, TrackerConfig};
 use ridi::data::{Listed, ReadOptions, Sequence};
+use ridi::features::Orientation;
 use ridi::frames::ImuSample;
 use ridi::frames::nalgebra::Vector3;
 use ridi::frames::{DeviceVec, Rot, UpAxis};
 use ridi::regress::{Cascade, NoProgress};
 use ridi::{
-    EvalOptions, GridChoice, LiveTracker, Method, Orientation, PlacementMap, SensorReading,
-    TrackOptions, TrainOptions, apply_orientation,
+    EvalOptions, GridChoice, LiveTracker, Method, PlacementMap, SensorReading, TrackOptions,
+    TrainOptions, apply_orientation,
 };
 use ridi_test_support::sample_dataset;
 
