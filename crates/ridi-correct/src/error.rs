@@ -2,13 +2,20 @@
 
 use thiserror::Error;
 
-/// `v` to four significant digits, for a message: a step between two timestamps is
-/// `0.505` s, not `0.5050000000000008`.
+/// `v` for a message, as the other crates print numbers: at most three decimals (a step
+/// between two timestamps is `0.505` s, not `0.5050000000000008`), four significant digits
+/// below a thousandth, so that a tiny step does not print as `0`.
 pub(crate) fn rounded(v: f64) -> f64 {
     if v == 0.0 || !v.is_finite() {
         return v;
     }
-    let scale = 10f64.powi(3 - v.abs().log10().floor() as i32);
+    let a = v.abs();
+    let digits = if a >= 1e-3 {
+        3
+    } else {
+        3 - a.log10().floor() as i32
+    };
+    let scale = 10f64.powi(digits);
     (v * scale).round() / scale
 }
 
@@ -143,7 +150,7 @@ mod tests {
             "gap of 0.505 s before frame 120 exceeds max_dt = 0.1 s"
         );
         assert_eq!(rounded(0.000123456), 0.0001235);
-        assert_eq!(rounded(1234.5678), 1235.0);
+        assert_eq!(rounded(1234.5678), 1234.568);
         assert_eq!(rounded(0.0), 0.0);
     }
 }
