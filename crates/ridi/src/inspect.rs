@@ -6,8 +6,8 @@ use ridi_frames::UpAxis;
 use ridi_regress::{Cascade, GridRow, Solver, StoredAs};
 use serde::Serialize;
 
-use ridi_features::Orientation;
 use crate::track::{TRACK_RATE_HZ, TRACK_RATE_TOLERANCE};
+use ridi_features::Orientation;
 
 /// Summary statistics of a scalar series.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
