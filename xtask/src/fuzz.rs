@@ -7,17 +7,28 @@
 //!
 //! Seeds are built in the input layout of each target (`fuzz/fuzz_targets/*.rs`): the raw and
 //! Tyrex targets take their files joined with NUL bytes, the RoNIN target a 2-byte length and
-//! `info.json` before the HDF5 bytes. The MAT files, which no fixture on disk holds, are written
-//! here ([`mat`]), small so that libFuzzer's mutations stay fast.
+//! `info.json` before the HDF5 bytes. The MAT files, which no fixture on disk holds, and the
+//! Tyrex runs are written in code, by the writer and of the synthetic run of ridi-data's own
+//! tests (`ridi_test_support`'s `MatWriter`, `tyrex_mocap`), small so that libFuzzer's mutations
+//! stay fast.
 
-use std::fmt::Write as _;
 use std::io::Read as _;
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
 use anyhow::{Context, Result, bail, ensure};
+use ridi_test_support::{
+    MatWriter, TYREX_OMEGA, TYREX_TIME_DIFF, qtm_take, tyrex_mocap, tyrex_phone_rows,
+};
 
-/// The targets of `fuzz/Cargo.toml`.
+/// The fuzz targets' harness of the Tyrex runs, the very file, for the check that the seeds are
+/// valid runs.
+#[cfg(test)]
+#[path = "../../fuzz/fuzz_targets/common/tyrex_run.rs"]
+#[allow(dead_code, reason = "`read_run` is the fuzz targets' entry point")]
+mod tyrex_run;
+
+/// The targets of `fuzz/Cargo.toml` (its `[[bin]]` names; a test checks they agree).
 pub const TARGETS: [&str; 9] = [
     "csv",
     "plain",
@@ -225,20 +236,24 @@ pub fn seeds(root: &Path, target: &str) -> Result<Vec<(String, Vec<u8>)>> {
             }
         }
         "mat" => {
-            let vars = mat::qtm_take(&mocap_frames(6));
-            out.push(("qtm.mat".into(), mat::file(&vars, false, false)));
-            out.push(("qtm-compressed.mat".into(), mat::file(&vars, true, false)));
-            out.push(("qtm-big-endian.mat".into(), mat::file(&vars, false, true)));
+            let vars = qtm(6);
+            out.push(("qtm.mat".into(), MatWriter::LE.file(&vars, false)));
+            out.push(("qtm-compressed.mat".into(), MatWriter::LE.file(&vars, true)));
+            out.push((
+                "qtm-big-endian.mat".into(),
+                MatWriter::BE.file(&vars, false),
+            ));
         }
         "tyrex" => {
-            let mat = mat::file(&mat::qtm_take(&mocap_frames(MOCAP_FRAMES)), false, false);
+            let vars = qtm(MOCAP_FRAMES);
             let run = android_run();
+            let mat = MatWriter::LE.file(&vars, false);
             out.push(("android".into(), nul_joined(&run, &mat)));
-            let zipped = mat::file(&mat::qtm_take(&mocap_frames(MOCAP_FRAMES)), true, false);
+            let zipped = MatWriter::LE.file(&vars, true);
             out.push(("android-compressed".into(), nul_joined(&run, &zipped)));
         }
         "tyrex_ios" => {
-            let mat = mat::file(&mat::qtm_take(&mocap_frames(MOCAP_FRAMES)), false, false);
+            let mat = MatWriter::LE.file(&qtm(MOCAP_FRAMES), false);
             out.push(("ios".into(), nul_joined(&ios_run(), &mat)));
         }
         "ilc" => {
@@ -345,10 +360,6 @@ fn nul_joined(files: &[String], mat: &[u8]) -> Vec<u8> {
     out
 }
 
-/// Turn rate of the synthetic runs about the room's z, rad/s.
-const OMEGA: f64 = 0.3;
-/// `timeAlignment.txt`: mocap time = phone time + this.
-const TIME_DIFF: f64 = -2.0;
 /// Phone samples of the synthetic runs: 100 Hz over 3 s of phone time.
 const PHONE_HZ: f64 = 100.0;
 const PHONE_S: f64 = 3.0;
@@ -357,27 +368,22 @@ const MOCAP_FRAMES: usize = 60;
 /// `[Time] BootTime` of the iOS run.
 const BOOT: f64 = 145_406.917_9;
 
-/// Rows of a phone file: `row(t)` at each phone time `t`.
+/// Rows of a phone file of the synthetic runs: `row(t)` at each phone time `t`.
 fn phone_rows(row: impl Fn(f64) -> String) -> String {
-    let mut s = String::new();
-    for k in 0..(PHONE_S * PHONE_HZ) as usize {
-        let t = 0.003 + k as f64 / PHONE_HZ;
-        writeln!(s, "{}", row(t)).expect("writing to a string");
-    }
-    s
+    tyrex_phone_rows(PHONE_HZ, PHONE_S, row)
 }
 
 /// The files of an Android run (in the target's order): the phone lies flat and turns about z
-/// at [`OMEGA`].
+/// at [`TYREX_OMEGA`].
 fn android_run() -> Vec<String> {
     vec![
         phone_rows(|t| format!("{t:.9} {:.6} 0.0 9.80665", 0.1 * t.sin())),
-        phone_rows(|t| format!("{t:.9} 0.0 0.0 {OMEGA}")),
+        phone_rows(|t| format!("{t:.9} 0.0 0.0 {TYREX_OMEGA}")),
         phone_rows(|t| {
-            let h = OMEGA * t / 2.0;
+            let h = TYREX_OMEGA * t / 2.0;
             format!("{t:.9} 0.0 0.0 {:.9} {:.9} 0.17453292", h.sin(), h.cos())
         }),
-        format!("  {TIME_DIFF:e}\n"),
+        format!("  {TYREX_TIME_DIFF:e}\n"),
     ]
 }
 
@@ -388,233 +394,48 @@ fn ios_run() -> Vec<String> {
     let at = |t: f64| t + BOOT;
     vec![
         phone_rows(|t| format!("{:.9} 0.0 0.0 -1.0", at(t))),
-        phone_rows(|t| format!("{:.9} 0.0 0.0 {OMEGA}", at(t))),
+        phone_rows(|t| format!("{:.9} 0.0 0.0 {TYREX_OMEGA}", at(t))),
         phone_rows(|t| {
-            let h = (OMEGA * t - std::f64::consts::FRAC_PI_2) / 2.0;
+            let h = (TYREX_OMEGA * t - std::f64::consts::FRAC_PI_2) / 2.0;
             format!("{:.9} {:.12} 0.0 0.0 {:.12}", at(t), h.cos(), h.sin())
         }),
         format!("[Time]\nBootTime = {BOOT}"),
-        format!("  {TIME_DIFF:e}\n"),
+        format!("  {TYREX_TIME_DIFF:e}\n"),
     ]
 }
 
-/// `n` mocap frames at 60 Hz of the synthetic runs' motion: positions (mm) moving along x at
-/// 1 m/s, rotations (column-major 3x3) the phone's turn at phone time = mocap time - TIME_DIFF.
-fn mocap_frames(n: usize) -> Vec<([f64; 3], [f64; 9])> {
-    (0..n)
-        .map(|i| {
-            let m = i as f64 / 60.0;
-            let (s, c) = (OMEGA * (m - TIME_DIFF)).sin_cos();
-            (
-                [m * 1000.0, 500.0, 1200.0],
-                [c, s, 0.0, -s, c, 0.0, 0.0, 0.0, 1.0],
-            )
-        })
-        .collect()
-}
-
-/// A writer of the few Level 5 MAT-file elements a QTM export uses (doubles, chars, 1x1
-/// structs, cells), plain or compressed, either byte order.
-pub mod mat {
-    use std::io::Write as _;
-
-    use flate2::Compression;
-    use flate2::write::ZlibEncoder;
-
-    const MI_INT8: u32 = 1;
-    const MI_INT32: u32 = 5;
-    const MI_UINT32: u32 = 6;
-    const MI_DOUBLE: u32 = 9;
-    const MI_MATRIX: u32 = 14;
-    const MI_COMPRESSED: u32 = 15;
-    const MI_UTF16: u32 = 17;
-    const CLASS_CELL: u32 = 1;
-    const CLASS_STRUCT: u32 = 2;
-    const CLASS_CHAR: u32 = 4;
-    const CLASS_DOUBLE: u32 = 6;
-
-    /// A value: a double array (dimensions, column-major data), a 1xN char array, a 1x1 struct,
-    /// a 1xN cell.
-    #[derive(Clone)]
-    pub enum V {
-        Num(Vec<usize>, Vec<f64>),
-        Char(String),
-        Struct(Vec<(&'static str, V)>),
-        Cell(Vec<V>),
-    }
-
-    /// A QTM export of one rigid body, as the Tyrex `.mat` files: `Take_1` with `FrameRate`
-    /// and `RigidBodies.Positions` (1x3xN) and `.Rotations` (1x9xN).
-    pub fn qtm_take(frames: &[([f64; 3], [f64; 9])]) -> Vec<(&'static str, V)> {
-        let n = frames.len();
-        let pos = frames.iter().flat_map(|f| f.0).collect();
-        let rot = frames.iter().flat_map(|f| f.1).collect();
-        let bodies = V::Struct(vec![
-            ("Bodies", V::Num(vec![1, 1], vec![1.0])),
-            ("Name", V::Cell(vec![V::Char("Phone".into())])),
-            ("Positions", V::Num(vec![1, 3, n], pos)),
-            ("Rotations", V::Num(vec![1, 9, n], rot)),
-        ]);
-        vec![(
-            "Take_1",
-            V::Struct(vec![
-                ("File", V::Char("C:\\take.qtm".into())),
-                ("Frames", V::Num(vec![1, 1], vec![n as f64])),
-                ("FrameRate", V::Num(vec![1, 1], vec![60.0])),
-                ("RigidBodies", bodies),
-            ]),
-        )]
-    }
-
-    struct W {
-        big_endian: bool,
-    }
-
-    impl W {
-        /// A value's bytes in the file's byte order, given both orders.
-        fn ordered<const N: usize>(&self, be: [u8; N], le: [u8; N]) -> [u8; N] {
-            if self.big_endian { be } else { le }
-        }
-
-        fn u32(&self, v: u32) -> [u8; 4] {
-            self.ordered(v.to_be_bytes(), v.to_le_bytes())
-        }
-
-        /// A data element (the small form up to 4 bytes, as MATLAB writes them).
-        fn elem(&self, ty: u32, data: &[u8]) -> Vec<u8> {
-            let mut out = Vec::new();
-            if !data.is_empty() && data.len() <= 4 {
-                out.extend(self.u32(((data.len() as u32) << 16) | ty));
-                out.extend(data);
-                out.resize(8, 0);
-            } else {
-                out.extend(self.u32(ty));
-                out.extend(self.u32(data.len() as u32));
-                out.extend(data);
-                out.resize(out.len().next_multiple_of(8), 0);
-            }
-            out
-        }
-
-        fn array_header(&self, class: u32, dims: &[usize], name: &str) -> Vec<u8> {
-            let flags = [self.u32(class), self.u32(0)].concat();
-            let dims: Vec<u8> = dims.iter().flat_map(|&d| self.u32(d as u32)).collect();
-            let mut out = self.elem(MI_UINT32, &flags);
-            out.extend(self.elem(MI_INT32, &dims));
-            out.extend(self.elem(MI_INT8, name.as_bytes()));
-            out
-        }
-
-        fn matrix(&self, name: &str, v: &V) -> Vec<u8> {
-            let body = match v {
-                V::Num(dims, data) => {
-                    let mut out = self.array_header(CLASS_DOUBLE, dims, name);
-                    let bytes: Vec<u8> = data
-                        .iter()
-                        .flat_map(|x| self.ordered(x.to_be_bytes(), x.to_le_bytes()))
-                        .collect();
-                    out.extend(self.elem(MI_DOUBLE, &bytes));
-                    out
-                }
-                V::Char(s) => {
-                    let units: Vec<u16> = s.encode_utf16().collect();
-                    let mut out = self.array_header(CLASS_CHAR, &[1, units.len()], name);
-                    let bytes: Vec<u8> = units
-                        .iter()
-                        .flat_map(|u| self.ordered(u.to_be_bytes(), u.to_le_bytes()))
-                        .collect();
-                    out.extend(self.elem(MI_UTF16, &bytes));
-                    out
-                }
-                V::Struct(fields) => {
-                    const NAME_LEN: usize = 32;
-                    let mut out = self.array_header(CLASS_STRUCT, &[1, 1], name);
-                    out.extend(self.elem(MI_INT32, &self.u32(NAME_LEN as u32)));
-                    let mut names = Vec::new();
-                    for (n, _) in fields {
-                        let mut b = n.as_bytes().to_vec();
-                        b.resize(NAME_LEN, 0);
-                        names.extend(b);
-                    }
-                    out.extend(self.elem(MI_INT8, &names));
-                    for (_, f) in fields {
-                        out.extend(self.matrix("", f));
-                    }
-                    out
-                }
-                V::Cell(items) => {
-                    let mut out = self.array_header(CLASS_CELL, &[1, items.len()], name);
-                    for it in items {
-                        out.extend(self.matrix("", it));
-                    }
-                    out
-                }
-            };
-            let mut out = self.u32(MI_MATRIX).to_vec();
-            out.extend(self.u32(body.len() as u32));
-            out.extend(body);
-            out
-        }
-    }
-
-    /// A MAT file of `vars`, each in a compressed element when `compress`.
-    pub fn file(vars: &[(&str, V)], compress: bool, big_endian: bool) -> Vec<u8> {
-        let w = W { big_endian };
-        let mut out = b"MATLAB 5.0 MAT-file, written by cargo xtask fuzz".to_vec();
-        out.resize(116, b' ');
-        out.extend([0u8; 8]);
-        out.extend(if big_endian {
-            *b"\x01\x00MI"
-        } else {
-            *b"\x00\x01IM"
-        });
-        for (name, v) in vars {
-            let m = w.matrix(name, v);
-            if compress {
-                let mut z = ZlibEncoder::new(Vec::new(), Compression::default());
-                z.write_all(&m).expect("writing to memory");
-                let z = z.finish().expect("writing to memory");
-                out.extend(w.u32(MI_COMPRESSED));
-                out.extend(w.u32(z.len() as u32));
-                out.extend(z);
-            } else {
-                out.extend(m);
-            }
-        }
-        out
-    }
+/// The QTM export of `n` mocap frames of the synthetic runs' motion.
+fn qtm(n: usize) -> Vec<(String, ridi_test_support::MatArray)> {
+    let (positions, rotations) = tyrex_mocap(n, &[]);
+    qtm_take("Take_1", 60.0, &positions, &rotations)
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
-    use ridi_data::tyrex::{self, TyrexOptions};
 
-    /// Lays `input` out as the Tyrex targets do (`fuzz/fuzz_targets/common/tyrex_run.rs`) and
-    /// reads the run with the targets' options.
-    fn read_tyrex(
-        input: &[u8],
-        layout: &str,
-        run_name: &str,
-        files: &[&str],
-    ) -> ridi_data::Result<tyrex::TyrexRead> {
-        let root = tempfile::tempdir().unwrap();
-        let run = root.path().join("datasets").join(layout).join(run_name);
-        let qualisys = root.path().join("datasets/qualisys");
-        std::fs::create_dir_all(&run).unwrap();
-        std::fs::create_dir_all(&qualisys).unwrap();
-        let mut parts = input.splitn(files.len() + 1, |&b| b == 0);
-        for name in files {
-            std::fs::write(run.join(name), parts.next().unwrap_or_default()).unwrap();
-        }
-        if let Some(mat) = parts.next() {
-            std::fs::write(qualisys.join(format!("{run_name}.mat")), mat).unwrap();
-        }
-        let opts = TyrexOptions {
-            min_part_s: 0.5,
-            ..TyrexOptions::default()
-        };
-        tyrex::read(&run, &opts)
+    /// The `[[bin]]` names of `fuzz/Cargo.toml`.
+    fn fuzz_bins(root: &Path) -> Vec<String> {
+        let text = std::fs::read_to_string(root.join("fuzz/Cargo.toml")).unwrap();
+        let manifest: toml::Table = toml::from_str(&text).unwrap();
+        manifest["bin"]
+            .as_array()
+            .expect("[[bin]] tables")
+            .iter()
+            .map(|b| b["name"].as_str().expect("a bin's name").to_owned())
+            .collect()
+    }
+
+    #[test]
+    fn targets_are_the_bins_of_the_fuzz_crate() {
+        let mut bins = fuzz_bins(&xtask::workspace_root());
+        bins.sort();
+        let mut targets = TARGETS.map(str::to_owned).to_vec();
+        targets.sort();
+        assert_eq!(
+            targets, bins,
+            "TARGETS against fuzz/Cargo.toml's [[bin]] names"
+        );
     }
 
     #[test]
@@ -655,7 +476,7 @@ mod tests {
         ];
         for (target, layout, run, files) in targets {
             for (name, seed) in seeds(&root, target).unwrap() {
-                let read = read_tyrex(&seed, layout, run, files)
+                let read = tyrex_run::try_read_run(&seed, layout, run, files)
                     .unwrap_or_else(|e| panic!("{target}/{name}: {e}"));
                 assert!(
                     read.sequences.iter().any(|s| s.ground_truth().is_some()),

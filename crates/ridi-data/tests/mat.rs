@@ -1,33 +1,36 @@
-//! MAT v5 reader: fixtures written by `mat_support` (a tiny writer), read back, and corrupted in
-//! every way that matters; no input may panic, and every error names the file (and the field
-//! where there is one).
-
-mod mat_support;
+//! MAT v5 reader: fixtures written by `ridi_test_support::MatWriter` (a tiny writer), read back,
+//! and corrupted in every way that matters; no input may panic, and every error names the file
+//! (and the field where there is one).
 
 use std::panic::{AssertUnwindSafe, catch_unwind};
 use std::path::Path;
 
-use mat_support::{V, W, le};
 use ridi_data::DataError;
 use ridi_data::{MAX_DEPTH, MatClass, MatFile, MatValue};
-use ridi_test_support::assert_names_file;
+use ridi_test_support::{MatArray, MatWriter, assert_names_file};
 
-fn sample() -> Vec<(&'static str, V)> {
+fn sample() -> Vec<(&'static str, MatArray)> {
     vec![
-        ("a", V::Num(vec![2, 3], vec![1.0, 2.0, 3.0, 4.0, 5.0, 6.0])),
-        ("s", V::Char("Nexus5-Handler".into())),
+        (
+            "a",
+            MatArray::Num(vec![2, 3], vec![1.0, 2.0, 3.0, 4.0, 5.0, 6.0]),
+        ),
+        ("s", MatArray::Char("Nexus5-Handler".into())),
         (
             "take",
-            V::Struct(vec![
-                ("FrameRate".into(), V::Num(vec![1, 1], vec![60.0])),
+            MatArray::Struct(vec![
+                ("FrameRate".into(), MatArray::Num(vec![1, 1], vec![60.0])),
                 (
                     "Inner".into(),
-                    V::Struct(vec![
+                    MatArray::Struct(vec![
                         (
                             "Names".into(),
-                            V::Cell(vec![V::Char("x".into()), V::Char("yz".into())]),
+                            MatArray::Cell(vec![
+                                MatArray::Char("x".into()),
+                                MatArray::Char("yz".into()),
+                            ]),
                         ),
-                        ("Empty".into(), V::Num(vec![0, 0], vec![])),
+                        ("Empty".into(), MatArray::Num(vec![0, 0], vec![])),
                     ]),
                 ),
             ]),
@@ -58,10 +61,10 @@ fn check_sample(m: &MatFile) {
 #[test]
 fn reads_plain_compressed_and_big_endian_files() {
     for (w, compress) in [
-        (le(), false),
-        (le(), true),
-        (W { big_endian: true }, false),
-        (W { big_endian: true }, true),
+        (MatWriter::LE, false),
+        (MatWriter::LE, true),
+        (MatWriter::BE, false),
+        (MatWriter::BE, true),
     ] {
         let bytes = w.file(&sample(), compress);
         let m = MatFile::from_bytes(&bytes, "sample.mat").unwrap();
@@ -75,7 +78,7 @@ fn reads_plain_compressed_and_big_endian_files() {
 fn reads_from_disk_and_io_errors_name_the_file() {
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("x.mat");
-    std::fs::write(&path, le().file(&sample(), true)).unwrap();
+    std::fs::write(&path, MatWriter::LE.file(&sample(), true)).unwrap();
     check_sample(&MatFile::read(&path).unwrap());
     let missing = dir.path().join("missing.mat");
     let e = MatFile::read(&missing).unwrap_err();
@@ -85,37 +88,40 @@ fn reads_from_disk_and_io_errors_name_the_file() {
 
 #[test]
 fn narrower_storage_types_integers_singles_and_complex_convert_to_f64() {
-    let w = le();
+    let w = MatWriter::LE;
     let vars = vec![
         (
             // MATLAB stores small whole doubles as uint8 to save space.
             "u8_as_double",
-            V::Typed {
+            MatArray::Typed {
                 dims: vec![1, 3],
-                class: mat_support::CLASS_DOUBLE,
-                mi_type: mat_support::MI_UINT8,
+                class: MatArray::CLASS_DOUBLE,
+                mi_type: MatArray::MI_UINT8,
                 data: vec![0, 7, 255],
             },
         ),
         (
             "i16",
-            V::Typed {
+            MatArray::Typed {
                 dims: vec![1, 2],
-                class: mat_support::CLASS_INT16,
-                mi_type: mat_support::MI_INT16,
+                class: MatArray::CLASS_INT16,
+                mi_type: MatArray::MI_INT16,
                 data: [(-300i16).to_le_bytes(), 12i16.to_le_bytes()].concat(),
             },
         ),
         (
             "single",
-            V::Typed {
+            MatArray::Typed {
                 dims: vec![1, 1],
-                class: mat_support::CLASS_SINGLE,
-                mi_type: mat_support::MI_SINGLE,
+                class: MatArray::CLASS_SINGLE,
+                mi_type: MatArray::MI_SINGLE,
                 data: 1.5f32.to_le_bytes().to_vec(),
             },
         ),
-        ("z", V::Complex(vec![1, 2], vec![1.0, 2.0], vec![-1.0, 0.5])),
+        (
+            "z",
+            MatArray::Complex(vec![1, 2], vec![1.0, 2.0], vec![-1.0, 0.5]),
+        ),
     ];
     let m = MatFile::from_bytes(&w.file(&vars, false), "t.mat").unwrap();
     assert_eq!(
@@ -134,7 +140,7 @@ fn narrower_storage_types_integers_singles_and_complex_convert_to_f64() {
 
 #[test]
 fn require_names_file_path_and_what_is_there() {
-    let m = MatFile::from_bytes(&le().file(&sample(), false), "dir/q.mat").unwrap();
+    let m = MatFile::from_bytes(&MatWriter::LE.file(&sample(), false), "dir/q.mat").unwrap();
     assert_eq!(m.require("take.FrameRate").unwrap().scalar(), Some(60.0));
     let e = m.require("take.RigidBodies").unwrap_err().to_string();
     assert_eq!(
@@ -169,24 +175,24 @@ fn read_err(bytes: &[u8]) -> String {
 fn header_problems_are_reported() {
     assert_eq!(read_err(b""), "bad.mat: field `header`: the file is empty");
     assert!(read_err(&[0u8; 100]).contains("shorter than the 128-byte"));
-    let mut h = le().header("MATLAB 5.0 MAT-file");
+    let mut h = MatWriter::LE.header("MATLAB 5.0 MAT-file");
     h[126..128].copy_from_slice(b"XX");
     assert!(read_err(&h).contains("not a Level 5 MAT-file"));
-    let mut h = le().header("MATLAB 7.3 MAT-file, HDF5");
+    let mut h = MatWriter::LE.header("MATLAB 7.3 MAT-file, HDF5");
     h[126..128].copy_from_slice(b"\0\0");
     assert!(read_err(&h).contains("7.3 (HDF5) is not supported"));
-    let mut h = le().header("MATLAB 5.0 MAT-file");
+    let mut h = MatWriter::LE.header("MATLAB 5.0 MAT-file");
     h[124] = 2;
     assert!(read_err(&h).contains("version 0x0102"));
     // A header alone is a valid file without variables.
-    let m = MatFile::from_bytes(&le().header("MATLAB 5.0 MAT-file"), "h.mat").unwrap();
+    let m = MatFile::from_bytes(&MatWriter::LE.header("MATLAB 5.0 MAT-file"), "h.mat").unwrap();
     assert_eq!(m.variables().count(), 0);
 }
 
 #[test]
 fn every_truncation_is_an_error_or_the_complete_variables_before_the_cut() {
     for compress in [false, true] {
-        let bytes = le().file(&sample(), compress);
+        let bytes = MatWriter::LE.file(&sample(), compress);
         let full: Vec<_> = MatFile::from_bytes(&bytes, "bad.mat")
             .unwrap()
             .variables()
@@ -225,7 +231,7 @@ fn every_truncation_is_an_error_or_the_complete_variables_before_the_cut() {
 
 #[test]
 fn truncation_inside_a_field_names_the_field() {
-    let bytes = le().file(&sample(), false);
+    let bytes = MatWriter::LE.file(&sample(), false);
     let e = read_err(&bytes[..bytes.len() - 20]);
     assert!(e.contains("field `take.Inner"), "{e}");
     assert!(e.contains("truncated"), "{e}");
@@ -242,7 +248,7 @@ fn random_corruption_never_panics_and_errors_name_the_file() {
         seed >> 33
     };
     for compress in [false, true] {
-        let bytes = le().file(&sample(), compress);
+        let bytes = MatWriter::LE.file(&sample(), compress);
         for _ in 0..3000 {
             let mut b = bytes.clone();
             for _ in 0..1 + next() % 3 {
@@ -263,12 +269,12 @@ fn random_corruption_never_panics_and_errors_name_the_file() {
 
 #[test]
 fn huge_declared_sizes_fail_fast_without_allocating() {
-    let w = le();
+    let w = MatWriter::LE;
     // 100000 x 100000 doubles declared, 8 bytes present.
-    let v = V::Typed {
+    let v = MatArray::Typed {
         dims: vec![100_000, 100_000],
-        class: mat_support::CLASS_DOUBLE,
-        mi_type: mat_support::MI_DOUBLE,
+        class: MatArray::CLASS_DOUBLE,
+        mi_type: MatArray::MI_DOUBLE,
         data: 1.0f64.to_le_bytes().to_vec(),
     };
     let e = read_err(&w.file(&[("big", v)], false));
@@ -277,7 +283,7 @@ fn huge_declared_sizes_fail_fast_without_allocating() {
         "{e}"
     );
     // A cell of 2^31 - 1 elements with nothing in it.
-    let mut body = w.matrix_body("c", &V::Cell(vec![]));
+    let mut body = w.matrix_body("c", &MatArray::Cell(vec![]));
     // Flags element (16 bytes), then the dimensions' 8-byte tag.
     let dims_at = 16 + 8;
     body[dims_at + 4..dims_at + 8].copy_from_slice(&i32::MAX.to_le_bytes());
@@ -294,41 +300,41 @@ fn an_empty_char_array_of_many_rows_is_an_empty_text_at_once() {
     // Rows of no characters cost 8 bytes to declare: `cargo xtask fuzz mat` found 738,201,856
     // of them (tests/fuzz_found/mat), and the reader spent its 10 s writing that many line
     // breaks; here the most a MAT dimension holds.
-    let v = V::Typed {
+    let v = MatArray::Typed {
         dims: vec![i32::MAX as usize, 0],
-        class: mat_support::CLASS_CHAR,
-        mi_type: mat_support::MI_UTF16,
+        class: MatArray::CLASS_CHAR,
+        mi_type: MatArray::MI_UTF16,
         data: vec![],
     };
-    let m = MatFile::from_bytes(&le().file(&[("c", v)], false), "c.mat").unwrap();
+    let m = MatFile::from_bytes(&MatWriter::LE.file(&[("c", v)], false), "c.mat").unwrap();
     let c = m.get("c").unwrap();
     assert_eq!(c.dims(), [i32::MAX as usize, 0]);
     // The length only: a failure must not print two billion line breaks.
     assert_eq!(c.as_str().map(str::len), Some(0));
     // Rows with characters are still the rows of the text.
-    let v = V::Typed {
+    let v = MatArray::Typed {
         dims: vec![2, 2],
-        class: mat_support::CLASS_CHAR,
-        mi_type: mat_support::MI_UTF16,
+        class: MatArray::CLASS_CHAR,
+        mi_type: MatArray::MI_UTF16,
         data: "acbd".encode_utf16().flat_map(u16::to_le_bytes).collect(),
     };
-    let m = MatFile::from_bytes(&le().file(&[("c", v)], false), "c.mat").unwrap();
+    let m = MatFile::from_bytes(&MatWriter::LE.file(&[("c", v)], false), "c.mat").unwrap();
     assert_eq!(m.get("c").unwrap().as_str(), Some("ab\ncd"));
 }
 
 #[test]
 fn nesting_is_limited() {
-    let mut v = V::Num(vec![1, 1], vec![1.0]);
+    let mut v = MatArray::Num(vec![1, 1], vec![1.0]);
     for _ in 0..MAX_DEPTH + 2 {
-        v = V::Cell(vec![v]);
+        v = MatArray::Cell(vec![v]);
     }
-    let e = read_err(&le().file(&[("deep", v)], false));
+    let e = read_err(&MatWriter::LE.file(&[("deep", v)], false));
     assert!(e.contains("nested deeper than"), "{e}");
-    let mut ok = V::Num(vec![1, 1], vec![1.0]);
+    let mut ok = MatArray::Num(vec![1, 1], vec![1.0]);
     for _ in 0..MAX_DEPTH {
-        ok = V::Cell(vec![ok]);
+        ok = MatArray::Cell(vec![ok]);
     }
-    let m = MatFile::from_bytes(&le().file(&[("deep", ok)], true), "ok.mat").unwrap();
+    let m = MatFile::from_bytes(&MatWriter::LE.file(&[("deep", ok)], true), "ok.mat").unwrap();
     let mut v = m.get("deep").unwrap();
     while let MatValue::Cell(c) = v {
         v = &c.items[0];
@@ -338,7 +344,7 @@ fn nesting_is_limited() {
 
 #[test]
 fn corrupt_zlib_stream_is_an_error() {
-    let mut bytes = le().file(&sample(), true);
+    let mut bytes = MatWriter::LE.file(&sample(), true);
     // Past the 2-byte zlib header of the first compressed element.
     for b in &mut bytes[128 + 8 + 4..128 + 8 + 24] {
         *b ^= 0x5a;

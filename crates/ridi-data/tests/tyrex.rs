@@ -1,23 +1,20 @@
 //! Tyrex reader on synthetic folders: known motion in, known sequence out, and an error naming
 //! file, line and field for each kind of bad input.
 
-mod mat_support;
-
 use std::f64::consts::FRAC_PI_2;
 use std::fmt::Write as _;
 use std::path::PathBuf;
 
-use mat_support::{V, le, qtm_like};
-use ridi_data::ridi_frames::{DeviceVec, STANDARD_GRAVITY, WorldFromDevice};
+use ridi_data::ridi_frames::{DeviceVec, STANDARD_GRAVITY};
 use ridi_data::tyrex::{self, TyrexOptions};
 use ridi_data::{DataError, OrientationSource};
+use ridi_test_support::{
+    MatArray, MatWriter, TYREX_OMEGA, TYREX_TIME_DIFF, qtm_take, tyrex_mocap, tyrex_phone_rows, yaw,
+};
 
-const OMEGA: f64 = 0.3;
-const TIME_DIFF: f64 = -2.0;
-
-/// A synthetic run: the phone lies flat, turns about z at `OMEGA` rad/s and moves along room x
-/// at 1 m/s. Phone samples at 200 Hz from 0.003 s for `phone_s` seconds; `frames` mocap frames
-/// at 60 Hz, phone time = mocap time + 2 s.
+/// A synthetic run (`ridi_test_support`'s): the phone lies flat, turns about z at
+/// `TYREX_OMEGA` rad/s and moves along room x at 1 m/s. Phone samples at 200 Hz from 0.003 s
+/// for `phone_s` seconds; `frames` mocap frames at 60 Hz, phone time = mocap time + 2 s.
 struct Fixture {
     _tmp: tempfile::TempDir,
     root: PathBuf,
@@ -25,35 +22,8 @@ struct Fixture {
     mat: PathBuf,
 }
 
-fn yaw(a: f64) -> WorldFromDevice {
-    WorldFromDevice::from_axis_angle(&ridi_data::ridi_frames::nalgebra::Vector3::z_axis(), a)
-}
-
 fn phone_rows(phone_s: f64, row: impl Fn(f64) -> String) -> String {
-    let n = (phone_s * 200.0) as usize;
-    let mut s = String::new();
-    for k in 0..n {
-        let t = 0.003 + k as f64 * 0.005;
-        writeln!(s, "{}", row(t)).unwrap();
-    }
-    s
-}
-
-fn frames(n: usize, lost: &[std::ops::Range<usize>]) -> (Vec<[f64; 3]>, Vec<[f64; 9]>) {
-    let mut p = Vec::new();
-    let mut r = Vec::new();
-    for i in 0..n {
-        let t = i as f64 / 60.0;
-        if lost.iter().any(|l| l.contains(&i)) {
-            p.push([f64::NAN; 3]);
-            r.push([f64::NAN; 9]);
-            continue;
-        }
-        p.push([t * 1000.0, 500.0, 1200.0]);
-        let m = yaw(OMEGA * t).matrix();
-        r.push(m.as_slice().try_into().unwrap());
-    }
-    (p, r)
+    tyrex_phone_rows(200.0, phone_s, row)
 }
 
 impl Fixture {
@@ -70,25 +40,26 @@ impl Fixture {
         );
         w(
             "gyroscope-calibrated.txt",
-            phone_rows(phone_s, |t| format!("{:.9} 0.0 0.0 {OMEGA}", t + 0.001)),
+            phone_rows(phone_s, |t| {
+                format!("{:.9} 0.0 0.0 {TYREX_OMEGA}", t + 0.001)
+            }),
         );
         w(
             "rotation-vector.txt",
             phone_rows(phone_s, |t| {
-                let [x, y, z, q] = yaw(OMEGA * t).to_xyzw();
+                let [x, y, z, q] = yaw(TYREX_OMEGA * t).to_xyzw();
                 format!("{t:.9} {x} {y} {z} {q} 0.17453292")
             }),
         );
-        w("timeAlignment.txt", format!("  {TIME_DIFF:e}\n"));
+        w("timeAlignment.txt", format!("  {TYREX_TIME_DIFF:e}\n"));
         w(
             "record.properties",
             "[Device]\nManufacturer = LGE\nModel = Nexus 5\n[Time]\nStartTime = 1".into(),
         );
-        let (p, r) = frames(mocap_frames, lost);
-        let vars = qtm_like("Take_1", 60.0, &p, &r);
-        let vars: Vec<(&str, V)> = vars.iter().map(|(n, v)| (n.as_str(), v.clone())).collect();
+        let (p, r) = tyrex_mocap(mocap_frames, lost);
+        let vars = qtm_take("Take_1", 60.0, &p, &r);
         let mat = root.join("datasets/qualisys").join(format!("{name}.mat"));
-        std::fs::write(&mat, le().file(&vars, true)).unwrap();
+        std::fs::write(&mat, MatWriter::LE.file(&vars, true)).unwrap();
         Fixture {
             _tmp: tmp,
             root,
@@ -131,7 +102,7 @@ fn known_motion_comes_out_aligned_resampled_and_in_the_right_frames() {
     let fx = Fixture::standard();
     let read = tyrex::read(&fx.dir, &TyrexOptions::default()).unwrap();
     assert!(read.warnings.is_empty(), "{:?}", read.warnings);
-    assert_eq!(read.time_diff_s, Some(TIME_DIFF));
+    assert_eq!(read.time_diff_s, Some(TYREX_TIME_DIFF));
     assert_eq!(read.device_model.as_deref(), Some("Nexus 5"));
     let [seq] = read.sequences.as_slice() else {
         panic!("{} parts", read.sequences.len())
@@ -157,11 +128,14 @@ fn known_motion_comes_out_aligned_resampled_and_in_the_right_frames() {
             "{t} {p:?}"
         );
         assert!(
-            gt.orientation[k].angle_to(&yaw(OMEGA * mocap_t)) < 1e-6,
+            gt.orientation[k].angle_to(&yaw(TYREX_OMEGA * mocap_t)) < 1e-6,
             "{t}"
         );
-        assert!(seq.orientation()[k].angle_to(&yaw(OMEGA * t)) < 1e-6, "{t}");
-        assert!((seq.gyro()[k] - DeviceVec::new(0.0, 0.0, OMEGA)).norm() < 1e-12);
+        assert!(
+            seq.orientation()[k].angle_to(&yaw(TYREX_OMEGA * t)) < 1e-6,
+            "{t}"
+        );
+        assert!((seq.gyro()[k] - DeviceVec::new(0.0, 0.0, TYREX_OMEGA)).norm() < 1e-12);
         // Flat phone: gravity is +z in the device frame, whatever the heading.
         assert!((seq.gravity()[k] - DeviceVec::new(0.0, 0.0, STANDARD_GRAVITY)).norm() < 1e-9);
         let lin = seq.linacce()[k];
@@ -340,7 +314,7 @@ fn rotation_vector_without_w_or_accuracy_is_accepted() {
     let read = tyrex::read(&fx.dir, &TyrexOptions::default()).unwrap();
     let seq = &read.sequences[0];
     let k = seq.len() / 2;
-    assert!(seq.orientation()[k].angle_to(&yaw(OMEGA * seq.time()[k])) < 1e-6);
+    assert!(seq.orientation()[k].angle_to(&yaw(TYREX_OMEGA * seq.time()[k])) < 1e-6);
 }
 
 fn assert_err(fx: &Fixture, expect: &[&str]) {
@@ -450,7 +424,7 @@ fn phone_files_cut_before_their_last_line_break_are_refused() {
 
     // The one-number `timeAlignment.txt` is exempt: a real one lacks its final break.
     let fx = Fixture::standard();
-    fx.write("timeAlignment.txt", &format!("  {TIME_DIFF:e}"));
+    fx.write("timeAlignment.txt", &format!("  {TYREX_TIME_DIFF:e}"));
     tyrex::read(&fx.dir, &TyrexOptions::default()).unwrap();
 }
 
@@ -528,10 +502,9 @@ fn implausible_values_and_units_name_file_line_and_field() {
     );
 }
 
-fn with_mat(vars: Vec<(String, V)>) -> Fixture {
+fn with_mat(vars: Vec<(String, MatArray)>) -> Fixture {
     let fx = Fixture::standard();
-    let vars: Vec<(&str, V)> = vars.iter().map(|(n, v)| (n.as_str(), v.clone())).collect();
-    std::fs::write(&fx.mat, le().file(&vars, false)).unwrap();
+    std::fs::write(&fx.mat, MatWriter::LE.file(&vars, false)).unwrap();
     fx
 }
 
@@ -541,11 +514,14 @@ fn mat_file_name(fx: &Fixture) -> String {
 
 #[test]
 fn mat_errors_name_the_file_and_field() {
-    let (p, r) = frames(600, &[]);
+    let (p, r) = tyrex_mocap(600, &[]);
 
     let fx = with_mat(vec![(
         "Take_1".into(),
-        V::Struct(vec![("FrameRate".into(), V::Num(vec![1, 1], vec![60.0]))]),
+        MatArray::Struct(vec![(
+            "FrameRate".into(),
+            MatArray::Num(vec![1, 1], vec![60.0]),
+        )]),
     )]);
     assert_err(
         &fx,
@@ -556,9 +532,9 @@ fn mat_errors_name_the_file_and_field() {
         ],
     );
 
-    let mut vars = qtm_like("Take_1", 60.0, &p, &r);
-    if let V::Struct(fields) = &mut vars[0].1
-        && let Some((_, V::Struct(rb))) = fields.iter_mut().find(|(n, _)| n == "RigidBodies")
+    let mut vars = qtm_take("Take_1", 60.0, &p, &r);
+    if let MatArray::Struct(fields) = &mut vars[0].1
+        && let Some((_, MatArray::Struct(rb))) = fields.iter_mut().find(|(n, _)| n == "RigidBodies")
     {
         rb.retain(|(n, _)| n != "Positions");
     }
@@ -571,13 +547,13 @@ fn mat_errors_name_the_file_and_field() {
         ],
     );
 
-    let fx = with_mat(qtm_like("Take_1", 60.0, &p, &r[..599]));
+    let fx = with_mat(qtm_take("Take_1", 60.0, &p, &r[..599]));
     assert_err(
         &fx,
         &["field `Take_1.RigidBodies.Rotations`: 599 frames, but Positions has 600"],
     );
 
-    let fx = with_mat(qtm_like("Take_1", 0.0, &p, &r));
+    let fx = with_mat(qtm_take("Take_1", 0.0, &p, &r));
     assert_err(
         &fx,
         &["field `Take_1.FrameRate`: expected one positive number"],
@@ -585,7 +561,7 @@ fn mat_errors_name_the_file_and_field() {
 
     let mut bad = r.clone();
     bad[42][0] = 2.0;
-    let fx = with_mat(qtm_like("Take_1", 60.0, &p, &bad));
+    let fx = with_mat(qtm_take("Take_1", 60.0, &p, &bad));
     assert_err(
         &fx,
         &["field `Take_1.RigidBodies.Rotations`: frame 43 is not a rotation matrix"],
@@ -594,11 +570,11 @@ fn mat_errors_name_the_file_and_field() {
     // A reflection is orthonormal but not a rotation.
     let mut bad = r.clone();
     bad[7] = [1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, -1.0];
-    let fx = with_mat(qtm_like("Take_1", 60.0, &p, &bad));
+    let fx = with_mat(qtm_take("Take_1", 60.0, &p, &bad));
     assert_err(&fx, &["frame 8 is not a rotation matrix", "det = -1"]);
 
     let lost = vec![[f64::NAN; 3]; 600];
-    let fx = with_mat(qtm_like("Take_1", 60.0, &lost, &r));
+    let fx = with_mat(qtm_take("Take_1", 60.0, &lost, &r));
     assert_err(&fx, &["every frame is NaN"]);
 }
 
@@ -607,12 +583,12 @@ fn mat_errors_name_the_file_and_field() {
 /// gives the nearest rotation.
 #[test]
 fn mocap_matrices_that_are_not_rotations_name_file_field_and_frame() {
-    let (p, r) = frames(600, &[]);
+    let (p, r) = tyrex_mocap(600, &[]);
 
     // 2 I: the unchecked conversion made it a "unit" quaternion with w = 1.32.
     let mut bad = r.clone();
     bad[99] = [2.0, 0.0, 0.0, 0.0, 2.0, 0.0, 0.0, 0.0, 2.0];
-    let fx = with_mat(qtm_like("Take_1", 60.0, &p, &bad));
+    let fx = with_mat(qtm_take("Take_1", 60.0, &p, &bad));
     assert_err(
         &fx,
         &[
@@ -629,7 +605,7 @@ fn mocap_matrices_that_are_not_rotations_name_file_field_and_frame() {
     // diag(-1, 1, 1): orthonormal, but a reflection.
     let mut bad = r.clone();
     bad[0] = [-1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0];
-    let fx = with_mat(qtm_like("Take_1", 60.0, &p, &bad));
+    let fx = with_mat(qtm_take("Take_1", 60.0, &p, &bad));
     assert_err(
         &fx,
         &[
@@ -642,20 +618,20 @@ fn mocap_matrices_that_are_not_rotations_name_file_field_and_frame() {
     // Perturbed by 1e-6 (the Tyrex exports are within 1e-7 of orthonormal): accepted, unit,
     // and within a few microradians of the true rotation. The standard fixture's 30 s of mocap,
     // so that the whole run can be read too.
-    let (p, r) = frames(60 * 30, &[]);
+    let (p, r) = tyrex_mocap(60 * 30, &[]);
     let mut noisy = r.clone();
     for (k, m) in noisy.iter_mut().enumerate() {
         for (j, v) in m.iter_mut().enumerate() {
             *v += 1e-6 * if (k + j) % 3 == 0 { 1.0 } else { -0.5 };
         }
     }
-    let fx = with_mat(qtm_like("Take_1", 60.0, &p, &noisy));
+    let fx = with_mat(qtm_take("Take_1", 60.0, &p, &noisy));
     let track = tyrex::read_ground_truth(&fx.mat).unwrap();
     assert_eq!(track.valid_count(), 60 * 30);
     for (i, pose) in track.pose.iter().enumerate() {
         let q = pose.unwrap().orientation;
         assert!((q.quaternion().norm() - 1.0).abs() < 1e-14);
-        let truth = yaw(OMEGA * i as f64 / 60.0);
+        let truth = yaw(TYREX_OMEGA * i as f64 / 60.0);
         assert!(
             q.angle_to(&truth) < 1e-5,
             "frame {i}: {}",
@@ -686,11 +662,11 @@ fn truncated_or_mangled_mat_is_an_error_naming_it() {
         ],
     );
 
-    let fx = with_mat(qtm_like(
+    let fx = with_mat(qtm_take(
         "Take_1",
         60.0,
-        &frames(600, &[]).0,
-        &frames(600, &[]).1,
+        &tyrex_mocap(600, &[]).0,
+        &tyrex_mocap(600, &[]).1,
     ));
     let bytes = std::fs::read(&fx.mat).unwrap();
     std::fs::write(&fx.mat, &bytes[..bytes.len() - 1000]).unwrap();
@@ -751,7 +727,7 @@ fn read_ground_truth_gives_mocap_rate_frames() {
     assert!((track.time[90] - 1.5).abs() < 1e-12);
     let p = track.pose[90].unwrap();
     assert!((p.position.x() - 1.5).abs() < 1e-12 && (p.position.z() - 1.2).abs() < 1e-12);
-    assert!(p.orientation.angle_to(&yaw(OMEGA * 1.5)) < 1e-9);
+    assert!(p.orientation.angle_to(&yaw(TYREX_OMEGA * 1.5)) < 1e-9);
     // Column-major 3x3: a quarter turn about z maps device x to room y.
     let q = yaw(FRAC_PI_2);
     let v = q * DeviceVec::new(1.0, 0.0, 0.0);
@@ -790,7 +766,7 @@ fn os_orientation_jumps_are_a_warning_not_a_gyro_unit_error() {
                 let glitch = [1000..1004, 3000..3004, 5000..5004]
                     .iter()
                     .any(|r| r.contains(&i));
-                let q = yaw(OMEGA * c[0] + if glitch { 1.5 } else { 0.0 });
+                let q = yaw(TYREX_OMEGA * c[0] + if glitch { 1.5 } else { 0.0 });
                 let [x, y, z, w] = q.to_xyzw();
                 format!("{} {x} {y} {z} {w} {}\n", c[0], c[5])
             })

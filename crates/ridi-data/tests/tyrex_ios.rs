@@ -3,26 +3,20 @@
 //! the Android ones, the Qualisys file is found regardless of case, Android and iOS runs are
 //! listed side by side, and each kind of bad input is an error naming file, line and field.
 
-mod mat_support;
-
 use std::f64::consts::FRAC_PI_2;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
-use mat_support::{V, le, qtm_like};
 use ridi_data::ridi_frames::nalgebra::Vector3;
 use ridi_data::ridi_frames::{
     DeviceVec, Rot, STANDARD_GRAVITY, World, WorldFromDevice, WorldVec, gravity_in_device,
 };
 use ridi_data::tyrex::{self, Layout, TyrexOptions};
 use ridi_data::{Format, OrientationSource, ReadOptions};
-use ridi_test_support::assert_names_file;
+use ridi_test_support::{MatWriter, TYREX_OMEGA, TYREX_TIME_DIFF, assert_names_file, qtm_take};
 
-/// Turn rate about the room's z, rad/s.
-const OMEGA: f64 = 0.3;
 /// Pitch of the phone about its own x axis, rad: gravity is on device y and z.
 const TILT: f64 = 0.5;
-const TIME_DIFF: f64 = -2.0;
 /// `[Time] BootTime` of the fixtures: the file times are phone clock + this.
 const BOOT: f64 = 145_406.917_9;
 /// Accelerometer and gyroscope (attitude) intervals of the iPhone 4S, s.
@@ -35,7 +29,7 @@ const GYRO_T0: f64 = 0.72;
 
 /// The true pose: world (east-north-up, and the mocap room) from device.
 fn truth(t: f64) -> WorldFromDevice {
-    Rot::<World, World>::from_axis_angle(&Vector3::z_axis(), OMEGA * t)
+    Rot::<World, World>::from_axis_angle(&Vector3::z_axis(), TYREX_OMEGA * t)
         * WorldFromDevice::from_axis_angle(&Vector3::x_axis(), TILT)
 }
 
@@ -63,19 +57,17 @@ fn rows(t0: f64, dt: f64, seconds: f64, offset: f64, row: impl Fn(f64) -> String
 }
 
 /// A QTM export of the true pose, `frames` at 60 Hz, the room origin moving along x at 1 m/s
-/// from mocap time 0; mocap time = phone time + `TIME_DIFF`.
+/// from mocap time 0; mocap time = phone time + `TYREX_TIME_DIFF`.
 fn qualisys(frames: usize) -> Vec<u8> {
     let mut p = Vec::new();
     let mut r = Vec::new();
     for i in 0..frames {
         let m = i as f64 / 60.0;
         p.push([m * 1000.0, 500.0, 1200.0]);
-        let matrix = truth(m - TIME_DIFF).matrix();
+        let matrix = truth(m - TYREX_TIME_DIFF).matrix();
         r.push(matrix.as_slice().try_into().unwrap());
     }
-    let vars = qtm_like("Take_1", 60.0, &p, &r);
-    let vars: Vec<(&str, V)> = vars.iter().map(|(n, v)| (n.as_str(), v.clone())).collect();
-    le().file(&vars, true)
+    MatWriter::LE.file(&qtm_take("Take_1", 60.0, &p, &r), true)
 }
 
 /// A Tyrex root in a temporary folder.
@@ -108,7 +100,7 @@ impl Root {
         w(
             "gyroscope.txt",
             rows(GYRO_T0, GYRO_DT, 39.0, BOOT, |t| {
-                let g = truth(t).inverse() * WorldVec::new(0.0, 0.0, OMEGA);
+                let g = truth(t).inverse() * WorldVec::new(0.0, 0.0, TYREX_OMEGA);
                 format!("{:.9} {:.9} {:.9}", g.x(), g.y(), g.z())
             }),
         );
@@ -122,7 +114,7 @@ impl Root {
         );
         // As in the shared runs: no line break after the last line.
         w("description.txt", format!("[Time]\nBootTime = {BOOT}"));
-        w("timeAlignment.txt", format!("  {TIME_DIFF:e}\n"));
+        w("timeAlignment.txt", format!("  {TYREX_TIME_DIFF:e}\n"));
         if let Some(mat) = mat {
             let file = self.root.join(format!("datasets/qualisys/{mat}.mat"));
             std::fs::write(file, qualisys(60 * 30)).unwrap();
@@ -145,7 +137,7 @@ impl Root {
         w(
             "gyroscope-calibrated.txt",
             rows(0.004, 0.005, 40.0, 0.0, |t| {
-                let g = truth(t).inverse() * WorldVec::new(0.0, 0.0, OMEGA);
+                let g = truth(t).inverse() * WorldVec::new(0.0, 0.0, TYREX_OMEGA);
                 format!("{:.9} {:.9} {:.9}", g.x(), g.y(), g.z())
             }),
         );
@@ -156,7 +148,7 @@ impl Root {
                 format!("{x} {y} {z} {qw} 0.17453292")
             }),
         );
-        w("timeAlignment.txt", format!("  {TIME_DIFF:e}\n"));
+        w("timeAlignment.txt", format!("  {TYREX_TIME_DIFF:e}\n"));
         w("record.properties", "[Device]\nModel = Nexus 5\n".into());
         let file = self.root.join(format!("datasets/qualisys/{name}.mat"));
         std::fs::write(file, qualisys(60 * 30)).unwrap();
@@ -197,7 +189,7 @@ fn units_sign_boot_time_and_heading_come_out_in_the_android_conventions() {
     let read = tyrex::read(&dir, &TyrexOptions::default()).unwrap();
     assert!(read.warnings.is_empty(), "{:?}", read.warnings);
     assert_eq!(read.layout, Layout::Ios);
-    assert_eq!(read.time_diff_s, Some(TIME_DIFF));
+    assert_eq!(read.time_diff_s, Some(TYREX_TIME_DIFF));
     assert_eq!(read.device_model.as_deref(), Some("iPhone 4S"));
     let [seq] = read.sequences.as_slice() else {
         panic!("{} parts", read.sequences.len())
@@ -240,11 +232,11 @@ fn units_sign_boot_time_and_heading_come_out_in_the_android_conventions() {
         assert!((seq.gravity()[k] - g).norm() < 1e-6);
         assert!((seq.linacce()[k].x() - 0.1 * t.sin()).abs() < 1e-4);
         // Gyro in rad/s as it is.
-        let w = truth(t).inverse() * WorldVec::new(0.0, 0.0, OMEGA);
+        let w = truth(t).inverse() * WorldVec::new(0.0, 0.0, TYREX_OMEGA);
         assert!((seq.gyro()[k].to_array()[0] - w.x()).abs() < 1e-9);
-        assert!((seq.gyro()[k].norm() - OMEGA).abs() < 1e-9);
+        assert!((seq.gyro()[k].norm() - TYREX_OMEGA).abs() < 1e-9);
         // Mocap time = phone time + timeDiff.
-        assert!((gt.position[k].x() - (t + TIME_DIFF)).abs() < 1e-9);
+        assert!((gt.position[k].x() - (t + TYREX_TIME_DIFF)).abs() < 1e-9);
         assert!(gt.orientation[k].angle_to(&truth(t)) < 1e-6);
     }
     // The file's own quaternion is a quarter turn off: the turn is what makes it agree.

@@ -4,31 +4,40 @@
 //! (`datasets/<layout>/<run>`, `datasets/qualisys/<run>.mat`) in a temp folder, and the run is
 //! read. Parts of half a second are kept (10 s by default), so that short inputs get through to
 //! the alignment and the ground truth.
+//!
+//! `cargo xtask fuzz`'s tests include this very file (`#[path]`) to check that its seeds are
+//! valid runs.
 
-use ridi_data::tyrex::{self, TyrexOptions};
+use ridi_data::tyrex::{self, TyrexOptions, TyrexRead};
 
+/// The targets' entry point: [`try_read_run`], whatever it returns.
 pub fn read_run(data: &[u8], layout: &str, run_name: &str, files: &[&str]) {
-    let Ok(root) = tempfile::tempdir() else {
-        return;
-    };
+    let _ = try_read_run(data, layout, run_name, files);
+}
+
+/// Lays `data` out as a run `run_name` of `layout` with `files` and reads it; an error of the
+/// temp folder is the `Err` of an I/O error, as the reader's own.
+pub fn try_read_run(
+    data: &[u8],
+    layout: &str,
+    run_name: &str,
+    files: &[&str],
+) -> Result<TyrexRead, Box<dyn std::error::Error>> {
+    let root = tempfile::tempdir()?;
     let run = root.path().join("datasets").join(layout).join(run_name);
     let qualisys = root.path().join("datasets/qualisys");
-    if std::fs::create_dir_all(&run).is_err() || std::fs::create_dir_all(&qualisys).is_err() {
-        return;
-    }
+    std::fs::create_dir_all(&run)?;
+    std::fs::create_dir_all(&qualisys)?;
     let mut parts = data.splitn(files.len() + 1, |&b| b == 0);
     for name in files {
-        let content = parts.next().unwrap_or_default();
-        if std::fs::write(run.join(name), content).is_err() {
-            return;
-        }
+        std::fs::write(run.join(name), parts.next().unwrap_or_default())?;
     }
     if let Some(mat) = parts.next() {
-        let _ = std::fs::write(qualisys.join(format!("{run_name}.mat")), mat);
+        std::fs::write(qualisys.join(format!("{run_name}.mat")), mat)?;
     }
     let opts = TyrexOptions {
         min_part_s: 0.5,
         ..TyrexOptions::default()
     };
-    let _ = tyrex::read(&run, &opts);
+    Ok(tyrex::read(&run, &opts)?)
 }
