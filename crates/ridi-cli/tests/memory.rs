@@ -202,19 +202,15 @@ fn small_model(dir: &Path) -> std::path::PathBuf {
     model
 }
 
-#[test]
-fn online_track_of_half_a_million_rows_runs_in_bounded_memory() {
-    let dir = tempfile::tempdir().unwrap();
-    let model = small_model(dir.path());
-    // 500 k rows: 3 s in the dev profile; whole, the recording took about 250 MB. Nearly twice
-    // the frames a plot keeps (ridi's PLOT_FRAMES): its points are thinned, not grown.
-    let csv = dir.path().join("long.csv");
-    long_recording(&csv, 500_000);
-    let traj = dir.path().join("traj.csv");
-    let plot = dir.path().join("traj.svg");
+/// Tracks `source` in `dir` online with a model and an SVG plot, within [`BOUND`]; the
+/// trajectory CSV's line count and the plot.
+fn track_online_with_plot(source: &Path, dir: &Path) -> (usize, std::path::PathBuf) {
+    let model = small_model(dir);
+    let traj = dir.join("traj.csv");
+    let plot = dir.join("traj.svg");
     let args = [
         "track",
-        csv.to_str().unwrap(),
+        source.to_str().unwrap(),
         "--model",
         model.to_str().unwrap(),
         "--online",
@@ -223,35 +219,32 @@ fn online_track_of_half_a_million_rows_runs_in_bounded_memory() {
         "--plot",
         plot.to_str().unwrap(),
     ];
-    assert_bounded(&args, dir.path());
+    assert_bounded(&args, dir);
+    (count_lines(&traj), plot)
+}
+
+#[test]
+fn online_track_of_half_a_million_rows_runs_in_bounded_memory() {
+    let dir = tempfile::tempdir().unwrap();
+    // 500 k rows: 3 s in the dev profile; whole, the recording took about 250 MB. Nearly twice
+    // the frames a plot keeps (ridi's PLOT_FRAMES): its points are thinned, not grown.
+    let csv = dir.path().join("long.csv");
+    long_recording(&csv, 500_000);
+    let (lines, plot) = track_online_with_plot(&csv, dir.path());
     // Every frame has its row, after the header.
-    assert_eq!(count_lines(&traj), 500_001);
+    assert_eq!(lines, 500_001);
     assert!(holds(&plot, b"<svg"), "no plot");
 }
 
 #[test]
 fn online_track_of_a_raw_folder_with_a_plot_runs_in_bounded_memory() {
     let dir = tempfile::tempdir().unwrap();
-    let model = small_model(dir.path());
     // 250 k records a file: 3 s in the dev profile; whole, the folder took about 145 MB. The
     // plot keeps 40 bytes a frame, every frame of these (10 MB).
     let raw = dir.path().join("long");
     long_raw_folder(&raw, 250_000);
-    let traj = dir.path().join("traj.csv");
-    let plot = dir.path().join("traj.svg");
-    let args = [
-        "track",
-        raw.to_str().unwrap(),
-        "--model",
-        model.to_str().unwrap(),
-        "--online",
-        "--out",
-        traj.to_str().unwrap(),
-        "--plot",
-        plot.to_str().unwrap(),
-    ];
-    assert_bounded(&args, dir.path());
-    assert_eq!(count_lines(&traj), 250_000 - 1600 + 1);
+    let (lines, plot) = track_online_with_plot(&raw, dir.path());
+    assert_eq!(lines, 250_000 - 1600 + 1);
     assert!(
         holds(&plot, b"ground truth"),
         "the plot has no ground truth"
