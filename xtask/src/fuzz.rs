@@ -64,7 +64,29 @@ pub const RUSTFLAGS: &[&str] = &[
 /// The libFuzzer limits of every run (before the caller's own arguments, which override them).
 pub const LIMITS: &[&str] = &["-rss_limit_mb=2048", "-timeout=10"];
 
-const TRIPLE: &str = "x86_64-unknown-linux-gnu";
+/// The host's target triple, as `rustc -vV` of `toolchain` reports it: sanitizer builds name
+/// it explicitly, as cargo-fuzz does, so that the flags do not reach build scripts.
+fn host_triple(toolchain: &str) -> Result<String> {
+    let out = Command::new("rustup")
+        .args(["run", toolchain, "rustc", "-vV"])
+        .output()
+        .with_context(|| format!("running rustup run {toolchain} rustc -vV"))?;
+    ensure!(
+        out.status.success(),
+        "rustup run {toolchain} rustc -vV failed"
+    );
+    host_of(&String::from_utf8_lossy(&out.stdout))
+        .map(str::to_owned)
+        .context("rustc -vV names no host")
+}
+
+/// The `host: ` line of `rustc -vV`'s output.
+fn host_of(version: &str) -> Option<&str> {
+    version
+        .lines()
+        .find_map(|l| l.strip_prefix("host: "))
+        .map(str::trim)
+}
 
 pub struct Options {
     /// A target of [`TARGETS`], or `all` for each in turn.
@@ -153,6 +175,7 @@ fn build(fuzz: &Path, targets: &[&str], toolchain: &str, asan: bool) -> Result<V
         flags.push(' ');
         flags.push_str(&more);
     }
+    let triple = host_triple(toolchain)?;
     // Through rustup, not the `CARGO` of this (stable) run.
     let mut cmd = Command::new("rustup");
     cmd.args(["run", toolchain, "cargo"])
@@ -162,7 +185,7 @@ fn build(fuzz: &Path, targets: &[&str], toolchain: &str, asan: bool) -> Result<V
             "--config",
             "profile.release.debug=true",
         ])
-        .args(["--target", TRIPLE])
+        .args(["--target", triple.as_str()])
         .current_dir(fuzz)
         .env("CARGO_TARGET_DIR", &target_dir)
         .env("RUSTFLAGS", &flags)
@@ -180,7 +203,7 @@ fn build(fuzz: &Path, targets: &[&str], toolchain: &str, asan: bool) -> Result<V
          nightly toolchain (`rustup toolchain install nightly`), and --no-asan where \
          AddressSanitizer does not work"
     );
-    let bin_dir = target_dir.join(TRIPLE).join("release");
+    let bin_dir = target_dir.join(&triple).join("release");
     Ok(targets.iter().map(|t| bin_dir.join(t)).collect())
 }
 
@@ -413,6 +436,13 @@ fn qtm(n: usize) -> Vec<(String, ridi_test_support::MatArray)> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn the_host_triple_is_read_from_rustc() {
+        let v = "rustc 1.97.0-nightly (abc 2026-05-19)\nbinary: rustc\nhost: aarch64-unknown-linux-gnu\nrelease: 1.97.0\n";
+        assert_eq!(host_of(v), Some("aarch64-unknown-linux-gnu"));
+        assert_eq!(host_of("rustc 1.0\n"), None);
+    }
 
     /// The `[[bin]]` names of `fuzz/Cargo.toml`.
     fn fuzz_bins(root: &Path) -> Vec<String> {
