@@ -257,8 +257,11 @@ pub fn baseline_for(root: &Path, model: &str, update: bool) -> Result<PathBuf> {
     let dir = root.join("benchmarks");
     let own = dir.join(format!("baseline-{}.json", slug(model)));
     let main = dir.join("baseline.json");
-    if own.is_file() || !update {
-        return Ok(if own.is_file() { own } else { main });
+    if own.is_file() {
+        return Ok(own);
+    }
+    if !update {
+        return Ok(main);
     }
     let text = match std::fs::read_to_string(&main) {
         Ok(text) => text,

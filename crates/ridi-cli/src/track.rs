@@ -47,11 +47,7 @@ pub(crate) struct Args {
 pub(crate) fn run(args: Args) -> Result<()> {
     // Every output is checked before any work, so that a bad --plot cannot leave the
     // trajectory written and the command failed.
-    let inputs = ReadFiles::of(
-        [Some(&args.sequence), args.model.as_ref()]
-            .into_iter()
-            .flatten(),
-    );
+    let inputs = ReadFiles::of(std::iter::once(&args.sequence).chain(&args.model));
     let mut output = TrackOutput::new(&args.out, &inputs)?;
     if let Some(plot) = &args.plot {
         output = output.with_plot(plot, &inputs)?;

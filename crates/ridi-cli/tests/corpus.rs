@@ -703,13 +703,8 @@ fn generate(dir: &Path) {
 
     // Tyrex runs of 10.5 s (a part shorter than 10 s is dropped): without any Qualisys
     // file, and with one that is a folder, a FIFO, empty, or no MAT file past its header.
-    let mat_header = {
-        let mut h = b"MATLAB 5.0 MAT-file, Platform: GLNXA64".to_vec();
-        h.resize(116, b' ');
-        h.extend([0; 8]);
-        h.extend(b"\x00\x01IM");
-        h
-    };
+    let mat_header =
+        ridi_test_support::MatWriter::LE.header("MATLAB 5.0 MAT-file, Platform: GLNXA64");
     let mut noise = ridi_test_support::SplitMix64(7);
     let garbage: Vec<u8> = (0..400).map(|_| noise.next_u64() as u8).collect();
     // A compressed element (type 15) that declares 2 GB.
@@ -887,10 +882,9 @@ fn tyrex_run(run: &Path, frames: usize) {
         ("gyroscope-calibrated.txt", "0.0 0.0 0.0"),
         ("rotation-vector.txt", "0.0 0.0 0.0 1.0 0.17"),
     ] {
-        let mut text = String::new();
-        for k in 0..frames {
-            let _ = writeln!(text, "{:.9} {values}", 0.003 + k as f64 * 0.005);
-        }
+        let text = ridi_test_support::tyrex_phone_rows(200.0, frames as f64 / 200.0, |t| {
+            format!("{t:.9} {values}")
+        });
         write(&run.join(file), text.as_bytes());
     }
 }

@@ -35,6 +35,11 @@ fn phone() -> Vec<[[f64; 3]; 4]> {
         .collect()
 }
 
+/// The time of the long recordings' frame `i` at 200 Hz, nanoseconds.
+fn ns(i: usize) -> u64 {
+    1_000_000_000 + 5_000_000 * i as u64
+}
+
 /// `values` as the long recordings write them, joined by `sep`.
 fn cells(values: &[f64], sep: &str) -> String {
     let cells: Vec<String> = values.iter().map(|v| format!("{v:.4}")).collect();
@@ -59,8 +64,7 @@ fn long_recording(path: &Path, rows: usize) {
     )
     .unwrap();
     for i in 0..rows {
-        let t = 1_000_000_000u64 + 5_000_000 * i as u64;
-        write!(w, "{i},{t},{}", bodies[i % 1000]).unwrap();
+        write!(w, "{i},{},{}", ns(i), bodies[i % 1000]).unwrap();
     }
     w.flush().unwrap();
 }
@@ -76,8 +80,7 @@ fn long_raw_folder(folder: &Path, rows: usize) {
         let mut w = create(&folder.join(name));
         w.write_all(b"# t x y z\n").unwrap();
         for i in 0..rows {
-            let t = 1_000_000_000u64 + 5_000_000 * i as u64;
-            writeln!(w, "{t} {}", bodies[i % 1000]).unwrap();
+            writeln!(w, "{} {}", ns(i), bodies[i % 1000]).unwrap();
         }
         w.flush().unwrap();
     }
@@ -88,8 +91,7 @@ fn long_raw_folder(folder: &Path, rows: usize) {
         let mut w = create(&folder.join(name));
         writeln!(w, "{header}").unwrap();
         for i in 0..rows {
-            let t = 1_000_000_000u64 + 5_000_000 * i as u64;
-            writeln!(w, "{t} {values}").unwrap();
+            writeln!(w, "{} {values}", ns(i)).unwrap();
         }
         w.flush().unwrap();
     }
@@ -194,11 +196,7 @@ fn small_model(dir: &Path) -> std::path::PathBuf {
         .args(["--out", model.to_str().unwrap(), "--grid", "none"])
         .output()
         .expect("run ridi");
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    assert!(out.status.success(), "{}", ridi_test_support::stderr(&out));
     model
 }
 

@@ -91,8 +91,7 @@ pub(crate) fn interpolate_with<T: Clone>(
     assert_eq!(src_t.len(), src.len(), "times and values differ in length");
     assert!(!src.is_empty(), "nothing to interpolate from");
     let mut samples = src_t.iter().copied().zip(src.iter().cloned());
-    let first = (src_t[0], src[0].clone());
-    samples.next();
+    let first = samples.next().expect("not empty: checked above");
     let last_time = src_t[src.len() - 1];
     let Ok(mut at) = Interpolator::new(first, samples.map(Ok::<_, Infallible>), last_time);
     dst_t

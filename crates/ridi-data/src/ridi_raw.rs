@@ -495,20 +495,14 @@ fn parse_records(bytes: &[u8], path: &Path, spec: &Spec, limits: &Validation) ->
 }
 
 /// Reads the file `spec` names in `folder`, refusing gaps beyond `limits` if it says so:
-/// `Ok(None)` when it is optional and absent or without rows.
+/// `Ok(None)` when it is optional and absent, or without rows ([`required`] refuses that).
 fn read_records(folder: &Path, spec: &Spec, limits: &Validation) -> Result<Option<Records>> {
     let path = folder.join(spec.name);
     if !spec.required() && !path.exists() {
         return Ok(None);
     }
     let rec = parse_records(&text::read_file(&path)?, &path, spec, limits)?;
-    if rec.time.is_empty() {
-        if spec.required() {
-            return Err(no_rows(&path));
-        }
-        return Ok(None);
-    }
-    Ok(Some(rec))
+    Ok((!rec.time.is_empty()).then_some(rec))
 }
 
 /// The error for a required file without records.
@@ -516,6 +510,7 @@ fn no_rows(path: &Path) -> DataError {
     DataError::format(Location::file(path), "has no data rows")
 }
 
+/// Reads the [`REQUIRED`] file `spec` names in `folder`: one without rows is an error.
 fn required(folder: &Path, spec: &Spec, limits: &Validation) -> Result<Records> {
     read_records(folder, spec, limits)?.ok_or_else(|| no_rows(&folder.join(spec.name)))
 }

@@ -57,6 +57,13 @@ fn walk(n: usize) -> Sequence {
     .unwrap()
 }
 
+/// `bytes` gzip-compressed.
+fn gzip(bytes: &[u8]) -> Vec<u8> {
+    let mut enc = flate2::write::GzEncoder::new(Vec::new(), flate2::Compression::fast());
+    enc.write_all(bytes).unwrap();
+    enc.finish().unwrap()
+}
+
 /// Writes `text` as `name` in `dir`.
 fn file(dir: &Path, name: &str, text: &str) -> PathBuf {
     let p = dir.join(name);
@@ -74,9 +81,7 @@ fn a_valid_recording_streams_as_the_sequence_it_reads_as() {
     write_ridi_plain(&seq, &plain).unwrap();
     // The same file gzip-compressed.
     let gz = dir.path().join("walk.csv.gz");
-    let mut enc = flate2::write::GzEncoder::new(Vec::new(), flate2::Compression::fast());
-    enc.write_all(&std::fs::read(&csv).unwrap()).unwrap();
-    std::fs::write(&gz, enc.finish().unwrap()).unwrap();
+    std::fs::write(&gz, gzip(&std::fs::read(&csv).unwrap())).unwrap();
     for path in [&csv, &plain, &gz] {
         let read = read_sequence(path, &ReadOptions::default()).unwrap();
         let rows = streamed(path, &ReadOptions::default()).unwrap();
@@ -285,9 +290,7 @@ fn raw_folders_stream_as_they_read() {
     let folder = dir.join("gz");
     write_files(&folder, &gz);
     for (name, content) in &gz {
-        let mut enc = flate2::write::GzEncoder::new(Vec::new(), flate2::Compression::fast());
-        enc.write_all(content.as_bytes()).unwrap();
-        std::fs::write(folder.join(name), enc.finish().unwrap()).unwrap();
+        std::fs::write(folder.join(name), gzip(content.as_bytes())).unwrap();
     }
     let whole = ridi_raw::read(&folder, &opts);
     assert!(whole.is_ok(), "{whole:?}");
@@ -442,9 +445,7 @@ fn a_raw_folder_with_one_fault_gets_the_whole_readers_error() {
         "{whole:?}"
     );
     assert_streams_as_read(&folder, &opts, &whole);
-    let mut enc = flate2::write::GzEncoder::new(Vec::new(), flate2::Compression::fast());
-    enc.write_all(&bytes).unwrap();
-    let gz = enc.finish().unwrap();
+    let gz = gzip(&bytes);
     std::fs::write(&magnet, &gz[..gz.len() - 10]).unwrap();
     let whole = ridi_raw::read(&folder, &opts);
     let e = whole.as_ref().unwrap_err().to_string();

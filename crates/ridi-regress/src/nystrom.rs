@@ -248,46 +248,44 @@ impl<'p> Map<'p> {
         Ok(Whitening { t, rank })
     }
 
-    /// Nyström features `φ = Tᵀ k(L, x)` of every row of `x` (`rows × rank`, `f32`), in
-    /// blocks of rows; `gammas` pairs each width with its map (one distance pass for all).
+    /// Nyström features `φ = Tᵀ k(L, x)` of width `gamma` (map `w`) of rows `rows` of `x`
+    /// (`None`: every row), `rows × rank` (`f32`), in blocks of rows: only a block of `x` is
+    /// gathered at a time.
     pub(crate) fn features(
         &self,
         x: FeatureMatrixRef<'_>,
-        gammas: &[(f32, &Whitening)],
-    ) -> Vec<Vec<f32>> {
+        rows: Option<&[usize]>,
+        gamma: f32,
+        w: &Whitening,
+    ) -> Vec<f32> {
         let m = self.m();
-        let n = x.rows();
-        let mut out: Vec<Vec<f32>> = gammas
-            .iter()
-            .map(|(_, w)| vec![0.0f32; n * w.rank])
-            .collect();
-        let t32: Vec<Vec<f32>> = gammas
-            .iter()
-            .map(|(_, w)| w.t.iter().map(|&v| v as f32).collect())
-            .collect();
+        let n = rows.map_or(x.rows(), <[usize]>::len);
+        let rank = w.rank;
+        let mut out = vec![0.0f32; n * rank];
+        let t: Vec<f32> = w.t.iter().map(|&v| v as f32).collect();
         for r0 in (0..n).step_by(BLOCK) {
             let r1 = (r0 + BLOCK).min(n);
-            let d = self.sq_dists(x.rows_range(r0, r1));
-            for (g, ((gamma, w), t)) in gammas.iter().zip(&t32).enumerate() {
-                let mut k = vec![0.0f32; d.len()];
-                kernel::exp_neg_scaled(&d, *gamma, &mut k);
-                let rank = w.rank;
-                let dst = &mut out[g][r0 * rank..r1 * rank];
-                // Row blocks in parallel, each GEMM sequential (the crate's pattern).
-                dst.par_chunks_mut(256 * rank)
-                    .zip(k.par_chunks(256 * m))
-                    .for_each(|(o, kb)| {
-                        let rows = kb.len() / m;
-                        matmul(
-                            MatMut::from_row_major_slice_mut(o, rows, rank),
-                            Accum::Replace,
-                            MatRef::from_row_major_slice(kb, rows, m),
-                            MatRef::from_row_major_slice(t, m, rank),
-                            1.0f32,
-                            Par::Seq,
-                        );
-                    });
-            }
+            let d = match rows {
+                None => self.sq_dists(x.rows_range(r0, r1)),
+                Some(idx) => self.sq_dists(x.select(&idx[r0..r1]).view()),
+            };
+            let mut k = vec![0.0f32; d.len()];
+            kernel::exp_neg_scaled(&d, gamma, &mut k);
+            let dst = &mut out[r0 * rank..r1 * rank];
+            // Row blocks in parallel, each GEMM sequential (the crate's pattern).
+            dst.par_chunks_mut(256 * rank)
+                .zip(k.par_chunks(256 * m))
+                .for_each(|(o, kb)| {
+                    let rows = kb.len() / m;
+                    matmul(
+                        MatMut::from_row_major_slice_mut(o, rows, rank),
+                        Accum::Replace,
+                        MatRef::from_row_major_slice(kb, rows, m),
+                        MatRef::from_row_major_slice(&t, m, rank),
+                        1.0f32,
+                        Par::Seq,
+                    );
+                });
         }
         out
     }
@@ -323,7 +321,7 @@ mod tests {
         let map = Map::new(x.view(), &idx, None).unwrap();
         let gamma = 0.05;
         let w = map.whitening(x.view(), &idx, gamma).unwrap();
-        let phi = &map.features(x.view(), &[(gamma, &w)])[0];
+        let phi = &map.features(x.view(), None, gamma, &w);
         let d = map.sq_dists(x.view());
         let mut worst = 0.0f64;
         for i in 0..60 {

@@ -1,5 +1,5 @@
 //! Kernel ridge regression on Nyström features, in closed form: the regressors of
-//! [`crate::NystromFit::Ridge`].
+//! the Nyström solver ([`crate::Solver::Nystrom`]).
 //!
 //! Each regressor minimizes `½‖w‖² + (C/2) Σ (φᵢ·w + b − yᵢ)²` over the rows of its
 //! placement, with the offset `b` free (unregularized, as SMO's `rho`): the normal equations

@@ -207,7 +207,8 @@ struct Keep {
 
 impl Scan {
     /// Reads the file `spec` names in `folder` once (see the module's documentation): `None`
-    /// when it is optional and absent or without records.
+    /// when it is optional and absent, or without records (which [`Rows::open`] refuses of a
+    /// required one).
     fn read(
         folder: &Path,
         spec: &'static Spec,
@@ -237,11 +238,7 @@ impl Scan {
             scan.record(&r, limits, keep);
         }
         records.finish()?;
-        match scan.found.records {
-            0 if spec.required() => Err(no_rows(&scan.found.path)),
-            0 => Ok(None),
-            _ => Ok(Some(scan)),
-        }
+        Ok((scan.found.records > 0).then_some(scan))
     }
 
     /// Counts `r`, the next record (the `self.found.records`-th).
@@ -319,17 +316,23 @@ impl Scan {
     }
 }
 
+/// A uniform timeline: `frames` times from `start` on, at `rate_hz`.
+#[derive(Debug, Clone, Copy)]
+struct Uniform {
+    start: f64,
+    rate_hz: f64,
+    frames: usize,
+}
+
 /// Where the frames' times come from, as the first pass found it.
 #[derive(Clone)]
 enum Clock {
     /// The records of `pose.txt` from index `kept.0` to `kept.1`.
-    Pose { found: Found, kept: (usize, usize) },
-    /// `frames` times from `start` on, at `rate_hz`.
-    Uniform {
-        start: f64,
-        rate_hz: f64,
-        frames: usize,
+    Pose {
+        found: Found,
+        kept: (usize, usize),
     },
+    Uniform(Uniform),
 }
 
 /// The frames' times, as they come.
@@ -342,9 +345,8 @@ enum Timeline {
         kept: (usize, usize),
     },
     Uniform {
-        start: f64,
-        rate_hz: f64,
-        frames: usize,
+        times: Uniform,
+        /// The index of the next time.
         next: usize,
     },
 }
@@ -357,16 +359,7 @@ impl Timeline {
                 next: 0,
                 kept,
             },
-            Clock::Uniform {
-                start,
-                rate_hz,
-                frames,
-            } => Timeline::Uniform {
-                start,
-                rate_hz,
-                frames,
-                next: 0,
-            },
+            Clock::Uniform(times) => Timeline::Uniform { times, next: 0 },
         })
     }
 
@@ -387,16 +380,11 @@ impl Timeline {
                 }
                 Ok(None)
             }
-            Timeline::Uniform {
-                start,
-                rate_hz,
-                frames,
-                next,
-            } => {
-                if *next == *frames {
+            Timeline::Uniform { times, next } => {
+                if *next == times.frames {
                     return Ok(None);
                 }
-                let t = uniform_time(*start, *rate_hz, *next);
+                let t = uniform_time(times.start, times.rate_hz, *next);
                 *next += 1;
                 Ok(Some((t, None)))
             }
@@ -489,11 +477,11 @@ impl Rows {
                 if frames == 0 {
                     return Err(no_frame(folder, opts));
                 }
-                Clock::Uniform {
+                Clock::Uniform(Uniform {
                     start,
                     rate_hz,
                     frames,
-                }
+                })
             }
         };
         if let Some((_, e)) = rv.not_rotation.take() {
@@ -566,7 +554,7 @@ impl Rows {
     fn pose(&self) -> Option<&Path> {
         match &self.plan.clock {
             Clock::Pose { found, .. } => Some(&found.path),
-            Clock::Uniform { .. } => None,
+            Clock::Uniform(_) => None,
         }
     }
 

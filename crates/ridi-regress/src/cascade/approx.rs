@@ -15,7 +15,6 @@ use super::{CascadeParams, RegressorChoice};
 use crate::error::RegressError;
 use crate::grid::{self, ChainPoint};
 use crate::linear::{self, LinearFit, Rows, Stop};
-use crate::matrix::View as _;
 use crate::nystrom::{self, Map, Nystrom};
 use crate::progress::{Progress, Stage};
 use crate::projection::Projection;
@@ -66,7 +65,7 @@ impl Cascade {
         let map = Map::new(x, &picked, projection.as_ref())?;
         let (classifier, clf_weights) = if k >= 2 {
             let wc = map.whitening(x, &picked, gamma_c)?;
-            let phi_c = map.features(x, &[(gamma_c, &wc)]).swap_remove(0);
+            let phi_c = map.features(x, None, gamma_c, &wc);
             let rank_c = wc.rank;
             let pairs: Vec<(usize, usize)> = (0..k)
                 .flat_map(|a| (a + 1..k).map(move |b| (a, b)))
@@ -124,9 +123,7 @@ impl Cascade {
                     .collect();
             let pmap = Map::new(x, &own, projection.as_ref())?;
             let wr = pmap.whitening(x, &own, gamma_r)?;
-            let phi = pmap
-                .features(x.select(idx).view(), &[(gamma_r, &wr)])
-                .swap_remove(0);
+            let phi = pmap.features(x, Some(idx), gamma_r, &wr);
             let (fits, chosen, table) =
                 ridge_fits(&phi, wr.rank, &targets, data, idx, params, name, progress)
                     .map_err(in_placement(name))?;
@@ -259,13 +256,14 @@ fn ridge_fits(
             report(progress, stage, 0, channels)?;
             // Channels may choose different `C`: one factorization per distinct value.
             let mut fits: Vec<Option<RidgeFit>> = vec![None; channels];
-            for &(c, _) in &best {
-                if fits.iter().zip(&best).any(|(f, b)| f.is_some() && b.0 == c) {
+            for ch in 0..channels {
+                if fits[ch].is_some() {
                     continue;
                 }
-                for (ch, fit) in all.solve(c)?.into_iter().enumerate() {
-                    if best[ch].0 == c {
-                        fits[ch] = Some(fit);
+                let c = best[ch].0;
+                for (other, fit) in all.solve(c)?.into_iter().enumerate() {
+                    if best[other].0 == c {
+                        fits[other] = Some(fit);
                     }
                 }
             }

@@ -6,7 +6,7 @@ use std::cell::RefCell;
 use rayon::prelude::*;
 use ridi_features::ridi_frames::StabHorizontal;
 
-use super::{Cascade, ClassModel, NystromParts};
+use super::{Cascade, ClassModel, ClassifierHead, NystromParts};
 use crate::error::RegressError;
 use crate::expansion::weighted_sums;
 use crate::kernel;
@@ -88,17 +88,13 @@ impl Cascade {
         FeatureMatrixRef::new(q, self.dim.max(1))?;
         Ok(SCRATCH.with(|s| {
             let s = &mut *s.borrow_mut();
-            let single = |c: &Self, q: &[f32], qn: f32, s: &mut Scratch| match &c.nystrom {
-                Some(n) => c.predict_single_nystrom(n, q, qn, s),
-                None => c.predict_single(q, qn, s),
-            };
             let Some(p) = &self.projection else {
-                return single(self, q, kernel::dot(q, q), s);
+                return self.predict_single(q, kernel::dot(q, q), s);
             };
             let mut z = std::mem::take(&mut s.z);
             z.resize(p.stored_dim(), 0.0);
             let qn = p.project_one(q, &mut s.centred, &mut z);
-            let out = single(self, &z, qn, s);
+            let out = self.predict_single(&z, qn, s);
             s.z = z;
             out
         }))
@@ -108,15 +104,18 @@ impl Cascade {
     /// and the remaining rows of the chosen one. Same arithmetic as [`Self::predict_block`]
     /// except for the summation order inside the dot products. `q` is in the stored form
     /// (projected when the samples are) and `qn` its squared norm as the distances need it.
+    /// A Nyström model's classifier is its landmarks' ([`Self::classify_single_nystrom`]);
+    /// its placements hold no classifier rows, so their regressors reuse no distance.
     fn predict_single(&self, q: &[f32], qn: f32, s: &mut Scratch) -> Prediction {
         let k = self.classes.len();
         // Where each placement's classifier distances start in `s.dist`.
         let offset = |p: usize| -> usize { self.classes[..p].iter().map(|c| c.n_classifier).sum() };
         let total: usize = self.classes.iter().map(|cl| cl.n_classifier).sum();
         s.dist.resize(total, 0.0);
-        let placement = match &self.classifier {
-            None => 0,
-            Some(head) => {
+        let placement = match (&self.classifier, &self.nystrom) {
+            (None, _) => 0,
+            (Some(head), Some(n)) => self.classify_single_nystrom(head, n, q, qn, s),
+            (Some(head), None) => {
                 let np = head.pairs.len();
                 s.dec.clear();
                 s.dec.resize(np, 0.0);
@@ -162,56 +161,39 @@ impl Cascade {
         }
     }
 
-    /// The single-query path of a Nyström model: one pass over the classifier's landmarks
-    /// and a dot product per pair, then one over the chosen placement's own landmarks.
-    fn predict_single_nystrom(
+    /// The placement of one query by a Nyström model's classifier: one pass over its
+    /// landmarks, then a dot product per pair.
+    fn classify_single_nystrom(
         &self,
+        head: &ClassifierHead,
         n: &NystromParts,
         q: &[f32],
         qn: f32,
         s: &mut Scratch,
-    ) -> Prediction {
-        let placement = match &self.classifier {
-            None => 0,
-            Some(head) => {
-                let m = n.landmarks.rows();
-                s.dist.resize(m, 0.0);
-                s.kv.resize(m, 0.0);
-                n.landmarks.dots(q, 0, &mut s.dist);
-                kernel::dist_from_dots(&mut s.dist, qn, &n.norms);
-                kernel::exp_neg_scaled(&s.dist, head.gamma, &mut s.kv);
-                s.dec.resize(head.pairs.len(), 0.0);
-                weighted_sum(&s.kv, &n.clf_weights, &mut s.dec);
-                s.dec.iter_mut().zip(&head.rho).for_each(|(v, r)| *v -= r);
-                s.votes.resize(self.classes.len(), 0);
-                svc::vote(&s.dec, &head.pairs, self.classes.len(), &mut s.votes)
-            }
-        };
-        let cl = &self.classes[placement];
-        s.kv.resize(cl.samples.rows(), 0.0);
-        cl.samples.dots(q, 0, &mut s.kv);
-        kernel::rbf_from_dots(&mut s.kv, qn, &cl.norms, self.regressor_gamma);
-        let mut v = [0.0f64; 3];
-        let v = &mut v[..cl.channels()];
-        weighted_sum(&s.kv, &cl.reg_coef, v);
-        Prediction {
-            placement,
-            velocity: cl.velocity(v),
-        }
+    ) -> usize {
+        let m = n.landmarks.rows();
+        s.dist.resize(m, 0.0);
+        s.kv.resize(m, 0.0);
+        n.landmarks.dots(q, 0, &mut s.dist);
+        kernel::dist_from_dots(&mut s.dist, qn, &n.norms);
+        kernel::exp_neg_scaled(&s.dist, head.gamma, &mut s.kv);
+        s.dec.resize(head.pairs.len(), 0.0);
+        weighted_sum(&s.kv, &n.clf_weights, &mut s.dec);
+        s.dec.iter_mut().zip(&head.rho).for_each(|(v, r)| *v -= r);
+        s.votes.resize(self.classes.len(), 0);
+        svc::vote(&s.dec, &head.pairs, self.classes.len(), &mut s.votes)
     }
 
     /// The placements of a block of queries by a Nyström model's classifier: one distance
     /// block from the queries (stored form) to its landmarks, then weighted sums.
     fn classify_block_nystrom(
         &self,
+        head: &ClassifierHead,
         n: &NystromParts,
         q: FeatureMatrixRef<'_>,
         qn: &[f32],
         out: &mut [Prediction],
     ) {
-        let Some(head) = &self.classifier else {
-            return out.iter_mut().for_each(|o| o.placement = 0);
-        };
         let (rows, m) = (q.rows(), n.landmarks.rows());
         let mut wide = Vec::new();
         n.landmarks.rows_f32(0, m, &mut wide);
@@ -348,15 +330,8 @@ impl Cascade {
             _ => (None, kernel::sq_norms(q)),
         };
         let q = projected.as_ref().map_or(q, FeatureMatrix::view);
-        if let Some(n) = &self.nystrom {
-            match forced {
-                Some(p) => out.iter_mut().for_each(|o| o.placement = p),
-                None => self.classify_block_nystrom(n, q, &qn, out),
-            }
-            // Its placements hold no classifier rows (validated): no distances to reuse.
-            return self.regress_block(rows, q, &qn, &[], forced, out);
-        }
-        // Squared distances to the classifier part of each placement.
+        // Squared distances to the classifier part of each placement (none of a Nyström
+        // model's: its classifier is its landmarks').
         let dists: Vec<Vec<f32>> = (0..self.classes.len())
             .map(|p| {
                 let nc = self.classes[p].n_classifier;
@@ -367,10 +342,11 @@ impl Cascade {
                 d
             })
             .collect();
-        match (forced, &self.classifier) {
-            (Some(p), _) => out.iter_mut().for_each(|o| o.placement = p),
-            (None, None) => out.iter_mut().for_each(|o| o.placement = 0),
-            (None, Some(head)) => {
+        match (forced, &self.classifier, &self.nystrom) {
+            (Some(p), _, _) => out.iter_mut().for_each(|o| o.placement = p),
+            (None, None, _) => out.iter_mut().for_each(|o| o.placement = 0),
+            (None, Some(head), Some(n)) => self.classify_block_nystrom(head, n, q, &qn, out),
+            (None, Some(head), None) => {
                 let np = head.pairs.len();
                 let mut dec = vec![0.0f64; m * np];
                 for (cl, d) in self.classes.iter().zip(&dists) {
