@@ -23,7 +23,7 @@ use anyhow::{Context, Result, bail, ensure};
 use ridi::data::tyrex::{self, TyrexOptions};
 use ridi::data::{Sequence, write_atomically};
 use ridi::features::Orientation;
-use ridi::regress::{NoProgress, Nystrom, Solver};
+use ridi::regress::{NoProgress, Nystrom, Solver, Storage};
 use ridi::{EvalOptions, GridChoice, PlacementMap, TrainOptions, apply_orientation};
 use ridi::{SequenceResult, check_evaluable};
 
@@ -409,6 +409,7 @@ pub fn train_options(
     }
     if let Some(m) = landmarks {
         train_opts.cascade.method = Solver::Nystrom(Nystrom::new(m, 0)?);
+        train_opts.cascade.storage = Storage::projected_for(&train_opts.cascade.method);
     }
     Ok(train_opts)
 }

@@ -122,16 +122,17 @@ impl From<OrientationArg> for Orientation {
 #[derive(Clone, Copy, PartialEq, ValueEnum)]
 enum StorageArg {
     /// Coordinates on the principal directions holding 99.99 % of the feature variance (several
-    /// times faster queries; velocities move by about as much as half precision moves them).
+    /// times faster queries; velocities move by about as much as half precision moves them);
+    /// with `--solver nystrom`, whose kernel is computed on them, 90 %.
     Projected,
     /// Every feature value in half precision.
     Half,
 }
 
-impl From<StorageArg> for Storage {
-    fn from(s: StorageArg) -> Self {
-        match s {
-            StorageArg::Projected => Storage::DEFAULT,
+impl StorageArg {
+    fn storage(self, method: &Solver) -> Storage {
+        match self {
+            StorageArg::Projected => Storage::projected_for(method),
             StorageArg::Half => Storage::Half,
         }
     }
@@ -186,12 +187,12 @@ pub(crate) fn run(args: Args) -> Result<()> {
     };
     opts.cascade.classifier_c = args.classifier_c;
     opts.cascade.regressors = GridChoice::from(args.grid).regressors();
-    opts.cascade.storage = args.storage.into();
     opts.cascade.speed = !args.no_speed;
     opts.cascade.method = match args.solver {
         SolverArg::Exact => Solver::Exact,
         SolverArg::Nystrom => Solver::Nystrom(Nystrom::new(args.landmarks, 0)?),
     };
+    opts.cascade.storage = args.storage.storage(&opts.cascade.method);
     let model = with_progress(|progress| ridi::train(listed.sequences(), &opts, progress))
         .map_err(|e| {
             let e = e.locate_in(&listed);

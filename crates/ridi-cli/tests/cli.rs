@@ -252,6 +252,44 @@ fn a_closed_stdout_is_no_panic() {
 }
 
 #[test]
+fn the_nystrom_solver_keeps_its_own_share_of_the_variance() {
+    // Its kernel is computed on the principal coordinates: `projected` keeps 90 % for it
+    // (`Storage::NYSTROM_DEFAULT`), not the exact solver's 99.99 %; `half` stays half.
+    let dir = tempfile::tempdir().unwrap();
+    let list = sample_dataset().join("list_Guillaume.txt");
+    let model = dir.path().join("m.ridi");
+    let stored = |storage: &str| {
+        let out = ridi(&[
+            "train",
+            "--list",
+            s(&list),
+            "--grid",
+            "none",
+            "--placement-map",
+            "tyrex4",
+            "--solver",
+            "nystrom",
+            "--landmarks",
+            "64",
+            "--storage",
+            storage,
+            "--out",
+            s(&model),
+        ]);
+        assert!(out.status.success(), "{}", stderr(&out));
+        let out = ridi(&["inspect", s(&model), "--json"]);
+        assert!(out.status.success(), "{}", stderr(&out));
+        let json: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+        let variance = json["stored_variance"].as_f64().unwrap();
+        (json["projected_components"].as_u64(), variance)
+    };
+    let (components, variance) = stored("projected");
+    assert!(components.is_some_and(|c| c < 304), "{components:?}");
+    assert!((0.9..0.9999).contains(&variance), "{variance}");
+    assert_eq!(stored("half"), (None, 1.0));
+}
+
+#[test]
 fn bad_flags_and_outputs_fail_before_any_work() {
     let dir = tempfile::tempdir().unwrap();
     let list = sample_dataset().join("list_Guillaume.txt");

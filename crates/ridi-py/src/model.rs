@@ -232,7 +232,8 @@ impl Callback {
 /// ``ridi.Sequence`` (each with ground truth and a placement label). The options are the
 /// command's flags: ``grid`` (``"paper"``, ``"small"``, ``"none"``), ``placement_map``
 /// (``"tyrex4"`` or a ``label,class`` file), ``orientation`` (``"recorded"``,
-/// ``"estimated"``), ``storage`` (``"projected"``, ``"half"``), ``solver`` (``"exact"``,
+/// ``"estimated"``), ``storage`` (``"projected"``: 99.99 % of the variance, 90 % with the
+/// Nyström solver; ``"half"``), ``solver`` (``"exact"``,
 /// ``"nystrom"``), ``landmarks``, ``turned_copies``, ``step`` (default ``10 * (turned_copies +
 /// 1)``), ``window`` (default 200), ``speed`` (``False`` for ``--no-speed``), ``up_axis``
 /// (``"plus-or-minus-y"``, ``"plus-y"``), ``standardize`` (``False`` for
@@ -306,11 +307,6 @@ pub(crate) fn train(
     };
     opts.cascade.classifier_c = options::positive("classifier_c", classifier_c)?;
     opts.cascade.regressors = grid.regressors();
-    opts.cascade.storage = choice(
-        "storage",
-        storage,
-        &[("projected", Storage::DEFAULT), ("half", Storage::Half)],
-    )?;
     opts.cascade.speed = speed;
     opts.cascade.method = match choice("solver", solver, &[("exact", false), ("nystrom", true)])? {
         false => Solver::Exact,
@@ -322,6 +318,12 @@ pub(crate) fn train(
             .map_err(|e| errors::value(e.to_string()))?,
         ),
     };
+    let projected = Storage::projected_for(&opts.cascade.method);
+    opts.cascade.storage = choice(
+        "storage",
+        storage,
+        &[("projected", projected), ("half", Storage::Half)],
+    )?;
     let map = options::placement_map(placement_map)?;
     let callback = Callback {
         callback: progress,

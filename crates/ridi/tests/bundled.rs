@@ -3,7 +3,7 @@
 #![cfg(feature = "bundled-model")]
 
 use ridi::data::{Listed, ReadOptions};
-use ridi::regress::{MODEL_FORMAT_VERSION, Solver};
+use ridi::regress::{MODEL_FORMAT_VERSION, Solver, StoredAs};
 use ridi::{EvalOptions, PlacementMap, TrainOptions};
 use ridi_test_support::sample_dataset;
 
@@ -23,6 +23,11 @@ fn the_bundled_model_decodes_with_this_builds_format_and_defaults() {
         "trained with other feature settings than this build's defaults"
     );
     assert!(matches!(model.solver(), Solver::Nystrom(_)));
+    // The Nyström solver's projection (`Storage::NYSTROM_DEFAULT`), not the exact one's.
+    let StoredAs::Projected { energy, .. } = model.stored_as() else {
+        panic!("stored in half precision")
+    };
+    assert!((0.9..0.9999).contains(&energy), "{energy}");
     assert_eq!(model.placements(), ["hand", "pocket", "running", "swing"]);
     // The scaling issue's bound, and crates.io's package limit with room for the rest.
     let size = model.to_bytes().unwrap().len();

@@ -75,6 +75,23 @@ impl Storage {
     /// half-precision rounding moves it, measured in docs/benchmarks.md). At 99.95 % (256
     /// directions) the largest change was 3-6x that of half precision.
     pub const DEFAULT: Self = Self::Projected { energy: 0.9999 };
+
+    /// The default of the Nyström solver: [`Storage::Projected`] keeping 90 % of the variance
+    /// (64 of 1200 directions on standardized Tyrex features, 91 %). A Nyström machine computes its kernel on these coordinates in training too,
+    /// so for it they are the kernel's input space, not a rounding of a trained model: on the
+    /// leave-one-person-out protocol over both Tyrex phones no figure moved beyond its interval
+    /// against 99.99 %, and a query streams a quarter of the bytes (docs/benchmarks.md).
+    pub const NYSTROM_DEFAULT: Self = Self::Projected { energy: 0.9 };
+
+    /// The projected storage `method` trains best with: [`Storage::NYSTROM_DEFAULT`] for
+    /// [`Solver::Nystrom`], [`Storage::DEFAULT`] for the exact solver (whose machines see the
+    /// features themselves).
+    pub fn projected_for(method: &Solver) -> Self {
+        match method {
+            Solver::Exact => Self::DEFAULT,
+            Solver::Nystrom(_) => Self::NYSTROM_DEFAULT,
+        }
+    }
 }
 
 impl Default for Storage {
