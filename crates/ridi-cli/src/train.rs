@@ -163,6 +163,21 @@ impl From<UpAxisArg> for UpAxis {
     }
 }
 
+/// Rows above which `ridi train` points the exact solver's user to `--solver nystrom`: the
+/// exact solver took 82 s on 50,392 rows and 891 s on 96,000 (2 cores, docs/benchmarks.md).
+const EXACT_SOLVER_NOTE_ROWS: usize = 60_000;
+
+/// The one-line note for `windows` training rows on the exact solver, if they are many.
+fn exact_solver_note(windows: usize) -> Option<String> {
+    (windows > EXACT_SOLVER_NOTE_ROWS).then(|| {
+        format!(
+            "note: {windows} training windows: the exact solver's time grows faster than their \
+             square (96,000 took 15 min on 2 cores); `--solver nystrom` trains them in about a \
+             minute, as accurate on the Tyrex protocol (docs/benchmarks.md)"
+        )
+    })
+}
+
 pub(crate) fn run(args: Args) -> Result<()> {
     crate::set_jobs(args.jobs)?;
     let out = &args.out;
@@ -193,6 +208,12 @@ pub(crate) fn run(args: Args) -> Result<()> {
         SolverArg::Nystrom => Solver::Nystrom(Nystrom::new(args.landmarks, 0)?),
     };
     opts.cascade.storage = args.storage.storage(&opts.cascade.method);
+    if opts.cascade.method == Solver::Exact {
+        let windows = ridi::training_windows(listed.sequences(), &opts)?;
+        if let Some(note) = exact_solver_note(windows) {
+            eprintln!("{note}");
+        }
+    }
     let model = with_progress(|progress| ridi::train(listed.sequences(), &opts, progress))
         .map_err(|e| {
             let e = e.locate_in(&listed);
@@ -245,4 +266,20 @@ pub(crate) fn with_progress(
 /// What the trained model is, as `ridi inspect` says it.
 pub(crate) fn print_training(model: &Cascade) {
     out!("{}", ridi::inspect_model(model));
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_exact_solver_note_names_the_rows_and_the_way_out_only_past_the_bound() {
+        assert_eq!(exact_solver_note(EXACT_SOLVER_NOTE_ROWS), None);
+        let note = exact_solver_note(100_742).unwrap();
+        assert!(note.starts_with("note: 100742 training windows"), "{note}");
+        assert!(
+            note.contains("`--solver nystrom`") && !note.contains('\n'),
+            "{note}"
+        );
+    }
 }

@@ -214,6 +214,15 @@ pub fn training_data(seqs: &[Sequence], config: &FeatureConfig) -> Result<Traini
     Ok(data)
 }
 
+/// The training windows (rows) [`train`] would build from `seqs` with `opts`, turned copies
+/// included, counted from the sequences' lengths alone: what training will cost before it
+/// starts (the exact solver's time grows faster than the square of the rows).
+pub fn training_windows(seqs: &[Sequence], opts: &TrainOptions) -> Result<usize> {
+    let schedule = SampleSchedule::training(&opts.features)?;
+    let windows: usize = seqs.iter().map(|s| schedule.frames(s.len()).len()).sum();
+    Ok(windows * (opts.turned_copies + 1))
+}
+
 /// Trains the cascade on labelled sequences (placement and ground truth required).
 pub fn train(
     seqs: &[Sequence],

@@ -784,3 +784,26 @@ fn without_frames(seq: &Sequence, drop: impl Fn(usize) -> bool) -> Sequence {
     }
     Sequence::new(parts).unwrap()
 }
+
+#[test]
+fn training_windows_counts_the_rows_training_builds() {
+    let seqs = load("list_Guillaume.txt");
+    for (step, copies) in [(20, 1), (7, 0), (33, 3)] {
+        let mut opts = TrainOptions {
+            turned_copies: copies,
+            ..TrainOptions::default()
+        };
+        opts.features.step = step;
+        let built = ridi::training_data(&seqs, &opts.features)
+            .unwrap()
+            .with_turned_copies(copies)
+            .unwrap()
+            .targets
+            .len();
+        assert_eq!(
+            ridi::training_windows(&seqs, &opts).unwrap(),
+            built,
+            "{step} {copies}"
+        );
+    }
+}
