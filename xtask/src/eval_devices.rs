@@ -391,8 +391,9 @@ pub struct Options {
 
 /// The protocol's training: `ridi train`'s defaults but C and epsilon fixed unless `grid` (the
 /// paper grid's search multiplies exact training by 48), with this sample step (`None`: ridi
-/// train's), orientation, and the Nyström solver on `landmarks` (`None`: exact). `cargo xtask model`
-/// trains the bundled model the same way.
+/// train's), orientation, and the Nyström solver on `landmarks` (`None`: exact) with its own
+/// projection (`Storage::projected_for`). `cargo xtask model` trains the bundled model the same
+/// way.
 pub fn train_options(
     step: Option<usize>,
     orientation: Orientation,
@@ -667,7 +668,8 @@ fn report(r: &Report<'_>, total_s: f64) -> String {
         },
         o.landmarks
             .map_or("the exact SMO solver".to_string(), |m| format!(
-                "the Nyström solver on {m} landmarks"
+                "the Nyström solver on {m} landmarks, its kernel's distances from the principal \
+                 coordinates holding 90 % of the variance"
             )),
     );
     let _ = writeln!(

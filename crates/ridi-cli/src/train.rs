@@ -49,8 +49,8 @@ pub(crate) struct Args {
     /// How the kernel machines are trained: `exact` (SMO, the paper's), or `nystrom`, which
     /// approximates the RBF kernel on --landmarks rows per machine, with a linear classifier
     /// and kernel ridge regressors on those features: training time and memory linear in the
-    /// rows, a model and a query that do not grow with them, velocities somewhat off the
-    /// exact ones (docs/benchmarks.md).
+    /// rows, a model and a query that do not grow with them, as accurate as the exact solver
+    /// on the Tyrex protocol (docs/benchmarks.md).
     #[arg(long, value_enum, default_value = "exact")]
     solver: SolverArg,
     /// Landmarks per machine of `--solver nystrom` (rows drawn at random with fixed seeds:
@@ -164,7 +164,8 @@ impl From<UpAxisArg> for UpAxis {
 }
 
 /// Rows above which `ridi train` points the exact solver's user to `--solver nystrom`: the
-/// exact solver took 82 s on 50,392 rows and 891 s on 96,000 (2 cores, docs/benchmarks.md).
+/// exact solver took 82 s on 50,392 rows and 891 s on 96,000 (2 cores; docs/benchmarks.md,
+/// "Training at scale: the Nyström solver").
 const EXACT_SOLVER_NOTE_ROWS: usize = 60_000;
 
 /// The one-line note for `windows` training rows on the exact solver, if they are many.
@@ -172,8 +173,8 @@ fn exact_solver_note(windows: usize) -> Option<String> {
     (windows > EXACT_SOLVER_NOTE_ROWS).then(|| {
         format!(
             "note: {windows} training windows: the exact solver's time grows faster than their \
-             square (96,000 took 15 min on 2 cores); `--solver nystrom` trains them in about a \
-             minute, as accurate on the Tyrex protocol (docs/benchmarks.md)"
+             square (96000 took 891 s on 2 cores); `--solver nystrom` trains in time linear in \
+             them (100742 in 37 s), as accurate on the Tyrex protocol (docs/benchmarks.md)"
         )
     })
 }

@@ -132,16 +132,6 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             } else {
                 RegressorChoice::Grid(GridSpec::default())
             };
-            let storage = match args
-                .iter()
-                .position(|a| a == "--storage")
-                .and_then(|i| args.get(i + 1))
-                .map(String::as_str)
-            {
-                None | Some("projected") => Storage::DEFAULT,
-                Some("half") => Storage::Half,
-                Some(other) => return Err(format!("unknown storage {other}").into()),
-            };
             let method = match args
                 .iter()
                 .position(|a| a == "--solver")
@@ -154,6 +144,16 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                     arg(&args, "--seed", 0),
                 )?),
                 Some(other) => return Err(format!("unknown solver {other}").into()),
+            };
+            let storage = match args
+                .iter()
+                .position(|a| a == "--storage")
+                .and_then(|i| args.get(i + 1))
+                .map(String::as_str)
+            {
+                None | Some("projected") => Storage::projected_for(&method),
+                Some("half") => Storage::Half,
+                Some(other) => return Err(format!("unknown storage {other}").into()),
             };
             let params = CascadeParams {
                 regressors,

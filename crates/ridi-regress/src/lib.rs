@@ -37,8 +37,9 @@
 //! the previous solution scaled by `C_new / C_old`. A trained [`Cascade`] stores each
 //! placement's samples once in half precision, by default as coordinates on the few principal
 //! directions that hold 99.99 % of the training features' variance (304 of 1200 on Tyrex
-//! features; [`Storage::NYSTROM_DEFAULT`] for the Nyström solver), else as the features
-//! ([`Storage`]): prediction is bound by the bytes it streams, and
+//! features), else as the features ([`Storage`]; ridi trains the Nyström solver with
+//! [`Storage::NYSTROM_DEFAULT`], see [`Storage::projected_for`]): prediction is bound by the
+//! bytes it streams, and
 //! [`Cascade::rounding_effect`] measures what the compact storage costs. At prediction one
 //! distance pass per placement feeds the classifier and is reused by the regressors
 //! ([`Cascade::predict`] batches with GEMM, [`Cascade::predict_one`] streams the rows once).
@@ -64,8 +65,9 @@
 //!
 //! What is approximated, then: the kernel beyond the landmarks' span, the classifier's offset,
 //! and the regressors' loss; and, with projected storage, the distances, which training
-//! computes from the stored principal coordinates as prediction does (so a smaller share of
-//! the variance, [`Storage::NYSTROM_DEFAULT`], changes the kernel, not only its rounding). Training is `O(rows·m·(dim + m))` (the features and the sums,
+//! computes from the stored principal coordinates (and each row's exact norm) as prediction
+//! does, so a smaller share of the variance ([`Storage::NYSTROM_DEFAULT`]) changes the
+//! kernel, not only its rounding. Training is `O(rows·m·(dim + m))` (the features and the sums,
 //! GEMMs) plus `O(m³)` per placement; the model keeps the landmarks (in the same [`Storage`],
 //! a placement's as its samples) with one weight per landmark and machine, `W^{-1/2}` folded
 //! in; a query is one kernel row against the classifier's landmarks and one against its

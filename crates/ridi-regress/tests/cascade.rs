@@ -489,6 +489,14 @@ fn half_precision_samples_stay_close_to_the_exact_model() {
     }
 }
 
+/// The stored coordinates of a projected model and their share of the variance.
+fn projected(model: &Cascade) -> (usize, f64) {
+    match model.stored_as() {
+        StoredAs::Projected { components, energy } => (components, energy),
+        other => panic!("not projected: {other:?}"),
+    }
+}
+
 #[test]
 fn projected_samples_stay_close_to_the_exact_model() {
     // 240 values per row with a handful of directions of variance plus faint noise.
@@ -508,9 +516,7 @@ fn projected_samples_stay_close_to_the_exact_model() {
         &mut NoProgress,
     )
     .unwrap();
-    let StoredAs::Projected { components, energy } = model.stored_as() else {
-        panic!("not projected: {:?}", model.stored_as());
-    };
+    let (components, energy) = projected(&model);
     assert_eq!(components, 64, "a few directions, at least 64 kept");
     assert!((0.999..=1.0).contains(&energy), "{energy}");
     let half = Cascade::train(&data.set(), &params(Storage::Half), &mut NoProgress).unwrap();
@@ -1022,4 +1028,47 @@ fn nystrom_settings_are_checked() {
         Cascade::train(&data.set(), &params, &mut NoProgress),
         Err(RegressError::InvalidParam(_))
     ));
+}
+
+#[test]
+fn a_projected_nystrom_model_answers_as_it_was_trained() {
+    // 240 values per row, so the projection applies (24-value rows fall back to half
+    // precision). The Nyström machines compute their distances from the stored coordinates
+    // in training as at prediction: one query equals the batched path, the model round-trips,
+    // and it answers close to the same training on half-precision rows.
+    let data = make_window(3, 4, 15, 1, 40);
+    let d = data.config.feature_dim();
+    let method = Solver::Nystrom(Nystrom::new(32, 5).unwrap());
+    assert_eq!(Storage::projected_for(&method), Storage::NYSTROM_DEFAULT);
+    assert_eq!(Storage::projected_for(&Solver::Exact), Storage::DEFAULT);
+    let model = Cascade::train(
+        &data.set(),
+        &fixed(Storage::projected_for(&method), method),
+        &mut NoProgress,
+    )
+    .unwrap();
+    let (components, energy) = projected(&model);
+    assert_eq!(components, 64, "the floor");
+    assert!((0.9..=1.0).contains(&energy), "{energy}");
+    let half = Cascade::train(&data.set(), &fixed(Storage::Half, method), &mut NoProgress).unwrap();
+    let test = make_window(3, 2, 20, 99, 40);
+    let xt = FeatureMatrixRef::new(&test.x, d).unwrap();
+    let batch = model.predict(xt).unwrap();
+    let (same, dv) = compare(&batch, &half.predict(xt).unwrap());
+    assert_eq!(same, 1.0);
+    assert!(dv.iter().all(|v| *v < 2e-2), "{dv:?}");
+    for (i, b) in batch.iter().enumerate() {
+        let one = model.predict_one(xt.row(i)).unwrap();
+        assert_eq!(one.placement, b.placement);
+        for ch in 0..2 {
+            assert!(
+                (one.velocity[ch] - b.velocity[ch]).abs() < 1e-4,
+                "query {i}"
+            );
+        }
+    }
+    assert_eq!(
+        Cascade::from_bytes(&model.to_bytes().unwrap()).unwrap(),
+        model
+    );
 }

@@ -220,7 +220,15 @@ pub fn training_data(seqs: &[Sequence], config: &FeatureConfig) -> Result<Traini
 pub fn training_windows(seqs: &[Sequence], opts: &TrainOptions) -> Result<usize> {
     let schedule = SampleSchedule::training(&opts.features)?;
     let windows: usize = seqs.iter().map(|s| schedule.frames(s.len()).len()).sum();
-    Ok(windows * (opts.turned_copies + 1))
+    opts.turned_copies
+        .checked_add(1)
+        .and_then(|copies| windows.checked_mul(copies))
+        .ok_or_else(|| {
+            PipelineError::Features(ridi_features::FeatureError::InvalidConfig(format!(
+                "{windows} windows with {} turned copies each: too many rows to count",
+                opts.turned_copies
+            )))
+        })
 }
 
 /// Trains the cascade on labelled sequences (placement and ground truth required).

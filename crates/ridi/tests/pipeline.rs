@@ -807,3 +807,14 @@ fn training_windows_counts_the_rows_training_builds() {
         );
     }
 }
+
+#[test]
+fn training_windows_refuses_a_count_it_cannot_hold() {
+    let seqs = load("list_Guillaume.txt");
+    let opts = TrainOptions {
+        turned_copies: usize::MAX,
+        ..TrainOptions::default()
+    };
+    let e = ridi::training_windows(&seqs, &opts).unwrap_err();
+    assert!(e.to_string().contains("too many rows"), "{e}");
+}

@@ -77,15 +77,20 @@ impl Storage {
     pub const DEFAULT: Self = Self::Projected { energy: 0.9999 };
 
     /// The default of the Nyström solver: [`Storage::Projected`] keeping 90 % of the variance
-    /// (64 of 1200 directions on standardized Tyrex features, 91 %). A Nyström machine computes its kernel on these coordinates in training too,
-    /// so for it they are the kernel's input space, not a rounding of a trained model: on the
-    /// leave-one-person-out protocol over both Tyrex phones no figure moved beyond its interval
-    /// against 99.99 %, and a query streams a quarter of the bytes (docs/benchmarks.md).
+    /// (64 of 1200 directions on standardized Tyrex features, 91 %). A Nyström machine computes
+    /// its distances from these coordinates (and each row's exact norm) in training too, so
+    /// for it they shape the kernel, not only the rounding of a trained model. The residual
+    /// then holds about a tenth of the variance, and the distances are no longer exact up to a
+    /// small product; measured on the leave-one-person-out protocol over both Tyrex phones, no
+    /// figure got worse beyond its interval against 99.99 % (velocity MSE S-x got better),
+    /// and a query streams a quarter of the bytes (docs/benchmarks.md). Not
+    /// [`Storage::default`]: a library user who picks [`Solver::Nystrom`] picks it too, with
+    /// [`Storage::projected_for`].
     pub const NYSTROM_DEFAULT: Self = Self::Projected { energy: 0.9 };
 
-    /// The projected storage `method` trains best with: [`Storage::NYSTROM_DEFAULT`] for
+    /// The projected storage ridi uses with `method`: [`Storage::NYSTROM_DEFAULT`] for
     /// [`Solver::Nystrom`], [`Storage::DEFAULT`] for the exact solver (whose machines see the
-    /// features themselves).
+    /// features themselves; the projection only stores them).
     pub fn projected_for(method: &Solver) -> Self {
         match method {
             Solver::Exact => Self::DEFAULT,
@@ -135,7 +140,8 @@ pub struct CascadeParams {
     /// [`RegressError::NotEnoughData`] (default 10).
     pub min_class_samples: usize,
     /// Sample storage of the trained model (prediction speed against a small, measured
-    /// change of the predictions).
+    /// change of the predictions); with [`Solver::Nystrom`] also the input of its kernel
+    /// ([`Storage::projected_for`] gives ridi's choice per solver).
     pub storage: Storage,
     /// Also regress the speed `|v|` per placement (a third epsilon-SVR on the same kernel)
     /// and scale each regressed velocity to it
