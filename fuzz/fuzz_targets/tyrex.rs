@@ -8,13 +8,6 @@ use libfuzzer_sys::fuzz_target;
 #[path = "common/tyrex_run.rs"]
 mod tyrex_run;
 
-const FILES: [&str; 4] = [
-    "accelerometer.txt",
-    "gyroscope-calibrated.txt",
-    "rotation-vector.txt",
-    "timeAlignment.txt",
-];
-
 fuzz_target!(|data: &[u8]| {
-    tyrex_run::read_run(data, "android", "A_Nexus5_NoDist_Texting", &FILES);
+    tyrex_run::read_run(data, &tyrex_run::ANDROID);
 });

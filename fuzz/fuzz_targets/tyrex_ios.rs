@@ -9,14 +9,6 @@ use libfuzzer_sys::fuzz_target;
 #[path = "common/tyrex_run.rs"]
 mod tyrex_run;
 
-const FILES: [&str; 5] = [
-    "accelerometer.txt",
-    "gyroscope.txt",
-    "attitude.txt",
-    "description.txt",
-    "timeAlignment.txt",
-];
-
 fuzz_target!(|data: &[u8]| {
-    tyrex_run::read_run(data, "ios", "A_iPhone4S_NoDist_Texting", &FILES);
+    tyrex_run::read_run(data, &tyrex_run::IOS);
 });

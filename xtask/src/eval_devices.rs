@@ -666,11 +666,18 @@ fn report(r: &Report<'_>, total_s: f64) -> String {
             Orientation::Recorded => "as recorded (Android rotation vector, Core Motion attitude)",
             Orientation::Estimated => "estimated from gyro and accelerometer",
         },
-        o.landmarks
-            .map_or("the exact SMO solver".to_string(), |m| format!(
-                "the Nyström solver on {m} landmarks, its kernel's distances from the principal \
-                 coordinates holding 90 % of the variance"
-            )),
+        o.landmarks.map_or("the exact SMO solver".to_string(), |m| {
+            // The projection the training used (`train_options`), as it was set.
+            let kernel = match r.train_opts.cascade.storage {
+                Storage::Projected { energy } => format!(
+                    ", its kernel's distances from the principal coordinates holding {:.0} % of \
+                     the variance",
+                    energy * 100.0
+                ),
+                Storage::Half => String::new(),
+            };
+            format!("the Nyström solver on {m} landmarks{kernel}")
+        }),
     );
     let _ = writeln!(
         md,

@@ -487,26 +487,12 @@ mod tests {
     #[test]
     fn tyrex_seeds_are_valid_runs_with_ground_truth() {
         let root = xtask::workspace_root();
-        let android = [
-            "accelerometer.txt",
-            "gyroscope-calibrated.txt",
-            "rotation-vector.txt",
-            "timeAlignment.txt",
-        ];
-        let ios = [
-            "accelerometer.txt",
-            "gyroscope.txt",
-            "attitude.txt",
-            "description.txt",
-            "timeAlignment.txt",
-        ];
-        let targets: [(&str, &str, &str, &[&str]); 2] = [
-            ("tyrex", "android", "A_Nexus5_NoDist_Texting", &android),
-            ("tyrex_ios", "ios", "A_iPhone4S_NoDist_Texting", &ios),
-        ];
-        for (target, layout, run, files) in targets {
+        for (target, run) in [
+            ("tyrex", &tyrex_run::ANDROID),
+            ("tyrex_ios", &tyrex_run::IOS),
+        ] {
             for (name, seed) in seeds(&root, target).unwrap() {
-                let read = tyrex_run::try_read_run(&seed, layout, run, files)
+                let read = tyrex_run::try_read_run(&seed, run)
                     .unwrap_or_else(|e| panic!("{target}/{name}: {e}"));
                 assert!(
                     read.sequences.iter().any(|s| s.ground_truth().is_some()),

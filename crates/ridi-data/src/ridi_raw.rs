@@ -55,14 +55,14 @@ const POSE_ROTATION_AT: usize = 3;
 
 /// The files of a raw folder, with the fields of their rows (`t` is in nanoseconds).
 pub const FILES: [(&str, &[&str]); 8] = [
-    ("gyro.txt", XYZ),
-    ("acce.txt", XYZ),
-    ("linacce.txt", XYZ),
-    ("gravity.txt", XYZ),
-    ("magnet.txt", XYZ),
-    ("orientation.txt", QUAT),
-    ("pose.txt", POSE),
-    ("step.txt", STEP),
+    (GYRO.name, GYRO.fields),
+    (ACCE.name, ACCE.fields),
+    (LINACCE.name, LINACCE.fields),
+    (GRAVITY.name, GRAVITY.fields),
+    (MAGNET.name, MAGNET.fields),
+    (ROTATION.name, ROTATION.fields),
+    (POSE_FILE.name, POSE_FILE.fields),
+    (STEP_FILE.name, STEP_FILE.fields),
 ];
 
 /// The most values a record of any of the [`FILES`] has (the fields but `t`).
@@ -167,11 +167,11 @@ impl text::Fields for RawFields {
 
 /// The files a raw folder must have.
 pub const REQUIRED: [&str; 5] = [
-    "gyro.txt",
-    "acce.txt",
-    "linacce.txt",
-    "gravity.txt",
-    "orientation.txt",
+    GYRO.name,
+    ACCE.name,
+    LINACCE.name,
+    GRAVITY.name,
+    ROTATION.name,
 ];
 
 /// Whether `folder` holds any of the [`REQUIRED`] files: a RIDI raw folder, complete or not

@@ -796,7 +796,7 @@ impl RowReader {
                 p.read_row(&self.path, max_gap_s, rows, self.previous.as_ref())?
                     .map(|(row, line)| (row, Some(line)))
             }
-            Source::Raw(raw) => raw.next_row()?,
+            Source::Raw(raw) => raw.next_row(self.sums.rows, self.previous.as_ref())?,
         };
         let Some((row, line)) = next else {
             return Ok(None);

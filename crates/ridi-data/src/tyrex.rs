@@ -732,7 +732,7 @@ fn read_stream<T>(
     let bytes = text::read_file(path)?;
     let mut content = text::as_text(&bytes, path)?;
     if let CutOff::Drop(warnings) = cut_off
-        && !content.trim_end_matches([' ', '\t', '\r']).ends_with('\n')
+        && !text::ends_in_break(content)
         && let Some((line, last)) = text::lines(content).last()
     {
         // `last` is a slice of `content`: keep what comes before it.

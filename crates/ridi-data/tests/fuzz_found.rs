@@ -7,26 +7,22 @@
 use std::path::Path;
 
 use ridi_data::MatFile;
-use ridi_test_support::assert_names_file;
+use ridi_test_support::{assert_names_file, file_names};
 
 /// The inputs found by `target`, (file name, bytes).
 fn found(target: &str) -> Vec<(String, Vec<u8>)> {
     let dir = Path::new(env!("CARGO_MANIFEST_DIR"))
         .join("tests/fuzz_found")
         .join(target);
-    let mut out: Vec<_> = std::fs::read_dir(&dir)
-        .unwrap_or_else(|e| panic!("{}: {e}", dir.display()))
-        .map(|e| e.unwrap().path())
-        .map(|p| {
-            (
-                p.file_name().unwrap().to_string_lossy().into_owned(),
-                std::fs::read(&p).unwrap(),
-            )
+    let names = file_names(&dir);
+    assert!(!names.is_empty(), "nothing in {}", dir.display());
+    names
+        .into_iter()
+        .map(|name| {
+            let bytes = std::fs::read(dir.join(&name)).unwrap();
+            (name, bytes)
         })
-        .collect();
-    out.sort();
-    assert!(!out.is_empty(), "nothing in {}", dir.display());
-    out
+        .collect()
 }
 
 /// Runs `read` on each input of `target`: it must not panic, and its error, if any, must name

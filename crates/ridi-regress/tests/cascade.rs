@@ -477,6 +477,16 @@ fn half_precision_samples_stay_close_to_the_exact_model() {
     // The single-query path (half-precision GEMV) agrees with the batched GEMM path up to the
     // summation order of the dot products (the distances cancel |q|² + |s|² - 2 q·s).
     let batch = model.predict(xt).unwrap();
+    assert_one_query_agrees(&model, xt, &batch);
+}
+
+/// One query at a time ([`Cascade::predict_one`]) agrees with the batched path `batch`:
+/// the same placements, velocities within 1e-4 m/s per channel.
+fn assert_one_query_agrees(
+    model: &Cascade,
+    xt: FeatureMatrixRef<'_>,
+    batch: &[ridi_regress::Prediction],
+) {
     for (i, b) in batch.iter().enumerate() {
         let one = model.predict_one(xt.row(i)).unwrap();
         assert_eq!(one.placement, b.placement);
@@ -1057,16 +1067,7 @@ fn a_projected_nystrom_model_answers_as_it_was_trained() {
     let (same, dv) = compare(&batch, &half.predict(xt).unwrap());
     assert_eq!(same, 1.0);
     assert!(dv.iter().all(|v| *v < 2e-2), "{dv:?}");
-    for (i, b) in batch.iter().enumerate() {
-        let one = model.predict_one(xt.row(i)).unwrap();
-        assert_eq!(one.placement, b.placement);
-        for ch in 0..2 {
-            assert!(
-                (one.velocity[ch] - b.velocity[ch]).abs() < 1e-4,
-                "query {i}"
-            );
-        }
-    }
+    assert_one_query_agrees(&model, xt, &batch);
     assert_eq!(
         Cascade::from_bytes(&model.to_bytes().unwrap()).unwrap(),
         model

@@ -388,16 +388,14 @@ impl TrackOutput {
                 false => Ok(()),
             }
         });
-        let tracked = match tracked {
-            Some(Err(e)) => return Err(e),
-            Some(Ok(t)) => t,
-            // `write_pending` ran the content, which tracked, unless it failed before.
-            None => {
-                pending.map_err(|e| OutputError::write(&self.csv, e))?;
-                return Err(PipelineError::Live("the recording was not tracked".into()));
-            }
-        };
+        if let Some(Err(e)) = tracked {
+            return Err(e);
+        }
         let csv = pending.map_err(|e| OutputError::write(&self.csv, e))?;
+        // `write_pending` ran the content, which tracked.
+        let Some(Ok(tracked)) = tracked else {
+            return Err(PipelineError::Live("the recording was not tracked".into()));
+        };
         #[cfg(feature = "plot")]
         if let (Some(plot), Some(points)) = (&self.plot, &points) {
             points.plot(&tracked.name, plot)?;

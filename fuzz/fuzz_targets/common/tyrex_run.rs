@@ -10,19 +10,54 @@
 
 use ridi_data::tyrex::{self, TyrexOptions, TyrexRead};
 
-/// The targets' entry point: [`try_read_run`], whatever it returns.
-pub fn read_run(data: &[u8], layout: &str, run_name: &str, files: &[&str]) {
-    let _ = try_read_run(data, layout, run_name, files);
+/// A run the input is laid out as: `datasets/<layout>/<name>` with `files`, in the order the
+/// input gives their contents.
+pub struct Run {
+    pub layout: &'static str,
+    pub name: &'static str,
+    pub files: &'static [&'static str],
 }
 
-/// Lays `data` out as a run `run_name` of `layout` with `files` and reads it; an error of the
-/// temp folder is the `Err` of an I/O error, as the reader's own.
-pub fn try_read_run(
-    data: &[u8],
-    layout: &str,
-    run_name: &str,
-    files: &[&str],
-) -> Result<TyrexRead, Box<dyn std::error::Error>> {
+/// The run of the `tyrex` target: an Android one.
+#[allow(dead_code, reason = "the `tyrex_ios` target has its own")]
+pub const ANDROID: Run = Run {
+    layout: "android",
+    name: "A_Nexus5_NoDist_Texting",
+    files: &[
+        "accelerometer.txt",
+        "gyroscope-calibrated.txt",
+        "rotation-vector.txt",
+        "timeAlignment.txt",
+    ],
+};
+
+/// The run of the `tyrex_ios` target: an iPhone one.
+#[allow(dead_code, reason = "the `tyrex` target has its own")]
+pub const IOS: Run = Run {
+    layout: "ios",
+    name: "A_iPhone4S_NoDist_Texting",
+    files: &[
+        "accelerometer.txt",
+        "gyroscope.txt",
+        "attitude.txt",
+        "description.txt",
+        "timeAlignment.txt",
+    ],
+};
+
+/// The targets' entry point: [`try_read_run`], whatever it returns.
+pub fn read_run(data: &[u8], run: &Run) {
+    let _ = try_read_run(data, run);
+}
+
+/// Lays `data` out as `run` and reads it; an error of the temp folder is the `Err` of an I/O
+/// error, as the reader's own.
+pub fn try_read_run(data: &[u8], run: &Run) -> Result<TyrexRead, Box<dyn std::error::Error>> {
+    let Run {
+        layout,
+        name: run_name,
+        files,
+    } = *run;
     let root = tempfile::tempdir()?;
     let run = root.path().join("datasets").join(layout).join(run_name);
     let qualisys = root.path().join("datasets/qualisys");

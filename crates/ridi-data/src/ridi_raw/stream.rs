@@ -418,9 +418,6 @@ pub(crate) struct Rows {
     magnet: Option<Sensor<DeviceVec>>,
     orientation: Sensor<WorldFromDevice>,
     steps: Option<Sensor<f64>>,
-    /// Frames made, and the time of the last.
-    frames: usize,
-    previous: Option<f64>,
 }
 
 impl Rows {
@@ -523,8 +520,6 @@ impl Rows {
                 .map(|s| sensor(s, opts, scalar_of))
                 .transpose()?,
             plan,
-            frames: 0,
-            previous: None,
         })
     }
 
@@ -573,18 +568,22 @@ impl Rows {
         synchronized_error(&self.plan.folder, self.pose(), line_of, e)
     }
 
-    /// The next frame, with its line of `pose.txt` when the pose is the clock. A step of the
-    /// timeline that the sequence refuses (a gap) is an error here, the first the sequence
-    /// checks. After the last frame, every file is read to its end ([`Reread`]).
-    pub(crate) fn next_row(&mut self) -> Result<Option<(Row, Option<usize>)>> {
+    /// The next frame, the `index`-th, after `previous`; with its line of `pose.txt` when the
+    /// pose is the clock. A step of the timeline that the sequence refuses (a gap) is an error
+    /// here, the first the sequence checks. After the last frame, every file is read to its end
+    /// ([`Reread`]).
+    pub(crate) fn next_row(
+        &mut self,
+        index: usize,
+        previous: Option<&Row>,
+    ) -> Result<Option<(Row, Option<usize>)>> {
         let Some((time, pose)) = self.timeline.next_frame()? else {
             self.read_to_end()?;
             return Ok(None);
         };
-        let index = self.frames;
         let line = pose.map(|r| r.line);
-        if let Some(previous) = self.previous
-            && let Err(e) = check_frame_step(index, previous, time, self.max_gap_s)
+        if let Some(previous) = previous
+            && let Err(e) = check_frame_step(index, previous.time, time, self.max_gap_s)
         {
             return Err(self.error(e, |i| line.filter(|_| i == index)));
         }
@@ -617,8 +616,6 @@ impl Rows {
                 .map(|s| s.at(time, lerp_scalar))
                 .transpose()?,
         };
-        self.frames += 1;
-        self.previous = Some(time);
         Ok(Some((row, line)))
     }
 

@@ -159,7 +159,11 @@ pub(crate) fn raw_with(
 
 /// The rows of the recording at `path` read as a stream, finished, or the error.
 pub(crate) fn streamed(path: &std::path::Path, opts: &ReadOptions) -> Result<Vec<Row>, String> {
-    let mut rows = RowReader::open(path, opts).map_err(|e| e.to_string())?;
+    drain(RowReader::open(path, opts).map_err(|e| e.to_string())?)
+}
+
+/// The rows of `rows` to its end, finished, or the error.
+fn drain(mut rows: RowReader) -> Result<Vec<Row>, String> {
     let mut out = Vec::new();
     for row in rows.by_ref() {
         out.push(row.map_err(|e| e.to_string())?);
@@ -209,25 +213,26 @@ pub(crate) fn assert_streams_as_read(
     opts: &ReadOptions,
     whole: &ridi_data::Result<Sequence>,
 ) {
-    let stream = streamed(path, opts);
-    let seq = match (whole, stream) {
-        (Err(e), stream) => {
+    // Opened once: its name and flags are checked before it streams its rows.
+    let reader = RowReader::open(path, opts).map_err(|e| e.to_string());
+    let (seq, reader) = match (whole, reader) {
+        (Err(e), reader) => {
+            let stream = reader.and_then(drain);
             assert_eq!(stream.map(|_| ()), Err(e.to_string()), "{}", path.display());
             return;
         }
         (Ok(_), Err(e)) => panic!("{}: streams as an error: {e}", path.display()),
-        (Ok(seq), Ok(rows)) => {
-            assert_eq!(rows.len(), seq.len(), "{}", path.display());
-            for (i, row) in rows.iter().enumerate() {
-                let expected = frame(seq, i);
-                assert_eq!(row_bits(row), row_bits(&expected), "frame {i}: {row:?}");
-            }
-            seq
-        }
+        (Ok(seq), Ok(reader)) => (seq, reader),
     };
-    let reader = RowReader::open(path, opts).unwrap();
     assert_eq!(reader.name(), seq.name());
     assert_eq!(reader.orientation_source(), seq.orientation_source());
     assert_eq!(reader.has_magnet(), seq.magnet().is_some());
     assert_eq!(reader.has_steps(), seq.steps().is_some());
+    let rows =
+        drain(reader).unwrap_or_else(|e| panic!("{}: streams as an error: {e}", path.display()));
+    assert_eq!(rows.len(), seq.len(), "{}", path.display());
+    for (i, row) in rows.iter().enumerate() {
+        let expected = frame(seq, i);
+        assert_eq!(row_bits(row), row_bits(&expected), "frame {i}: {row:?}");
+    }
 }
