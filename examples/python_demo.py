@@ -46,6 +46,18 @@ def print_table(report):
             f"{key:<10} {m['rte_5s_m']:>9.3f} {m['ate_m']:>9.3f} {m['rte_m']:>9.3f}"
             f" {m['mpe_m']:>9.3f} {ratio:>11}"
         )
+    # Each device's mean RTE 5 s when the sequences span phones (`ridi::Report::per_device`).
+    devices = sorted({s["device"] for s in report["sequences"] if s.get("device")})
+    if len(devices) > 1:
+        print("\nRTE 5 s per device (m):")
+        for d in devices:
+            runs = [s for s in report["sequences"] if s.get("device") == d]
+            means = ", ".join(
+                f"{key} {np.mean([s['methods'][key]['rte_5s_m'] for s in runs]):.3f}"
+                for key in report["methods"]
+            )
+            plural = "" if len(runs) == 1 else "s"
+            print(f"  {d} ({len(runs)} sequence{plural}): {means}")
 
 
 def aligned(estimate, truth, t, seconds=10.0):

@@ -70,7 +70,8 @@ enum Task {
     #[command(hide = true)]
     EvalOrientation(OrientationArgs),
     /// Rebuild the bundled sample (datasets/sample) from the Tyrex data: 24 s of every Nexus 5
-    /// run, RIDI processed layout, gzip + f32, with list files.
+    /// run without disturbance and of two of Thibaud's iPhone 4S runs, RIDI processed layout,
+    /// gzip + f32, with sidecars and list files.
     Sample {
         /// Tyrex root [default: <workspace>/../shared/data/raw/tyrex-attitude-smartphones, else
         /// <workspace>/datasets/tyrex from `cargo xtask fetch tyrex`].

@@ -179,4 +179,23 @@ fn print_summary(report: &Report) {
             );
         }
     }
+    // A test set that spans phones says how each fared: the question a new phone asks.
+    let devices = report.per_device();
+    if devices.len() > 1 {
+        outln!("\nRTE 5 s per device (m):");
+        for d in &devices {
+            let methods: Vec<String> = report
+                .methods
+                .iter()
+                .filter_map(|key| d.rte_5s_m(key).map(|v| format!("{key} {v:.3}")))
+                .collect();
+            let plural = if d.sequences == 1 { "" } else { "s" };
+            outln!(
+                "  {} ({} sequence{plural}): {}",
+                shown(&d.group),
+                d.sequences,
+                methods.join(", ")
+            );
+        }
+    }
 }

@@ -1026,7 +1026,10 @@ fn demo_writes_model_reports_and_plots_all_or_nothing() {
             + &line("Guillaume_Nexus5_NoDist_Swinging", "Swinging"),
     )
     .unwrap();
-    let test = line("Jakob_Nexus5_NoDist_Texting", "Texting");
+    // The held-out runs span two phones, as the bundled sample's do: the iPhone run's device
+    // comes from its sidecar.
+    let test = line("Jakob_Nexus5_NoDist_Texting", "Texting")
+        + &line("Thibaud_iPhone4S_NoDist_Texting", "Texting");
     std::fs::write(data.join("list_test.txt"), &test).unwrap();
     let out = dir.path().join("demo");
     let demo = || {
@@ -1042,6 +1045,16 @@ fn demo_writes_model_reports_and_plots_all_or_nothing() {
     };
     let run = demo();
     assert!(run.status.success(), "{}", stderr(&run));
+    let printed = String::from_utf8_lossy(&run.stdout);
+    for says in [
+        "RTE 5 s per device (m):",
+        "  Nexus 5 (1 sequence): ridi ",
+        "  iPhone 4S (1 sequence): ridi ",
+    ] {
+        assert!(printed.contains(says), "{says:?} not in {printed}");
+    }
+    let md = std::fs::read_to_string(out.join("report.md")).unwrap();
+    assert!(md.contains("| iPhone 4S | 1 |"), "{md}");
     let report = std::fs::read(out.join("report.json")).unwrap();
     let model = std::fs::read(out.join("model.ridi")).unwrap();
     ridi::regress::Cascade::from_bytes(&model).unwrap();
@@ -1076,7 +1089,7 @@ fn demo_writes_model_reports_and_plots_all_or_nothing() {
     };
     fails_before_training(
         demo(),
-        &["list_test.txt:2: sequence `short`: has 150 frames"],
+        &["list_test.txt:3: sequence `short`: has 150 frames"],
     );
     let after: Vec<_> = std::fs::read_dir(&out)
         .unwrap()

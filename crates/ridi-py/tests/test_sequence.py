@@ -31,7 +31,8 @@ def test_read_gives_numpy_arrays_and_metadata(seq, ridi_bin):
     assert inspected["rate_hz"] == pytest.approx(seq.rate_hz)
     assert abs(seq.median_rate_hz - 200.0) < 20.0
     assert (seq.device, seq.device_imu_rate_hz) == (inspected["device"], inspected["device_imu_rate_hz"])
-    assert seq.orientation_source == "game-rotation-vector"
+    # The sample's sidecar: a Nexus 5 and its rotation vector (the Tyrex runs recorded that).
+    assert (seq.device, seq.orientation_source) == ("Nexus 5", "rotation-vector")
     assert (seq.magnet, seq.steps) == (None, None)
     assert "Thibaud_Nexus5_NoDist_Texting" in repr(seq)
 
@@ -47,8 +48,9 @@ def test_read_any_and_a_forced_format(seq):
 
 def test_read_list_labels_and_checks(tmp_path):
     seqs = ridi.read_list(SAMPLE / "list_test.txt", placement_map="tyrex4", purpose="evaluation")
-    assert len(seqs) == 8
+    assert len(seqs) == 10
     assert {s.placement for s in seqs} == {"hand", "pocket", "running", "swing"}
+    assert {s.device for s in seqs} == {"Nexus 5", "iPhone 4S"}
     raw = ridi.read_list([SAMPLE / "list_test.txt"])
     assert [s.placement for s in raw][:2] == ["AR", "BackPocket"]
     bad = tmp_path / "list.txt"

@@ -367,7 +367,60 @@ fn fmt_opt(v: Option<f64>) -> String {
 /// What a table of `report.md` groups sequences by (placement, device).
 type GroupKey = fn(&SequenceResult) -> Option<&str>;
 
+/// The mean of each method's metrics over the sequences of one group: one placement
+/// ([`Report::per_placement`]) or one device ([`Report::per_device`]).
+#[derive(Debug, Clone, PartialEq)]
+pub struct GroupSummary {
+    /// The placement label or device model the group's sequences share.
+    pub group: String,
+    /// How many sequences the group holds.
+    pub sequences: usize,
+    /// Each method's mean metrics over the group, by method key.
+    pub means: BTreeMap<String, TrajectoryMetrics>,
+}
+
+impl GroupSummary {
+    /// The mean RTE 5 s of the method `key` over the group, if it ran.
+    pub fn rte_5s_m(&self, key: &str) -> Option<f64> {
+        self.means.get(key).map(|m| m.rte_5s_m)
+    }
+}
+
 impl Report {
+    /// Each placement's means, in label order (empty when no sequence names its placement).
+    pub fn per_placement(&self) -> Vec<GroupSummary> {
+        self.grouped(|s| s.placement.as_deref())
+    }
+
+    /// Each device's means, in model order (empty when no sequence names its device).
+    pub fn per_device(&self) -> Vec<GroupSummary> {
+        self.grouped(|s| s.device.as_deref())
+    }
+
+    fn grouped(&self, key_of: GroupKey) -> Vec<GroupSummary> {
+        let reports = sequence_reports(self.sequences.iter());
+        let keys: BTreeSet<&str> = self.sequences.iter().filter_map(key_of).collect();
+        keys.into_iter()
+            .map(|k| {
+                let subset: Vec<SequenceReport> = self
+                    .sequences
+                    .iter()
+                    .zip(&reports)
+                    .filter(|(s, _)| key_of(s) == Some(k))
+                    .map(|(_, r)| r.clone())
+                    .collect();
+                GroupSummary {
+                    group: k.to_string(),
+                    sequences: subset.len(),
+                    means: summarize(&subset)
+                        .into_iter()
+                        .map(|s| (s.method, s.mean))
+                        .collect(),
+                }
+            })
+            .collect()
+    }
+
     /// The markdown report: overall summary, per placement, per device (when the sequences
     /// name theirs), per sequence, velocity and placement results. Control characters in names
     /// are escaped (`\u{1b}`), as in messages.
@@ -432,14 +485,12 @@ impl Report {
                 let _ = writeln!(out);
             }
         }
-        let reports = sequence_reports(self.sequences.iter());
-        let groups: [(&str, GroupKey); 2] = [
-            ("placement", |s| s.placement.as_deref()),
-            ("device", |s| s.device.as_deref()),
+        let groups = [
+            ("placement", self.per_placement()),
+            ("device", self.per_device()),
         ];
-        for (what, key_of) in groups {
-            let keys: BTreeSet<&str> = self.sequences.iter().filter_map(key_of).collect();
-            if keys.is_empty() {
+        for (what, groups) in groups {
+            if groups.is_empty() {
                 continue;
             }
             let _ = writeln!(out, "\n## Per {what} (mean RTE 5 s, m)\n");
@@ -452,26 +503,15 @@ impl Report {
                 "\n| --- | --- |{}",
                 " --- |".repeat(self.methods.len())
             );
-            for k in keys {
-                let subset: Vec<SequenceReport> = self
-                    .sequences
-                    .iter()
-                    .zip(&reports)
-                    .filter(|(s, _)| key_of(s) == Some(k))
-                    .map(|(_, r)| r.clone())
-                    .collect();
-                let means: BTreeMap<String, TrajectoryMetrics> = summarize(&subset)
-                    .into_iter()
-                    .map(|s| (s.method, s.mean))
-                    .collect();
-                let _ = write!(out, "| {k} | {} |", subset.len());
+            for g in groups {
+                let _ = write!(out, "| {} | {} |", g.group, g.sequences);
                 for key in &self.methods {
-                    let v = means.get(key).map(|m| m.rte_5s_m);
-                    let _ = write!(out, " {} |", fmt_opt(v));
+                    let _ = write!(out, " {} |", fmt_opt(g.rte_5s_m(key)));
                 }
                 let _ = writeln!(out);
             }
         }
+        let reports = sequence_reports(self.sequences.iter());
         for metric in [
             Metric::Rte5sM,
             Metric::PathLengthRatio,
@@ -664,9 +704,22 @@ mod tests {
         assert!(md.contains("| iPhone 4S | 1 | 2.000 |"), "{md}");
         // The placement table still holds every sequence.
         assert!(md.contains("| hand | 4 | 3.750 |"), "{md}");
+        // The same groups for a caller, in model order; a sequence without a device is in none.
+        let devices = r.per_device();
+        let got: Vec<(&str, usize, Option<f64>)> = devices
+            .iter()
+            .map(|g| (g.group.as_str(), g.sequences, g.rte_5s_m("ridi")))
+            .collect();
+        assert_eq!(
+            got,
+            [("Nexus 5", 2, Some(2.0)), ("iPhone 4S", 1, Some(2.0))]
+        );
+        assert_eq!(devices[0].rte_5s_m("pdr"), None);
+        assert_eq!(r.per_placement().len(), 1);
         // Without devices, no device table; JSON without the key reads as no device.
         let none = report(vec![result("a", None, 1.0)]);
         assert!(!none.to_markdown().contains("Per device"));
+        assert!(none.per_device().is_empty());
         let json = serde_json::to_string(&none).unwrap();
         assert!(!json.contains("\"device\""), "{json}");
         let back: Report = serde_json::from_str(&json).unwrap();

@@ -107,7 +107,8 @@ pub use convert::{CONVERT_RATE_HZ, ConvertOptions, ConvertSummary, Converted, co
 pub use demo::Demo;
 pub use error::{PipelineError, Result};
 pub use evaluate::{
-    EvalOptions, Report, SequenceResult, Traces, check_evaluable, evaluate, placement_warnings,
+    EvalOptions, GroupSummary, Report, SequenceResult, Traces, check_evaluable, evaluate,
+    placement_warnings,
 };
 pub use inspect::{
     Inspection, ModelInspection, PlacementModel, RegressorSummary, SeriesStats, inspect,

@@ -87,7 +87,11 @@ fn a_bad_source_leaves_no_conversion_behind() {
     std::fs::remove_dir_all(src.join("b_seq")).unwrap();
     let summary = convert(&src, &out, &ConvertOptions::default()).unwrap();
     assert_eq!(summary.sequences.len(), 2);
-    assert_eq!(summary.lists, [out.join("list_all.txt")]);
+    // The sample's runs name their phone, so the device's list comes too.
+    assert_eq!(
+        summary.lists,
+        [out.join("list_all.txt"), out.join("list_nexus5.txt")]
+    );
     let names: Vec<String> = files_under(&out)
         .iter()
         .map(|p| p.strip_prefix(&*out.to_string_lossy()).unwrap().to_string())
@@ -98,10 +102,13 @@ fn a_bad_source_leaves_no_conversion_behind() {
             "/a_seq",
             "/a_seq/processed",
             "/a_seq/processed/data.csv",
+            "/a_seq/processed/data.csv.meta",
             "/c_seq",
             "/c_seq/processed",
             "/c_seq/processed/data.csv",
+            "/c_seq/processed/data.csv.meta",
             "/list_all.txt",
+            "/list_nexus5.txt",
             "/notes.txt"
         ]
     );
@@ -191,8 +198,9 @@ fn a_source_of_another_format_than_given_says_what_it_is_and_what_was_expected()
         .unwrap();
         assert_eq!(summary.sequences[0].frames, s.len());
     }
+    // Two lists, and per sequence its folder, `processed`, the data and its sidecar.
     let files = files_under(&out);
-    assert_eq!(files.len(), 7, "{files:?}");
+    assert_eq!(files.len(), 10, "{files:?}");
     assert!(!files.iter().any(|f| f.contains("staging")), "{files:?}");
 }
 
@@ -366,7 +374,14 @@ fn devices_are_kept_with_one_list_per_device() {
     let device =
         |model: &str, rate: f64| Some(DeviceInfo::new(model).unwrap().with_imu_rate(rate).unwrap());
     let write = |name: &str, d: Option<DeviceInfo>| {
-        let mut s = walk.clone();
+        // Without a device, also the layout's own orientation source: no sidecar at all.
+        let mut s = if d.is_none() {
+            let mut parts = walk.clone().into_parts();
+            parts.orientation_source = None;
+            ridi::data::Sequence::new(parts).unwrap()
+        } else {
+            walk.clone()
+        };
         s.set_device(d);
         let folder = src.join(name).join("processed");
         std::fs::create_dir_all(&folder).unwrap();
@@ -427,7 +442,8 @@ fn devices_are_kept_with_one_list_per_device() {
         text.contains("device:       iPhone 4S, IMU at 90.2 Hz (this sequence: 200 Hz)\n"),
         "{text}"
     );
-    let text = ridi::inspect(&walk, Format::RidiCsv).to_string();
+    let unknown = read_sequence(out.join("plain"), &opts).unwrap();
+    let text = ridi::inspect(&unknown, Format::RidiCsv).to_string();
     assert!(text.contains("device:       (unknown)\n"), "{text}");
 
     // Converted again without its device, a sequence loses the old sidecar with its old data.

@@ -55,7 +55,18 @@ fn batch_and_online(seq: &Sequence, model: &ridi::regress::Cascade) -> (ridi::Tr
 fn train_track_and_evaluate_on_the_sample_dataset() {
     let train = load("list_train.txt");
     let test = load("list_test.txt");
-    assert_eq!((train.len(), test.len()), (16, 8));
+    // The held-out person on the training phone and on one the model never saw.
+    assert_eq!((train.len(), test.len()), (16, 10));
+    let devices = |seqs: &[Sequence]| -> Vec<String> {
+        let mut d: Vec<String> = seqs
+            .iter()
+            .map(|s| s.device().map_or("-".into(), |d| d.model().to_string()))
+            .collect();
+        d.dedup();
+        d
+    };
+    assert_eq!(devices(&train), ["Nexus 5"]);
+    assert_eq!(devices(&test), ["Nexus 5", "iPhone 4S"]);
     let model = quick_model(&train);
     assert_eq!(model.placements(), ["hand", "pocket", "running", "swing"]);
 
@@ -68,8 +79,8 @@ fn train_track_and_evaluate_on_the_sample_dataset() {
     assert!(back.feature_config().standardization.is_some());
 
     let (report, traces) = ridi::evaluate(&test, &model, &EvalOptions::default()).unwrap();
-    assert_eq!(report.sequences.len(), 8);
-    assert_eq!(traces.len(), 8);
+    assert_eq!(report.sequences.len(), 10);
+    assert_eq!(traces.len(), 10);
     let ridi = report.summary["ridi"];
     let raw = report.summary["raw"];
     let still = report.summary["still"];
@@ -128,6 +139,7 @@ fn train_track_and_evaluate_on_the_sample_dataset() {
     }
     let md = std::fs::read_to_string(dir.path().join("report.md")).unwrap();
     assert!(md.contains("## Per placement") && md.contains("| ridi |"));
+    assert!(md.contains("| Nexus 5 | 8 |") && md.contains("| iPhone 4S | 2 |"));
     // Sequences whose ground truth hardly moves while the alignment is fitted are named, with
     // their travel, in the warning and only there.
     let warning = md
