@@ -478,7 +478,7 @@ fn run_measured(cmd: &mut Command) -> Result<(f64, Option<f64>)> {
 }
 
 /// End-to-end figures with the built `ridi` binary on the bundled sample: `ridi demo` (train
-/// 16 runs without grid search, evaluate 8), with `--grid small` in full mode, and tracking
+/// 16 runs without grid search, evaluate 10), with `--grid small` in full mode, and tracking
 /// throughput, batch and streaming, with the demo's model on one 24 s run.
 fn time_demo(ridi: &Path, root: &Path, quick: bool) -> Result<Vec<Figure>> {
     let out = tempfile::tempdir()?;

@@ -187,7 +187,10 @@ fn print_summary(report: &Report) {
             let methods: Vec<String> = report
                 .methods
                 .iter()
-                .filter_map(|key| d.rte_5s_m(key).map(|v| format!("{key} {v:.3}")))
+                .filter_map(|key| {
+                    let m = d.summary.get(key)?;
+                    Some(format!("{key} {:.3}", m.rte_5s_m))
+                })
                 .collect();
             let plural = if d.sequences == 1 { "" } else { "s" };
             outln!(

@@ -23,8 +23,8 @@ fn median(v: &mut [f64]) -> f64 {
 /// that a bad value is reported on its own line, before any resampling).
 ///
 /// Besides time and gravity, the defaults are hard physical bounds on single values and wide
-/// unit checks on whole channels, far from real data. Measured over the 24 bundled samples
-/// (`datasets/sample`), the 24 Tyrex runs (Nexus 5, 34 sequences once split at mocap losses,
+/// unit checks on whole channels, far from real data. Measured over the bundled sample's 24
+/// Nexus 5 runs (`datasets/sample`), the 24 Tyrex runs (Nexus 5, 34 sequences once split at mocap losses,
 /// including running with the phone in the hand and in a pocket) and the 12 Indoor Location
 /// Competition walks (OPPO PBCM10), streams as read and sequences as built:
 ///

@@ -370,29 +370,27 @@ type GroupKey = fn(&SequenceResult) -> Option<&str>;
 /// The mean of each method's metrics over the sequences of one group: one placement
 /// ([`Report::per_placement`]) or one device ([`Report::per_device`]).
 #[derive(Debug, Clone, PartialEq)]
+#[non_exhaustive]
 pub struct GroupSummary {
     /// The placement label or device model the group's sequences share.
     pub group: String,
     /// How many sequences the group holds.
     pub sequences: usize,
-    /// Each method's mean metrics over the group, by method key.
-    pub means: BTreeMap<String, TrajectoryMetrics>,
-}
-
-impl GroupSummary {
-    /// The mean RTE 5 s of the method `key` over the group, if it ran.
-    pub fn rte_5s_m(&self, key: &str) -> Option<f64> {
-        self.means.get(key).map(|m| m.rte_5s_m)
-    }
+    /// Mean of each metric over the group's sequences, per method key (as
+    /// [`Report::summary`] over all of them).
+    pub summary: BTreeMap<String, TrajectoryMetrics>,
 }
 
 impl Report {
-    /// Each placement's means, in label order (empty when no sequence names its placement).
+    /// Each placement's means, sorted by label. A sequence without a placement is in no group,
+    /// so the groups may hold fewer sequences than the report.
     pub fn per_placement(&self) -> Vec<GroupSummary> {
         self.grouped(|s| s.placement.as_deref())
     }
 
-    /// Each device's means, in model order (empty when no sequence names its device).
+    /// Each device's means, sorted by model name (byte order: `Nexus 5` before `iPhone 4S`). A
+    /// sequence without a device is in no group, so the groups may hold fewer sequences than
+    /// the report (none when no sequence names its device).
     pub fn per_device(&self) -> Vec<GroupSummary> {
         self.grouped(|s| s.device.as_deref())
     }
@@ -412,7 +410,7 @@ impl Report {
                 GroupSummary {
                     group: k.to_string(),
                     sequences: subset.len(),
-                    means: summarize(&subset)
+                    summary: summarize(&subset)
                         .into_iter()
                         .map(|s| (s.method, s.mean))
                         .collect(),
@@ -506,7 +504,8 @@ impl Report {
             for g in groups {
                 let _ = write!(out, "| {} | {} |", g.group, g.sequences);
                 for key in &self.methods {
-                    let _ = write!(out, " {} |", fmt_opt(g.rte_5s_m(key)));
+                    let v = g.summary.get(key).map(|m| m.rte_5s_m);
+                    let _ = write!(out, " {} |", fmt_opt(v));
                 }
                 let _ = writeln!(out);
             }
@@ -694,28 +693,40 @@ mod tests {
     fn results_are_grouped_by_device_when_the_sequences_name_theirs() {
         let r = report(vec![
             result("a", Some("Nexus 5"), 1.0),
-            result("b", Some("iPhone 4S"), 2.0),
+            result("b", Some("iPhone 4S"), 5.0),
             result("c", Some("Nexus 5"), 3.0),
             result("d", None, 9.0),
         ]);
         let md = r.to_markdown();
         assert!(md.contains("## Per device (mean RTE 5 s, m)"), "{md}");
         assert!(md.contains("| Nexus 5 | 2 | 2.000 |"), "{md}");
-        assert!(md.contains("| iPhone 4S | 1 | 2.000 |"), "{md}");
+        assert!(md.contains("| iPhone 4S | 1 | 5.000 |"), "{md}");
         // The placement table still holds every sequence.
-        assert!(md.contains("| hand | 4 | 3.750 |"), "{md}");
-        // The same groups for a caller, in model order; a sequence without a device is in none.
-        let devices = r.per_device();
-        let got: Vec<(&str, usize, Option<f64>)> = devices
-            .iter()
-            .map(|g| (g.group.as_str(), g.sequences, g.rte_5s_m("ridi")))
-            .collect();
+        assert!(md.contains("| hand | 4 | 4.500 |"), "{md}");
+        // The same groups for a caller, sorted by name; a sequence without a device is in none.
+        let groups = |g: Vec<GroupSummary>| -> Vec<(String, usize, Option<f64>)> {
+            g.into_iter()
+                .map(|g| {
+                    (
+                        g.group,
+                        g.sequences,
+                        g.summary.get("ridi").map(|m| m.rte_5s_m),
+                    )
+                })
+                .collect()
+        };
         assert_eq!(
-            got,
-            [("Nexus 5", 2, Some(2.0)), ("iPhone 4S", 1, Some(2.0))]
+            groups(r.per_device()),
+            [
+                ("Nexus 5".to_string(), 2, Some(2.0)),
+                ("iPhone 4S".to_string(), 1, Some(5.0))
+            ]
         );
-        assert_eq!(devices[0].rte_5s_m("pdr"), None);
-        assert_eq!(r.per_placement().len(), 1);
+        assert!(!r.per_device()[0].summary.contains_key("pdr"));
+        assert_eq!(
+            groups(r.per_placement()),
+            [("hand".to_string(), 4, Some(4.5))]
+        );
         // Without devices, no device table; JSON without the key reads as no device.
         let none = report(vec![result("a", None, 1.0)]);
         assert!(!none.to_markdown().contains("Per device"));
