@@ -30,6 +30,7 @@ use ridi::{SequenceResult, check_evaluable};
 
 use crate::bootstrap::{self, Interval};
 use crate::eval_tyrex::{PEOPLE, interval_cell};
+use crate::eval_tyrex::{Truth, oracle_rte, swapped_rte};
 
 /// The protocol's runs, relative to the workspace root.
 pub const RUN_LIST: &str = "datasets/protocols/tyrex-runs.txt";
@@ -316,6 +317,10 @@ struct Tested {
     /// RIDI's RTE 5 s with the OS orientation's jumps bridged by the gyro (the sequence's own
     /// where it has none).
     bridged_rte: f64,
+    /// RIDI's RTE 5 s with each regressed velocity's speed, then its direction, then both from
+    /// the ground truth ([`eval_tyrex::swapped_rte`], [`eval_tyrex::oracle_rte`]): which part of
+    /// the error is speed, which heading, and the floor the correction and orientation leave.
+    swapped_rte: [f64; 3],
 }
 
 /// A run's figures: its sequences averaged, weighted by frames ([`METRICS`] order).
@@ -326,6 +331,8 @@ struct RunFigures {
     values: [f64; METRICS.len()],
     /// [`Tested::bridged_rte`], averaged the same way.
     bridged_rte: f64,
+    /// [`Tested::swapped_rte`], averaged the same way.
+    swapped_rte: [f64; 3],
     /// Whether a part of the run had orientation jumps.
     jumps: bool,
 }
@@ -333,35 +340,46 @@ struct RunFigures {
 /// Averages each run's parts into the run, weighted by their frames. A figure a part lacks
 /// (`NaN`, e.g. a path ratio without a path) leaves the part out of that figure's mean.
 fn per_run(tested: &[Tested]) -> Vec<RunFigures> {
-    type Sums = ([(f64, f64); METRICS.len()], (f64, f64), bool);
+    // Weighted sums of METRICS, then of the bridged RTE and the swapped ones.
+    type Sums = ([(f64, f64); METRICS.len()], [(f64, f64); 4], bool);
+    let add = |acc: &mut (f64, f64), w: f64, v: f64| {
+        if v.is_finite() {
+            acc.0 += w * v;
+            acc.1 += w;
+        }
+    };
     let mut runs: BTreeMap<usize, (String, Sums)> = BTreeMap::new();
     for t in tested {
         let e = runs.entry(t.run).or_insert_with(|| {
             let placement = t.result.placement.clone().unwrap_or_else(|| "-".into());
-            (placement, ([(0.0, 0.0); METRICS.len()], (0.0, 0.0), false))
+            (
+                placement,
+                ([(0.0, 0.0); METRICS.len()], [(0.0, 0.0); 4], false),
+            )
         });
         let w = t.frames as f64;
         for (acc, m) in e.1.0.iter_mut().zip(&METRICS) {
-            let v = (m.of)(&t.result);
-            if v.is_finite() {
-                acc.0 += w * v;
-                acc.1 += w;
-            }
+            add(acc, w, (m.of)(&t.result));
         }
-        if t.bridged_rte.is_finite() {
-            e.1.1.0 += w * t.bridged_rte;
-            e.1.1.1 += w;
+        let [speed, direction, truth] = t.swapped_rte;
+        for (acc, v) in
+            e.1.1
+                .iter_mut()
+                .zip([t.bridged_rte, speed, direction, truth])
+        {
+            add(acc, w, v);
         }
         e.1.2 |= t.bridged_rte != (METRICS[RTE].of)(&t.result);
     }
     let mean = |(s, w): (f64, f64)| if w > 0.0 { s / w } else { f64::NAN };
     runs.into_iter()
         .map(
-            |(run, (placement, (sums, bridged_sums, jumps)))| RunFigures {
+            |(run, (placement, (sums, [bridged, speed, direction, truth], jumps)))| RunFigures {
                 run,
                 placement,
                 values: sums.map(mean),
-                bridged_rte: mean(bridged_sums),
+                bridged_rte: mean(bridged),
+                swapped_rte: [mean(speed), mean(direction), mean(truth)],
                 jumps,
             },
         )
@@ -591,7 +609,8 @@ pub fn run(opts: Options) -> Result<PathBuf> {
                 if test.is_empty() {
                     continue;
                 }
-                let (report, _) = ridi::evaluate(&test, &model, &eval_opts)?;
+                let (report, traces) = ridi::evaluate(&test, &model, &eval_opts)?;
+                let correction = eval_opts.track.correction_for(&model);
                 let bridged_rte: BTreeMap<String, f64> = if with_bridges.is_empty() {
                     BTreeMap::new()
                 } else {
@@ -601,16 +620,23 @@ pub fn run(opts: Options) -> Result<PathBuf> {
                         .map(|q| (q.name.clone(), (METRICS[RTE].of)(q)))
                         .collect()
                 };
-                for ((result, s), run) in report.sequences.into_iter().zip(&test).zip(test_runs) {
+                let tracked = report.sequences.into_iter().zip(&traces).zip(&test);
+                for (((result, trace), s), run) in tracked.zip(test_runs) {
                     let bridged_rte = bridged_rte
                         .get(&result.name)
                         .copied()
                         .unwrap_or_else(|| (METRICS[RTE].of)(&result));
+                    let swapped = |truth| swapped_rte(s, trace, correction, truth);
                     rows.push(Tested {
                         run,
                         frames: s.len(),
                         result,
                         bridged_rte,
+                        swapped_rte: [
+                            swapped(Truth::Speed)?,
+                            swapped(Truth::Direction)?,
+                            oracle_rte(s, model.feature_config().window, &eval_opts)?,
+                        ],
                     });
                 }
             }
@@ -731,6 +757,7 @@ fn report(r: &Report<'_>, total_s: f64) -> String {
     }
     goals(&mut md, r);
     across(&mut md, r);
+    error_sources(&mut md, r);
     if let Some(k) = r.protocols.iter().position(|p| p.name == BOTH_PHONES.name) {
         let runs = all(k);
         let _ = writeln!(
@@ -797,6 +824,44 @@ fn report(r: &Report<'_>, total_s: f64) -> String {
         }
     }
     md
+}
+
+/// Both phones' RTE 5 s with each regressed velocity's speed, then its direction, then both
+/// taken from the ground truth: which of the two the remaining error is, and the floor, over all
+/// runs and per device.
+fn error_sources(md: &mut String, r: &Report<'_>) {
+    let Some(k) = r.protocols.iter().position(|p| p.name == BOTH_PHONES.name) else {
+        return;
+    };
+    let _ = writeln!(
+        md,
+        "\n## Where RIDI's RTE 5 s comes from (both phones)\n\nThe same tracks with one half of \
+         each regressed velocity replaced by the ground truth's (in S; the correction and the \
+         evaluation unchanged): the true speed with the regressed direction, and the true \
+         direction with the regressed speed, and the ground-truth velocity itself (the floor \
+         the correction and the orientation leave). RTE 5 s (m), means over runs.\n\n| device \
+         | runs | RIDI | true speed, regressed direction | true direction, regressed speed | \
+         ground-truth velocity |\n| --- | --- | --- | --- | --- | --- |"
+    );
+    let all: Vec<&RunFigures> = r.figures[k].iter().collect();
+    let mut groups: BTreeMap<String, Vec<&RunFigures>> = BTreeMap::new();
+    for f in &all {
+        groups
+            .entry(r.runs[f.run].device_condition())
+            .or_default()
+            .push(f);
+    }
+    for (name, g) in std::iter::once(("all runs".to_string(), all)).chain(groups) {
+        let _ = writeln!(
+            md,
+            "| {name} | {} | {} | {} | {} | {} |",
+            g.len(),
+            interval_cell(figure(&g, RTE), false),
+            interval_cell(interval_of(&g, |f| f.swapped_rte[0]), false),
+            interval_cell(interval_of(&g, |f| f.swapped_rte[1]), false),
+            interval_cell(interval_of(&g, |f| f.swapped_rte[2]), false),
+        );
+    }
 }
 
 /// RTE 5 s of a model that never saw the test phone against the same people's model trained on
@@ -1188,18 +1253,21 @@ mod tests {
                 frames: 100,
                 result: result("A_part1", 1.0, 2.0),
                 bridged_rte: 3.0,
+                swapped_rte: [0.5, f64::NAN, 0.1],
             },
             Tested {
                 run: 3,
                 frames: 300,
                 result: result("A_part2", 3.0, 2.0),
                 bridged_rte: 3.0,
+                swapped_rte: [1.5, 0.25, 0.1],
             },
             Tested {
                 run: 1,
                 frames: 50,
                 result: result("B", 4.0, 1.0),
                 bridged_rte: 4.0,
+                swapped_rte: [2.0, 1.0, 0.3],
             },
         ];
         let runs = per_run(&tested);
@@ -1209,6 +1277,10 @@ mod tests {
         // A part tracked differently when bridged marks its run; (100 * 3 + 300 * 3) / 400.
         assert!(runs[1].jumps && !runs[0].jumps);
         assert_eq!((runs[1].bridged_rte, runs[0].bridged_rte), (3.0, 4.0));
+        // The swapped figures average alike, (100 * 0.5 + 300 * 1.5) / 400; a part without one
+        // leaves it to the others.
+        assert_eq!(runs[1].swapped_rte, [1.25, 0.25, 0.1]);
+        assert_eq!(runs[0].swapped_rte, [2.0, 1.0, 0.3]);
         // No RIDI-MAG in these results: the figure is missing, not zero.
         assert!(runs[0].values[7].is_nan());
         let all: Vec<&RunFigures> = runs.iter().collect();
@@ -1261,6 +1333,7 @@ mod tests {
             run,
             placement: "hand".into(),
             bridged_rte: rte,
+            swapped_rte: [rte; 3],
             jumps: false,
             values: {
                 let mut v = [0.0; METRICS.len()];

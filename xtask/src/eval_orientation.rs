@@ -17,8 +17,56 @@ use ridi_frames::{
     Device, DeviceVec, FilterConfig, Rot, WorldFromDevice, estimate_orientation, orientation_errors,
 };
 
-/// Report path, relative to the workspace root.
-pub const DEFAULT_OUT: &str = "docs/bench-orientation.md";
+/// The phone whose undisturbed Tyrex runs are evaluated.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum Phone {
+    /// The Nexus 5 (Android rotation vector).
+    Nexus5,
+    /// The iPhone 4S (Core Motion attitude; its gyro drifts several times faster).
+    Iphone4s,
+}
+
+impl Phone {
+    /// What its run folders' names hold.
+    fn runs(self) -> &'static str {
+        match self {
+            Phone::Nexus5 => "_Nexus5_NoDist_",
+            Phone::Iphone4s => "_iPhone4S_NoDist_",
+        }
+    }
+
+    fn name(self) -> &'static str {
+        match self {
+            Phone::Nexus5 => "Nexus 5",
+            Phone::Iphone4s => "iPhone 4S",
+        }
+    }
+
+    /// The orientation the phone's OS reports, as the report's bullet describes it.
+    fn os_orientation(self) -> &'static str {
+        match self {
+            Phone::Nexus5 => {
+                "the Android `TYPE_ROTATION_VECTOR` the reader gives as the device orientation \
+                 (magnetometer-based heading: its drift shows magnetic disturbance in the mocap \
+                 room, not gyro drift)"
+            }
+            Phone::Iphone4s => {
+                "the Core Motion attitude the reader gives as the device orientation, turned as \
+                 the authors' loader turns it (magnetometer-aided heading; its tilt is lost while \
+                 running, `docs/datasets.md`)"
+            }
+        }
+    }
+
+    /// Report path, relative to the workspace root.
+    pub fn default_out(self) -> &'static str {
+        match self {
+            Phone::Nexus5 => "docs/bench-orientation.md",
+            Phone::Iphone4s => "docs/bench-orientation-iphone4s.md",
+        }
+    }
+}
+
 /// Shorter parts give a drift slope dominated by noise, so they are not evaluated.
 pub const MIN_PART_S: f64 = 10.0;
 const KP_GRID: [f64; 3] = [0.1, 0.5, 2.0];
@@ -284,6 +332,8 @@ pub fn evaluate_part(
 /// Everything the report is made of.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Evaluation {
+    /// The phone whose runs were evaluated.
+    pub phone: Phone,
     /// Configurations, same order as [`PartEval::estimator`].
     pub configs: Vec<FilterConfig>,
     /// Evaluated parts, in run order.
@@ -295,16 +345,19 @@ pub struct Evaluation {
     pub alignment_check: Vec<PartEval>,
 }
 
-/// Reads every Tyrex run under `data` and evaluates each part of at least [`MIN_PART_S`] with
-/// ground truth. `progress` receives one line per run.
-pub fn evaluate(data: &Path, mut progress: impl FnMut(&str)) -> Result<Evaluation> {
+/// Reads every undisturbed Tyrex run of `phone` under `data` and evaluates each part of at least
+/// [`MIN_PART_S`] with ground truth. `progress` receives one line per run.
+pub fn evaluate(data: &Path, phone: Phone, mut progress: impl FnMut(&str)) -> Result<Evaluation> {
     let data = &xtask::tyrex_root(Some(data.to_path_buf()))?;
-    // The protocol's runs: the 24 Nexus 5 runs without magnetic disturbance.
+    // The protocol's runs: the phone's 24 runs without magnetic disturbance.
     let dirs: Vec<_> = tyrex::list_sequences(data)
         .with_context(|| format!("listing Tyrex runs in {}", data.display()))?
         .runs
         .into_iter()
-        .filter(|d| d.to_string_lossy().contains("_Nexus5_NoDist_"))
+        .filter(|d| {
+            d.file_name()
+                .is_some_and(|n| n.to_string_lossy().contains(phone.runs()))
+        })
         .collect();
     let configs = configs();
     let default_only = &configs[..1];
@@ -388,6 +441,7 @@ pub fn evaluate(data: &Path, mut progress: impl FnMut(&str)) -> Result<Evaluatio
         );
     }
     Ok(Evaluation {
+        phone,
         configs,
         parts,
         notes,
@@ -438,7 +492,8 @@ fn write_report(s: &mut String, eval: &Evaluation, command: &str) -> std::fmt::R
 
     writeln!(
         s,
-        "# Orientation accuracy on Tyrex (Nexus 5, motion capture)\n"
+        "# Orientation accuracy on Tyrex ({}, motion capture)\n",
+        eval.phone.name()
     )?;
     writeln!(
         s,
@@ -478,9 +533,12 @@ fn write_report(s: &mut String, eval: &Evaluation, command: &str) -> std::fmt::R
     )?;
     writeln!(
         s,
-        "- **rotation vector**: the Android `TYPE_ROTATION_VECTOR` the reader gives as the \
-         device orientation (magnetometer-based heading: its drift shows magnetic disturbance \
-         in the mocap room, not gyro drift);"
+        "- **{}** (RV in the tables): {};",
+        match eval.phone {
+            Phone::Nexus5 => "rotation vector",
+            Phone::Iphone4s => "attitude",
+        },
+        eval.phone.os_orientation()
     )?;
     writeln!(
         s,
@@ -691,8 +749,11 @@ fn write_report(s: &mut String, eval: &Evaluation, command: &str) -> std::fmt::R
 }
 
 /// The subcommand: evaluates `data` and writes the report to `out` atomically.
-pub fn run(data: Option<PathBuf>, out: Option<PathBuf>) -> Result<PathBuf> {
+pub fn run(data: Option<PathBuf>, out: Option<PathBuf>, phone: Phone) -> Result<PathBuf> {
     let mut command = String::from("cargo xtask eval orientation");
+    if phone != Phone::Nexus5 {
+        command.push_str(" --phone iphone4s");
+    }
     if let Some(d) = &data {
         write!(command, " --data {}", d.display())?;
     }
@@ -701,8 +762,8 @@ pub fn run(data: Option<PathBuf>, out: Option<PathBuf>) -> Result<PathBuf> {
     }
     let root = xtask::workspace_root();
     let data = xtask::tyrex_root(data)?;
-    let out = out.unwrap_or_else(|| root.join(DEFAULT_OUT));
-    let eval = evaluate(&data, |line| eprintln!("{line}"))?;
+    let out = out.unwrap_or_else(|| root.join(phone.default_out()));
+    let eval = evaluate(&data, phone, |line| eprintln!("{line}"))?;
     let report = render(&eval, &command);
     ridi_data::write_atomically(&out, |w| w.write_all(report.as_bytes()))
         .with_context(|| format!("writing {}", out.display()))?;
@@ -861,6 +922,7 @@ mod tests {
             })
             .collect();
         let eval = Evaluation {
+            phone: Phone::Nexus5,
             configs: cfgs,
             parts,
             notes: vec!["a note".into()],
@@ -898,14 +960,19 @@ mod tests {
     fn missing_data_folder_is_a_clear_error() {
         let tmp = tempfile::tempdir().unwrap();
         let missing = tmp.path().join("nope");
-        let err = evaluate(&missing, |_| {}).unwrap_err().to_string();
+        let err = evaluate(&missing, Phone::Nexus5, |_| {})
+            .unwrap_err()
+            .to_string();
         assert!(
             err.contains("Tyrex data folder") && err.contains("nope"),
             "{err}"
         );
         assert!(err.contains("--data"), "{err}");
         // A folder without runs is refused by the reader, with the path.
-        let err = format!("{:#}", evaluate(tmp.path(), |_| {}).unwrap_err());
+        let err = format!(
+            "{:#}",
+            evaluate(tmp.path(), Phone::Iphone4s, |_| {}).unwrap_err()
+        );
         assert!(err.contains("listing Tyrex runs"), "{err}");
     }
 

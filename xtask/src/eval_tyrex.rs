@@ -264,14 +264,14 @@ impl SeqRow {
 
 /// Which half of each regressed velocity [`swapped_rte`] takes from the ground truth.
 #[derive(Debug, Clone, Copy)]
-enum Truth {
+pub(crate) enum Truth {
     Speed,
     Direction,
 }
 
 /// RIDI's RTE 5 s on `seq` when each regressed velocity takes its speed or its direction from
 /// the ground truth: which part of the error is heading, which is speed.
-fn swapped_rte(
+pub(crate) fn swapped_rte(
     seq: &Sequence,
     traces: &Traces,
     correction: CorrectionConfig,
@@ -339,7 +339,7 @@ fn person(seq: &Sequence) -> &str {
 
 /// RTE 5 s of the correction driven by ground-truth velocities: the floor the orientation sets,
 /// at the frames a model with feature window `window` regresses.
-fn oracle_rte(seq: &Sequence, window: usize, opts: &EvalOptions) -> Result<f64> {
+pub(crate) fn oracle_rte(seq: &Sequence, window: usize, opts: &EvalOptions) -> Result<f64> {
     let config = ridi::features::FeatureConfig {
         window,
         ..Default::default()

@@ -200,9 +200,13 @@ struct OrientationArgs {
     /// <workspace>/datasets/tyrex from `cargo xtask fetch tyrex`].
     #[arg(long, value_name = "DIR")]
     data: Option<PathBuf>,
-    /// Report to write [default: <workspace>/docs/bench-orientation.md].
+    /// Report to write [default: <workspace>/docs/bench-orientation.md, for the iPhone 4S
+    /// docs/bench-orientation-iphone4s.md].
     #[arg(long, value_name = "FILE")]
     out: Option<PathBuf>,
+    /// The phone whose 24 undisturbed runs are evaluated.
+    #[arg(long, value_enum, default_value = "nexus5")]
+    phone: eval_orientation::Phone,
 }
 
 fn main() -> ExitCode {
@@ -307,7 +311,7 @@ fn run(cli: Cli) -> Result<()> {
             print!("{}", eval_devices::compare(&before, &after)?);
         }
         Task::Eval(Eval::Orientation(args)) | Task::EvalOrientation(args) => {
-            let out = eval_orientation::run(args.data, args.out)?;
+            let out = eval_orientation::run(args.data, args.out, args.phone)?;
             println!("wrote {}", out.display());
         }
         Task::Model { data, out } => {
