@@ -626,17 +626,23 @@ pub fn run(opts: Options) -> Result<PathBuf> {
                         .get(&result.name)
                         .copied()
                         .unwrap_or_else(|| (METRICS[RTE].of)(&result));
+                    // Reported for both phones only: the other protocols skip the work.
                     let swapped = |truth| swapped_rte(s, trace, correction, truth);
+                    let swapped_rte = if p.name == BOTH_PHONES.name {
+                        [
+                            swapped(Truth::Speed)?,
+                            swapped(Truth::Direction)?,
+                            oracle_rte(s, model.feature_config().window, &eval_opts)?,
+                        ]
+                    } else {
+                        [f64::NAN; 3]
+                    };
                     rows.push(Tested {
                         run,
                         frames: s.len(),
                         result,
                         bridged_rte,
-                        swapped_rte: [
-                            swapped(Truth::Speed)?,
-                            swapped(Truth::Direction)?,
-                            oracle_rte(s, model.feature_config().window, &eval_opts)?,
-                        ],
+                        swapped_rte,
                     });
                 }
             }

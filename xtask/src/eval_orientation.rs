@@ -1,5 +1,6 @@
 //! `cargo xtask eval orientation`: how close the gyro + accelerometer orientation estimator of
-//! ridi-frames, and the Android rotation vector, come to the motion-capture orientation of the
+//! ridi-frames, and the orientation the phone's OS reports (the Android rotation vector, with
+//! `--phone iphone4s` the Core Motion attitude), come to the motion-capture orientation of the
 //! Tyrex benchmark.
 //!
 //! Tilt is compared directly (both world frames have z up). Heading is only compared through
@@ -680,8 +681,8 @@ fn write_report(s: &mut String, eval: &Evaluation, command: &str) -> std::fmt::R
             s,
             "Tilt RMS (°) with the published alignment and with \
              `TyrexOptions::extra_time_diff_s = {ALIGNMENT_CHECK_S}` (the residual lag the reader \
-             documents), default estimator: how much of the tilt error is clock alignment rather \
-             than estimation.\n"
+             documents, measured on the Nexus 5 runs), default estimator: how much of the tilt \
+             error is clock alignment rather than estimation.\n"
         )?;
         writeln!(
             s,
@@ -714,7 +715,14 @@ fn write_report(s: &mut String, eval: &Evaluation, command: &str) -> std::fmt::R
         row("**all**", &all, Some(&shifted_all))?;
     }
 
-    writeln!(s, "\n## Per part (default estimator and rotation vector)\n")?;
+    writeln!(
+        s,
+        "\n## Per part (default estimator and {})\n",
+        match eval.phone {
+            Phone::Nexus5 => "rotation vector",
+            Phone::Iphone4s => "attitude",
+        }
+    )?;
     writeln!(
         s,
         "| part | motion | s | mocap excluded s | est. tilt RMS ° | est. tilt mean ° | est. drift °/min | RV tilt \
@@ -752,7 +760,10 @@ fn write_report(s: &mut String, eval: &Evaluation, command: &str) -> std::fmt::R
 pub fn run(data: Option<PathBuf>, out: Option<PathBuf>, phone: Phone) -> Result<PathBuf> {
     let mut command = String::from("cargo xtask eval orientation");
     if phone != Phone::Nexus5 {
-        command.push_str(" --phone iphone4s");
+        use clap::ValueEnum as _;
+        if let Some(v) = phone.to_possible_value() {
+            write!(command, " --phone {}", v.get_name())?;
+        }
     }
     if let Some(d) = &data {
         write!(command, " --data {}", d.display())?;

@@ -142,8 +142,8 @@ enum Eval {
     /// 24 Nexus 5 runs; writes docs/bench-accuracy.md.
     Tyrex(TyrexArgs),
     /// Compare the gyro + accelerometer orientation estimator (default gains and a kp/ki
-    /// sweep) and the Android rotation vector with the Tyrex motion capture, and write a
-    /// markdown report.
+    /// sweep) and the OS orientation (Android rotation vector, or the iPhone's Core Motion
+    /// attitude) with the Tyrex motion capture, and write a markdown report.
     Orientation(OrientationArgs),
     /// Compare two reports of `eval tyrex` (e.g. `--orientation recorded` and `estimated`):
     /// RIDI's figures on the runs both tested (both phones' protocol), paired run by run, with
