@@ -6,7 +6,8 @@
 //! model never saw), `SECONDS` seconds each from the longest usable part of the run (skipping
 //! its first `SKIP_S` seconds, where the mocap and the walker settle), written as
 //! gzip-compressed `data.csv.gz` with `f32` precision and its sidecar (the device), to stay
-//! under 15 MB. List files: one per person, `list_all.txt`, and the demo split
+//! under 15 MB. List files: one per person, one per phone (`list_nexus5.txt`,
+//! `list_iphone4s.txt`, as `ridi convert` names them), `list_all.txt`, and the demo split
 //! `list_train.txt` (Guillaume, Jakob) / `list_test.txt` (Thibaud). Placements are the motion
 //! names.
 
@@ -36,6 +37,8 @@ struct Entry {
     person: String,
     name: String,
     motion: String,
+    /// `DeviceInfo::key` of its phone (`nexus5`, `iphone4s`).
+    device: Option<String>,
 }
 
 /// Builds the sample from the Tyrex root `data` into `out` (replacing its sequence folders and
@@ -95,6 +98,7 @@ pub fn build(data: &Path, out: &Path) -> Result<()> {
             person,
             name,
             motion,
+            device: seq.device().map(|d| d.key()),
         });
     }
     // A copy without one of the named iPhone runs would give a sample its lists and docs do
@@ -128,6 +132,18 @@ pub fn build(data: &Path, out: &Path) -> Result<()> {
         lists.push((
             p.to_string(),
             lines.iter().filter(|l| l.person == p).collect(),
+        ));
+    }
+    // One list per phone, named as `ridi convert` names them.
+    let devices: std::collections::BTreeSet<&str> =
+        lines.iter().filter_map(|l| l.device.as_deref()).collect();
+    for d in devices {
+        lists.push((
+            d.to_string(),
+            lines
+                .iter()
+                .filter(|l| l.device.as_deref() == Some(d))
+                .collect(),
         ));
     }
     for (key, entries) in lists {

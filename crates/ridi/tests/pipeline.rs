@@ -67,6 +67,13 @@ fn train_track_and_evaluate_on_the_sample_dataset() {
     };
     assert_eq!(devices(&train), ["Nexus 5"]);
     assert_eq!(devices(&test), ["Nexus 5", "iPhone 4S"]);
+    // Each phone's list, as `ridi convert` writes them.
+    let iphone = load("list_iphone4s.txt");
+    assert_eq!(
+        (iphone.len(), devices(&iphone)),
+        (2, vec!["iPhone 4S".into()])
+    );
+    assert_eq!(load("list_nexus5.txt").len(), 24);
     let model = quick_model(&train);
     assert_eq!(model.placements(), ["hand", "pocket", "running", "swing"]);
 
