@@ -80,9 +80,13 @@ fn benches(c: &mut Criterion) {
         b.iter(|| model.predict(x).unwrap())
     });
     // The Nyström solver on the same rows: training (landmarks, features, the linear
-    // classifier, the ridge regressors) and one query, on up to 1024 landmarks per machine.
+    // classifier, the ridge regressors) and one query, on up to 1024 landmarks per machine,
+    // with the projection its users get (`Storage::projected_for`: its kernel's distances
+    // from the principal coordinates).
+    let method = Solver::Nystrom(Nystrom::new(1024, 0).unwrap());
     let nystrom = CascadeParams {
-        method: Solver::Nystrom(Nystrom::new(1024, 0).unwrap()),
+        storage: Storage::projected_for(&method),
+        method,
         ..params.clone()
     };
     g.bench_function("cascade_train_nystrom_2000_1024", |b| {
