@@ -35,15 +35,27 @@ use crate::eval_tyrex::{Truth, oracle_rte, swapped_rte};
 /// The protocol's runs, relative to the workspace root.
 pub const RUN_LIST: &str = "datasets/protocols/tyrex-runs.txt";
 
-/// The phone of a run.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord)]
-enum Phone {
+/// The phone of a run (also `cargo xtask eval orientation --phone`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, clap::ValueEnum)]
+pub(crate) enum Phone {
+    /// The Nexus 5 (Android rotation vector).
+    #[value(name = "nexus5")]
     Nexus5,
+    /// The iPhone 4S (Core Motion attitude).
+    #[value(name = "iphone4s")]
     IPhone4S,
 }
 
 impl Phone {
-    fn name(self) -> &'static str {
+    /// What a run folder's name calls it: `<person>_<token>_<condition>_<motion>`.
+    pub(crate) fn token(self) -> &'static str {
+        match self {
+            Phone::Nexus5 => "Nexus5",
+            Phone::IPhone4S => "iPhone4S",
+        }
+    }
+
+    pub(crate) fn name(self) -> &'static str {
         match self {
             Phone::Nexus5 => "Nexus 5",
             Phone::IPhone4S => "iPhone 4S",
@@ -111,8 +123,8 @@ fn parse_run(line: &str) -> Result<Run> {
         bail!("expected a folder named <person>_<phone>_<NoDist|Dist>_<motion>");
     };
     let phone = match (layout, phone) {
-        ("android", "Nexus5") => Phone::Nexus5,
-        ("ios", "iPhone4S") => Phone::IPhone4S,
+        ("android", t) if t == Phone::Nexus5.token() => Phone::Nexus5,
+        ("ios", t) if t == Phone::IPhone4S.token() => Phone::IPhone4S,
         _ => bail!(
             "unknown phone {phone:?} under {layout:?} (Nexus5 under android, iPhone4S under ios)"
         ),
@@ -771,14 +783,7 @@ fn report(r: &Report<'_>, total_s: f64) -> String {
             "\n## Both phones, per device and condition\n\n{}",
             table_header("device")
         );
-        let mut groups: BTreeMap<String, Vec<&RunFigures>> = BTreeMap::new();
-        for f in &runs {
-            groups
-                .entry(r.runs[f.run].device_condition())
-                .or_default()
-                .push(f);
-        }
-        for (name, g) in &groups {
+        for (name, g) in &by_device_condition(r.runs, runs.iter().copied()) {
             let _ = writeln!(md, "| {name} | {}", cells(g));
         }
         let _ = writeln!(
@@ -832,6 +837,21 @@ fn report(r: &Report<'_>, total_s: f64) -> String {
     md
 }
 
+/// `figures` by their run's device and condition ([`Run::device_condition`]), in name order.
+fn by_device_condition<'f>(
+    runs: &[Run],
+    figures: impl IntoIterator<Item = &'f RunFigures>,
+) -> BTreeMap<String, Vec<&'f RunFigures>> {
+    let mut groups: BTreeMap<String, Vec<&RunFigures>> = BTreeMap::new();
+    for f in figures {
+        groups
+            .entry(runs[f.run].device_condition())
+            .or_default()
+            .push(f);
+    }
+    groups
+}
+
 /// Both phones' RTE 5 s with each regressed velocity's speed, then its direction, then both
 /// taken from the ground truth: which of the two the remaining error is, and the floor, over all
 /// runs and per device.
@@ -850,13 +870,7 @@ fn error_sources(md: &mut String, r: &Report<'_>) {
          ground-truth velocity |\n| --- | --- | --- | --- | --- | --- |"
     );
     let all: Vec<&RunFigures> = r.figures[k].iter().collect();
-    let mut groups: BTreeMap<String, Vec<&RunFigures>> = BTreeMap::new();
-    for f in &all {
-        groups
-            .entry(r.runs[f.run].device_condition())
-            .or_default()
-            .push(f);
-    }
+    let groups = by_device_condition(r.runs, all.iter().copied());
     for (name, g) in std::iter::once(("all runs".to_string(), all)).chain(groups) {
         let _ = writeln!(
             md,
@@ -974,13 +988,10 @@ fn jumps(md: &mut String, r: &Report<'_>) {
          difference is paired run by run.\n\n| runs | count | bridged | as recorded | bridged - \
          as recorded |\n| --- | --- | --- | --- | --- |"
     );
-    let mut groups: BTreeMap<String, Vec<&RunFigures>> = BTreeMap::new();
-    for f in r.figures[k].iter().filter(|f| f.jumps) {
-        groups
-            .entry(r.runs[f.run].device_condition())
-            .or_default()
-            .push(f);
-        groups.entry("all".into()).or_default().push(f);
+    let with_jumps: Vec<&RunFigures> = r.figures[k].iter().filter(|f| f.jumps).collect();
+    let mut groups = by_device_condition(r.runs, with_jumps.iter().copied());
+    if !with_jumps.is_empty() {
+        groups.insert("all".into(), with_jumps);
     }
     for (name, g) in &groups {
         let raw: Vec<f64> = g.iter().map(|f| f.values[RTE]).collect();

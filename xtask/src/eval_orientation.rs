@@ -13,58 +13,37 @@ use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result, bail};
+
+use crate::eval_devices::Phone;
 use ridi_data::tyrex::{self, TyrexOptions};
 use ridi_frames::{
     Device, DeviceVec, FilterConfig, Rot, WorldFromDevice, estimate_orientation, orientation_errors,
 };
 
-/// The phone whose undisturbed Tyrex runs are evaluated.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
-pub enum Phone {
-    /// The Nexus 5 (Android rotation vector).
-    Nexus5,
-    /// The iPhone 4S (Core Motion attitude; its gyro drifts several times faster).
-    Iphone4s,
+/// The OS orientation of `phone`: its name in the report, and what the report's bullet says
+/// of it.
+fn os_orientation(phone: Phone) -> (&'static str, &'static str) {
+    match phone {
+        Phone::Nexus5 => (
+            "rotation vector",
+            "the Android `TYPE_ROTATION_VECTOR` the reader gives as the device orientation \
+             (magnetometer-based heading: its drift shows magnetic disturbance in the mocap room, \
+             not gyro drift)",
+        ),
+        Phone::IPhone4S => (
+            "attitude",
+            "the Core Motion attitude the reader gives as the device orientation, turned as the \
+             authors' loader turns it (magnetometer-aided heading; its tilt is lost while \
+             running, `docs/datasets.md`)",
+        ),
+    }
 }
 
-impl Phone {
-    /// What its run folders' names hold.
-    fn runs(self) -> &'static str {
-        match self {
-            Phone::Nexus5 => "_Nexus5_NoDist_",
-            Phone::Iphone4s => "_iPhone4S_NoDist_",
-        }
-    }
-
-    fn name(self) -> &'static str {
-        match self {
-            Phone::Nexus5 => "Nexus 5",
-            Phone::Iphone4s => "iPhone 4S",
-        }
-    }
-
-    /// The orientation the phone's OS reports, as the report's bullet describes it.
-    fn os_orientation(self) -> &'static str {
-        match self {
-            Phone::Nexus5 => {
-                "the Android `TYPE_ROTATION_VECTOR` the reader gives as the device orientation \
-                 (magnetometer-based heading: its drift shows magnetic disturbance in the mocap \
-                 room, not gyro drift)"
-            }
-            Phone::Iphone4s => {
-                "the Core Motion attitude the reader gives as the device orientation, turned as \
-                 the authors' loader turns it (magnetometer-aided heading; its tilt is lost while \
-                 running, `docs/datasets.md`)"
-            }
-        }
-    }
-
-    /// Report path, relative to the workspace root.
-    pub fn default_out(self) -> &'static str {
-        match self {
-            Phone::Nexus5 => "docs/bench-orientation.md",
-            Phone::Iphone4s => "docs/bench-orientation-iphone4s.md",
-        }
+/// Report path of `phone`, relative to the workspace root.
+pub fn default_out(phone: Phone) -> &'static str {
+    match phone {
+        Phone::Nexus5 => "docs/bench-orientation.md",
+        Phone::IPhone4S => "docs/bench-orientation-iphone4s.md",
     }
 }
 
@@ -351,13 +330,14 @@ pub struct Evaluation {
 pub fn evaluate(data: &Path, phone: Phone, mut progress: impl FnMut(&str)) -> Result<Evaluation> {
     let data = &xtask::tyrex_root(Some(data.to_path_buf()))?;
     // The protocol's runs: the phone's 24 runs without magnetic disturbance.
+    let runs = format!("_{}_NoDist_", phone.token());
     let dirs: Vec<_> = tyrex::list_sequences(data)
         .with_context(|| format!("listing Tyrex runs in {}", data.display()))?
         .runs
         .into_iter()
         .filter(|d| {
             d.file_name()
-                .is_some_and(|n| n.to_string_lossy().contains(phone.runs()))
+                .is_some_and(|n| n.to_string_lossy().contains(&runs))
         })
         .collect();
     let configs = configs();
@@ -535,11 +515,8 @@ fn write_report(s: &mut String, eval: &Evaluation, command: &str) -> std::fmt::R
     writeln!(
         s,
         "- **{}** (RV in the tables): {};",
-        match eval.phone {
-            Phone::Nexus5 => "rotation vector",
-            Phone::Iphone4s => "attitude",
-        },
-        eval.phone.os_orientation()
+        os_orientation(eval.phone).0,
+        os_orientation(eval.phone).1
     )?;
     writeln!(
         s,
@@ -718,10 +695,7 @@ fn write_report(s: &mut String, eval: &Evaluation, command: &str) -> std::fmt::R
     writeln!(
         s,
         "\n## Per part (default estimator and {})\n",
-        match eval.phone {
-            Phone::Nexus5 => "rotation vector",
-            Phone::Iphone4s => "attitude",
-        }
+        os_orientation(eval.phone).0
     )?;
     writeln!(
         s,
@@ -773,7 +747,7 @@ pub fn run(data: Option<PathBuf>, out: Option<PathBuf>, phone: Phone) -> Result<
     }
     let root = xtask::workspace_root();
     let data = xtask::tyrex_root(data)?;
-    let out = out.unwrap_or_else(|| root.join(phone.default_out()));
+    let out = out.unwrap_or_else(|| root.join(default_out(phone)));
     let eval = evaluate(&data, phone, |line| eprintln!("{line}"))?;
     let report = render(&eval, &command);
     ridi_data::write_atomically(&out, |w| w.write_all(report.as_bytes()))
@@ -982,7 +956,7 @@ mod tests {
         // A folder without runs is refused by the reader, with the path.
         let err = format!(
             "{:#}",
-            evaluate(tmp.path(), Phone::Iphone4s, |_| {}).unwrap_err()
+            evaluate(tmp.path(), Phone::IPhone4S, |_| {}).unwrap_err()
         );
         assert!(err.contains("listing Tyrex runs"), "{err}");
     }

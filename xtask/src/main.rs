@@ -206,7 +206,7 @@ struct OrientationArgs {
     out: Option<PathBuf>,
     /// The phone whose 24 undisturbed runs are evaluated.
     #[arg(long, value_enum, default_value = "nexus5")]
-    phone: eval_orientation::Phone,
+    phone: eval_devices::Phone,
 }
 
 fn main() -> ExitCode {

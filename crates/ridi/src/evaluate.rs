@@ -396,17 +396,11 @@ impl Report {
     }
 
     fn grouped(&self, key_of: GroupKey) -> Vec<GroupSummary> {
-        let reports = sequence_reports(self.sequences.iter());
         let keys: BTreeSet<&str> = self.sequences.iter().filter_map(key_of).collect();
         keys.into_iter()
             .map(|k| {
-                let subset: Vec<SequenceReport> = self
-                    .sequences
-                    .iter()
-                    .zip(&reports)
-                    .filter(|(s, _)| key_of(s) == Some(k))
-                    .map(|(_, r)| r.clone())
-                    .collect();
+                let subset =
+                    sequence_reports(self.sequences.iter().filter(|s| key_of(s) == Some(k)));
                 GroupSummary {
                     group: k.to_string(),
                     sequences: subset.len(),
