@@ -448,6 +448,9 @@ pub struct Options {
     /// Training sample step in frames (`None`: ridi train's).
     pub step: Option<usize>,
     pub orientation: Orientation,
+    /// With the estimated orientation, its heading corrected by the recorded one's (as
+    /// `ridi track --heading`); `None` keeps the gyro's.
+    pub recorded_heading: Option<ridi::frames::HeadingConfig>,
     /// Nyström landmarks instead of the exact solver.
     pub landmarks: Option<usize>,
     /// Search the paper's grid by cross-validation on the training people (`false`: C = 10,
@@ -570,14 +573,15 @@ pub fn run(opts: Options) -> Result<PathBuf> {
         seqs.len(),
         runs.len()
     );
-    apply_orientation(opts.orientation, &mut seqs)?;
+    apply_orientation(opts.orientation, opts.recorded_heading.as_ref(), &mut seqs)?;
     PlacementMap::tyrex_groups().apply(&mut seqs);
     for s in bridged.iter_mut().flatten() {
         PlacementMap::tyrex_groups().apply(std::slice::from_mut(s));
     }
 
     let train_opts = train_options(opts.step, opts.orientation, opts.landmarks, opts.grid)?;
-    let eval_opts = EvalOptions::default();
+    let mut eval_opts = EvalOptions::default();
+    eval_opts.track.recorded_heading = opts.recorded_heading;
 
     let mut tested: Vec<Vec<Tested>> = vec![Vec::new(); protocols.len()];
     let mut skipped: Vec<String> = Vec::new();
@@ -705,6 +709,9 @@ fn report(r: &Report<'_>, total_s: f64) -> String {
     }
     if o.orientation == Orientation::Estimated {
         command.push_str(" --orientation estimated");
+        if o.recorded_heading.is_none() {
+            command.push_str(" --heading gyro");
+        }
     }
     if let Some(m) = o.landmarks {
         let _ = write!(command, " --landmarks {m}");
@@ -744,7 +751,14 @@ fn report(r: &Report<'_>, total_s: f64) -> String {
         },
         match o.orientation {
             Orientation::Recorded => "as recorded (Android rotation vector, Core Motion attitude)",
-            Orientation::Estimated => "estimated from gyro and accelerometer",
+            Orientation::Estimated if o.recorded_heading.is_some() => {
+                "estimated from gyro and accelerometer, its heading drift corrected by the \
+                 recorded orientation's slow heading (`ridi track`'s default)"
+            }
+            Orientation::Estimated => {
+                "estimated from gyro and accelerometer, its heading the gyro's alone \
+                 (`ridi track --heading gyro`)"
+            }
         },
         o.landmarks.map_or("the exact SMO solver".to_string(), |m| {
             // The projection the training used (`train_options`), as it was set.

@@ -17,7 +17,8 @@ use anyhow::{Context, Result, bail};
 use crate::eval_devices::Phone;
 use ridi_data::tyrex::{self, TyrexOptions};
 use ridi_frames::{
-    Device, DeviceVec, FilterConfig, Rot, WorldFromDevice, estimate_orientation, orientation_errors,
+    Device, DeviceVec, FilterConfig, HeadingConfig, Rot, WorldFromDevice, estimate_orientation,
+    orientation_errors, with_reference_heading,
 };
 
 /// The OS orientation of `phone`: its name in the report, and what the report's bullet says
@@ -54,6 +55,9 @@ const KI_GRID: [f64; 2] = [0.0, 0.01];
 /// Accelerometer gates tried at the default gains: a gate locked to one phase of a periodic
 /// motion biases the tilt, so its effect is worth keeping in view next to the gains.
 const TOLERANCE_GRID: [f64; 3] = [0.3, 1.0, 2.0];
+/// Time constants of the heading correction tried (`HeadingConfig::time_constant`), s: the
+/// default is the one with the lowest pooled heading RMS on both phones' runs.
+pub const HEADING_TIME_CONSTANTS: [f64; 5] = [2.0, 5.0, 10.0, 20.0, 40.0];
 /// The residual lag the Tyrex reader documents for its published time alignment
 /// (`TyrexOptions::extra_time_diff_s`), evaluated as a side check of how much of the tilt error
 /// is timing rather than estimation.
@@ -72,6 +76,9 @@ pub struct Metrics {
     pub tilt_mean_deg: f64,
     /// Least-squares slope of the heading difference, degrees per minute.
     pub drift_deg_per_min: f64,
+    /// Root mean square of the heading difference about its mean, degrees: how far the
+    /// heading strays, drift and fast errors alike, whatever the constant offset.
+    pub heading_rms_deg: f64,
 }
 
 /// Compares `estimate` with `truth` sample by sample (same timeline `time`).
@@ -88,12 +95,20 @@ pub fn metrics(
     let drift = errs
         .heading_drift_per_minute(time)
         .context("heading drift undefined: all time stamps are equal")?;
+    let mean = errs.heading_drift.iter().sum::<f64>() / n as f64;
+    let spread = errs
+        .heading_drift
+        .iter()
+        .map(|h| (h - mean) * (h - mean))
+        .sum::<f64>()
+        / n as f64;
     Ok(Metrics {
         samples: n,
         duration_s: time[n - 1] - time[0],
         tilt_rms_deg: errs.tilt_rms().to_degrees(),
         tilt_mean_deg: (errs.tilt.iter().sum::<f64>() / n as f64).to_degrees(),
         drift_deg_per_min: drift.to_degrees(),
+        heading_rms_deg: spread.sqrt().to_degrees(),
     })
 }
 
@@ -113,12 +128,14 @@ pub struct Pooled {
     pub mean_abs_drift: f64,
     /// Largest |drift| of any part, degrees per minute.
     pub max_abs_drift: f64,
+    /// [`Metrics::heading_rms_deg`] pooled over all samples, degrees.
+    pub heading_rms_deg: f64,
 }
 
 /// Pools per-part metrics: tilt per sample (so long parts weigh more), drift per duration.
 pub fn pool<'a>(items: impl IntoIterator<Item = &'a Metrics>) -> Option<Pooled> {
-    let (mut parts, mut n, mut dur, mut sq, mut sum, mut drift, mut max) =
-        (0usize, 0usize, 0.0, 0.0, 0.0, 0.0, 0.0f64);
+    let (mut parts, mut n, mut dur, mut sq, mut sum, mut drift, mut max, mut heading) =
+        (0usize, 0usize, 0.0, 0.0, 0.0, 0.0, 0.0f64, 0.0);
     for m in items {
         let k = m.samples as f64;
         parts += 1;
@@ -128,6 +145,7 @@ pub fn pool<'a>(items: impl IntoIterator<Item = &'a Metrics>) -> Option<Pooled> 
         sum += k * m.tilt_mean_deg;
         drift += m.duration_s * m.drift_deg_per_min.abs();
         max = max.max(m.drift_deg_per_min.abs());
+        heading += k * m.heading_rms_deg * m.heading_rms_deg;
     }
     (n > 0 && dur > 0.0).then(|| Pooled {
         parts,
@@ -136,6 +154,7 @@ pub fn pool<'a>(items: impl IntoIterator<Item = &'a Metrics>) -> Option<Pooled> 
         tilt_mean_deg: sum / n as f64,
         mean_abs_drift: drift / dur,
         max_abs_drift: max,
+        heading_rms_deg: (heading / n as f64).sqrt(),
     })
 }
 
@@ -249,11 +268,17 @@ pub struct PartEval {
     pub rotation_vector: Metrics,
     /// The estimator for each of [`configs`], same order.
     pub estimator: Vec<Metrics>,
+    /// The default estimator's heading corrected by the OS orientation's
+    /// (`ridi_frames::with_reference_heading`), for each of [`HEADING_TIME_CONSTANTS`] at the
+    /// default `max_rate`; empty where not evaluated.
+    pub corrected: Vec<Metrics>,
 }
 
 /// Runs every configuration of `configs` on one part and compares it, and the rotation vector
-/// `rv`, with the mocap orientation `truth`, on the samples [`mocap_mask`] keeps. The
-/// estimator always runs on the whole part: the mask only chooses where it is judged.
+/// `rv`, with the mocap orientation `truth`, on the samples [`mocap_mask`] keeps; with
+/// `with_corrected`, also the first configuration's estimate with its heading corrected by
+/// `rv`'s ([`PartEval::corrected`]). The estimator always runs on the whole part: the mask only
+/// chooses where it is judged.
 #[allow(clippy::too_many_arguments)]
 pub fn evaluate_part(
     name: &str,
@@ -264,6 +289,7 @@ pub fn evaluate_part(
     rv: &[WorldFromDevice],
     truth: &[WorldFromDevice],
     configs: &[FilterConfig],
+    with_corrected: bool,
 ) -> Result<PartEval> {
     let keep = mocap_mask(time, gyro, truth);
     let kept = |v: &[WorldFromDevice]| -> Vec<WorldFromDevice> {
@@ -286,11 +312,27 @@ pub fn evaluate_part(
         .filter(|(_, k)| !(k[0] && k[1]))
         .map(|(t, _)| t[1] - t[0])
         .sum();
+    let mut corrected = Vec::new();
     let estimator = configs
         .iter()
-        .map(|c| {
+        .enumerate()
+        .map(|(i, c)| {
             let est = estimate_orientation(time, gyro, acce, c)
                 .with_context(|| format!("{name}: estimator (kp {}, ki {})", c.kp, c.ki))?;
+            if i == 0 && with_corrected {
+                for time_constant in HEADING_TIME_CONSTANTS {
+                    let config = HeadingConfig {
+                        time_constant,
+                        ..HeadingConfig::default()
+                    };
+                    let h = with_reference_heading(time, &est, rv, &config)
+                        .with_context(|| format!("{name}: heading correction"))?;
+                    corrected.push(
+                        metrics(&kept_time, &kept(&h), &kept_truth)
+                            .with_context(|| format!("{name}: corrected heading"))?,
+                    );
+                }
+            }
             metrics(&kept_time, &kept(&est), &kept_truth)
                 .with_context(|| format!("{name}: estimator"))
         })
@@ -306,6 +348,7 @@ pub fn evaluate_part(
         rotation_vector: metrics(&kept_time, &kept(rv), &kept_truth)
             .with_context(|| format!("{name}: rotation vector"))?,
         estimator,
+        corrected,
     })
 }
 
@@ -386,6 +429,7 @@ pub fn evaluate(data: &Path, phone: Phone, mut progress: impl FnMut(&str)) -> Re
                 seq.orientation(),
                 &gt.orientation,
                 &configs,
+                true,
             )?);
         }
         let read = tyrex::read(dir, &shifted)
@@ -403,6 +447,7 @@ pub fn evaluate(data: &Path, phone: Phone, mut progress: impl FnMut(&str)) -> Re
                     seq.orientation(),
                     &gt.orientation,
                     default_only,
+                    false,
                 )?);
             }
         }
@@ -692,6 +737,53 @@ fn write_report(s: &mut String, eval: &Evaluation, command: &str) -> std::fmt::R
         row("**all**", &all, Some(&shifted_all))?;
     }
 
+    if all
+        .iter()
+        .all(|p| p.corrected.len() == HEADING_TIME_CONSTANTS.len())
+    {
+        let default_tc = HeadingConfig::default();
+        writeln!(
+            s,
+            "\n## Heading corrected by the {}\n",
+            os_orientation(eval.phone).0
+        )?;
+        writeln!(
+            s,
+            "The default estimator turned onto the slow part of the {}'s heading \
+             (`ridi_frames::with_reference_heading`, what `ridi track` does with a model on the \
+             estimated orientation): each change of the heading difference is clamped to \
+             `max_rate` = {} rad/s times its time step and the sum passes a causal first-order \
+             low-pass of the time constant below; the tilt stays the estimator's. **heading RMS** is the \
+             heading difference to the mocap about its mean, pooled over samples, degrees; * \
+             marks `HeadingConfig::default()`. All parts pooled.\n",
+            os_orientation(eval.phone).0,
+            default_tc.max_rate
+        )?;
+        writeln!(
+            s,
+            "| heading | heading RMS ° | mean abs drift °/min | max abs drift °/min |"
+        )?;
+        writeln!(s, "|---|---:|---:|---:|")?;
+        let mut row = |label: String, p: Pooled| {
+            writeln!(
+                s,
+                "| {label} | {:.2} | {:.2} | {:.2} |",
+                p.heading_rms_deg, p.mean_abs_drift, p.max_abs_drift
+            )
+        };
+        row("estimator".into(), pooled_est(&all, 0))?;
+        row(os_orientation(eval.phone).0.into(), pooled_rv(&all))?;
+        for (i, tc) in HEADING_TIME_CONSTANTS.iter().enumerate() {
+            let p = pool(all.iter().map(|p| &p.corrected[i])).expect("non-empty");
+            let mark = if *tc == default_tc.time_constant {
+                " *"
+            } else {
+                ""
+            };
+            row(format!("corrected, time constant {tc} s{mark}"), p)?;
+        }
+    }
+
     writeln!(
         s,
         "\n## Per part (default estimator and {})\n",
@@ -813,9 +905,23 @@ mod tests {
             &rv,
             &truth,
             &cfgs,
+            true,
         )
         .unwrap();
         assert_eq!(e.estimator.len(), cfgs.len());
+        // The corrected heading keeps the exact tilt and follows the reference's slow slip,
+        // the more closely the shorter the time constant.
+        assert_eq!(e.corrected.len(), HEADING_TIME_CONSTANTS.len());
+        for m in &e.corrected {
+            assert!(m.tilt_rms_deg < 1e-6, "{m:?}");
+            assert!(
+                m.drift_deg_per_min > 0.0 && m.drift_deg_per_min < 2.0,
+                "{m:?}"
+            );
+        }
+        for w in e.corrected.windows(2) {
+            assert!(w[0].drift_deg_per_min > w[1].drift_deg_per_min, "{w:?}");
+        }
         for m in &e.estimator {
             assert_eq!(m.samples, 4001);
             assert!((m.duration_s - 20.0).abs() < 1e-9);
@@ -862,8 +968,10 @@ mod tests {
             &truth,
             &mocap,
             &configs()[..1],
+            false,
         )
         .unwrap();
+        assert!(e.corrected.is_empty());
         assert!((e.excluded_s - 1.005).abs() < 0.011, "{}", e.excluded_s);
         for m in [e.estimator[0], e.rotation_vector] {
             assert_eq!(m.samples, 4001 - dropped.len());
@@ -882,6 +990,7 @@ mod tests {
             tilt_rms_deg: tilt,
             tilt_mean_deg: tilt / 2.0,
             drift_deg_per_min: drift,
+            heading_rms_deg: 2.0 * tilt,
         };
         let a = m(100, 10.0, 1.0, 3.0);
         let b = m(300, 30.0, 3.0, -1.0);
@@ -892,6 +1001,7 @@ mod tests {
         // |3| over 10 s and |-1| over 30 s: signs must not cancel.
         assert!((p.mean_abs_drift - 1.5).abs() < 1e-12);
         assert_eq!(p.max_abs_drift, 3.0);
+        assert!((p.heading_rms_deg - 2.0 * p.tilt_rms_deg).abs() < 1e-12);
         assert_eq!(pool([]), None);
     }
 
@@ -903,7 +1013,10 @@ mod tests {
             .iter()
             .map(|name| {
                 let motion = tyrex::motion_of(name).unwrap();
-                evaluate_part(name, motion, &time, &gyro, &acce, &truth, &truth, &cfgs).unwrap()
+                evaluate_part(
+                    name, motion, &time, &gyro, &acce, &truth, &truth, &cfgs, true,
+                )
+                .unwrap()
             })
             .collect();
         let eval = Evaluation {
@@ -924,8 +1037,10 @@ mod tests {
         assert!(md.contains("- a note"));
         // Texting before BackPocket: the benchmark's motion order, not the alphabet.
         assert!(md.find("| Texting | 1 |").unwrap() < md.find("| BackPocket | 1 |").unwrap());
-        // The grid rows, the default marked once.
-        assert_eq!(md.matches(" * |").count(), 3);
+        // The grid rows, the default marked once; the heading correction's default too.
+        assert_eq!(md.matches(" * |").count(), 4);
+        assert!(md.contains("## Heading corrected by the rotation vector"));
+        assert!(md.contains("| corrected, time constant 5 s * |"));
         for kp in KP_GRID {
             for ki in KI_GRID {
                 assert!(
@@ -982,6 +1097,7 @@ mod tests {
             seq.orientation(),
             &gt.orientation,
             &configs()[..1],
+            false,
         )
         .unwrap();
         let (m, r) = (e.estimator[0], e.rotation_vector);

@@ -367,7 +367,8 @@ pub(crate) fn oracle_rte(seq: &Sequence, window: usize, opts: &EvalOptions) -> R
 fn prepare(all: &[Sequence], v: &Variant) -> Result<Vec<Sequence>> {
     let mut seqs = all.to_vec();
     // Once here rather than in every fold's training and evaluation (which then find it done).
-    apply_orientation(v.orientation, &mut seqs)?;
+    let heading = EvalOptions::default().track.recorded_heading;
+    apply_orientation(v.orientation, heading.as_ref(), &mut seqs)?;
     if v.groups {
         PlacementMap::tyrex_groups().apply(&mut seqs);
     }

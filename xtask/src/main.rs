@@ -184,6 +184,10 @@ struct TyrexArgs {
     /// accelerometer.
     #[arg(long, value_name = "SOURCE", default_value = "estimated", value_parser = ["recorded", "estimated"], conflicts_with = "variants")]
     orientation: String,
+    /// With the estimated orientation: its heading drift `corrected` by the recorded
+    /// orientation's slow heading (`ridi track`'s default), or the `gyro`'s alone.
+    #[arg(long, value_name = "HEADING", default_value = "corrected", value_parser = ["corrected", "gyro"], conflicts_with = "variants")]
+    heading: String,
     /// Train with the Nyström solver on this many landmarks instead of the exact SMO.
     #[arg(long, value_name = "N", conflicts_with = "variants")]
     landmarks: Option<usize>,
@@ -301,6 +305,8 @@ fn run(cli: Cli) -> Result<()> {
                         "estimated" => ridi::features::Orientation::Estimated,
                         _ => ridi::features::Orientation::Recorded,
                     },
+                    recorded_heading: (args.heading == "corrected")
+                        .then(ridi::frames::HeadingConfig::default),
                     landmarks: args.landmarks,
                     grid: args.grid == "paper",
                 })?

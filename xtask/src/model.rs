@@ -31,7 +31,8 @@ pub fn run(data: Option<PathBuf>, out: Option<PathBuf>) -> Result<PathBuf> {
     let started = Instant::now();
     let mut seqs = read_all_runs(&data)?;
     let orientation = Orientation::Estimated;
-    apply_orientation(orientation, &mut seqs)?;
+    // Training does not see the heading (features and targets live in S).
+    apply_orientation(orientation, None, &mut seqs)?;
     PlacementMap::tyrex_groups().apply(&mut seqs);
     eprintln!(
         "{} sequences read in {:.0} s",

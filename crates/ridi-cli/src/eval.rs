@@ -13,7 +13,7 @@ use ridi::{
     EvalFolder, EvalOptions, EvalPlots, EvalWritten, Method, Purpose, Report, TrackOptions,
 };
 
-use crate::{Plots, count, non_negative, parse_align, placement_smoothing};
+use crate::{Heading, Plots, count, non_negative, parse_align, placement_smoothing};
 
 #[derive(clap::Args)]
 pub(crate) struct Args {
@@ -47,6 +47,12 @@ pub(crate) struct Args {
     /// label within it, centred on it; 0 keeps each window's own label, as in the paper.
     #[arg(long, value_name = "SECONDS", default_value_t = 10.0, value_parser = non_negative)]
     placement_window: f64,
+    /// With a model on the estimated orientation: `corrected` turns the gyro's heading onto
+    /// the slow part of the recorded orientation's, so that its drift does not bend the track
+    /// (resets and magnetic corrections pass at 0.1 rad/s at most); `gyro` keeps the gyro's
+    /// heading. A model on the recorded orientation tracks with that.
+    #[arg(long, value_enum, default_value = "corrected")]
+    heading: Heading,
     /// Stretch every trajectory is aligned to the ground truth on (2D rigid, no scale):
     /// its first SECONDS, as in the paper, or `all` for the whole run (a best case that
     /// hides initial-heading errors).
@@ -79,6 +85,7 @@ pub(crate) fn run(args: Args) -> Result<()> {
         methods,
         track: TrackOptions {
             placement_smoothing: placement_smoothing(args.placement_window),
+            recorded_heading: args.heading.recorded_heading(),
             ..TrackOptions::default()
         },
         metrics: EvalConfig {

@@ -182,6 +182,25 @@ fn parse_align(text: &str) -> std::result::Result<AlignWindow, String> {
     }
 }
 
+/// `--heading`: where tracking with a model on the estimated orientation takes its heading.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub(crate) enum Heading {
+    /// The gyro's, its drift corrected by the slow part of the recorded orientation's.
+    Corrected,
+    /// The gyro's alone.
+    Gyro,
+}
+
+impl Heading {
+    /// [`TrackOptions::recorded_heading`](ridi::TrackOptions::recorded_heading).
+    fn recorded_heading(self) -> Option<ridi::frames::HeadingConfig> {
+        match self {
+            Heading::Corrected => Some(ridi::frames::HeadingConfig::default()),
+            Heading::Gyro => None,
+        }
+    }
+}
+
 /// `--placement-window` (checked by clap: finite, at least 0): 0 turns the majority vote off.
 fn placement_smoothing(window_s: f64) -> Option<PlacementSmoother> {
     (window_s > 0.0).then_some(PlacementSmoother { window_s })

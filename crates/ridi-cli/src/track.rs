@@ -8,7 +8,7 @@ use ridi::ReadFiles;
 use ridi::data::{ReadOptions, shown};
 use ridi::{PipelineError, TrackOptions, TrackOutput, apply_orientation};
 
-use crate::{MAX_FRAMES_APART, count, non_negative, placement_smoothing, positive};
+use crate::{Heading, MAX_FRAMES_APART, count, non_negative, placement_smoothing, positive};
 
 #[derive(clap::Args)]
 pub(crate) struct Args {
@@ -42,6 +42,12 @@ pub(crate) struct Args {
     /// window's own label, as in the paper.
     #[arg(long, value_name = "SECONDS", default_value_t = 10.0, value_parser = non_negative)]
     placement_window: f64,
+    /// With a model on the estimated orientation: `corrected` turns the gyro's heading onto
+    /// the slow part of the recorded orientation's, so that its drift does not bend the track
+    /// (resets and magnetic corrections pass at 0.1 rad/s at most); `gyro` keeps the gyro's
+    /// heading. A model on the recorded orientation tracks with that.
+    #[arg(long, value_enum, default_value = "corrected")]
+    heading: Heading,
 }
 
 pub(crate) fn run(args: Args) -> Result<()> {
@@ -73,7 +79,11 @@ pub(crate) fn run(args: Args) -> Result<()> {
         eprintln!("warning: {}", shown(w));
     }
     // The model's orientation, once, so that the plot shows what was tracked.
-    apply_orientation(model.feature_config().orientation, &mut loaded.sequences)?;
+    apply_orientation(
+        model.feature_config().orientation,
+        opts.recorded_heading.as_ref(),
+        &mut loaded.sequences,
+    )?;
     let [seq] = &loaded.sequences[..] else {
         bail!(
             "{} holds {} sequences; convert it with `ridi convert` and track each",
@@ -107,6 +117,7 @@ fn track_options(args: &Args) -> TrackOptions {
         regress_every: args.regress_every,
         online: args.online,
         placement_smoothing: placement_smoothing(args.placement_window),
+        recorded_heading: args.heading.recorded_heading(),
         ..TrackOptions::default()
     };
     opts.correction.lambda = args.lambda;

@@ -1183,3 +1183,40 @@ fn track_and_eval_without_a_model_use_the_bundled_one_and_say_so() {
     assert!(stderr(&out).contains("no --model: using the bundled model"));
     assert!(eval.join("report.json").is_file());
 }
+
+#[test]
+fn the_heading_is_the_corrected_gyros_unless_asked_for_the_gyros_alone() {
+    // The bundled model is on the estimated orientation: its heading drifts with the gyro,
+    // which the recorded orientation corrects by default.
+    let dir = tempfile::tempdir().unwrap();
+    let seq = sample_dataset().join("Thibaud_iPhone4S_NoDist_Texting");
+    let track = |name: &str, extra: &[&str]| {
+        let csv = dir.path().join(name);
+        let mut args = vec!["track", s(&seq), "--out", s(&csv)];
+        args.extend_from_slice(extra);
+        let out = ridi(&args);
+        assert!(out.status.success(), "{}", stderr(&out));
+        std::fs::read_to_string(csv).unwrap()
+    };
+    let default = track("default.csv", &[]);
+    assert_eq!(default, track("corrected.csv", &["--heading", "corrected"]));
+    let gyro = track("gyro.csv", &["--heading", "gyro"]);
+    assert_eq!(gyro.lines().count(), default.lines().count());
+    assert_ne!(gyro, default);
+    // Online as in batch.
+    assert_ne!(
+        track("gyro-online.csv", &["--heading", "gyro", "--online"]),
+        track("online.csv", &["--online"])
+    );
+    let out = ridi(&[
+        "track",
+        s(&seq),
+        "--out",
+        s(&dir.path().join("bad.csv")),
+        "--heading",
+        "magnetic",
+    ]);
+    assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
+    assert!(stderr(&out).contains("--heading"), "{}", stderr(&out));
+    assert!(!dir.path().join("bad.csv").exists());
+}

@@ -218,15 +218,7 @@ fn run_batch(
     gyro: &[DeviceVec],
     acce: &[DeviceVec],
 ) -> Result<Vec<WorldFromDevice>, EstimateError> {
-    for (what, len) in [("gyro", gyro.len()), ("acce", acce.len())] {
-        if len != time.len() {
-            return Err(EstimateError::LengthMismatch {
-                what,
-                expected: time.len(),
-                found: len,
-            });
-        }
-    }
+    same_lengths(time.len(), [("gyro", gyro.len()), ("acce", acce.len())])?;
     let mut out = Vec::with_capacity(time.len());
     for i in 0..time.len() {
         filter.push(time[i], gyro[i], acce[i], &mut out)?;
@@ -492,6 +484,22 @@ impl Running {
     }
 }
 
+/// [`EstimateError::LengthMismatch`] for the first input whose length is not `expected` (the
+/// time stamps').
+pub(crate) fn same_lengths(
+    expected: usize,
+    inputs: [(&'static str, usize); 2],
+) -> Result<(), EstimateError> {
+    match inputs.into_iter().find(|&(_, len)| len != expected) {
+        Some((what, found)) => Err(EstimateError::LengthMismatch {
+            what,
+            expected,
+            found,
+        }),
+        None => Ok(()),
+    }
+}
+
 fn mean_leading_nonzero(acce: &[DeviceVec], count: usize) -> Option<DeviceVec> {
     let mut sum = DeviceVec::ZERO;
     let mut n = 0usize;
@@ -539,7 +547,7 @@ pub fn heading_difference<W1: Frame, W2: Frame>(
     wrap_angle(yaw)
 }
 
-fn wrap_angle(a: f64) -> f64 {
+pub(crate) fn wrap_angle(a: f64) -> f64 {
     use std::f64::consts::{PI, TAU};
     let w = a.rem_euclid(TAU);
     if w > PI { w - TAU } else { w }

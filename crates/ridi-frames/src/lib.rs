@@ -32,12 +32,14 @@
 //! # Orientation without a magnetometer
 //!
 //! The orientation estimator is a Mahony complementary filter on gyroscope and accelerometer
-//! ([`estimate_orientation`], gains in [`FilterConfig`]) for recordings without a usable
-//! orientation; [`OrientationFilter`] is the same filter one sample at a time, for live
-//! streams. It starts with heading 0 ([`initial_orientation`]). [`tilt_error`],
+//! ([`estimate_orientation`], gains in [`FilterConfig`]): `ridi` trains and tracks with it by
+//! default (a recorded orientation's tilt may be lost while running, its heading jumps).
+//! [`OrientationFilter`] is the same filter one sample at a time, for live streams. It starts with heading 0 ([`initial_orientation`]). [`tilt_error`],
 //! [`heading_difference`] and [`orientation_errors`] compare any orientation track with a
 //! reference (e.g. motion capture): tilt error in the device frame, heading drift as the yaw of
-//! the relative rotation.
+//! the relative rotation. [`HeadingCorrector`] (and [`with_reference_heading`] over whole
+//! tracks) takes the slow part of a recorded orientation's heading onto the estimate, whose
+//! heading drifts with the gyro bias, and keeps the estimate's tilt.
 //!
 //! # Example
 //!
@@ -77,6 +79,7 @@
 mod estimate;
 mod frame;
 mod gravity;
+mod heading;
 mod horizontal;
 mod imu;
 mod rotation;
@@ -92,6 +95,7 @@ pub use gravity::{
     STANDARD_GRAVITY, UP_S, UP_W, UpAxis, align_gravity, gravity_and_linacce, gravity_in_device,
     stab_from_world,
 };
+pub use heading::{HeadingConfig, HeadingCorrector, with_reference_heading};
 pub use horizontal::{Horizontal, StabHorizontal, WorldHorizontal};
 pub use imu::{ImuError, ImuFrames, ImuSample, ImuStream};
 pub use rotation::{QuatError, Rot, StabFromDevice, StabFromWorld, WorldFromDevice};

@@ -19,7 +19,8 @@ use crate::options::{self, Inputs};
 /// ``data`` is a list file, several, or a list of ``ridi.Sequence`` with ground truth.
 /// ``methods`` are keys of ``ridi.METHODS`` (default: all, in that order); ``placement_map``,
 /// ``placement_window`` (seconds, 0 for the paper's per-window labels), ``align`` (seconds,
-/// or ``"all"``) and ``jobs`` are ``ridi eval``'s options with its defaults.
+/// or ``"all"``), ``heading`` (``"corrected"`` or ``"gyro"``, as ``ridi.track``'s) and
+/// ``jobs`` are ``ridi eval``'s options with its defaults.
 ///
 /// >>> report = ridi.evaluate("datasets/sample/list_test.txt", model,
 /// ...                        placement_map="tyrex4")           # doctest: +SKIP
@@ -28,7 +29,7 @@ use crate::options::{self, Inputs};
 #[pyfunction]
 #[pyo3(signature = (
     data, model, *, methods=None, placement_map=None, placement_window=10.0, align=None,
-    jobs=None,
+    heading="corrected", jobs=None,
 ))]
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn evaluate<'py>(
@@ -39,6 +40,7 @@ pub(crate) fn evaluate<'py>(
     placement_map: Option<PathBuf>,
     placement_window: f64,
     align: Option<&Bound<'py, PyAny>>,
+    heading: &str,
     jobs: Option<usize>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let inputs = Inputs::extract(data)?;
@@ -59,6 +61,7 @@ pub(crate) fn evaluate<'py>(
         methods,
         track: TrackOptions {
             placement_smoothing: options::placement_smoothing(placement_window)?,
+            recorded_heading: options::recorded_heading(heading)?,
             ..TrackOptions::default()
         },
         metrics: EvalConfig {

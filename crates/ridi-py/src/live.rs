@@ -74,7 +74,9 @@ impl Update {
 /// ``gravity`` and ``linacce`` with every sample; one trained with
 /// ``orientation="estimated"`` estimates its own from gyro and accelerometer, and its first
 /// frames come out together once it knows the initial tilt (``finish`` releases what a short
-/// stream leaves). A refused sample (non-finite, beyond any phone sensor, not after the
+/// stream leaves); given the phone's ``orientation`` too, it corrects the gyro's heading drift
+/// by that orientation's slow heading (``heading="corrected"``, the default; ``"gyro"`` keeps
+/// the gyro's). A refused sample (non-finite, beyond any phone sensor, not after the
 /// previous one) raises ``ValueError`` and leaves the tracker as it was; a gap longer than
 /// 0.1 s starts a new segment (``Update.restarted``).
 ///
@@ -104,7 +106,7 @@ impl LiveTracker {
     #[new]
     #[pyo3(signature = (
         model, *, regress_every=50, lambda_=0.1, estimate_initial_velocity=false,
-        placement_window=10.0,
+        placement_window=10.0, heading="corrected",
     ))]
     fn new(
         model: &Bound<'_, Model>,
@@ -112,6 +114,7 @@ impl LiveTracker {
         lambda_: f64,
         estimate_initial_velocity: bool,
         placement_window: f64,
+        heading: &str,
     ) -> PyResult<Self> {
         let opts = options::track_options(
             true,
@@ -119,6 +122,7 @@ impl LiveTracker {
             lambda_,
             estimate_initial_velocity,
             placement_window,
+            heading,
         )?;
         let model = Arc::clone(&model.get().inner);
         // SAFETY: the cascade lives in `model`'s heap allocation, which this tracker keeps
@@ -133,8 +137,10 @@ impl LiveTracker {
     }
 
     /// Adds one sample: ``time`` in seconds, ``gyro`` (rad/s) and ``acce`` (m/s², with
-    /// gravity) as 3 values in the device frame, and for a model trained on the recorded
-    /// orientation the phone's ``orientation`` ``[w, x, y, z]``, ``gravity`` and ``linacce``.
+    /// gravity) as 3 values in the device frame, and the phone's ``orientation`` ``[w, x, y, z]``,
+    /// ``gravity`` and ``linacce`` (needed by a model trained on the recorded orientation; one
+    /// on the estimated orientation takes only the slow heading of ``orientation``, which may
+    /// come alone).
     /// Returns the updates of the frames whose pose became known (one, except while an
     /// estimated orientation starts up).
     #[pyo3(signature = (time, gyro, acce, *, orientation=None, gravity=None, linacce=None))]
@@ -149,17 +155,32 @@ impl LiveTracker {
         gravity: Option<[f64; 3]>,
         linacce: Option<[f64; 3]>,
     ) -> PyResult<Vec<Update>> {
+        let estimated = self.model.feature_config().orientation == Orientation::Estimated;
+        let quaternion = |q: [f64; 4]| {
+            rotation(q).map_err(|e| errors::value(format!("`orientation` at t = {time} s: {e}")))
+        };
         let recorded = match (orientation, gravity, linacce) {
             (None, None, None) => None,
             (Some(q), Some(g), Some(l)) => Some(Recorded {
-                orientation: rotation(q)
-                    .map_err(|e| errors::value(format!("`orientation` at t = {time} s: {e}")))?,
+                orientation: quaternion(q)?,
                 gravity: DeviceVec::from_array(g),
                 linacce: DeviceVec::from_array(l),
             }),
+            // Only the heading is taken from it: gravity and linear acceleration follow.
+            (Some(q), None, None) if estimated => {
+                let orientation = quaternion(q)?;
+                let (gravity, linacce) =
+                    ridi::frames::gravity_and_linacce(orientation, DeviceVec::from_array(acce));
+                Some(Recorded {
+                    orientation,
+                    gravity,
+                    linacce,
+                })
+            }
             _ => {
                 return Err(errors::value(
-                    "give `orientation`, `gravity` and `linacce` together, or none of them",
+                    "give `orientation`, `gravity` and `linacce` together, or none of them \
+                     (a model on the estimated orientation takes `orientation` alone)",
                 ));
             }
         };

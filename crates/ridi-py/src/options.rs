@@ -71,6 +71,19 @@ pub(crate) fn placement_smoothing(window_s: f64) -> PyResult<Option<PlacementSmo
     Ok((window_s > 0.0).then_some(PlacementSmoother { window_s }))
 }
 
+/// `heading`: `"corrected"` (the gyro's heading drift corrected by the recorded orientation's
+/// slow heading) or `"gyro"`, as `--heading`.
+pub(crate) fn recorded_heading(heading: &str) -> PyResult<Option<ridi::frames::HeadingConfig>> {
+    choice(
+        "heading",
+        heading,
+        &[
+            ("corrected", Some(ridi::frames::HeadingConfig::default())),
+            ("gyro", None),
+        ],
+    )
+}
+
 /// `align`: seconds, or `"all"` for the whole run, as `ridi eval --align`.
 pub(crate) fn align(value: &Bound<'_, PyAny>) -> PyResult<AlignWindow> {
     if let Ok(text) = value.extract::<String>() {
@@ -95,11 +108,13 @@ pub(crate) fn track_options(
     lambda: f64,
     estimate_initial_velocity: bool,
     placement_window: f64,
+    heading: &str,
 ) -> PyResult<ridi::TrackOptions> {
     let mut opts = ridi::TrackOptions {
         regress_every: count("regress_every", regress_every, 1, MAX_FRAMES_APART)?,
         online,
         placement_smoothing: placement_smoothing(placement_window)?,
+        recorded_heading: recorded_heading(heading)?,
         ..ridi::TrackOptions::default()
     };
     opts.correction.lambda = positive("lambda_", lambda)?;

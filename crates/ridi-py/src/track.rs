@@ -152,8 +152,10 @@ impl Track {
 /// ``regress_every`` frames, the accelerometer bias corrected so that the integrated velocity
 /// follows them, and integrated twice. ``online=True`` is ``ridi track --online`` (a
 /// correction every 200 frames over the latest 1,000; the poses a ``LiveTracker`` gives).
-/// ``lambda_`` (``--lambda``), ``estimate_initial_velocity`` and ``placement_window``
-/// (seconds, 0 for each window's own label) are the command's options, with its defaults.
+/// ``lambda_`` (``--lambda``), ``estimate_initial_velocity``, ``placement_window``
+/// (seconds, 0 for each window's own label) and ``heading`` (``"corrected"``: a model on the
+/// estimated orientation takes the recorded orientation's slow heading to correct the gyro's
+/// drift; ``"gyro"``: the gyro's alone) are the command's options, with its defaults.
 ///
 /// Raises ``ValueError`` naming the sequence for one at another rate than 200 Hz, shorter than
 /// the model's window or with a gap longer than 0.1 s.
@@ -164,7 +166,7 @@ impl Track {
 #[pyfunction]
 #[pyo3(signature = (
     sequence, model, online=false, *, regress_every=50, lambda_=0.1,
-    estimate_initial_velocity=false, placement_window=10.0,
+    estimate_initial_velocity=false, placement_window=10.0, heading="corrected",
 ))]
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn track(
@@ -176,6 +178,7 @@ pub(crate) fn track(
     lambda_: f64,
     estimate_initial_velocity: bool,
     placement_window: f64,
+    heading: &str,
 ) -> PyResult<Track> {
     let opts = options::track_options(
         online,
@@ -183,6 +186,7 @@ pub(crate) fn track(
         lambda_,
         estimate_initial_velocity,
         placement_window,
+        heading,
     )?;
     let (seq, model) = (&sequence.get().inner, &model.get().inner);
     // `ridi::track` gives the sequence the model's orientation itself.

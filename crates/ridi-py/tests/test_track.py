@@ -54,6 +54,31 @@ def test_track_options_reach_the_cli_flags(seq, model, model_file, ridi_bin, tmp
     np.testing.assert_allclose(track.position, numbers[:, 1:4], rtol=0, atol=1e-9)
 
 
+def test_heading_gyro_is_the_cli_flag_and_what_a_live_tracker_without_orientation_gives(
+    seq, model, model_file, ridi_bin, tmp_path
+):
+    numbers, _ = cli_track(ridi_bin, model_file, tmp_path / "cli.csv", "--heading", "gyro")
+    gyro = ridi.track(seq, model, heading="gyro")
+    np.testing.assert_allclose(gyro.position, numbers[:, 1:4], rtol=0, atol=1e-9)
+    # The default corrects the gyro's heading by the recorded orientation's: another track.
+    assert np.abs(ridi.track(seq, model).position - gyro.position).max() > 1e-6
+    online = ridi.track(seq, model, online=True, heading="gyro")
+    live = ridi.LiveTracker(model, heading="gyro")
+    updates = []
+    for i in range(len(seq)):
+        updates += live.push(seq.time[i], seq.gyro[i], seq.acce[i])
+    updates += live.finish()
+    np.testing.assert_array_equal(np.array([u.position for u in updates]), online.position)
+    # The orientation alone corrects the heading as the whole recorded triple does.
+    corrected = ridi.track(seq, model, online=True)
+    live = ridi.LiveTracker(model)
+    updates = []
+    for i in range(len(seq)):
+        updates += live.push(seq.time[i], seq.gyro[i], seq.acce[i], orientation=seq.orientation[i])
+    updates += live.finish()
+    np.testing.assert_array_equal(np.array([u.position for u in updates]), corrected.position)
+
+
 def test_regress_is_what_track_corrects_with(seq, model):
     track = ridi.track(seq, model)
     regs = ridi.regress(seq, model)
@@ -124,6 +149,7 @@ def test_untrackable_sequences_are_named(seq, model):
         (dict(lambda_=-1.0), r"`lambda_` is -1"),
         (dict(placement_window=-2.0), r"`placement_window` is -2"),
         (dict(placement_window=float("nan")), r"`placement_window` is NaN"),
+        (dict(heading="magnetic"), r"`heading` is 'magnetic'; expected one of 'corrected', 'gyro'"),
     ],
 )
 def test_bad_tracking_options_are_refused(seq, model, options, message):

@@ -45,8 +45,10 @@ fn main() -> Result<(), Error> {
         Some(p) => Cascade::load(p)?,
         None => ridi::bundled_model()?,
     };
+    // The recording as read: the live tracker estimates the orientation a model on the
+    // estimated one needs, its heading corrected by the recorded one, as `ridi track
+    // --online` of a streamed recording does.
     let seq = read_sequence(&seq_path, &ReadOptions::default())?;
-    let seq = ridi::oriented(&seq, model.feature_config().orientation)?;
     let readings: Vec<SensorReading> = (0..seq.len())
         .map(|i| SensorReading::of_frame(&seq, i))
         .collect();

@@ -115,6 +115,11 @@ pub struct Report {
     pub placement_confusion: Option<ConfusionMatrix>,
     /// Alignment and metric settings.
     pub config: EvalConfig,
+    /// The heading correction tracking used with a model on the estimated orientation
+    /// ([`TrackOptions::recorded_heading`](crate::TrackOptions::recorded_heading); `None`:
+    /// the gyro's heading, as in reports written before the field existed).
+    #[serde(default)]
+    pub recorded_heading: Option<ridi_frames::HeadingConfig>,
     /// Methods in report order.
     pub methods: Vec<String>,
     /// Things to know before reading the numbers, one sentence each ([`placement_warnings`]);
@@ -138,7 +143,11 @@ struct Evaluated {
 
 fn evaluate_one(seq: &Sequence, model: &Cascade, opts: &EvalOptions) -> Result<Evaluated> {
     // Baselines see the same orientation as the model.
-    let seq = oriented(seq, model.feature_config().orientation)?;
+    let seq = oriented(
+        seq,
+        model.feature_config().orientation,
+        opts.track.recorded_heading.as_ref(),
+    )?;
     let seq = seq.as_ref();
     let gt = seq
         .ground_truth()
@@ -330,6 +339,7 @@ pub fn evaluate(
             placement_accuracy,
             placement_confusion,
             config: opts.metrics,
+            recorded_heading: opts.track.recorded_heading,
             methods: opts.methods.iter().map(|m| m.key().to_string()).collect(),
             // Without regressions there is no placement accuracy to warn about.
             warnings: if opts.methods.iter().any(|m| m.needs_model()) {
@@ -430,6 +440,18 @@ impl Report {
             },
             self.config.rte_window_s,
             self.config.short_rte_window_s
+        );
+        let _ = writeln!(
+            out,
+            "Heading with a model on the estimated orientation: {}.\n",
+            match self.recorded_heading {
+                Some(h) => format!(
+                    "the gyro's, its drift corrected by the recorded orientation's slow heading \
+                     (time constant {} s, changes clamped at {} rad/s)",
+                    h.time_constant, h.max_rate
+                ),
+                None => "the gyro's alone".to_string(),
+            }
         );
         let _ = writeln!(
             out,
@@ -678,6 +700,7 @@ mod tests {
             placement_accuracy: Some(1.0),
             placement_confusion: None,
             config: EvalConfig::default(),
+            recorded_heading: None,
             methods: vec!["ridi".into()],
             warnings: Vec::new(),
         }

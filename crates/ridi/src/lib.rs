@@ -31,7 +31,10 @@
 //!   applied to features it was not trained on.
 //! - **Batch and live tracking are one code path.** `ridi track --online` and [`track()`] with
 //!   [`TrackOptions::online`] feed a recording through [`LiveTracker`] sample by sample, so the
-//!   streaming poses a program gets are the ones the command line tests.
+//!   streaming poses a program gets are the ones the command line tests. A recording whose
+//!   orientation was estimated before (`ridi track` estimates it once, for its plot) streams
+//!   with that orientation; the estimator and heading correction of the stream give the same
+//!   one bit for bit, which the tests hold.
 //! - **Outputs are checked first and written all or nothing, here.** An output is refused
 //!   before any work when it cannot be written or would replace an input
 //!   ([`check_output_file`], [`check_output_folder`], [`check_not_input`]); a command's files

@@ -3,8 +3,10 @@
 //! [`LiveTracker`] is the streaming tracker of `ridi-correct` with a trained cascade as its
 //! regressor and, for models trained on an orientation estimated from gyro and accelerometer
 //! ([`Orientation::Estimated`]), the same estimator running on the stream
-//! ([`OrientationFilter`]), so a live caller hands over what the phone measures and gets what
-//! `ridi track --online` would give for the same recording.
+//! ([`OrientationFilter`]) with its heading drift corrected by the orientation each sample
+//! carries ([`HeadingCorrector`], [`TrackOptions::recorded_heading`]), so a live caller hands
+//! over what the phone measures and gets what `ridi track --online` would give for the same
+//! recording.
 
 use std::collections::VecDeque;
 
@@ -14,7 +16,9 @@ use ridi_correct::{
 };
 use ridi_data::{Channel, Sequence, Validation};
 use ridi_features::{FeatureExtractor, FeatureMatrixRef, Orientation};
-use ridi_frames::{DeviceVec, FilterConfig, ImuSample, OrientationFilter, WorldFromDevice};
+use ridi_frames::{
+    DeviceVec, FilterConfig, HeadingCorrector, ImuSample, OrientationFilter, WorldFromDevice,
+};
 use ridi_regress::Cascade;
 
 use crate::error::{PipelineError, Result};
@@ -101,8 +105,9 @@ impl VelocityRegressor for CascadeRegressor<'_> {
 }
 
 /// What the phone's operating system reports besides gyro and accelerometer: its orientation
-/// (Android's game rotation vector, Tango) and the gravity and linear acceleration derived from
-/// it, all as `ridi_data::Sequence` holds them.
+/// (Android's rotation vector or game rotation vector, Core Motion's attitude) and the gravity
+/// and linear acceleration derived from it, all as `ridi_data::Sequence` holds them. Not a
+/// ground truth: a model on the estimated orientation takes its slow heading.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Recorded {
     /// World-from-device orientation.
@@ -111,6 +116,21 @@ pub struct Recorded {
     pub gravity: DeviceVec,
     /// Linear acceleration, device frame, m/s².
     pub linacce: DeviceVec,
+}
+
+impl Recorded {
+    /// Frame `frame` of `seq`'s orientation, gravity and linear acceleration, whatever their
+    /// source.
+    ///
+    /// # Panics
+    /// When `frame` is not below `seq.len()`.
+    pub fn of_frame(seq: &Sequence, frame: usize) -> Self {
+        Self {
+            orientation: seq.orientation()[frame],
+            gravity: seq.gravity()[frame],
+            linacce: seq.linacce()[frame],
+        }
+    }
 }
 
 /// One reading of a phone's sensors, as a live stream delivers it: raw gyro and accelerometer,
@@ -126,27 +146,26 @@ pub struct SensorReading {
     /// Accelerometer (including gravity, reading up at rest), device frame, m/s².
     pub acce: DeviceVec,
     /// The recorded orientation: required by a model trained on it
-    /// ([`Orientation::Recorded`]); a model with an estimated orientation ignores it and
-    /// estimates its own from `gyro` and `acce`.
+    /// ([`Orientation::Recorded`]); a model with an estimated orientation estimates its own
+    /// from `gyro` and `acce` and takes only the slow part of the recorded heading, to correct
+    /// the gyro's drift ([`TrackOptions::recorded_heading`]; a sample without one keeps the
+    /// correction reached so far).
     pub recorded: Option<Recorded>,
 }
 
 impl SensorReading {
     /// Frame `frame` of a recording, with its recorded orientation: to play a recording back
-    /// as a stream.
+    /// as a stream. A sequence whose orientation was estimated already has none recorded.
     ///
     /// # Panics
     /// When `frame` is not below `seq.len()`.
     pub fn of_frame(seq: &Sequence, frame: usize) -> Self {
+        let recorded = seq.orientation_source() != Some(ridi_data::OrientationSource::Estimated);
         Self {
             time: seq.time()[frame],
             gyro: seq.gyro()[frame],
             acce: seq.acce()[frame],
-            recorded: Some(Recorded {
-                orientation: seq.orientation()[frame],
-                gravity: seq.gravity()[frame],
-                linacce: seq.linacce()[frame],
-            }),
+            recorded: recorded.then(|| Recorded::of_frame(seq, frame)),
         }
     }
 }
@@ -159,7 +178,9 @@ impl SensorReading {
 /// tilt (its settling pass over the first
 /// [`FilterConfig::settle_time`](ridi_frames::FilterConfig::settle_time), 2 s) and then come
 /// out together; [`finish`](Self::finish) releases what a stream too short for that leaves.
-/// Pushing a whole recording gives exactly the poses of `ridi track --online`
+/// The recorded orientation a sample carries corrects the estimate's heading drift (a sample
+/// without one keeps the correction reached; a stream that starts without one stays in the
+/// estimate's world frame). Pushing a whole recording gives exactly the poses of `ridi track --online`
 /// ([`track`](crate::track()) with [`TrackOptions::online`]), which runs through this type.
 ///
 /// A refused sample (a non-finite field, a value no phone sensor gives as the readers'
@@ -203,11 +224,16 @@ pub struct LiveTracker<'m> {
     limits: Validation,
 }
 
+type Waiting = (f64, DeviceVec, DeviceVec, Option<WorldFromDevice>);
+
 /// The orientation estimate of a stream, and the samples waiting for it.
 #[derive(Debug)]
 struct Estimator {
     filter: OrientationFilter,
-    waiting: VecDeque<(f64, DeviceVec, DeviceVec)>,
+    /// Corrects the estimate's heading by the recorded orientation's, where samples carry one.
+    heading: Option<HeadingCorrector>,
+    /// Time, gyro, accelerometer and recorded orientation of each sample waiting.
+    waiting: VecDeque<Waiting>,
     orientations: Vec<WorldFromDevice>,
 }
 
@@ -230,6 +256,10 @@ impl<'m> LiveTracker<'m> {
             Orientation::Recorded => None,
             Orientation::Estimated => Some(Estimator {
                 filter: OrientationFilter::new(FilterConfig::default())?,
+                heading: opts
+                    .recorded_heading
+                    .map(HeadingCorrector::new)
+                    .transpose()?,
                 waiting: VecDeque::new(),
                 orientations: Vec::new(),
             }),
@@ -238,6 +268,17 @@ impl<'m> LiveTracker<'m> {
             tracker,
             estimator,
             limits: Validation::default(),
+        })
+    }
+
+    /// A tracker that takes each sample's `recorded` orientation as it is, whatever the
+    /// model's: for a recording whose orientation was estimated before (a sequence whose
+    /// [`OrientationSource`](ridi_data::OrientationSource) is `Estimated`), whose heading
+    /// correction the estimator could not make again without the recorded orientation.
+    pub(crate) fn with_given_orientation(model: &'m Cascade, opts: &TrackOptions) -> Result<Self> {
+        Ok(Self {
+            estimator: None,
+            ..Self::new(model, opts)?
         })
     }
 
@@ -280,8 +321,12 @@ impl<'m> LiveTracker<'m> {
         }
         est.filter
             .push(sample.time, sample.gyro, sample.acce, &mut est.orientations)?;
-        est.waiting
-            .push_back((sample.time, sample.gyro, sample.acce));
+        est.waiting.push_back((
+            sample.time,
+            sample.gyro,
+            sample.acce,
+            sample.recorded.map(|r| r.orientation),
+        ));
         self.drain(out)
     }
 
@@ -356,8 +401,17 @@ impl<'m> LiveTracker<'m> {
         };
         // One orientation per sample given, in order: the oldest waiting samples are known.
         let known = est.orientations.len().min(est.waiting.len());
-        for (q, (time, gyro, acce)) in est.orientations.drain(..).zip(est.waiting.drain(..known)) {
+        for (q, (time, gyro, acce, recorded)) in
+            est.orientations.drain(..).zip(est.waiting.drain(..known))
+        {
+            // Gravity from the estimate itself, as batch tracking takes it: the turn about
+            // the vertical changes neither.
             let (gravity, linacce) = ridi_frames::gravity_and_linacce(q, acce);
+            let q = match (&mut est.heading, recorded) {
+                (Some(h), Some(r)) => h.correct(time, q, r)?,
+                (Some(h), None) => h.hold(q),
+                (None, _) => q,
+            };
             out.push(self.tracker.push(&ImuSample {
                 time,
                 gyro,

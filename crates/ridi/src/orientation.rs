@@ -1,16 +1,23 @@
 //! Which orientation a sequence is tracked with: the recorded one (Tango, the Android rotation
 //! vector) or one estimated from gyro and accelerometer by `ridi-frames`.
 //!
-//! The magnetometer-aided Android rotation vector turns with the magnetic field indoors (up to
-//! 93 deg/min on the Tyrex runs, docs/bench-orientation.md) while the gyro drifts a few degrees
-//! per minute, so the estimate gives straighter tracks wherever the recorded orientation uses the
-//! magnetometer. The choice also replaces gravity and linear acceleration, so that the three
-//! stay consistent.
+//! The magnetometer-aided Android rotation vector jumps and bends with the magnetic field indoors
+//! (up to 93 deg/min on the Tyrex runs, docs/bench-orientation.md), and Core Motion's attitude
+//! loses its tilt while running; the estimate's tilt does not, so gravity, S and the features
+//! come from the estimate. The choice also replaces gravity and linear acceleration, so that the
+//! three stay consistent.
+//!
+//! The estimate's heading drifts with the gyro's bias about the vertical (28 deg/min on the
+//! Tyrex iPhone 4S). Where the sequence has a recorded orientation, its slow heading corrects
+//! that drift ([`ridi_frames::HeadingCorrector`]: resets and magnetic corrections faster than
+//! a gyro bias are dropped). The heading enters neither gravity nor S, so the features, and
+//! a model, are the same with or without it; only the world frame the tracker integrates in
+//! turns.
 
 use std::borrow::Cow;
 
 use ridi_data::{OrientationSource, Sequence};
-use ridi_frames::{FilterConfig, estimate_orientation, gravity_and_linacce};
+use ridi_frames::{FilterConfig, HeadingConfig, estimate_orientation, gravity_and_linacce};
 
 use crate::error::{PipelineError, Result};
 
@@ -18,26 +25,55 @@ use ridi_features::Orientation;
 
 /// `seq` with its orientation replaced by a gyro + accelerometer estimate, gravity by the
 /// estimate's gravity (standard magnitude) and linear acceleration by accelerometer minus that
-/// gravity.
+/// gravity. With `heading`, the estimate's heading drift is corrected by the slow heading of
+/// `seq`'s own orientation ([`ridi_frames::with_reference_heading`]), unless that orientation
+/// is an estimate itself or the ground truth.
 ///
 /// # Errors
 /// When the estimator rejects the input (non-finite samples) or the result fails validation.
-pub fn with_estimated_orientation(seq: &Sequence, filter: &FilterConfig) -> Result<Sequence> {
+pub fn with_estimated_orientation(
+    seq: &Sequence,
+    filter: &FilterConfig,
+    heading: Option<&HeadingConfig>,
+) -> Result<Sequence> {
+    let failed = |what: &str, e: ridi_frames::EstimateError| {
+        PipelineError::sequence(seq.name(), format!("{what}: {e}"))
+    };
     let q = estimate_orientation(seq.time(), seq.gyro(), seq.acce(), filter)
-        .map_err(|e| PipelineError::sequence(seq.name(), format!("orientation estimate: {e}")))?;
+        .map_err(|e| failed("orientation estimate", e))?;
     let mut p = seq.clone().into_parts();
+    // From the estimate itself: a turn about the vertical changes neither, and so the
+    // features are bit for bit those of training, which skips the heading.
     (p.gravity, p.linacce) = q
         .iter()
         .zip(&p.acce)
         .map(|(&q, &a)| gravity_and_linacce(q, a))
         .unzip();
-    p.orientation = q;
+    p.orientation = match heading {
+        Some(heading) if heading_reference(seq.orientation_source()) => {
+            ridi_frames::with_reference_heading(seq.time(), &q, seq.orientation(), heading)
+                .map_err(|e| failed("heading from the recorded orientation", e))?
+        }
+        _ => q,
+    };
     p.orientation_source = Some(OrientationSource::Estimated);
     Sequence::new(p).map_err(|e| PipelineError::sequence(seq.name(), e.to_string()))
 }
 
+/// Whether an orientation from `source` may correct an estimate's heading: one a phone
+/// recorded, not an estimate, and not the ground truth (which would hand tracking the answer
+/// it is judged by).
+pub(crate) fn heading_reference(source: Option<OrientationSource>) -> bool {
+    !matches!(
+        source,
+        Some(OrientationSource::Estimated | OrientationSource::GroundTruth)
+    )
+}
+
 /// `seq` with the orientation `choice` asks for: `seq` itself when it has it already (a recorded
-/// one, or one estimated before), else a copy with the estimate swapped in.
+/// one, or one estimated before), else a copy with the estimate swapped in, its heading
+/// corrected by the recorded one's when `heading` is given
+/// ([`TrackOptions::recorded_heading`](crate::TrackOptions::recorded_heading)).
 ///
 /// Models record the orientation they were trained with
 /// ([`FeatureConfig::orientation`](ridi_features::FeatureConfig::orientation)); training,
@@ -47,13 +83,18 @@ pub fn with_estimated_orientation(seq: &Sequence, filter: &FilterConfig) -> Resu
 /// # Errors
 /// [`Orientation::Recorded`] for a sequence whose orientation was already replaced by an
 /// estimate (the recorded one is gone), and as [`with_estimated_orientation`].
-pub fn oriented(seq: &Sequence, choice: Orientation) -> Result<Cow<'_, Sequence>> {
+pub fn oriented<'a>(
+    seq: &'a Sequence,
+    choice: Orientation,
+    heading: Option<&HeadingConfig>,
+) -> Result<Cow<'a, Sequence>> {
     let estimated = seq.orientation_source() == Some(OrientationSource::Estimated);
     match (choice, estimated) {
         (Orientation::Recorded, false) | (Orientation::Estimated, true) => Ok(Cow::Borrowed(seq)),
         (Orientation::Estimated, false) => Ok(Cow::Owned(with_estimated_orientation(
             seq,
             &FilterConfig::default(),
+            heading,
         )?)),
         (Orientation::Recorded, true) => Err(recorded_wanted(seq.name())),
     }
@@ -73,9 +114,13 @@ pub(crate) fn recorded_wanted(name: &str) -> PipelineError {
 ///
 /// # Errors
 /// As [`oriented`].
-pub fn apply_orientation(choice: Orientation, seqs: &mut [Sequence]) -> Result<()> {
+pub fn apply_orientation(
+    choice: Orientation,
+    heading: Option<&HeadingConfig>,
+    seqs: &mut [Sequence],
+) -> Result<()> {
     for s in seqs.iter_mut() {
-        if let Cow::Owned(o) = oriented(s, choice)? {
+        if let Cow::Owned(o) = oriented(s, choice, heading)? {
             *s = o;
         }
     }
@@ -97,9 +142,9 @@ mod tests {
             .into_sequences();
         seqs.truncate(1);
         let before = seqs[0].clone();
-        apply_orientation(Orientation::Recorded, &mut seqs).unwrap();
+        apply_orientation(Orientation::Recorded, None, &mut seqs).unwrap();
         assert_eq!(seqs[0], before);
-        apply_orientation(Orientation::Estimated, &mut seqs).unwrap();
+        apply_orientation(Orientation::Estimated, None, &mut seqs).unwrap();
         let after = &seqs[0];
         assert_eq!(
             after.orientation_source(),
@@ -128,15 +173,64 @@ mod tests {
         );
         // Estimated twice is estimated once; the recorded orientation cannot be asked back.
         assert!(matches!(
-            oriented(after, Orientation::Estimated),
+            oriented(
+                after,
+                Orientation::Estimated,
+                Some(&HeadingConfig::default())
+            ),
             Ok(Cow::Borrowed(_))
         ));
-        let err = oriented(after, Orientation::Recorded)
+        let err = oriented(after, Orientation::Recorded, None)
             .unwrap_err()
             .to_string();
         assert!(
             err.contains(after.name()) && err.contains("recorded"),
             "{err}"
         );
+    }
+
+    #[test]
+    fn the_recorded_heading_turns_the_estimate_and_leaves_its_gravity() {
+        let list = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("../../datasets/sample/list_iphone4s.txt");
+        let seqs = Listed::read(&[list], &ReadOptions::default())
+            .unwrap()
+            .into_sequences();
+        let seq = &seqs[0];
+        let filter = FilterConfig::default();
+        let gyro_only = with_estimated_orientation(seq, &filter, None).unwrap();
+        let corrected =
+            with_estimated_orientation(seq, &filter, Some(&HeadingConfig::default())).unwrap();
+        assert_eq!(
+            corrected.orientation_source(),
+            Some(OrientationSource::Estimated)
+        );
+        // Gravity and linear acceleration, and so the features, are the estimate's exactly.
+        assert_eq!(corrected.gravity(), gyro_only.gravity());
+        assert_eq!(corrected.linacce(), gyro_only.linacce());
+        // Against the recorded (Core Motion) heading the gyro's drifts; the corrected one
+        // follows it after a lag of about the time constant.
+        let drift = |s: &Sequence| {
+            ridi_frames::orientation_errors(s.orientation(), seq.orientation())
+                .unwrap()
+                .heading_drift_per_minute(seq.time())
+                .unwrap()
+                .abs()
+        };
+        let (before, after) = (drift(&gyro_only), drift(&corrected));
+        assert!(after < 0.6 * before, "{after} against {before} rad/min");
+        // Nor is the ground truth, which would give tracking the answer it is judged by.
+        let mut parts = seq.clone().into_parts();
+        parts.orientation_source = Some(OrientationSource::GroundTruth);
+        let truth_sourced = Sequence::new(parts).unwrap();
+        let with_truth =
+            with_estimated_orientation(&truth_sourced, &filter, Some(&HeadingConfig::default()))
+                .unwrap();
+        assert_eq!(with_truth.orientation(), gyro_only.orientation());
+        // An estimate is never the reference of another.
+        let again =
+            with_estimated_orientation(&gyro_only, &filter, Some(&HeadingConfig::default()))
+                .unwrap();
+        assert_eq!(again.orientation(), gyro_only.orientation());
     }
 }

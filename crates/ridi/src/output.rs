@@ -685,6 +685,7 @@ mod tests {
             placement_accuracy: None,
             placement_confusion: None,
             config: ridi_eval::EvalConfig::default(),
+            recorded_heading: Some(ridi_frames::HeadingConfig::default()),
             methods: Vec::new(),
             warnings: vec!["a warning".into()],
         }

@@ -243,7 +243,11 @@ pub fn regress_sequence(
     model: &Cascade,
     opts: &TrackOptions,
 ) -> Result<(Vec<FrameVelocity>, Vec<usize>)> {
-    let seq = oriented(seq, model.feature_config().orientation)?;
+    let seq = oriented(
+        seq,
+        model.feature_config().orientation,
+        opts.recorded_heading.as_ref(),
+    )?;
     let seq = seq.as_ref();
     let fx = FeatureExtractor::new(model.feature_config().clone())?;
     let frames = SampleSchedule::every(fx.config(), opts.regress_every)?.frames(seq.len());
@@ -426,11 +430,15 @@ pub fn track(seq: &Sequence, model: &Cascade, opts: &TrackOptions) -> Result<Tra
         // The live tracker estimates an estimated orientation on the stream itself; a
         // recorded one must still be there.
         if model.feature_config().orientation == Orientation::Recorded {
-            oriented(seq, Orientation::Recorded)?;
+            oriented(seq, Orientation::Recorded, None)?;
         }
         return track_online(seq, model, opts);
     }
-    let seq = oriented(seq, model.feature_config().orientation)?;
+    let seq = oriented(
+        seq,
+        model.feature_config().orientation,
+        opts.recorded_heading.as_ref(),
+    )?;
     let seq = seq.as_ref();
     let (regressions, placements) = regress_sequence(seq, model, opts)?;
     correct_with(
@@ -442,11 +450,37 @@ pub fn track(seq: &Sequence, model: &Cascade, opts: &TrackOptions) -> Result<Tra
     )
 }
 
+/// The live tracker [`track`] streams the frames of a recording whose orientation comes from
+/// `source` into: one that takes an orientation estimated before as it is (the estimator could
+/// not make its heading correction again), else one that estimates it, correcting its heading
+/// only by an orientation the phone recorded.
+fn live_for<'m>(
+    model: &'m Cascade,
+    opts: &TrackOptions,
+    source: Option<ridi_data::OrientationSource>,
+) -> Result<LiveTracker<'m>> {
+    if source == Some(ridi_data::OrientationSource::Estimated) {
+        LiveTracker::with_given_orientation(model, opts)
+    } else if crate::orientation::heading_reference(source) {
+        LiveTracker::new(model, opts)
+    } else {
+        let opts = TrackOptions {
+            recorded_heading: None,
+            ..*opts
+        };
+        LiveTracker::new(model, &opts)
+    }
+}
+
 fn track_online(seq: &Sequence, model: &Cascade, opts: &TrackOptions) -> Result<Track> {
-    let mut live = LiveTracker::new(model, opts)?;
+    let mut live = live_for(model, opts, seq.orientation_source())?;
     let mut updates = Vec::with_capacity(seq.len());
     for i in 0..seq.len() {
-        live.push(&SensorReading::of_frame(seq, i), &mut updates)
+        let reading = SensorReading {
+            recorded: Some(crate::live::Recorded::of_frame(seq, i)),
+            ..SensorReading::of_frame(seq, i)
+        };
+        live.push(&reading, &mut updates)
             .map_err(|e| PipelineError::sequence(seq.name(), format!("frame {i}: {e}")))?;
     }
     live.finish(&mut updates)
@@ -521,7 +555,7 @@ fn track_rows(
     };
     let written = &mut written;
     let names = model.placements();
-    let mut live = LiveTracker::new(model, opts)?;
+    let mut live = live_for(model, opts, rows.orientation_source())?;
     csv_header(out).map_err(&mut *written)?;
     let max_dt = opts.correction.max_dt;
     let mut rate = ridi_data::MedianTest::default();

@@ -3,6 +3,7 @@
 //! for them.
 
 use ridi_correct::{CorrectionConfig, PlacementSmoother};
+use ridi_frames::HeadingConfig;
 use ridi_regress::Cascade;
 use serde::{Deserialize, Serialize};
 
@@ -21,6 +22,18 @@ pub struct TrackOptions {
     /// velocity comes from that placement's regressors: centred on it in batch, the window
     /// before it when streaming. `None` keeps every window's own label (the paper).
     pub placement_smoothing: Option<PlacementSmoother>,
+    /// For a model on the estimated orientation: the recorded orientation's slow heading
+    /// corrects the estimate's heading drift ([`HeadingCorrector`]); `None` keeps the gyro's
+    /// heading. Features, and so the regressed velocities, are the same either way; the
+    /// world frame the correction integrates in is not.
+    ///
+    /// [`HeadingCorrector`]: ridi_frames::HeadingCorrector
+    #[serde(default = "default_recorded_heading")]
+    pub recorded_heading: Option<HeadingConfig>,
+}
+
+fn default_recorded_heading() -> Option<HeadingConfig> {
+    Some(HeadingConfig::default())
 }
 
 impl Default for TrackOptions {
@@ -30,6 +43,7 @@ impl Default for TrackOptions {
             correction: CorrectionConfig::default(),
             online: false,
             placement_smoothing: Some(PlacementSmoother::default()),
+            recorded_heading: default_recorded_heading(),
         }
     }
 }
@@ -44,5 +58,23 @@ impl TrackOptions {
             up_axis: model.feature_config().up_axis,
             ..self.correction
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn options_written_without_the_heading_read_with_its_default() {
+        let json = serde_json::to_value(TrackOptions::default()).unwrap();
+        let mut without = json.clone();
+        without.as_object_mut().unwrap().remove("recorded_heading");
+        let read: TrackOptions = serde_json::from_value(without).unwrap();
+        assert_eq!(read, TrackOptions::default());
+        let mut gyro = json;
+        gyro["recorded_heading"] = serde_json::Value::Null;
+        let read: TrackOptions = serde_json::from_value(gyro).unwrap();
+        assert_eq!(read.recorded_heading, None);
     }
 }

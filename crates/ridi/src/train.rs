@@ -174,7 +174,9 @@ pub fn training_data(seqs: &[Sequence], config: &FeatureConfig) -> Result<Traini
         .par_iter()
         .map(|s| {
             check_frames(s, &config)?;
-            let s = oriented(s, config.orientation)?;
+            // Features and targets do not see the heading (both live in S, and targets come
+            // from the ground truth's orientation), so training skips its correction.
+            let s = oriented(s, config.orientation, None)?;
             let s = s.as_ref();
             let frames = schedule.frames(s.len());
             let features = fx.features(&fx.stabilize(&s.imu())?, &frames)?;

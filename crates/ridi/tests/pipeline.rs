@@ -456,7 +456,12 @@ fn a_model_tracks_in_the_orientation_it_was_trained_with() {
     // orientation was estimated before.
     let seq = load("list_Jakob.txt").swap_remove(7);
     let mut pre = vec![seq.clone()];
-    apply_orientation(Orientation::Estimated, &mut pre).unwrap();
+    apply_orientation(
+        Orientation::Estimated,
+        TrackOptions::default().recorded_heading.as_ref(),
+        &mut pre,
+    )
+    .unwrap();
     let a = ridi::track(&seq, &model, &TrackOptions::default()).unwrap();
     let b = ridi::track(&pre[0], &model, &TrackOptions::default()).unwrap();
     assert_eq!(a.position, b.position);
@@ -499,6 +504,18 @@ fn a_model_tracks_in_the_orientation_it_was_trained_with() {
     assert_eq!(
         tracker.regressor().made(),
         (a.regressions.as_slice(), a.placements.as_slice())
+    );
+    // The sequence estimated before streams with its own orientation: the same poses again.
+    let b = ridi::track(&pre[0], &model, &online).unwrap();
+    assert_eq!(a.position, b.position);
+    // The heading correction turns the track, not the features: the same regressions.
+    let gyro = TrackOptions {
+        recorded_heading: None,
+        ..TrackOptions::default()
+    };
+    assert_eq!(
+        ridi::regress_sequence(&seq, &model, &gyro).unwrap(),
+        ridi::regress_sequence(&seq, &model, &TrackOptions::default()).unwrap()
     );
     let (report, _) = ridi::evaluate(&pre, &model, &EvalOptions::default()).unwrap();
     assert!(report.summary["ridi"].rte_5s_m.is_finite());
@@ -594,7 +611,7 @@ fn a_live_stream_gets_its_poses_sample_by_sample_dataset() {
             );
         }
         updates.clear();
-        live.push(&sample(i, false), &mut updates).unwrap();
+        live.push(&sample(i, true), &mut updates).unwrap();
         let expected = match i {
             _ if i < held => 0,
             _ if i == held => held + 1,
@@ -607,6 +624,24 @@ fn a_live_stream_gets_its_poses_sample_by_sample_dataset() {
     live.finish(&mut updates).unwrap();
     assert!(updates.is_empty());
     assert_eq!(positions, whole.position);
+    // Without the recorded orientation the heading stays the gyro's: the poses of tracking
+    // without `recorded_heading`, which differ.
+    let gyro_heading = TrackOptions {
+        recorded_heading: None,
+        ..opts
+    };
+    let whole_gyro = ridi::track(&seq, &model, &gyro_heading).unwrap();
+    assert_ne!(whole_gyro.position, whole.position);
+    let mut bare = LiveTracker::new(&model, &opts).unwrap();
+    let mut bare_positions = Vec::new();
+    for i in 0..seq.len() {
+        updates.clear();
+        bare.push(&sample(i, false), &mut updates).unwrap();
+        bare_positions.extend(updates.iter().map(|u| u.pose.position));
+    }
+    updates.clear();
+    bare.finish(&mut updates).unwrap();
+    assert_eq!(bare_positions, whole_gyro.position);
     // A dropped second: a new segment from the position reached, nothing integrated across.
     let mut late = sample(seq.len() - 1, false);
     late.time += 1.0;

@@ -111,7 +111,12 @@ fn streamed_and_whole(source: &Path, model: &Cascade, dir: &Path) -> [(Vec<u8>, 
 
     let whole = files("whole");
     let mut loaded = ridi::read_any(source, None, &ReadOptions::default()).unwrap();
-    ridi::apply_orientation(model.feature_config().orientation, &mut loaded.sequences).unwrap();
+    ridi::apply_orientation(
+        model.feature_config().orientation,
+        opts.recorded_heading.as_ref(),
+        &mut loaded.sequences,
+    )
+    .unwrap();
     let seq = &loaded.sequences[0];
     let track = ridi::track(seq, model, &opts).unwrap();
     output(&whole).write(seq, &track).unwrap();

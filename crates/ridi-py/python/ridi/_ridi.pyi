@@ -174,6 +174,7 @@ class LiveTracker:
         lambda_: float = 0.1,
         estimate_initial_velocity: bool = False,
         placement_window: float = 10.0,
+        heading: Literal["corrected", "gyro"] = "corrected",
     ) -> None: ...
     def push(
         self,
@@ -248,6 +249,7 @@ def track(
     lambda_: float = 0.1,
     estimate_initial_velocity: bool = False,
     placement_window: float = 10.0,
+    heading: Literal["corrected", "gyro"] = "corrected",
 ) -> Track:
     """Tracks a sequence as ``ridi track`` (``--online``) does."""
 
@@ -259,6 +261,7 @@ def evaluate(
     placement_map: Optional[StrPath] = None,
     placement_window: float = 10.0,
     align: Union[float, Literal["all"], None] = None,
+    heading: Literal["corrected", "gyro"] = "corrected",
     jobs: Optional[int] = None,
 ) -> Dict[str, Any]:
     """RIDI and its baselines against ground truth: the dict of ``report.json``."""
