@@ -312,31 +312,36 @@ pub fn evaluate_part(
         .filter(|(_, k)| !(k[0] && k[1]))
         .map(|(t, _)| t[1] - t[0])
         .sum();
-    let mut corrected = Vec::new();
-    let estimator = configs
+    let estimates = configs
         .iter()
-        .enumerate()
-        .map(|(i, c)| {
-            let est = estimate_orientation(time, gyro, acce, c)
-                .with_context(|| format!("{name}: estimator (kp {}, ki {})", c.kp, c.ki))?;
-            if i == 0 && with_corrected {
-                for time_constant in HEADING_TIME_CONSTANTS {
-                    let config = HeadingConfig {
-                        time_constant,
-                        ..HeadingConfig::default()
-                    };
-                    let h = with_reference_heading(time, &est, rv, &config)
-                        .with_context(|| format!("{name}: heading correction"))?;
-                    corrected.push(
-                        metrics(&kept_time, &kept(&h), &kept_truth)
-                            .with_context(|| format!("{name}: corrected heading"))?,
-                    );
-                }
-            }
-            metrics(&kept_time, &kept(&est), &kept_truth)
+        .map(|c| {
+            estimate_orientation(time, gyro, acce, c)
+                .with_context(|| format!("{name}: estimator (kp {}, ki {})", c.kp, c.ki))
+        })
+        .collect::<Result<Vec<_>>>()?;
+    let estimator = estimates
+        .iter()
+        .map(|est| {
+            metrics(&kept_time, &kept(est), &kept_truth)
                 .with_context(|| format!("{name}: estimator"))
         })
         .collect::<Result<Vec<_>>>()?;
+    let corrected = match estimates.first().filter(|_| with_corrected) {
+        Some(est) => HEADING_TIME_CONSTANTS
+            .iter()
+            .map(|&time_constant| {
+                let config = HeadingConfig {
+                    time_constant,
+                    ..HeadingConfig::default()
+                };
+                let h = with_reference_heading(time, est, rv, &config)
+                    .with_context(|| format!("{name}: heading correction"))?;
+                metrics(&kept_time, &kept(&h), &kept_truth)
+                    .with_context(|| format!("{name}: corrected heading"))
+            })
+            .collect::<Result<Vec<_>>>()?,
+        None => Vec::new(),
+    };
     Ok(PartEval {
         name: name.to_owned(),
         motion: motion.to_owned(),

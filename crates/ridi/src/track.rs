@@ -476,9 +476,12 @@ fn track_online(seq: &Sequence, model: &Cascade, opts: &TrackOptions) -> Result<
     let mut live = live_for(model, opts, seq.orientation_source())?;
     let mut updates = Vec::with_capacity(seq.len());
     for i in 0..seq.len() {
+        // The recorded orientation whatever its source: `live_for` chose what it is used for.
         let reading = SensorReading {
+            time: seq.time()[i],
+            gyro: seq.gyro()[i],
+            acce: seq.acce()[i],
             recorded: Some(crate::live::Recorded::of_frame(seq, i)),
-            ..SensorReading::of_frame(seq, i)
         };
         live.push(&reading, &mut updates)
             .map_err(|e| PipelineError::sequence(seq.name(), format!("frame {i}: {e}")))?;
