@@ -271,17 +271,19 @@ pub fn baseline_for(root: &Path, model: &str, update: bool) -> Result<PathBuf> {
     };
     let base: Report =
         serde_json::from_str(&text).with_context(|| format!("parsing {}", main.display()))?;
-    // The recorded model may be a prefix of the full name ("AMD EPYC" of "AMD EPYC 7763"); an
-    // empty one (no "model name" in /proc/cpuinfo) is nobody's.
-    let recorded = base.machine.model.as_str();
-    Ok(
-        if !recorded.is_empty() && !model.is_empty() && model.starts_with(recorded) {
-            main
-        } else {
-            own
-        },
-    )
+    // The same name only (spacing, case and punctuation aside): a recorded "AMD EPYC" says
+    // nothing of the generation, so an "AMD EPYC 7763" records into its own file rather than
+    // over it. A name without letters or digits (none in /proc/cpuinfo) is nobody's.
+    let recorded = slug(&base.machine.model);
+    Ok(if recorded != UNKNOWN_CPU && recorded == slug(model) {
+        main
+    } else {
+        own
+    })
 }
+
+/// [`slug`] of a CPU model name without letters or digits.
+const UNKNOWN_CPU: &str = "unknown-cpu";
 
 /// `model` as a file name part: lowercase ASCII letters and digits, runs of anything else one
 /// `-` ("Intel(R) Xeon(R) Processor" -> "intel-r-xeon-r-processor").
@@ -296,7 +298,7 @@ fn slug(model: &str) -> String {
     }
     let out = out.trim_end_matches('-');
     if out.is_empty() {
-        "unknown-cpu".into()
+        UNKNOWN_CPU.into()
     } else {
         out.into()
     }
@@ -839,12 +841,24 @@ mod tests {
             reference: REFERENCE.into(),
             figures: Vec::new(),
         };
-        base.machine.model = "AMD EPYC".into();
+        base.machine.model = "AMD EPYC 7763 64-Core Processor".into();
         write_json(&main, &base).unwrap();
-        // The main baseline's model, or a fuller name of it: the main one.
-        let epyc = "AMD EPYC 7763 64-Core Processor";
+        // The main baseline's model, spaced otherwise: the main one.
+        let epyc = " AMD EPYC 7763  64-Core Processor";
         assert_eq!(baseline_for(root, epyc, true).unwrap(), main);
         assert_eq!(baseline_for(root, epyc, false).unwrap(), main);
+        // A name that only begins like it is another CPU's (another EPYC generation): its
+        // own file, the main one compared until it has one.
+        let other = "AMD EPYC 9654 96-Core Processor";
+        let own = root.join("benchmarks/baseline-amd-epyc-9654-96-core-processor.json");
+        assert_eq!(baseline_for(root, other, true).unwrap(), own);
+        assert_eq!(baseline_for(root, other, false).unwrap(), main);
+        base.machine.model = "AMD EPYC".into();
+        write_json(&main, &base).unwrap();
+        assert_eq!(
+            baseline_for(root, epyc, true).unwrap(),
+            root.join("benchmarks/baseline-amd-epyc-7763-64-core-processor.json")
+        );
         // Another model: recorded into its own; compared with the main one until it has one.
         let xeon = "Intel(R) Xeon(R) Processor";
         assert_eq!(baseline_for(root, xeon, true).unwrap(), intel);
@@ -852,13 +866,20 @@ mod tests {
         write_json(&intel, &base).unwrap();
         assert_eq!(baseline_for(root, xeon, false).unwrap(), intel);
         assert_eq!(baseline_for(root, xeon, true).unwrap(), intel);
-        // A main baseline without a model is no CPU's: never recorded over.
-        base.machine.model = String::new();
-        write_json(&main, &base).unwrap();
-        assert_eq!(
-            baseline_for(root, epyc, true).unwrap(),
-            root.join("benchmarks/baseline-amd-epyc-7763-64-core-processor.json")
-        );
+        // A main baseline without a model is no CPU's: never recorded over, not even by a
+        // machine that names none either.
+        for nameless in ["", " - "] {
+            base.machine.model = nameless.into();
+            write_json(&main, &base).unwrap();
+            assert_eq!(
+                baseline_for(root, epyc, true).unwrap(),
+                root.join("benchmarks/baseline-amd-epyc-7763-64-core-processor.json")
+            );
+            assert_eq!(
+                baseline_for(root, "", true).unwrap(),
+                root.join("benchmarks/baseline-unknown-cpu.json")
+            );
+        }
         // One that cannot be read is an error, not an absent one to write.
         std::fs::remove_file(&main).unwrap();
         std::fs::create_dir(&main).unwrap();

@@ -456,18 +456,21 @@ pub struct Options {
     /// Search the paper's grid by cross-validation on the training people (`false`: C = 10,
     /// epsilon = 0.01 fixed).
     pub grid: bool,
+    /// Seed of training's random draws ([`ridi::regress::CascadeParams::set_seed`]).
+    pub seed: u64,
 }
 
 /// The protocol's training: `ridi train`'s defaults but C and epsilon fixed unless `grid` (the
 /// paper grid's search multiplies exact training by 48), with this sample step (`None`: ridi
 /// train's), orientation, and the Nyström solver on `landmarks` (`None`: exact) with its own
-/// projection (`Storage::projected_for`). `cargo xtask model` trains the bundled model the same
-/// way.
+/// projection (`Storage::projected_for`), its random draws seeded with `seed`. `cargo xtask
+/// model` trains the bundled model the same way.
 pub fn train_options(
     step: Option<usize>,
     orientation: Orientation,
     landmarks: Option<usize>,
     grid: bool,
+    seed: u64,
 ) -> Result<TrainOptions> {
     let mut train_opts = TrainOptions::default();
     if !grid {
@@ -481,6 +484,7 @@ pub fn train_options(
         train_opts.cascade.method = Solver::Nystrom(Nystrom::new(m, 0)?);
         train_opts.cascade.storage = Storage::projected_for(&train_opts.cascade.method);
     }
+    train_opts.cascade.set_seed(seed);
     Ok(train_opts)
 }
 
@@ -579,7 +583,13 @@ pub fn run(opts: Options) -> Result<PathBuf> {
         PlacementMap::tyrex_groups().apply(std::slice::from_mut(s));
     }
 
-    let train_opts = train_options(opts.step, opts.orientation, opts.landmarks, opts.grid)?;
+    let train_opts = train_options(
+        opts.step,
+        opts.orientation,
+        opts.landmarks,
+        opts.grid,
+        opts.seed,
+    )?;
     let mut eval_opts = EvalOptions::default();
     eval_opts.track.recorded_heading = opts.recorded_heading;
 
@@ -648,7 +658,12 @@ pub fn run(opts: Options) -> Result<PathBuf> {
                         [
                             swapped(Truth::Speed)?,
                             swapped(Truth::Direction)?,
-                            oracle_rte(s, model.feature_config().window, &eval_opts)?,
+                            oracle_rte(
+                                s,
+                                model.feature_config(),
+                                eval_opts.track.regress_every,
+                                correction,
+                            )?,
                         ]
                     } else {
                         [f64::NAN; 3]
@@ -718,6 +733,9 @@ fn report(r: &Report<'_>, total_s: f64) -> String {
     }
     if o.grid {
         command.push_str(" --grid paper");
+    }
+    if o.seed != 0 {
+        let _ = write!(command, " --seed {}", o.seed);
     }
     let _ = writeln!(
         md,

@@ -21,7 +21,7 @@ use ridi::correct::{CorrectionConfig, FrameVelocity, InitialVelocity, PlacementS
 use ridi::data::tyrex::{self, TyrexOptions};
 use ridi::data::{Sequence, write_atomically};
 use ridi::eval::{AlignWindow, EvalConfig, evaluate_trajectory};
-use ridi::features::{Orientation, SampleSchedule, compute_targets};
+use ridi::features::{FeatureConfig, Orientation, SampleSchedule, compute_targets};
 use ridi::frames::UpAxis;
 use ridi::ground_truth_view;
 use ridi::regress::{Cascade, Gamma, NoProgress};
@@ -338,14 +338,16 @@ fn person(seq: &Sequence) -> &str {
 }
 
 /// RTE 5 s of the correction driven by ground-truth velocities: the floor the orientation sets,
-/// at the frames a model with feature window `window` regresses.
-pub(crate) fn oracle_rte(seq: &Sequence, window: usize, opts: &EvalOptions) -> Result<f64> {
-    let config = ridi::features::FeatureConfig {
-        window,
-        ..Default::default()
-    };
-    let frames = SampleSchedule::every(&config, opts.track.regress_every)?.frames(seq.len());
-    let targets = compute_targets(&ground_truth_view(seq)?, &config, &frames)?;
+/// a model's targets (its `config`: window, smoothing, S) every `regress_every` frames through
+/// its `correction` (`TrackOptions::correction_for`).
+pub(crate) fn oracle_rte(
+    seq: &Sequence,
+    config: &FeatureConfig,
+    regress_every: usize,
+    correction: CorrectionConfig,
+) -> Result<f64> {
+    let frames = SampleSchedule::every(config, regress_every)?.frames(seq.len());
+    let targets = compute_targets(&ground_truth_view(seq)?, config, &frames)?;
     let regs: Vec<FrameVelocity> = frames
         .iter()
         .zip(&targets.values)
@@ -354,7 +356,7 @@ pub(crate) fn oracle_rte(seq: &Sequence, window: usize, opts: &EvalOptions) -> R
             velocity: *v,
         })
         .collect();
-    let est = baseline_trajectory(Method::Ridi, seq, &regs, opts.track.correction)?;
+    let est = baseline_trajectory(Method::Ridi, seq, &regs, correction)?;
     let gt = seq.ground_truth().context("no ground truth")?.horizontal();
     Ok(
         evaluate_trajectory(seq.time(), &est, &gt, &EvalConfig::default())?
@@ -432,41 +434,34 @@ fn run_variant(seqs: &[Sequence], models: &[Cascade], train_s: f64, v: &Variant)
             per_sequence.push(SeqRow::new(r, t, s, correction)?);
         }
         for s in &test {
-            oracle.push(oracle_rte(s, model.feature_config().window, &eval_opts)?);
+            let (config, every) = (model.feature_config(), eval_opts.track.regress_every);
+            let correction = eval_opts.track.correction_for(model);
+            oracle.push(oracle_rte(s, config, every, correction)?);
         }
     }
     eprintln!("  {}: evaluated", v.name);
     let results: Vec<&SequenceResult> = per_sequence.iter().map(|r| &r.result).collect();
-    let n = results.len() as f64;
-    let mean = |f: &dyn Fn(&SequenceResult) -> f64| results.iter().map(|r| f(r)).sum::<f64>() / n;
+    let mean = |f: &dyn Fn(&SequenceResult) -> f64| mean_defined(results.iter().map(|r| f(r)));
     let per_method = |f: fn(&ridi::eval::TrajectoryMetrics) -> f64| {
         Method::ALL
             .iter()
             .map(|m| {
-                let vals: Vec<f64> = results.iter().map(|r| f(&r.methods[m.key()])).collect();
-                (
-                    m.key().to_string(),
-                    vals.iter().sum::<f64>() / vals.len() as f64,
-                )
+                let mean = mean_defined(results.iter().map(|r| f(&r.methods[m.key()])));
+                (m.key().to_string(), mean)
             })
             .collect::<Vec<_>>()
     };
     Ok(Row {
         sequences: results.len(),
         velocity_mse: [mean(&|r| r.velocity_mse[0]), mean(&|r| r.velocity_mse[1])],
-        placement_accuracy: mean(&|r| r.placement_accuracy.unwrap_or(0.0)),
+        placement_accuracy: mean(&|r| r.placement_accuracy.unwrap_or(f64::NAN)),
         rte_5s: per_method(|m| m.rte_5s_m),
         ate: per_method(|m| m.ate_m),
         path_ratio: per_method(|m| m.path_length_ratio.unwrap_or(f64::NAN)),
-        oracle_rte_5s: oracle.iter().sum::<f64>() / oracle.len() as f64,
-        rte_5s_whole: per_sequence.iter().map(|s| s.rte_5s_whole).sum::<f64>() / n,
-        rte_5s_swapped: [0, 1].map(|k| {
-            per_sequence
-                .iter()
-                .map(|s| s.rte_5s_swapped[k])
-                .sum::<f64>()
-                / n
-        }),
+        oracle_rte_5s: mean_defined(oracle.into_iter()),
+        rte_5s_whole: mean_defined(per_sequence.iter().map(|s| s.rte_5s_whole)),
+        rte_5s_swapped: [0, 1]
+            .map(|k| mean_defined(per_sequence.iter().map(|s| s.rte_5s_swapped[k]))),
         train_s,
         per_sequence,
     })
@@ -476,7 +471,8 @@ fn run_variant(seqs: &[Sequence], models: &[Cascade], train_s: f64, v: &Variant)
 /// (`<run>_part<k>`) are first averaged into their run, weighted by their frames. Returns the
 /// number of runs, velocity MSE, RTE 5 s, ATE, path length ratio and placement accuracy.
 fn per_run_means(r: &Row) -> (usize, [f64; 6]) {
-    let mut runs: BTreeMap<&str, (f64, [f64; 6])> = BTreeMap::new();
+    // Per run and figure: the weighted sum and its weight (a part without the figure left out).
+    let mut runs: BTreeMap<&str, [(f64, f64); 6]> = BTreeMap::new();
     for s in &r.per_sequence {
         let q = &s.result;
         let run = run_of(&q.name);
@@ -487,23 +483,29 @@ fn per_run_means(r: &Row) -> (usize, [f64; 6]) {
             ridi.rte_5s_m,
             ridi.ate_m,
             ridi.path_length_ratio.unwrap_or(f64::NAN),
-            q.placement_accuracy.unwrap_or(0.0),
+            q.placement_accuracy.unwrap_or(f64::NAN),
         ];
         let w = s.frames as f64;
-        let e = runs.entry(run).or_insert((0.0, [0.0; 6]));
-        e.0 += w;
-        for (acc, v) in e.1.iter_mut().zip(values) {
-            *acc += w * v;
+        let e = runs.entry(run).or_insert([(0.0, 0.0); 6]);
+        for (acc, v) in e.iter_mut().zip(values) {
+            if v.is_finite() {
+                acc.0 += w * v;
+                acc.1 += w;
+            }
         }
     }
-    let n = runs.len();
-    let mut means = [0.0; 6];
-    for (w, sums) in runs.values() {
-        for (m, s) in means.iter_mut().zip(sums) {
-            *m += s / w / n as f64;
-        }
-    }
-    (n, means)
+    let means =
+        std::array::from_fn(|k| mean_defined(runs.values().map(|sums| sums[k].0 / sums[k].1)));
+    (runs.len(), means)
+}
+
+/// Mean of the finite values (a sequence without a figure, `NaN`, is left out of its mean,
+/// as the device protocols do); `NaN` when none has it.
+fn mean_defined(values: impl Iterator<Item = f64>) -> f64 {
+    let (sum, n) = values
+        .filter(|v| v.is_finite())
+        .fold((0.0, 0usize), |(s, n), v| (s + v, n + 1));
+    if n == 0 { f64::NAN } else { sum / n as f64 }
 }
 
 /// The run a test sequence belongs to: its name without the `_part<k>` of a run split at a gap.
@@ -615,15 +617,14 @@ fn per_placement(md: &mut String, v: &Variant, r: &Row) {
             .map(|s| &s.result)
             .filter(|s| s.placement.as_deref() == Some(label))
             .collect();
-        let n = rows.len() as f64;
-        let m = |f: &dyn Fn(&SequenceResult) -> f64| rows.iter().map(|r| f(r)).sum::<f64>() / n;
+        let m = |f: &dyn Fn(&SequenceResult) -> f64| mean_defined(rows.iter().map(|r| f(r)));
         let _ = writeln!(
             md,
             "| {label} | {} | {:.3} / {:.3} | {:.3} | {:.3} | {:.3} | {:.3} |",
             rows.len(),
             m(&|r| r.velocity_mse[0]),
             m(&|r| r.velocity_mse[1]),
-            m(&|r| r.placement_accuracy.unwrap_or(0.0)),
+            m(&|r| r.placement_accuracy.unwrap_or(f64::NAN)),
             m(&|r| r.methods["ridi"].rte_5s_m),
             m(&|r| r.methods["ridi"].ate_m),
             m(&|r| r.methods["ridi"].path_length_ratio.unwrap_or(f64::NAN)),
@@ -883,7 +884,7 @@ pub(crate) mod tests {
             .join("../datasets/sample/Thibaud_Nexus5_NoDist_Texting");
         let seq = ridi::data::read_sequence(&dir, &Default::default()).unwrap();
         let opts = EvalOptions::default();
-        let config = ridi::features::FeatureConfig::default();
+        let config = FeatureConfig::default();
         let frames = SampleSchedule::every(&config, opts.track.regress_every)
             .unwrap()
             .frames(seq.len());
@@ -915,7 +916,7 @@ pub(crate) mod tests {
         };
         let correction = opts.track.correction;
         let rte = |t: &Traces, which| swapped_rte(&seq, t, correction, which).unwrap();
-        let oracle = oracle_rte(&seq, config.window, &opts).unwrap();
+        let oracle = oracle_rte(&seq, &config, opts.track.regress_every, correction).unwrap();
         // The true direction restores the ground truth exactly; the true speed changes nothing
         // while only the direction is wrong, and mends the shortening.
         let only_turned = traces(turned.clone());
@@ -944,6 +945,23 @@ pub(crate) mod tests {
         assert!((m[2] - (2.5 + 4.0 + 2.0) / 3.0).abs() < 1e-12, "{m:?}");
         assert!((m[0] - m[2]).abs() < 1e-12 && (m[3] - 2.0 * m[2]).abs() < 1e-12);
         assert_eq!((m[4], m[5]), (1.0, 1.0));
+    }
+
+    #[test]
+    fn a_figure_a_sequence_lacks_is_left_out_of_its_mean() {
+        let mut a = seq("A_Phoning", 100, 1.0);
+        let mut b = seq("B_Swinging", 100, 3.0);
+        // A path without length has no ratio; a model of one placement, no accuracy.
+        a.result.methods.get_mut("ridi").unwrap().path_length_ratio = None;
+        b.result.placement_accuracy = None;
+        let row = Row {
+            per_sequence: vec![a, b],
+            ..Row::default()
+        };
+        let (_, m) = per_run_means(&row);
+        assert_eq!((m[4], m[5]), (1.0, 1.0), "{m:?}");
+        assert!(mean_defined([f64::NAN].into_iter()).is_nan());
+        assert_eq!(mean_defined([2.0, f64::NAN, 4.0].into_iter()), 3.0);
     }
 
     #[test]

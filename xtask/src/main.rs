@@ -196,6 +196,15 @@ struct TyrexArgs {
     /// training without).
     #[arg(long, value_name = "GRID", default_value = "none", value_parser = ["none", "paper"], conflicts_with = "variants")]
     grid: String,
+    /// Seed of training's random draws (`ridi train --seed`): the Nyström landmarks and
+    /// sweeps, the grid's folds. Reports of other seeds show how much a figure owes to them.
+    #[arg(
+        long,
+        value_name = "N",
+        default_value_t = 0,
+        conflicts_with = "variants"
+    )]
+    seed: u64,
 }
 
 #[derive(Args)]
@@ -309,6 +318,7 @@ fn run(cli: Cli) -> Result<()> {
                         .then(ridi::frames::HeadingConfig::default),
                     landmarks: args.landmarks,
                     grid: args.grid == "paper",
+                    seed: args.seed,
                 })?
             };
             println!("wrote {}", out.display());

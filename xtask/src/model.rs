@@ -41,7 +41,7 @@ pub fn run(data: Option<PathBuf>, out: Option<PathBuf>) -> Result<PathBuf> {
     );
     // C fixed as the protocol fixes it: its search did not change a figure beyond its
     // interval there (docs/benchmarks.md).
-    let opts = train_options(STEP, orientation, Some(LANDMARKS), false)?;
+    let opts = train_options(STEP, orientation, Some(LANDMARKS), false, 0)?;
     let t0 = Instant::now();
     let mut progress = |e: &ProgressEvent<'_>| {
         if e.done == e.total {

@@ -234,7 +234,8 @@ impl Callback {
 /// (``"tyrex4"`` or a ``label,class`` file), ``orientation`` (``"recorded"``,
 /// ``"estimated"``), ``storage`` (``"projected"``: 99.99 % of the variance, 90 % with the
 /// Nyström solver; ``"half"``), ``solver`` (``"exact"``,
-/// ``"nystrom"``), ``landmarks``, ``turned_copies``, ``step`` (default ``10 * (turned_copies +
+/// ``"nystrom"``), ``landmarks``, ``seed`` (of the grid's folds and the Nyström draws),
+/// ``turned_copies``, ``step`` (default ``10 * (turned_copies +
 /// 1)``), ``window`` (default 200), ``speed`` (``False`` for ``--no-speed``), ``up_axis``
 /// (``"plus-or-minus-y"``, ``"plus-y"``), ``standardize`` (``False`` for
 /// ``--no-standardize``), ``classifier_c`` and ``jobs`` (worker threads, default all cores).
@@ -251,7 +252,7 @@ impl Callback {
 #[pyfunction]
 #[pyo3(signature = (
     data, *, grid="paper", placement_map=None, orientation="estimated", storage="projected",
-    solver="exact", landmarks=Nystrom::DEFAULT_LANDMARKS, turned_copies=1, step=None,
+    solver="exact", landmarks=Nystrom::DEFAULT_LANDMARKS, seed=0, turned_copies=1, step=None,
     window=None, speed=true, up_axis="plus-or-minus-y", standardize=true, classifier_c=10.0,
     jobs=None, progress=None,
 ))]
@@ -265,6 +266,7 @@ pub(crate) fn train(
     storage: &str,
     solver: &str,
     landmarks: usize,
+    seed: u64,
     turned_copies: usize,
     step: Option<usize>,
     window: Option<usize>,
@@ -318,6 +320,7 @@ pub(crate) fn train(
             .map_err(|e| errors::value(e.to_string()))?,
         ),
     };
+    opts.cascade.set_seed(seed);
     let projected = Storage::projected_for(&opts.cascade.method);
     opts.cascade.storage = choice(
         "storage",

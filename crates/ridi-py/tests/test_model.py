@@ -33,6 +33,16 @@ def test_the_nystrom_solver_gives_the_cli_model_bytes(ridi_bin, tmp_path):
     assert same, "the Nyström model differs from the one `ridi train` writes"
     # The Nyström solver's own projection (90 %), not the exact solver's 99.99 %.
     assert 0.9 <= model.describe()["stored_variance"] < 0.9999
+    # Another seed draws other landmarks: another model, the same from both.
+    ridi_bin("train", "--list", GUILLAUME, "--out", out, "--grid", "none",
+             "--placement-map", "tyrex4", "--solver", "nystrom", "--landmarks", "64",
+             "--seed", "3")
+    seeded = ridi.train(GUILLAUME, grid="none", placement_map="tyrex4", solver="nystrom",
+                        landmarks=64, seed=3)
+    same = seeded.to_bytes() == out.read_bytes()
+    assert same, "the seeded Nyström model differs from the one `ridi train` writes"
+    other = seeded.to_bytes() != model.to_bytes()
+    assert other, "the seed did not change the landmarks"
 
 
 def test_save_load_pickle_and_describe(model, model_file, ridi_bin):

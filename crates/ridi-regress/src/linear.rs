@@ -140,8 +140,8 @@ fn primal(x: Rows<'_>, d: &[f64]) -> (Vec<f64>, f64, Vec<f64>) {
 }
 
 /// L1-loss C-SVC: `min_α ½ αᵀQα − Σα`, `0 ≤ α ≤ C`, `Q_st = y_s y_t (x_s·x_t + BIAS²)`.
-/// `positive[s]` is the label of row `s`.
-pub(crate) fn svc(x: Rows<'_>, positive: &[bool], c: f64, settings: &Stop) -> LinearFit {
+/// `positive[s]` is the label of row `s`; `seed` orders the sweeps over the rows.
+pub(crate) fn svc(x: Rows<'_>, positive: &[bool], c: f64, settings: &Stop, seed: u64) -> LinearFit {
     let n = x.idx.len();
     let y: Vec<f64> = positive
         .iter()
@@ -152,7 +152,7 @@ pub(crate) fn svc(x: Rows<'_>, positive: &[bool], c: f64, settings: &Stop) -> Li
     let mut index: Vec<usize> = (0..n).collect();
     let mut active = n;
     let (mut pg_max_old, mut pg_min_old) = (f64::INFINITY, f64::NEG_INFINITY);
-    let mut rng = SplitMix64(0);
+    let mut rng = SplitMix64(seed);
     let mut epochs = 0;
     let mut converged = false;
     while epochs < settings.max_epochs {
@@ -311,7 +311,7 @@ mod tests {
             idx: &idx,
         };
         let c = 5.0;
-        let fit = svc(rows, &positive, c, &tight());
+        let fit = svc(rows, &positive, c, &tight(), 0);
         assert!(fit.converged);
         let alpha = reference(&x, d, &vec![1.0; n], 0.0, &vec![0.0; n], &vec![c; n], &sign);
         let coef: Vec<f64> = alpha.iter().zip(&sign).map(|(a, s)| a * s).collect();
@@ -324,7 +324,13 @@ mod tests {
         let sep: Vec<bool> = (0..n)
             .map(|i| x[i * d] - 0.5 * x[i * d + 1] > 0.1)
             .collect();
-        let fit = svc(rows, &sep, 100.0, &Stop::new(0.1, &SmoSettings::default()));
+        let fit = svc(
+            rows,
+            &sep,
+            100.0,
+            &Stop::new(0.1, &SmoSettings::default()),
+            0,
+        );
         for (i, &s) in sep.iter().enumerate() {
             let f = dot(&fit.w, &x[i * d..(i + 1) * d]) + fit.bias;
             assert_eq!(f > 0.0, s, "row {i}: {f}");
@@ -342,8 +348,8 @@ mod tests {
         };
         let stop = Stop::new(0.1, &SmoSettings::default());
         let positive: Vec<bool> = y.iter().map(|&v| v > 0.3).collect();
-        let a = svc(rows, &positive, 1.0, &stop);
-        let b = svc(rows, &positive, 1.0, &stop);
+        let a = svc(rows, &positive, 1.0, &stop, 0);
+        let b = svc(rows, &positive, 1.0, &stop, 0);
         assert_eq!(a.w, b.w);
         assert_eq!(a.dual, b.dual);
     }

@@ -80,7 +80,8 @@ impl Nystrom {
     /// The regressors are solved in closed form.
     pub const DEFAULT_TOL: f64 = 0.1;
 
-    /// `landmarks` rows drawn with `seed` (a training set with fewer rows uses them all).
+    /// `landmarks` rows drawn with `seed` (a training set with fewer rows uses them all), which
+    /// also orders the linear classifier's sweeps.
     /// Fails unless `2 <= landmarks <= MAX_LANDMARKS`.
     pub fn new(landmarks: usize, seed: u64) -> Result<Self, RegressError> {
         if !(2..=Self::MAX_LANDMARKS).contains(&landmarks) {
@@ -107,6 +108,10 @@ impl Nystrom {
         Ok(Self { tol, ..self })
     }
 
+    pub(crate) fn reseed(&mut self, seed: u64) {
+        self.seed = seed;
+    }
+
     /// Stopping tolerance of the classifier's dual solver.
     pub fn tol(&self) -> f64 {
         self.tol
@@ -117,7 +122,7 @@ impl Nystrom {
         self.landmarks
     }
 
-    /// Seed of the landmark draw.
+    /// Seed of the landmark draw and of the linear classifier's sweep order.
     pub fn seed(&self) -> u64 {
         self.seed
     }

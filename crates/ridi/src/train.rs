@@ -8,7 +8,7 @@ use ridi_features::{
     FeatureConfig, FeatureExtractor, FeatureMatrix, FeatureMatrixRef, GroundTruthView, Orientation,
     SampleSchedule, Standardization, compute_targets,
 };
-use ridi_frames::{StabHorizontal, UpAxis};
+use ridi_frames::{Frame, Rot, StabHorizontal, UpAxis, Vec3};
 use ridi_regress::{Cascade, CascadeParams, GridSpec, Progress, RegressorChoice, TrainingSet};
 use serde::{Deserialize, Serialize};
 
@@ -97,7 +97,9 @@ impl Default for TrainOptions {
     }
 }
 
-/// Features, targets and labels of a training set, one row per sample.
+/// Features, targets and labels of a training set, one row per sample, the sequences' rows in
+/// an order of their own (by name, then content), so that the order in which sequences are
+/// given changes neither these rows nor the model trained on them.
 #[derive(Debug, Clone, PartialEq)]
 pub struct TrainingData {
     /// Features (`n x dim`), not standardized.
@@ -108,7 +110,8 @@ pub struct TrainingData {
     pub placements: Vec<usize>,
     /// Placement names, sorted.
     pub placement_names: Vec<String>,
-    /// Index of the sequence each sample comes from.
+    /// The sequence each sample comes from, numbered in the rows' order (not the order the
+    /// sequences were given in).
     pub groups: Vec<u64>,
 }
 
@@ -168,9 +171,10 @@ pub fn training_data(seqs: &[Sequence], config: &FeatureConfig) -> Result<Traini
         })
         .collect::<Result<_>>()?;
     let names: Vec<String> = names.into_iter().map(str::to_string).collect();
+    let ordered = canonical_order(seqs);
     let schedule = SampleSchedule::training(&config)?;
     let fx = FeatureExtractor::new(config.clone())?;
-    let per_seq: Vec<(FeatureMatrix, Vec<StabHorizontal>)> = seqs
+    let per_seq: Vec<(FeatureMatrix, Vec<StabHorizontal>)> = ordered
         .par_iter()
         .map(|s| {
             check_frames(s, &config)?;
@@ -191,7 +195,7 @@ pub fn training_data(seqs: &[Sequence], config: &FeatureConfig) -> Result<Traini
         placement_names: names,
         groups: Vec::new(),
     };
-    for (g, (seq, (features, targets))) in seqs.iter().zip(per_seq).enumerate() {
+    for (g, (&seq, (features, targets))) in ordered.iter().zip(per_seq).enumerate() {
         let p = data
             .placement_names
             .iter()
@@ -214,6 +218,46 @@ pub fn training_data(seqs: &[Sequence], config: &FeatureConfig) -> Result<Traini
         ));
     }
     Ok(data)
+}
+
+/// `seqs` in an order of their own: by name and placement label, then length, then the bit
+/// patterns of every channel training reads (timestamps, IMU, gravity, orientation, ground
+/// truth), so that sequences it cannot tell apart give the same rows. The rows of
+/// [`training_data`] follow it, and the solvers are order-sensitive (the Nyström landmark
+/// draw and its classifier's sweeps, the folds of the grid search): without it, the same
+/// recordings listed in another order would give another model, and `ridi train` on `ridi
+/// convert`'s lists another model than training on the reader's sequences.
+fn canonical_order(seqs: &[Sequence]) -> Vec<&Sequence> {
+    fn vecs<F: Frame>(v: &[Vec3<F>]) -> impl Iterator<Item = u64> + '_ {
+        v.iter().flat_map(|v| v.to_array()).map(f64::to_bits)
+    }
+    fn rots<A: Frame, B: Frame>(r: &[Rot<A, B>]) -> impl Iterator<Item = u64> + '_ {
+        r.iter().flat_map(|q| q.to_wxyz()).map(f64::to_bits)
+    }
+    // Lazy: two sequences are compared only as far as they agree.
+    fn content(s: &Sequence) -> impl Iterator<Item = u64> + '_ {
+        let gt = s.ground_truth();
+        let gt_position = gt.map_or(&[][..], |g| &g.position[..]);
+        let gt_orientation = gt.map_or(&[][..], |g| &g.orientation[..]);
+        s.time()
+            .iter()
+            .map(|t| t.to_bits())
+            .chain(vecs(s.gyro()))
+            .chain(vecs(s.acce()))
+            .chain(vecs(s.linacce()))
+            .chain(vecs(s.gravity()))
+            .chain(rots(s.orientation()))
+            .chain(std::iter::once(u64::from(gt.is_some())))
+            .chain(vecs(gt_position))
+            .chain(rots(gt_orientation))
+    }
+    let mut order: Vec<&Sequence> = seqs.iter().collect();
+    order.sort_by(|a, b| {
+        (a.name(), a.placement(), a.len())
+            .cmp(&(b.name(), b.placement(), b.len()))
+            .then_with(|| content(a).cmp(content(b)))
+    });
+    order
 }
 
 /// The training windows (rows) [`train`] would build from `seqs` with `opts`, turned copies

@@ -219,6 +219,7 @@ def train(
     storage: Literal["projected", "half"] = "projected",
     solver: Literal["exact", "nystrom"] = "exact",
     landmarks: int = 2048,
+    seed: int = 0,
     turned_copies: int = 1,
     step: Optional[int] = None,
     window: Optional[int] = None,

@@ -84,7 +84,7 @@ impl Cascade {
                         dim: rank_c,
                         idx: &rows,
                     };
-                    linear::svc(x, &positive, params.classifier_c, &stop)
+                    linear::svc(x, &positive, params.classifier_c, &stop, cfg.seed())
                 })
                 .collect();
             report(progress, Stage::Classifier, pairs.len(), pairs.len())?;

@@ -152,6 +152,21 @@ pub struct CascadeParams {
     pub speed: bool,
 }
 
+impl CascadeParams {
+    /// Seeds the random draws of training: the grid's sequence-to-fold shuffle
+    /// ([`GridSpec::seed`]) and, with the Nyström solver ([`Nystrom::seed`](crate::Nystrom::seed)),
+    /// its landmarks and the order of its linear classifier's sweeps; 0 by default. Set it after [`Self::regressors`] and [`Self::method`]. Models trained
+    /// with other seeds show how much a figure owes to these draws.
+    pub fn set_seed(&mut self, seed: u64) {
+        if let RegressorChoice::Grid(g) = &mut self.regressors {
+            g.seed = seed;
+        }
+        if let Solver::Nystrom(n) = &mut self.method {
+            n.reseed(seed);
+        }
+    }
+}
+
 impl Default for CascadeParams {
     fn default() -> Self {
         Self {
