@@ -429,13 +429,10 @@ fn run_variant(seqs: &[Sequence], models: &[Cascade], train_s: f64, v: &Variant)
             .cloned()
             .collect();
         let (report, traces) = ridi::evaluate(&test, model, &eval_opts)?;
+        let correction = eval_opts.track.correction_for(model);
+        let (config, every) = (model.feature_config(), eval_opts.track.regress_every);
         for ((r, t), s) in report.sequences.into_iter().zip(&traces).zip(&test) {
-            let correction = eval_opts.track.correction_for(model);
             per_sequence.push(SeqRow::new(r, t, s, correction)?);
-        }
-        for s in &test {
-            let (config, every) = (model.feature_config(), eval_opts.track.regress_every);
-            let correction = eval_opts.track.correction_for(model);
             oracle.push(oracle_rte(s, config, every, correction)?);
         }
     }

@@ -34,8 +34,9 @@
 //! The orientation estimator is a Mahony complementary filter on gyroscope and accelerometer
 //! ([`estimate_orientation`], gains in [`FilterConfig`]): `ridi` trains and tracks with it by
 //! default (a recorded orientation's tilt may be lost while running, its heading jumps).
-//! [`OrientationFilter`] is the same filter one sample at a time, for live streams. It starts with heading 0 ([`initial_orientation`]). [`tilt_error`],
-//! [`heading_difference`] and [`orientation_errors`] compare any orientation track with a
+//! [`OrientationFilter`] is the same filter one sample at a time, for live streams. It starts
+//! with heading 0 ([`initial_orientation`]). [`tilt_error`], [`heading_difference`] and
+//! [`orientation_errors`] compare any orientation track with a
 //! reference (e.g. motion capture): tilt error in the device frame, heading drift as the yaw of
 //! the relative rotation. [`HeadingCorrector`] (and [`with_reference_heading`] over whole
 //! tracks) takes the slow part of a recorded orientation's heading onto the estimate, whose
