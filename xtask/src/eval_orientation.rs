@@ -17,7 +17,7 @@ use anyhow::{Context, Result, bail};
 use crate::eval_devices::Phone;
 use ridi_data::tyrex::{self, TyrexOptions};
 use ridi_frames::{
-    Device, DeviceVec, FilterConfig, HeadingConfig, Rot, WorldFromDevice, estimate_orientation,
+    DeviceVec, FilterConfig, HeadingConfig, WorldFromDevice, estimate_orientation,
     orientation_errors, with_reference_heading,
 };
 
@@ -178,81 +178,29 @@ pub fn configs() -> Vec<FilterConfig> {
     out
 }
 
-/// Window over which the mocap's rotation is checked against the gyro's, s: long enough that a
-/// flip interpolated across a short loss shows as one large disagreement, short enough that
-/// gyro bias adds nothing (0.1 s at 0.01 rad/s is 0.06°).
-pub const MOCAP_CHECK_WINDOW_S: f64 = 0.1;
-/// Largest disagreement between the mocap's and the gyro's rotation over one window, rad,
-/// before the mocap is taken as wrong. Tyrex's mocap sometimes flips the rigid body for a
-/// fraction of a second (wrong marker labelling; the reader's interpolation across short losses
-/// then turns through the flip at 30-40 rad/s): disagreements up to 180°, in two of the 34
-/// parts. Everywhere else the two agree within 0.7 rad (40°, at worst in a pocket while running:
-/// marker jitter on impacts, and the ~20 ms residual lag at rates up to 20 rad/s), which is left
-/// in: it is part of what the mocap is.
-pub const MOCAP_MAX_DISAGREEMENT: f64 = 1.0;
-/// Suspect windows closer than this, s, belong to one bad stretch: between two flips the body
-/// is often still flipped even where the mocap and the gyro agree on the rotation.
-pub const MOCAP_MERGE_S: f64 = 1.0;
-/// Margin excluded on each side of a bad stretch, s.
-pub const MOCAP_PAD_S: f64 = 0.25;
-
-/// Which samples have a trustworthy mocap orientation (`true` = keep). A window of
-/// [`MOCAP_CHECK_WINDOW_S`] is suspect when the rotation the mocap shows across it and the
-/// rotation the gyro integrates over it differ by more than [`MOCAP_MAX_DISAGREEMENT`];
-/// suspect windows within [`MOCAP_MERGE_S`] are merged into one stretch, and each stretch is
-/// widened by [`MOCAP_PAD_S`].
+/// Which samples have a trustworthy mocap orientation (`true` = keep): outside the stretches
+/// [`tyrex::mocap_gyro_conflicts`] finds, the check by which the reader already cuts flipped
+/// stretches out of its ground truth (`TyrexOptions::max_mocap_gyro_rad`). Run again on the
+/// 200 Hz sequences, it catches what interpolation across a short loss between flipped poses
+/// turned through, and keeps the figures honest when a reader was told to trust the mocap.
 ///
 /// Without this, one flip is enough to ruin the heading figures of every source: the heading
 /// difference jumps by about half a turn and back, the unwrapping in
 /// `ridi_frames::orientation_errors` may take either branch, and whole turns accumulate into a
 /// drift of hundreds of degrees per minute.
 pub fn mocap_mask(time: &[f64], gyro: &[DeviceVec], truth: &[WorldFromDevice]) -> Vec<bool> {
-    let n = time.len();
-    // Gyro attitude from an arbitrary start: only its changes over a window are used, and
-    // those do not depend on the start.
-    let mut attitude = Vec::with_capacity(n);
-    let mut q = Rot::<Device, Device>::identity();
-    for k in 0..n {
-        if k > 0 {
-            let dt = (time[k] - time[k - 1]).max(0.0);
-            let rate = (*gyro[k - 1].vector() + *gyro[k].vector()) * 0.5;
-            q = q * Rot::from_scaled_axis(rate * dt);
-        }
-        attitude.push(q);
-    }
-    let mut suspect = Vec::new();
-    let mut end = 0;
-    for k in 0..n {
-        while end + 1 < n && time[end] < time[k] + MOCAP_CHECK_WINDOW_S {
-            end += 1;
-        }
-        if end <= k {
-            break;
-        }
-        let by_mocap = truth[k].inverse() * truth[end];
-        let by_gyro = attitude[k].inverse() * attitude[end];
-        if by_mocap.angle_to(&by_gyro) > MOCAP_MAX_DISAGREEMENT {
-            suspect.push((k, end));
-        }
-    }
-    let mut keep = vec![true; n];
-    let mut i = 0;
-    while i < suspect.len() {
-        let mut j = i;
-        let mut to = suspect[i].1;
-        while j + 1 < suspect.len() && time[suspect[j + 1].0] - time[to] <= MOCAP_MERGE_S {
-            j += 1;
-            to = to.max(suspect[j].1);
-        }
-        let (from, to) = (time[suspect[i].0] - MOCAP_PAD_S, time[to] + MOCAP_PAD_S);
-        for (k, flag) in keep.iter_mut().enumerate() {
-            if time[k] >= from && time[k] <= to {
-                *flag = false;
-            }
-        }
-        i = j + 1;
-    }
-    keep
+    // One timeline without gaps: every window is judged.
+    let bad = tyrex::mocap_gyro_conflicts(
+        time,
+        truth,
+        time,
+        gyro,
+        tyrex::MAX_MOCAP_GYRO_RAD,
+        f64::INFINITY,
+    );
+    time.iter()
+        .map(|&t| !bad.iter().any(|&(a, b)| t >= a && t <= b))
+        .collect()
 }
 
 /// One evaluated part of a run.
@@ -587,12 +535,17 @@ fn write_report(s: &mut String, eval: &Evaluation, command: &str) -> std::fmt::R
     let total: f64 = eval.parts.iter().map(|p| p.estimator[0].duration_s).sum();
     writeln!(
         s,
-        "Mocap quality control: where the rotation the mocap shows over {MOCAP_CHECK_WINDOW_S} s differs from the one \
-         the gyro integrates by more than {MOCAP_MAX_DISAGREEMENT} rad (a flipped rigid body, or \
-         interpolation across a loss between flipped poses), the samples are judged by nobody: \
-         suspect windows closer than {MOCAP_MERGE_S} s are merged into one stretch, widened by \
-         {MOCAP_PAD_S} s each side, and left out of every figure (the estimator still runs \
-         through them). {excluded:.1} s of {:.1} min were left out; see the per-part table.\n",
+        "Mocap quality control: where the rotation the mocap shows over {} s differs from the one \
+         the gyro integrates by more than {} rad (a flipped rigid body, or interpolation across \
+         a loss between flipped poses), the reader cuts the mocap out as a loss \
+         (`TyrexOptions::max_mocap_gyro_rad`); the same check on the 200 Hz sequences leaves \
+         out what remains: suspect windows closer than {} s are merged into one stretch, \
+         widened by {} s each side, and judged by nobody (the estimator still runs through \
+         them). {excluded:.1} s of {:.1} min were left out; see the per-part table.\n",
+        tyrex::MOCAP_CHECK_WINDOW_S,
+        tyrex::MAX_MOCAP_GYRO_RAD,
+        tyrex::MOCAP_MERGE_S,
+        tyrex::MOCAP_PAD_S,
         total / 60.0
     )?;
 
@@ -860,6 +813,7 @@ fn signed_2dp(x: f64) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use ridi_frames::Device;
     use ridi_frames::nalgebra::Vector3;
     use ridi_frames::{Rot, World, gravity_in_device};
 

@@ -3,10 +3,10 @@
 //!
 //! Every person and motion of the Nexus 5 runs without magnetic disturbance, and a slice of the
 //! iPhone 4S runs (`IPHONE_RUNS`: the held-out person's, so that the demo tracks a phone its
-//! model never saw), `SECONDS` seconds each from the longest usable part of the run (skipping
-//! its first `SKIP_S` seconds, where the mocap and the walker settle), written as
-//! gzip-compressed `data.csv.gz` with `f32` precision and its sidecar (the device), to stay
-//! under 15 MB. List files: one per person, one per phone (`list_nexus5.txt`,
+//! model never saw), `SECONDS` seconds each from the first part of the run long enough, else
+//! its longest (skipping the part's first `SKIP_S` seconds, where the mocap and the walker
+//! settle), written as gzip-compressed `data.csv.gz` with `f32` precision and its sidecar (the
+//! device), to stay under 15 MB. List files: one per person, one per phone (`list_nexus5.txt`,
 //! `list_iphone4s.txt`, as `ridi convert` names them), `list_all.txt`, and the demo split
 //! `list_train.txt` (Guillaume, Jakob) / `list_test.txt` (Thibaud). Placements are the motion
 //! names.
@@ -57,10 +57,17 @@ pub fn build(data: &Path, out: &Path) -> Result<()> {
             continue;
         }
         let read = tyrex::read(&dir, &TyrexOptions::default())?;
+        // The first part that holds the whole slice, else the longest: a cut later in the run
+        // (a mocap loss, a flip the reader cuts out) leaves the slice where it was.
         let Some(part) = read
             .sequences
             .iter()
-            .max_by(|a, b| a.duration().total_cmp(&b.duration()))
+            .find(|s| s.duration() >= SKIP_S + SECONDS)
+            .or_else(|| {
+                read.sequences
+                    .iter()
+                    .max_by(|a, b| a.duration().total_cmp(&b.duration()))
+            })
         else {
             bail!("{}: no usable part", dir.display());
         };

@@ -90,6 +90,15 @@
 //! `iPhone 4S`); its IMU rate is the slower of the accelerometer's and the gyroscope's own rates
 //! (198.6 Hz on the Nexus 5, 90 Hz on the iPhone 4S).
 //!
+//! # Mocap faults
+//! Two checks cut mocap frames out as losses before anything is interpolated: where the
+//! mocap's up axis is further than [`TyrexOptions::max_mocap_tilt_deg`] from the phone
+//! orientation's and the accelerometer sides with the phone (a mis-solved body), and where the
+//! rotation the mocap shows over 0.1 s contradicts the one the gyro integrates
+//! ([`TyrexOptions::max_mocap_gyro_rad`], [`mocap_gyro_conflicts`]: a body solved flipped, which
+//! a tilt check cannot see when the flip is about the vertical, and which would turn the
+//! velocity targets the wrong way). Each is reported in [`TyrexRead::warnings`] with its times.
+//!
 //! # Gaps
 //! Mocap losses up to [`TyrexOptions::max_mocap_gap_s`] are interpolated across; a longer one,
 //! or a gap in a phone stream longer than [`TyrexOptions::max_sensor_gap_s`], splits the
@@ -158,6 +167,11 @@ use crate::{
 };
 
 mod ios;
+mod mocap_gyro;
+
+pub use mocap_gyro::{
+    MAX_MOCAP_GYRO_RAD, MOCAP_CHECK_WINDOW_S, MOCAP_MERGE_S, MOCAP_PAD_S, mocap_gyro_conflicts,
+};
 
 /// Mocap frame rate assumed when a `.mat` has no `FrameRate` (the Tyrex captures are 60 Hz).
 pub const DEFAULT_MOCAP_RATE_HZ: f64 = 60.0;
@@ -203,10 +217,15 @@ pub struct TyrexOptions {
     /// frames it discredits are treated as mocap losses, a phone orientation it discredits is
     /// a warning ([`MAX_MOCAP_TILT_DEG`]). Infinity trusts both.
     pub max_mocap_tilt_deg: f64,
+    /// Where the rotation the mocap shows over [`MOCAP_CHECK_WINDOW_S`] differs from the one the
+    /// gyro integrates by more than this, rad, the mocap flipped the rigid body: those stretches
+    /// ([`mocap_gyro_conflicts`]) are treated as mocap losses. Infinity trusts the mocap.
+    pub max_mocap_gyro_rad: f64,
     /// Bridge the OS orientation's jumps by the gyro, keeping the heading continuous across them
     /// ([`bridge_orientation_jumps`]). Off by default: on the disturbed Nexus 5 runs the jumps
     /// mostly correct a heading the magnetic field had bent, and bridging them raised RIDI's
-    /// RTE 5 s by 0.22 m [0.02, 0.45] (`cargo xtask eval tyrex`, docs/bench-devices.md).
+    /// RTE 5 s by 0.18 m [0.01, 0.38] (`cargo xtask eval tyrex --step 40 --orientation
+    /// recorded`, its table "Orientation jumps").
     pub bridge_orientation_jumps: bool,
     /// Limits every output sequence is checked against.
     pub validation: Validation,
@@ -223,6 +242,7 @@ impl Default for TyrexOptions {
             ground_truth: true,
             extra_time_diff_s: 0.0,
             max_mocap_tilt_deg: MAX_MOCAP_TILT_DEG,
+            max_mocap_gyro_rad: MAX_MOCAP_GYRO_RAD,
             bridge_orientation_jumps: false,
             validation: Validation::default(),
         }
@@ -1054,7 +1074,6 @@ fn judge_tilt(
 /// The stretches of frames judged `which`, `a-b s` (phone clock), the first few, and their
 /// number of frames.
 fn verdict_spans(time: &[f64], verdicts: &[TiltVerdict], which: TiltVerdict) -> (usize, String) {
-    const SHOWN: usize = 5;
     let mut spans: Vec<(f64, f64)> = Vec::new();
     let mut frames = 0;
     for (i, (&t, &v)) in time.iter().zip(verdicts).enumerate() {
@@ -1067,6 +1086,12 @@ fn verdict_spans(time: &[f64], verdicts: &[TiltVerdict], which: TiltVerdict) -> 
             _ => spans.push((t, t)),
         }
     }
+    (frames, spans_text(&spans))
+}
+
+/// The first few of `spans`, `a-b s`, and how many more there are.
+fn spans_text(spans: &[(f64, f64)]) -> String {
+    const SHOWN: usize = 5;
     let mut text: Vec<String> = spans
         .iter()
         .take(SHOWN)
@@ -1075,7 +1100,22 @@ fn verdict_spans(time: &[f64], verdicts: &[TiltVerdict], which: TiltVerdict) -> 
     if spans.len() > SHOWN {
         text.push(format!("and {} more", spans.len() - SHOWN));
     }
-    (frames, text.join(", "))
+    text.join(", ")
+}
+
+/// Mocap frames: times (phone clock), positions, orientations.
+type Mocap = (Vec<f64>, Vec<WorldVec>, Vec<WorldFromDevice>);
+
+/// `mocap` without the frames `lost` says are lost.
+fn without_lost(mocap: Mocap, lost: impl Fn(usize) -> bool) -> Mocap {
+    let (t, p, q) = mocap;
+    let mut kept = (Vec::new(), Vec::new(), Vec::new());
+    for i in (0..t.len()).filter(|&i| !lost(i)) {
+        kept.0.push(t[i]);
+        kept.1.push(p[i]);
+        kept.2.push(q[i]);
+    }
+    kept
 }
 
 /// Intersection of two sorted lists of disjoint closed intervals.
@@ -1154,6 +1194,16 @@ fn read_android(dir: &Path, name: &str, warnings: &mut Vec<String>) -> Result<Ph
 /// layouts, frames, time alignment and gap handling.
 pub fn read(dir: impl AsRef<Path>, options: &TyrexOptions) -> Result<TyrexRead> {
     let dir = dir.as_ref();
+    if options.max_mocap_gyro_rad.is_nan() || options.max_mocap_gyro_rad <= 0.0 {
+        return Err(DataError::format(
+            Location::file(dir).with_field("max_mocap_gyro_rad"),
+            format!(
+                "the mocap's largest disagreement with the gyro must be positive (infinity \
+                 trusts the mocap), got {}",
+                options.max_mocap_gyro_rad
+            ),
+        ));
+    }
     if !(options.rate_hz.is_finite() && options.rate_hz > 0.0) {
         return Err(DataError::format(
             Location::file(dir).with_field("rate_hz"),
@@ -1208,7 +1258,7 @@ pub fn read(dir: impl AsRef<Path>, options: &TyrexOptions) -> Result<TyrexRead> 
     };
     let mut time_diff_s = None;
     // Valid mocap frames on the phone clock.
-    let mut truth: Option<(Vec<f64>, Vec<WorldVec>, Vec<WorldFromDevice>)> = None;
+    let mut truth: Option<Mocap> = None;
     if let Some(mat) = &mat {
         let diff = read_time_diff(&dir.join("timeAlignment.txt"))? + options.extra_time_diff_s;
         time_diff_s = Some(diff);
@@ -1244,22 +1294,39 @@ pub fn read(dir: impl AsRef<Path>, options: &TyrexOptions) -> Result<TyrexRead> 
                 t.len(),
                 options.max_mocap_tilt_deg,
             ));
-            let mut kept = (Vec::new(), Vec::new(), Vec::new());
-            for (i, _) in verdicts
-                .iter()
-                .enumerate()
-                .filter(|(_, v)| **v != TiltVerdict::MocapWrong)
-            {
-                kept.0.push(t[i]);
-                kept.1.push(p[i]);
-                kept.2.push(q[i]);
-            }
-            (t, p, q) = kept;
+            (t, p, q) = without_lost((t, p, q), |i| verdicts[i] == TiltVerdict::MocapWrong);
+        }
+        let conflicts = mocap_gyro_conflicts(
+            &t,
+            &q,
+            &gyro.time,
+            &gyro.values,
+            options.max_mocap_gyro_rad,
+            options.max_mocap_gap_s,
+        );
+        if !conflicts.is_empty() {
+            let before = t.len();
+            let inside = |x: f64| conflicts.iter().any(|&(a, b)| x >= a && x <= b);
+            let lost: Vec<bool> = t.iter().map(|&x| inside(x)).collect();
+            (t, p, q) = without_lost((t, p, q), |i| lost[i]);
+            warnings.push(format!(
+                "{}: the mocap's rotation over {MOCAP_CHECK_WINDOW_S} s differs from the \
+                 gyro's by more than {} rad in {} stretch(es) ({}, phone clock, with {MOCAP_PAD_S} s \
+                 margins): the rigid body was solved flipped there; {} of {before} mocap frames \
+                 treated as mocap losses",
+                mat.display(),
+                options.max_mocap_gyro_rad,
+                conflicts.len(),
+                spans_text(&conflicts),
+                before - t.len(),
+            ));
         }
         if t.is_empty() {
             return Err(DataError::format(
                 Location::file(mat).with_field("RigidBodies.Positions"),
-                "the mocap never tracked the body: every frame is NaN",
+                "no mocap frame left: every frame is NaN, or was cut out by the checks the \
+                 warnings name (a rigid body that does not coincide with the device frame, or \
+                 a `timeAlignment.txt` off by a tenth of a second, fails them all)",
             ));
         }
         let gt_spans = intervals(&t, options.max_mocap_gap_s, |i| {

@@ -200,6 +200,59 @@ fn short_mocap_losses_are_bridged_and_long_ones_split() {
     );
 }
 
+/// The mocap solves the body turned by half a turn about the vertical for half a second: the
+/// tilt agrees with the phone's, so only the gyro can tell. The reader cuts the stretch out as a
+/// mocap loss, splitting the run, and says when; told to trust the mocap, it keeps the flip.
+#[test]
+fn a_mocap_flip_the_gyro_contradicts_is_cut_out_with_a_warning() {
+    let fx = Fixture::standard();
+    let (p, mut r) = tyrex_mocap(60 * 30, &[]);
+    for (i, rot) in r.iter_mut().enumerate().take(930).skip(900) {
+        let m = yaw(TYREX_OMEGA * i as f64 / 60.0 + std::f64::consts::PI).matrix();
+        *rot = m.as_slice().try_into().unwrap();
+    }
+    std::fs::write(
+        &fx.mat,
+        MatWriter::LE.file(&qtm_take("Take_1", 60.0, &p, &r), true),
+    )
+    .unwrap();
+    let read = tyrex::read(&fx.dir, &TyrexOptions::default()).unwrap();
+    let flips: Vec<&String> = read
+        .warnings
+        .iter()
+        .filter(|w| w.contains("the rigid body was solved flipped there"))
+        .collect();
+    assert_eq!(flips.len(), 1, "{:?}", read.warnings);
+    // Mocap frames 900..930 are at 17.0-17.483 s on the phone clock: suspect windows from a
+    // window (0.1 s) before the first to a window after the last, then 0.25 s margins.
+    assert!(flips[0].contains("(16.65-17.83 s"), "{}", flips[0]);
+    assert!(
+        flips[0].contains(&format!("{}", fx.mat.display())),
+        "{}",
+        flips[0]
+    );
+    assert_eq!(read.sequences.len(), 2, "{:?}", read.warnings);
+    for seq in &read.sequences {
+        let gt = seq.ground_truth().unwrap();
+        for (k, &t) in seq.time().iter().enumerate() {
+            let expected = yaw(TYREX_OMEGA * (t - 2.0));
+            assert!(gt.orientation[k].angle_to(&expected) < 1e-6, "{t}");
+            assert!(!(16.65..=17.83).contains(&t), "{t}");
+        }
+    }
+    let trusting = TyrexOptions {
+        max_mocap_gyro_rad: f64::INFINITY,
+        ..TyrexOptions::default()
+    };
+    let read = tyrex::read(&fx.dir, &trusting).unwrap();
+    assert_eq!(read.sequences.len(), 1);
+    assert!(
+        read.warnings.iter().all(|w| !w.contains("flipped")),
+        "{:?}",
+        read.warnings
+    );
+}
+
 #[test]
 fn a_gap_in_a_phone_stream_splits_and_names_its_line() {
     let fx = Fixture::standard();
@@ -696,6 +749,17 @@ fn bad_options_are_rejected() {
     )
     .unwrap_err();
     assert!(e.to_string().contains("rate_hz"), "{e}");
+    for bad in [0.0, -1.0, f64::NAN] {
+        let e = tyrex::read(
+            &fx.dir,
+            &TyrexOptions {
+                max_mocap_gyro_rad: bad,
+                ..TyrexOptions::default()
+            },
+        )
+        .unwrap_err();
+        assert!(e.to_string().contains("max_mocap_gyro_rad"), "{e}");
+    }
     let e = tyrex::read(
         &fx.dir,
         &TyrexOptions {

@@ -742,3 +742,67 @@ fn a_phone_orientation_that_loses_its_tilt_is_reported_not_the_mocap_dropped() {
         }
     }
 }
+
+/// The mocap solves the rigid body flipped for a second or so in 11 of the 66 runs (wrong marker
+/// labelling: its rotation turns by up to half a turn within 0.1 s while the gyro shows nothing
+/// of the kind), worst in Jakob's hand-held running runs. The reader cuts those stretches out as
+/// mocap losses and says so; what it returns agrees with the gyro over every 0.1 s. Read with
+/// the check off, the same runs' ground truth does not.
+#[test]
+#[ignore = "needs ../shared beside the checkout: `cargo test --workspace --tests -- --ignored` (.ci/run)"]
+fn mocap_flips_the_gyro_contradicts_are_cut_out() {
+    let conflicts = |seq: &ridi_data::Sequence| {
+        let gt = seq.ground_truth().unwrap();
+        let found = tyrex::mocap_gyro_conflicts(
+            seq.time(),
+            &gt.orientation,
+            seq.time(),
+            seq.gyro(),
+            tyrex::MAX_MOCAP_GYRO_RAD,
+            TyrexOptions::default().max_mocap_gap_s,
+        );
+        found.iter().map(|(a, b)| b - a).sum::<f64>()
+    };
+    let trusting = TyrexOptions {
+        max_mocap_gyro_rad: f64::INFINITY,
+        ..TyrexOptions::default()
+    };
+    let mut flipped = Vec::new();
+    for dir in tyrex::list_sequences(root()).unwrap().runs {
+        let name = dir.file_name().unwrap().to_string_lossy().into_owned();
+        let read = tyrex::read(&dir, &TyrexOptions::default()).unwrap();
+        for seq in &read.sequences {
+            assert_eq!(conflicts(seq), 0.0, "{}", seq.name());
+        }
+        let warned = read
+            .warnings
+            .iter()
+            .any(|w| w.contains("the rigid body was solved flipped there"));
+        let before: f64 = tyrex::read(&dir, &trusting)
+            .unwrap()
+            .sequences
+            .iter()
+            .map(conflicts)
+            .sum();
+        eprintln!(
+            "{name:45} {:5.1} s in conflict when trusted, warned: {warned}",
+            before.abs()
+        );
+        // Every conflict the trusting read lets through is warned about. Not every warning
+        // shows in the trusting read: a flip next to a long loss falls in a part too short to
+        // keep (Thibaud_Nexus5_Dist_FrontPocket).
+        assert!(warned || before == 0.0, "{name}: {before} s");
+        if warned {
+            flipped.push((name, before));
+        }
+    }
+    assert_eq!(flipped.len(), 11, "{flipped:?}");
+    for run in [
+        "Jakob_Nexus5_NoDist_RunningHand",
+        "Jakob_iPhone4S_NoDist_RunningHand",
+        "Thibaud_Nexus5_NoDist_Swinging",
+    ] {
+        let before = flipped.iter().find(|f| f.0 == run).map(|f| f.1);
+        assert!(before.is_some_and(|s| s > 0.5), "{run}: {flipped:?}");
+    }
+}

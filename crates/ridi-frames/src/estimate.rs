@@ -86,11 +86,10 @@ pub struct FilterConfig {
     /// The default (2.0) only drops readings above three times gravity. A tight gate looks
     /// attractive (strong accelerations say little about up) but is harmful for periodic
     /// motion: the samples that pass are locked to one phase of the stride, whose acceleration
-    /// does not average out, and the filter converges to a wrong tilt. On the Tyrex benchmark
-    /// (24 recordings, 34 parts, all samples pooled) a gate of 0.3 gave a tilt RMS of 26
-    /// degrees (78 and 93 degrees on two hand-held running recordings) against 4.4 with the
-    /// default; the worst part without the gate lost 1.7 degrees (a pocket running recording,
-    /// 7.0 against 5.3).
+    /// does not average out, and the filter converges to a wrong tilt. On the Tyrex Nexus 5
+    /// runs (all samples pooled; `cargo xtask eval orientation`, `docs/bench-orientation.md`) a
+    /// gate of 0.3 gives a tilt RMS of 32 degrees (89 over the hand-held running runs) against
+    /// 3.6 with the default.
     pub accel_tolerance: f64,
     /// Number of leading nonzero accelerometer samples averaged for the initial tilt.
     pub init_samples: usize,
