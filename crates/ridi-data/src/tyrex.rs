@@ -1310,10 +1310,10 @@ pub fn read(dir: impl AsRef<Path>, options: &TyrexOptions) -> Result<TyrexRead> 
             let lost: Vec<bool> = t.iter().map(|&x| inside(x)).collect();
             (t, p, q) = without_lost((t, p, q), |i| lost[i]);
             warnings.push(format!(
-                "{}: the mocap's rotation over {MOCAP_CHECK_WINDOW_S} s differs from the \
-                 gyro's by more than {} rad in {} stretch(es) ({}, phone clock, with {MOCAP_PAD_S} s \
-                 margins): the rigid body was solved flipped there; {} of {before} mocap frames \
-                 treated as mocap losses",
+                "{}: the mocap's rotation contradicts the gyro's (by more than {} rad over \
+                 {MOCAP_CHECK_WINDOW_S} s, or in its offset from the gyro's attitude) in {} \
+                 stretch(es) ({}, phone clock, with {MOCAP_PAD_S} s margins): the rigid body was \
+                 solved flipped there; {} of {before} mocap frames treated as mocap losses",
                 mat.display(),
                 options.max_mocap_gyro_rad,
                 conflicts.len(),
