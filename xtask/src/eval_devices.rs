@@ -28,7 +28,7 @@ use ridi::regress::{NoProgress, Nystrom, Solver, Storage};
 use ridi::{EvalOptions, GridChoice, PlacementMap, TrainOptions, apply_orientation};
 use ridi::{SequenceResult, check_evaluable};
 
-use crate::bootstrap::{self, Interval};
+use crate::bootstrap::{self, FiniteMean, Interval};
 use crate::eval_tyrex::{PEOPLE, interval_cell};
 use crate::eval_tyrex::{Truth, oracle_rte, swapped_rte};
 
@@ -352,26 +352,24 @@ struct RunFigures {
 /// Averages each run's parts into the run, weighted by their frames. A figure a part lacks
 /// (`NaN`, e.g. a path ratio without a path) leaves the part out of that figure's mean.
 fn per_run(tested: &[Tested]) -> Vec<RunFigures> {
-    // Weighted sums of METRICS, then of the bridged RTE and the swapped ones.
-    type Sums = ([(f64, f64); METRICS.len()], [(f64, f64); 4], bool);
-    let add = |acc: &mut (f64, f64), w: f64, v: f64| {
-        if v.is_finite() {
-            acc.0 += w * v;
-            acc.1 += w;
-        }
-    };
+    // Weighted means of METRICS, then of the bridged RTE and the swapped ones.
+    type Sums = ([FiniteMean; METRICS.len()], [FiniteMean; 4], bool);
     let mut runs: BTreeMap<usize, (String, Sums)> = BTreeMap::new();
     for t in tested {
         let e = runs.entry(t.run).or_insert_with(|| {
             let placement = t.result.placement.clone().unwrap_or_else(|| "-".into());
             (
                 placement,
-                ([(0.0, 0.0); METRICS.len()], [(0.0, 0.0); 4], false),
+                (
+                    [FiniteMean::default(); METRICS.len()],
+                    [FiniteMean::default(); 4],
+                    false,
+                ),
             )
         });
         let w = t.frames as f64;
         for (acc, m) in e.1.0.iter_mut().zip(&METRICS) {
-            add(acc, w, (m.of)(&t.result));
+            acc.add(w, (m.of)(&t.result));
         }
         let [speed, direction, truth] = t.swapped_rte;
         for (acc, v) in
@@ -379,11 +377,11 @@ fn per_run(tested: &[Tested]) -> Vec<RunFigures> {
                 .iter_mut()
                 .zip([t.bridged_rte, speed, direction, truth])
         {
-            add(acc, w, v);
+            acc.add(w, v);
         }
         e.1.2 |= t.bridged_rte != (METRICS[RTE].of)(&t.result);
     }
-    let mean = |(s, w): (f64, f64)| if w > 0.0 { s / w } else { f64::NAN };
+    let mean = |m: FiniteMean| m.mean();
     runs.into_iter()
         .map(
             |(run, (placement, (sums, [bridged, speed, direction, truth], jumps)))| RunFigures {

@@ -15,7 +15,7 @@ use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
-use crate::bootstrap::{self, Interval};
+use crate::bootstrap::{self, FiniteMean, Interval};
 use anyhow::{Context, Result};
 use ridi::correct::{CorrectionConfig, FrameVelocity, InitialVelocity, PlacementSmoother};
 use ridi::data::tyrex::{self, TyrexOptions};
@@ -438,12 +438,12 @@ fn run_variant(seqs: &[Sequence], models: &[Cascade], train_s: f64, v: &Variant)
     }
     eprintln!("  {}: evaluated", v.name);
     let results: Vec<&SequenceResult> = per_sequence.iter().map(|r| &r.result).collect();
-    let mean = |f: &dyn Fn(&SequenceResult) -> f64| mean_defined(results.iter().map(|r| f(r)));
+    let mean = |f: &dyn Fn(&SequenceResult) -> f64| FiniteMean::of(results.iter().map(|r| f(r)));
     let per_method = |f: fn(&ridi::eval::TrajectoryMetrics) -> f64| {
         Method::ALL
             .iter()
             .map(|m| {
-                let mean = mean_defined(results.iter().map(|r| f(&r.methods[m.key()])));
+                let mean = FiniteMean::of(results.iter().map(|r| f(&r.methods[m.key()])));
                 (m.key().to_string(), mean)
             })
             .collect::<Vec<_>>()
@@ -455,10 +455,10 @@ fn run_variant(seqs: &[Sequence], models: &[Cascade], train_s: f64, v: &Variant)
         rte_5s: per_method(|m| m.rte_5s_m),
         ate: per_method(|m| m.ate_m),
         path_ratio: per_method(|m| m.path_length_ratio.unwrap_or(f64::NAN)),
-        oracle_rte_5s: mean_defined(oracle.into_iter()),
-        rte_5s_whole: mean_defined(per_sequence.iter().map(|s| s.rte_5s_whole)),
+        oracle_rte_5s: FiniteMean::of(oracle),
+        rte_5s_whole: FiniteMean::of(per_sequence.iter().map(|s| s.rte_5s_whole)),
         rte_5s_swapped: [0, 1]
-            .map(|k| mean_defined(per_sequence.iter().map(|s| s.rte_5s_swapped[k]))),
+            .map(|k| FiniteMean::of(per_sequence.iter().map(|s| s.rte_5s_swapped[k]))),
         train_s,
         per_sequence,
     })
@@ -468,8 +468,7 @@ fn run_variant(seqs: &[Sequence], models: &[Cascade], train_s: f64, v: &Variant)
 /// (`<run>_part<k>`) are first averaged into their run, weighted by their frames. Returns the
 /// number of runs, velocity MSE, RTE 5 s, ATE, path length ratio and placement accuracy.
 fn per_run_means(r: &Row) -> (usize, [f64; 6]) {
-    // Per run and figure: the weighted sum and its weight (a part without the figure left out).
-    let mut runs: BTreeMap<&str, [(f64, f64); 6]> = BTreeMap::new();
+    let mut runs: BTreeMap<&str, [FiniteMean; 6]> = BTreeMap::new();
     for s in &r.per_sequence {
         let q = &s.result;
         let run = run_of(&q.name);
@@ -483,26 +482,13 @@ fn per_run_means(r: &Row) -> (usize, [f64; 6]) {
             q.placement_accuracy.unwrap_or(f64::NAN),
         ];
         let w = s.frames as f64;
-        let e = runs.entry(run).or_insert([(0.0, 0.0); 6]);
+        let e = runs.entry(run).or_default();
         for (acc, v) in e.iter_mut().zip(values) {
-            if v.is_finite() {
-                acc.0 += w * v;
-                acc.1 += w;
-            }
+            acc.add(w, v);
         }
     }
-    let means =
-        std::array::from_fn(|k| mean_defined(runs.values().map(|sums| sums[k].0 / sums[k].1)));
+    let means = std::array::from_fn(|k| FiniteMean::of(runs.values().map(|m| m[k].mean())));
     (runs.len(), means)
-}
-
-/// Mean of the finite values (a sequence without a figure, `NaN`, is left out of its mean,
-/// as the device protocols do); `NaN` when none has it.
-fn mean_defined(values: impl Iterator<Item = f64>) -> f64 {
-    let (sum, n) = values
-        .filter(|v| v.is_finite())
-        .fold((0.0, 0usize), |(s, n), v| (s + v, n + 1));
-    if n == 0 { f64::NAN } else { sum / n as f64 }
 }
 
 /// The run a test sequence belongs to: its name without the `_part<k>` of a run split at a gap.
@@ -614,7 +600,7 @@ fn per_placement(md: &mut String, v: &Variant, r: &Row) {
             .map(|s| &s.result)
             .filter(|s| s.placement.as_deref() == Some(label))
             .collect();
-        let m = |f: &dyn Fn(&SequenceResult) -> f64| mean_defined(rows.iter().map(|r| f(r)));
+        let m = |f: &dyn Fn(&SequenceResult) -> f64| FiniteMean::of(rows.iter().map(|r| f(r)));
         let _ = writeln!(
             md,
             "| {label} | {} | {:.3} / {:.3} | {:.3} | {:.3} | {:.3} | {:.3} |",
@@ -957,8 +943,8 @@ pub(crate) mod tests {
         };
         let (_, m) = per_run_means(&row);
         assert_eq!((m[4], m[5]), (1.0, 1.0), "{m:?}");
-        assert!(mean_defined([f64::NAN].into_iter()).is_nan());
-        assert_eq!(mean_defined([2.0, f64::NAN, 4.0].into_iter()), 3.0);
+        assert!(FiniteMean::of([f64::NAN]).is_nan());
+        assert_eq!(FiniteMean::of([2.0, f64::NAN, 4.0]), 3.0);
     }
 
     #[test]

@@ -49,7 +49,7 @@ pub(crate) struct Args {
     /// How the kernel machines are trained: `exact` (SMO, the paper's), or `nystrom`, which
     /// approximates the RBF kernel on --landmarks rows per machine, with a linear classifier
     /// and kernel ridge regressors on those features: training time and memory linear in the
-    /// rows, a model and a query that do not grow with them, within 0.06 m RTE 5 s of the
+    /// rows, a model and a query that do not grow with them, within 0.08 m RTE 5 s of the
     /// exact solver on the Tyrex protocol (docs/benchmarks.md).
     #[arg(long, value_enum, default_value = "exact")]
     solver: SolverArg,

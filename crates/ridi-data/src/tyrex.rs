@@ -950,6 +950,10 @@ fn clipping(acce: &Stream<DeviceVec>) -> Option<String> {
     })
 }
 
+/// Slack on a gap limit, s, so that a gap of exactly the limit (e.g. 15 mocap frames at 60 Hz
+/// against 0.25 s) counts as within it despite rounding.
+const GAP_TOLERANCE_S: f64 = 1e-9;
+
 /// Time spans without long gaps: `[start, end]` of each run of samples whose spacing stays
 /// within `max_gap`, with a warning for each split.
 fn intervals(time: &[f64], max_gap: f64, mut on_gap: impl FnMut(usize)) -> Vec<(f64, f64)> {
@@ -959,8 +963,7 @@ fn intervals(time: &[f64], max_gap: f64, mut on_gap: impl FnMut(usize)) -> Vec<(
     };
     let mut start = first;
     for (i, w) in time.windows(2).enumerate() {
-        // A tolerance so that a gap of exactly `max_gap` (e.g. 15 mocap frames) is kept.
-        if w[1] - w[0] > max_gap + 1e-9 {
+        if w[1] - w[0] > max_gap + GAP_TOLERANCE_S {
             out.push((start, w[0]));
             on_gap(i + 1);
             start = w[1];

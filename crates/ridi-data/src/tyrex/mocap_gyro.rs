@@ -101,8 +101,8 @@ pub fn mocap_gyro_conflicts(
     let time = &mocap_time[from..to];
     let truth = &mocap[from..to];
     let by_gyro = interpolate_rot(gyro_time, &attitude, time);
-    // The same tolerance as the reader's split (`intervals`), so that a loss it bridges is judged.
-    let lost = gaps_before(time, max_gap_s + 1e-9);
+    // The reader's split tolerance, so that a loss it bridges is judged.
+    let lost = gaps_before(time, max_gap_s + super::GAP_TOLERANCE_S);
 
     // Edges: windows whose two rotations disagree, merged into stretches of frame indices.
     let mut stretches: Vec<(usize, usize)> = Vec::new();
