@@ -1,7 +1,9 @@
 //! Rust errors as Python exceptions: `OSError` (and its subclasses) for files that cannot be
 //! read or written, `ValueError` for data, lists and options that are wrong. The message is the
 //! one line the command line prints after `error:`, naming the file, line and field, or the
-//! sequence, array and frame.
+//! sequence, array and frame, with control characters escaped as it escapes them
+//! ([`ridi::data::shown`]): a file name holding a line break or a terminal escape sequence does
+//! not split the message or reach the user's terminal raw.
 
 use std::error::Error;
 use std::io::ErrorKind;
@@ -12,7 +14,7 @@ use pyo3::exceptions::{
     PyFileExistsError, PyFileNotFoundError, PyIsADirectoryError, PyNotADirectoryError, PyOSError,
     PyPermissionError, PyValueError,
 };
-use ridi::data::DataError;
+use ridi::data::{DataError, shown};
 use ridi::regress::RegressError;
 use ridi::{OutputError, PipelineError};
 
@@ -35,6 +37,7 @@ pub(crate) fn one_line(e: &(dyn Error + 'static)) -> String {
 
 /// The `OSError` subclass Python raises for `kind`.
 fn os_error(kind: ErrorKind, message: String) -> PyErr {
+    let message = shown(message);
     match kind {
         ErrorKind::NotFound => PyFileNotFoundError::new_err(message),
         ErrorKind::PermissionDenied => PyPermissionError::new_err(message),
@@ -94,7 +97,7 @@ pub(crate) fn pipeline_in(e: PipelineError, context: Option<String>) -> PyErr {
     };
     match file_kind(&e) {
         Some(kind) => os_error(kind, message),
-        None => PyValueError::new_err(message),
+        None => value(message),
     }
 }
 
@@ -110,11 +113,11 @@ pub(crate) fn model_file(e: RegressError, doing: &str, path: &Path) -> PyErr {
     let message = format!("{doing} {}: {}", path.display(), one_line(&*e.under(path)));
     match kind {
         Some(kind) => os_error(kind, message),
-        None => PyValueError::new_err(message),
+        None => value(message),
     }
 }
 
-/// Bad input of the Python caller itself (an option, an array).
+/// A `ValueError`: bad data, or bad input of the Python caller itself (an option, an array).
 pub(crate) fn value(message: impl Into<String>) -> PyErr {
-    PyValueError::new_err(message.into())
+    PyValueError::new_err(shown(message.into()))
 }

@@ -4,12 +4,13 @@ bad input refused with a message naming the file, line and field, or the array a
 import gzip
 import json
 import shutil
+import subprocess
 
 import numpy as np
 import pytest
 
 import ridi
-from conftest import SAMPLE, arrays_of
+from conftest import RIDI_BIN, SAMPLE, arrays_of
 
 RUN = SAMPLE / "Thibaud_Nexus5_NoDist_Texting"
 
@@ -69,6 +70,24 @@ def test_read_list_labels_and_checks(tmp_path):
 def test_a_missing_file_is_an_os_error(tmp_path):
     with pytest.raises(FileNotFoundError, match="nowhere"):
         ridi.read(tmp_path / "nowhere" / "data.csv")
+
+
+def test_control_characters_in_names_are_escaped_as_the_cli_escapes_them(tmp_path, seq):
+    data = tmp_path / "line\nbreak\x1b[2J" / "data.csv"
+    with pytest.raises(FileNotFoundError) as raised:
+        ridi.read(data)
+    message = str(raised.value)
+    assert "\n" not in message and "\x1b" not in message, message
+    assert "line\\nbreak\\u{1b}[2J" in message
+    cli = subprocess.run([str(RIDI_BIN), "inspect", str(data)], capture_output=True, text=True)
+    assert cli.returncode != 0 and cli.stderr == f"error: {message}\n"
+    with pytest.raises(FileNotFoundError, match=r"cannot load model .*line\\nbreak\\u\{1b\}"):
+        ridi.load(data.parent / "m.ridi")
+    args = arrays_of(seq)
+    args["gyro"][7, 1] = np.nan
+    args["name"] = "walk\x1b]0;x\x07"
+    with pytest.raises(ValueError, match=r"sequence `walk\\u\{1b\}\]0;x\\u\{7\}`: `gyro`"):
+        ridi.Sequence(**args)
 
 
 def test_a_corrupt_cell_is_named_by_file_line_and_field(tmp_path):
