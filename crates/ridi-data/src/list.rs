@@ -12,7 +12,7 @@
 use std::path::{Path, PathBuf};
 
 use crate::detect::{read_sequence, source_files};
-use crate::error::{DataError, Location, Result};
+use crate::error::{DataError, Location, Result, shown};
 use crate::options::ReadOptions;
 use crate::text;
 use crate::{FileId, Sequence};
@@ -156,7 +156,7 @@ impl Listed {
             if !e.path.exists() {
                 return Err(DataError::format(
                     e.location().with_field("path"),
-                    format!("sequence `{}` does not exist", e.path.display()),
+                    format!("sequence `{}` does not exist", shown(&e.path)),
                 ));
             }
             // An unknown format is reported by the read below.
@@ -250,8 +250,8 @@ fn listed_twice(e: &ListEntry, first: &ListEntry) -> DataError {
         format!(
             "sequence `{}` is the recording already listed at {}:{}; a recording listed \
              twice would count twice, or be tested on after training on it",
-            e.path.display(),
-            first.list.display(),
+            shown(&e.path),
+            shown(&first.list),
             first.line
         ),
     )
@@ -265,9 +265,9 @@ fn copy_error(e: &ListEntry, first: &ListEntry) -> DataError {
             "sequence `{}` holds the same recording as `{}`, listed at {}:{} (the same \
              timestamps, gyro and accelerometer samples); a recording listed twice would \
              count twice, or be tested on after training on it",
-            e.path.display(),
-            first.path.display(),
-            first.list.display(),
+            shown(&e.path),
+            shown(&first.path),
+            shown(&first.list),
             first.line
         ),
     )

@@ -155,7 +155,7 @@ use ridi_frames::nalgebra::Matrix3;
 use ridi_frames::{DeviceVec, QuatError, STANDARD_GRAVITY, WorldFromDevice, WorldVec};
 
 use crate::android;
-use crate::error::{DataError, Location, Result};
+use crate::error::{DataError, Location, Result, shown};
 use crate::mat::{MatFile, MatValue, dims_text};
 use crate::options::ReadOptions;
 use crate::resample::{interpolate_rot, interpolate_vec3, uniform_timeline};
@@ -395,11 +395,7 @@ impl TyrexRuns {
     /// when every run has it.
     pub fn warning(&self) -> Option<String> {
         (!self.without_mocap.is_empty()).then(|| {
-            let names: Vec<String> = self
-                .without_mocap
-                .iter()
-                .map(|p| p.display().to_string())
-                .collect();
+            let names: Vec<String> = self.without_mocap.iter().map(shown).collect();
             format!(
                 "{} run folder(s) without a Qualisys file in ../../qualisys/ skipped: {}",
                 names.len(),
@@ -466,13 +462,13 @@ pub fn list_sequences(root: impl AsRef<Path>) -> Result<TyrexRuns> {
         }
     }
     if out.runs.is_empty() && out.without_mocap.is_empty() {
-        let shown: Vec<String> = bases.iter().map(|b| b.display().to_string()).collect();
+        let names: Vec<String> = bases.iter().map(shown).collect();
         return Err(DataError::format(
             Location::file(&bases[0]),
             format!(
                 "no Tyrex sequence folder (with accelerometer.txt) here or in datasets/android/ \
                  or datasets/ios/ (looked in {})",
-                shown.join(", ")
+                names.join(", ")
             ),
         ));
     }
@@ -548,8 +544,8 @@ fn ground_truth_file(dir: &Path) -> Result<Option<PathBuf>> {
                 "{} Qualisys files match the run `{}` but for case ({} and {}): keep one",
                 found.len(),
                 dir.file_name().unwrap_or_default().to_string_lossy(),
-                first.display(),
-                second.display()
+                shown(first),
+                shown(second)
             ),
         )),
     }
@@ -761,7 +757,7 @@ fn read_stream<T>(
         warnings.push(format!(
             "{}:{line}: the file ends inside this record, without a line break (cut off while \
              being written): the record is left out",
-            path.display()
+            shown(path)
         ));
     }
     // About 45 bytes per row in these files: reserving avoids regrowing the vectors.
@@ -915,7 +911,7 @@ fn device_of(
             Err(e) => {
                 warnings.push(format!(
                     "{}:{line}: field `Model`: {e}: the device is taken from the run's name",
-                    file.display()
+                    shown(file)
                 ));
                 None
             }
@@ -944,7 +940,7 @@ fn clipping(acce: &Stream<DeviceVec>) -> Option<String> {
         format!(
             "{}: {:.1} % of the samples are clipped at +-{peak:.3} m/s^2: the accelerometer range \
              was exceeded",
-            acce.path.display(),
+            shown(&acce.path),
             share * 100.0
         )
     })
@@ -1144,7 +1140,7 @@ fn stream_intervals<T>(s: &Stream<T>, max_gap: f64, warnings: &mut Vec<String>) 
     intervals(&s.time, max_gap, |i| {
         warnings.push(format!(
             "{}:{}: gap of {:.3} s in the samples at {:.3} s (phone clock): recording split",
-            s.path.display(),
+            shown(&s.path),
             s.lines[i],
             s.time[i] - s.time[i - 1],
             s.time[i - 1]
@@ -1282,7 +1278,7 @@ pub fn read(dir: impl AsRef<Path>, options: &TyrexOptions) -> Result<TyrexRead> 
                  the accelerometer sides with the mocap, for {wrong} of {} mocap frames ({at}): \
                  gravity and linear acceleration derived from it are wrong there (tracking with \
                  the orientation estimated from gyro and accelerometer avoids them)",
-                rv.path.display(),
+                shown(&rv.path),
                 options.max_mocap_tilt_deg,
                 t.len()
             ));
@@ -1293,7 +1289,7 @@ pub fn read(dir: impl AsRef<Path>, options: &TyrexOptions) -> Result<TyrexRead> 
                 "{}: {dropped} of {} mocap frames tilted more than {} degrees from the phone's \
                  orientation, the accelerometer siding with the phone ({at}): the mocap \
                  mis-solved the body there; treated as mocap losses",
-                mat.display(),
+                shown(mat),
                 t.len(),
                 options.max_mocap_tilt_deg,
             ));
@@ -1317,7 +1313,7 @@ pub fn read(dir: impl AsRef<Path>, options: &TyrexOptions) -> Result<TyrexRead> 
                  {MOCAP_CHECK_WINDOW_S} s, or in its offset from the gyro's attitude) in {} \
                  stretch(es) ({}, phone clock, with {MOCAP_PAD_S} s margins): the rigid body was \
                  solved flipped there; {} of {before} mocap frames treated as mocap losses",
-                mat.display(),
+                shown(mat),
                 options.max_mocap_gyro_rad,
                 conflicts.len(),
                 spans_text(&conflicts),
@@ -1335,7 +1331,7 @@ pub fn read(dir: impl AsRef<Path>, options: &TyrexOptions) -> Result<TyrexRead> 
         let gt_spans = intervals(&t, options.max_mocap_gap_s, |i| {
             warnings.push(format!(
                 "{}: mocap lost the body for {:.3} s from {:.3} s (phone clock): recording split",
-                mat.display(),
+                shown(mat),
                 t[i] - t[i - 1],
                 t[i - 1]
             ));
@@ -1411,15 +1407,13 @@ pub fn read(dir: impl AsRef<Path>, options: &TyrexOptions) -> Result<TyrexRead> 
             text::sequence_error(path, None, &TyrexFields, e)
         })?;
         let jumps = seq.orientation_jumps();
-        warnings.extend(
-            orientation_jump_warning(&rv.path.display().to_string(), &jumps).map(|w| {
-                if options.bridge_orientation_jumps {
-                    format!("{w}; bridged by the gyro, the heading kept across them")
-                } else {
-                    w
-                }
-            }),
-        );
+        warnings.extend(orientation_jump_warning(&shown(&rv.path), &jumps).map(|w| {
+            if options.bridge_orientation_jumps {
+                format!("{w}; bridged by the gyro, the heading kept across them")
+            } else {
+                w
+            }
+        }));
         let seq = if options.bridge_orientation_jumps && !jumps.is_empty() {
             bridged(seq, &jumps, options.gravity, limits)
                 .map_err(|e| text::sequence_error(&rv.path, None, &TyrexFields, e))?

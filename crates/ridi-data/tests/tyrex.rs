@@ -254,6 +254,31 @@ fn a_mocap_flip_the_gyro_contradicts_is_cut_out_with_a_warning() {
 }
 
 #[test]
+fn warnings_escape_control_characters_in_the_paths_they_name() {
+    let fx = Fixture::standard();
+    // The run's folder under a root whose name holds a line break and a terminal escape.
+    let root = fx.root.with_file_name("ty\nrex\u{1b}[2J");
+    std::fs::rename(&fx.root, &root).unwrap();
+    let dir = root.join(fx.dir.strip_prefix(&fx.root).unwrap());
+    let path = dir.join("gyroscope-calibrated.txt");
+    let text = std::fs::read_to_string(&path).unwrap();
+    let kept: String = text
+        .lines()
+        .filter(|l| !l.starts_with("20."))
+        .map(|l| format!("{l}\n"))
+        .collect();
+    std::fs::write(&path, kept).unwrap();
+    let read = tyrex::read(&dir, &TyrexOptions::default()).unwrap();
+    let gap = read
+        .warnings
+        .iter()
+        .find(|w| w.contains("gap of"))
+        .expect("a gap warning");
+    assert!(!gap.chars().any(char::is_control), "{gap:?}");
+    assert!(gap.contains("ty\\nrex\\u{1b}[2J/"), "{gap}");
+}
+
+#[test]
 fn a_gap_in_a_phone_stream_splits_and_names_its_line() {
     let fx = Fixture::standard();
     // Drop 1 s of gyro samples around phone time 20 s.

@@ -321,7 +321,8 @@ impl Sequence {
 fn warn(py: Python<'_>, warnings: &[String]) -> PyResult<()> {
     let category = py.get_type::<PyUserWarning>();
     for w in warnings {
-        let text = std::ffi::CString::new(w.replace('\0', " ")).expect("no NUL left");
+        // Escaped as the command line prints them; `shown` escapes NUL too.
+        let text = std::ffi::CString::new(ridi::data::shown(w)).expect("NUL is escaped");
         PyErr::warn(py, &category, &text, 1)?;
     }
     Ok(())

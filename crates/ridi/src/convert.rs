@@ -148,7 +148,7 @@ fn sources(source: &Path, from: Option<Format>) -> Result<Sources, DataError> {
                     "no {want} here, but {} source(s) of another format (the first, {}, is \
                      {what}): convert without --from, or with that format",
                     other.len(),
-                    other[0].display()
+                    ridi_data::shown(&other[0])
                 ),
             )
         }
@@ -250,9 +250,9 @@ fn labels_from_lists(source: &Path) -> ListLabels {
                 Some(first) if *first != label => warnings.push(format!(
                     "{}:{}: placement `{label}` of {} differs from `{first}` in an earlier \
                      list: kept `{first}`",
-                    list.display(),
+                    ridi_data::shown(&list),
                     e.line,
-                    e.path.display()
+                    ridi_data::shown(&e.path)
                 )),
                 Some(_) => {}
             }

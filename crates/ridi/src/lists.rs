@@ -66,8 +66,8 @@ pub fn load_listed(
                         "a sequence named `{}` is already listed at {}:{} (another recording): \
                          an evaluation names its report rows and plots after the sequence; \
                          rename one",
-                        seq.name(),
-                        entries[j].list.display(),
+                        ridi_data::shown(seq.name()),
+                        ridi_data::shown(&entries[j].list),
                         entries[j].line
                     ),
                 )

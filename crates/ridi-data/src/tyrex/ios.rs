@@ -17,7 +17,7 @@ use ridi_frames::{DeviceVec, QuatError, Rot, STANDARD_GRAVITY, World, WorldFromD
 
 use super::{CutOff, PhoneStreams, Stream, device_of, ini_value, read_stream};
 use crate::OrientationSource;
-use crate::error::{DataError, Location, Result};
+use crate::error::{DataError, Location, Result, shown};
 use crate::text;
 
 /// Files only the iOS layout has (what [`layout_of`](super::layout_of) looks for).
@@ -179,7 +179,7 @@ fn clipping(acce: &Stream<DeviceVec>) -> Option<String> {
     Some(format!(
         "{}: {:.1} % of the samples are clipped near the largest reading of their axis ({} \
          m/s^2, within {:.0} %): the accelerometer range was exceeded",
-        acce.path.display(),
+        shown(&acce.path),
         share * 100.0,
         axes.join(", "),
         CLIP_BAND * 100.0
