@@ -90,6 +90,35 @@ def test_control_characters_in_names_are_escaped_as_the_cli_escapes_them(tmp_pat
         ridi.Sequence(**args)
 
 
+def test_reader_warnings_are_escaped_as_the_cli_prints_them(tmp_path):
+    # A Tyrex run (no motion capture) under a folder named with a line break and an escape
+    # sequence: a flat phone turning about z at 0.3 rad/s, 40 s at 200 Hz, gyro lost for 1 s.
+    run = tmp_path / "ty\nrex\x1b[2J" / "datasets" / "android" / "Ann_Nexus5_NoDist_Texting"
+    run.mkdir(parents=True)
+    t = 0.003 + np.arange(8000) / 200.0
+
+    def rows(cols):
+        return "".join(" ".join(f"{v:.9f}" for v in r) + "\n" for r in cols)
+
+    half = 0.15 * t
+    (run / "accelerometer.txt").write_text(
+        rows(np.c_[t, 0.1 * np.sin(t), np.zeros_like(t), np.full_like(t, 9.80665)]))
+    kept = (t < 19.5) | (t >= 20.5)
+    (run / "gyroscope-calibrated.txt").write_text(
+        rows(np.c_[t + 0.001, np.zeros_like(t), np.zeros_like(t), np.full_like(t, 0.3)][kept]))
+    (run / "rotation-vector.txt").write_text(rows(np.c_[
+        t, np.zeros_like(t), np.zeros_like(t), np.sin(half), np.cos(half), np.full_like(t, 0.17)]))
+    (run / "record.properties").write_text(
+        "[Device]\nManufacturer = LGE\nModel = Nexus 5\n[Time]\nStartTime = 1")
+    with pytest.warns(UserWarning) as caught:
+        parts = ridi.read_any(run)
+    assert len(parts) == 2
+    messages = [str(w.message) for w in caught]
+    gap = [m for m in messages if "gap of" in m]
+    assert gap, messages
+    assert "ty\\nrex\\u{1b}[2J" in gap[0] and not any(c in gap[0] for c in "\n\x1b"), gap[0]
+
+
 def test_a_corrupt_cell_is_named_by_file_line_and_field(tmp_path):
     folder = tmp_path / "run" / "processed"
     folder.mkdir(parents=True)
