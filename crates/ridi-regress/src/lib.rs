@@ -90,7 +90,7 @@
 //!
 //! (one query: CPU time on one thread; held-out: 2000 windows of later sequences; these
 //! features need 607 principal directions, so both models store half precision.) The model
-//! and the query no longer grow with the rows, and the held-out error stays the exact
+//! and the query do not grow with the rows, and the held-out error stays the exact
 //! solver's. On the real Tyrex features, whose exact models keep nearly every row as a support
 //! vector, the difference in speed is larger: `docs/benchmarks.md` ("Training at scale") has
 //! the figures on up to 430,000 rows, and the device protocol's accuracy.
