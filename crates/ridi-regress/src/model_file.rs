@@ -79,8 +79,11 @@ impl Cascade {
         decode(bytes)
     }
 
-    /// Writes the model file atomically: a temporary file in the same directory, `fsync`,
-    /// rename.
+    /// Writes the model file atomically: a temporary file in the same directory
+    /// (`.<name>.tmp<pid>-<n>`), `fsync`, rename. An error removes the temporary file; a process
+    /// killed while saving leaves it, since this crate keeps no record of other processes'
+    /// files. `ridi::save_model` writes through `ridi_data::write_atomically` instead, which
+    /// removes what killed runs left.
     pub fn save(&self, path: impl AsRef<Path>) -> Result<(), RegressError> {
         save(self, path.as_ref())
     }
