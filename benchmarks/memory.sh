@@ -1,7 +1,7 @@
 #!/bin/sh
 # Peak resident memory of `ridi track --online` (with and without a plot) and `ridi inspect` on
-# long synthetic recordings, a RIDI data.csv and a raw folder (docs/benchmarks.md, "Memory of
-# long recordings").
+# long synthetic recordings, a RIDI data.csv and a raw folder, beside `ridi track` in batch,
+# which reads the recording whole (docs/benchmarks.md, "Memory of long recordings").
 # Usage: benchmarks/memory.sh [RIDI_BINARY] [ROWS...]
 # Defaults: target/release/ridi (cargo build --release -p ridi-cli), 1000000 and 10000000 rows.
 # Needs python3 and GNU time (/usr/bin/time); writes up to 3.1 GB into a temporary folder.
@@ -29,6 +29,8 @@ for n in $rows; do
         /usr/bin/time -f "$n rows, $source: track --online --plot peak %M KiB, %e s" \
             "$ridi" track "$tmp/$source" --model "$tmp/m.ridi" --online --out "$tmp/t.csv" \
             --plot "$tmp/t.png" > /dev/null
+        /usr/bin/time -f "$n rows, $source: track (batch, read whole) peak %M KiB, %e s" \
+            "$ridi" track "$tmp/$source" --model "$tmp/m.ridi" --out "$tmp/t.csv" > /dev/null
     done
     rm -rf "$tmp/long.csv" "$tmp/raw" "$tmp/t.csv" "$tmp/t.png"
 done
