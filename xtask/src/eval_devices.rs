@@ -358,14 +358,7 @@ fn per_run(tested: &[Tested]) -> Vec<RunFigures> {
     for t in tested {
         let e = runs.entry(t.run).or_insert_with(|| {
             let placement = t.result.placement.clone().unwrap_or_else(|| "-".into());
-            (
-                placement,
-                (
-                    [FiniteMean::default(); METRICS.len()],
-                    [FiniteMean::default(); 4],
-                    false,
-                ),
-            )
+            (placement, Sums::default())
         });
         let w = t.frames as f64;
         for (acc, m) in e.1.0.iter_mut().zip(&METRICS) {
@@ -381,15 +374,14 @@ fn per_run(tested: &[Tested]) -> Vec<RunFigures> {
         }
         e.1.2 |= t.bridged_rte != (METRICS[RTE].of)(&t.result);
     }
-    let mean = |m: FiniteMean| m.mean();
     runs.into_iter()
         .map(
             |(run, (placement, (sums, [bridged, speed, direction, truth], jumps)))| RunFigures {
                 run,
                 placement,
-                values: sums.map(mean),
-                bridged_rte: mean(bridged),
-                swapped_rte: [mean(speed), mean(direction), mean(truth)],
+                values: sums.map(|m| m.mean()),
+                bridged_rte: bridged.mean(),
+                swapped_rte: [speed, direction, truth].map(|m| m.mean()),
                 jumps,
             },
         )

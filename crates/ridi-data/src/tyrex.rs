@@ -160,7 +160,7 @@ use crate::mat::{MatFile, MatValue, dims_text};
 use crate::options::ReadOptions;
 use crate::resample::{interpolate_rot, interpolate_vec3, uniform_timeline};
 use crate::text::{self, Nan};
-use crate::validation::orientation_jump_warning;
+use crate::validation::{orientation_jump_warning, spans_text};
 use crate::{
     Channel, DeviceInfo, GroundTruth, OrientationJump, OrientationSource, Sequence, SequenceError,
     SequenceParts, Validation, bridge_orientation_jumps,
@@ -1086,20 +1086,6 @@ fn verdict_spans(time: &[f64], verdicts: &[TiltVerdict], which: TiltVerdict) -> 
         }
     }
     (frames, spans_text(&spans))
-}
-
-/// The first few of `spans`, `a-b s`, and how many more there are.
-fn spans_text(spans: &[(f64, f64)]) -> String {
-    const SHOWN: usize = 5;
-    let mut text: Vec<String> = spans
-        .iter()
-        .take(SHOWN)
-        .map(|(a, b)| format!("{a:.2}-{b:.2} s"))
-        .collect();
-    if spans.len() > SHOWN {
-        text.push(format!("and {} more", spans.len() - SHOWN));
-    }
-    text.join(", ")
 }
 
 /// Mocap frames: times (phone clock), positions, orientations.

@@ -511,7 +511,7 @@ pub fn bridge_orientation_jumps(
 }
 
 /// The device's rotation over one step of the gyro (the mean of its two readings).
-fn gyro_step(dt: f64, g0: DeviceVec, g1: DeviceVec) -> ridi_frames::Rot<Device, Device> {
+pub(crate) fn gyro_step(dt: f64, g0: DeviceVec, g1: DeviceVec) -> ridi_frames::Rot<Device, Device> {
     let w = ((g0 + g1) * (0.5 * dt)).to_array();
     ridi_frames::Rot::from_scaled_axis(Vector3::new(w[0], w[1], w[2]))
 }
@@ -527,17 +527,9 @@ fn yaw_between(to: WorldFromDevice, from: WorldFromDevice) -> WorldFromWorld {
 /// One line for a reader's warnings about `jumps` in the orientation read from `file`:
 /// how many, where (the first few), how fast; `None` without jumps.
 pub(crate) fn orientation_jump_warning(file: &str, jumps: &[OrientationJump]) -> Option<String> {
-    const SHOWN: usize = 5;
     let peak = jumps.iter().map(|j| j.peak_rate).fold(0.0, f64::max);
     let steps: usize = jumps.iter().map(|j| j.fast_steps).sum();
-    let mut at: Vec<String> = jumps
-        .iter()
-        .take(SHOWN)
-        .map(|j| format!("{:.2}-{:.2} s", j.time.0, j.time.1))
-        .collect();
-    if jumps.len() > SHOWN {
-        at.push(format!("and {} more", jumps.len() - SHOWN));
-    }
+    let at: Vec<(f64, f64)> = jumps.iter().map(|j| j.time).collect();
     (!jumps.is_empty()).then(|| {
         format!(
             "{file}: the orientation jumps {} time(s) ({steps} frame steps turning at up to {} \
@@ -545,9 +537,24 @@ pub(crate) fn orientation_jump_warning(file: &str, jumps: &[OrientationJump]) ->
              clock): OS heading corrections or resets, left out of the gyro check",
             jumps.len(),
             short(peak),
-            at.join(", ")
+            spans_text(&at)
         )
     })
+}
+
+/// The first few of `spans`, `a-b s`, and how many more there are: where a warning's findings
+/// are.
+pub(crate) fn spans_text(spans: &[(f64, f64)]) -> String {
+    const SHOWN: usize = 5;
+    let mut text: Vec<String> = spans
+        .iter()
+        .take(SHOWN)
+        .map(|(a, b)| format!("{a:.2}-{b:.2} s"))
+        .collect();
+    if spans.len() > SHOWN {
+        text.push(format!("and {} more", spans.len() - SHOWN));
+    }
+    text.join(", ")
 }
 
 /// Smallest RMS rotation rate of the orientation, rad/s, at which

@@ -16,6 +16,7 @@
 use ridi_frames::{Device, DeviceVec, Rot, WorldFromDevice};
 
 use crate::resample::interpolate_rot;
+use crate::validation::gyro_step;
 
 /// Window over which the mocap's rotation is checked against the gyro's, s: long enough that a
 /// flip interpolated across a short loss shows as one large disagreement, short enough that
@@ -72,15 +73,13 @@ pub fn mocap_gyro_conflicts(
         return Vec::new();
     }
     let gyro_time = &gyro_time[..g];
-    // The gyro's attitude: each sample's device frame seen from the first sample's. Trapezoidal
-    // rates.
+    // The gyro's attitude: each sample's device frame seen from the first sample's.
     let mut attitude: Vec<Rot<Device, Device>> = Vec::with_capacity(g);
     let mut q = Rot::<Device, Device>::identity();
     for k in 0..g {
         if k > 0 {
             let dt = (gyro_time[k] - gyro_time[k - 1]).max(0.0);
-            let rate = (*gyro[k - 1].vector() + *gyro[k].vector()) * 0.5;
-            q = q * Rot::from_scaled_axis(rate * dt);
+            q = q * gyro_step(dt, gyro[k - 1], gyro[k]);
         }
         attitude.push(q);
     }
