@@ -409,8 +409,8 @@ pub fn evaluate(data: &Path, phone: Phone, mut progress: impl FnMut(&str)) -> Re
             |n| n.to_string_lossy().into_owned(),
         );
         progress(&format!(
-            "{name}: {} part(s) evaluated",
-            parts.len() - before
+            "{name}: {} evaluated",
+            ridi_data::counted(parts.len() - before, "part")
         ));
     }
     if parts.is_empty() {

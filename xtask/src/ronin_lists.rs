@@ -84,8 +84,8 @@ pub fn write_lists(root: &Path, protocols: &Path) -> Result<(Vec<PathBuf>, Vec<S
         if !missing.is_empty() {
             let _ = writeln!(out, "# missing: {}", missing.join(" "));
             warnings.push(format!(
-                "ronin: {} sequence(s) of `{split}` not in {}: {}",
-                missing.len(),
+                "ronin: {} of `{split}` not in {}: {}",
+                ridi_data::counted(missing.len(), "sequence"),
                 root.display(),
                 missing.join(" ")
             ));

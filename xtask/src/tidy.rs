@@ -87,7 +87,10 @@ pub fn run(root: &Path) -> Result<()> {
     for p in &problems {
         let _ = writeln!(text, "  {p}");
     }
-    bail!("tidy found {} problem(s):\n{text}", problems.len())
+    bail!(
+        "tidy found {}:\n{text}",
+        ridi_data::counted(problems.len(), "problem")
+    )
 }
 
 /// A workspace crate: its folder and the workspace crates it depends on.

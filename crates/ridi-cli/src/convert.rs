@@ -19,9 +19,15 @@ pub(crate) struct Args {
     #[arg(long, value_enum)]
     from: Option<FromFormat>,
     /// Resample every sequence to this rate, 1.001 to 9990 Hz (linear interpolation, slerp
-    /// for rotations); a gap longer than 5 frame intervals is refused: split it first.
+    /// for rotations); a gap longer than 5 frame intervals is refused: split it first
+    /// (--split-at-gaps).
     #[arg(long, value_name = "HZ", value_parser = rate_hz)]
     rate: Option<f64>,
+    /// Cut every sequence at each gap longer than this (before --rate), into parts named
+    /// `<name>_part1`, `_part2`, ...; parts shorter than 1 s are dropped with a warning. 0.1 cuts
+    /// where `ridi track` refuses a gap. The readers refuse gaps longer than 1 s whatever this says
+    #[arg(long, value_name = "SECONDS", value_parser = gap_s)]
+    split_at_gaps: Option<f64>,
 }
 
 #[derive(Clone, Copy, ValueEnum)]
@@ -64,18 +70,33 @@ fn rate_hz(text: &str) -> std::result::Result<f64, String> {
     }
 }
 
+/// `--split-at-gaps`: a positive number of seconds below the readers' longest gap (1 s), or
+/// nothing would ever be cut.
+fn gap_s(text: &str) -> std::result::Result<f64, String> {
+    let max = ReadOptions::default().validation.max_gap_s;
+    match text.parse::<f64>() {
+        Ok(x) if x > 0.0 && x < max => Ok(x),
+        _ => Err(format!(
+            "`{text}` is not a number of seconds above 0 and below {max} (the longest gap the \
+             readers accept)"
+        )),
+    }
+}
+
 pub(crate) fn run(
     Args {
         source,
         out,
         from,
         rate,
+        split_at_gaps,
     }: Args,
 ) -> Result<()> {
     let opts = ridi::ConvertOptions {
         from: from.map(Format::from),
         read: ReadOptions::default(),
         rate_hz: rate,
+        split_gaps_s: split_at_gaps,
     };
     ridi::check_output_folder(&out)?;
     let summary = ridi::convert(&source, &out, &opts)?;

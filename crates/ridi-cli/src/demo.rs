@@ -14,7 +14,8 @@ pub(crate) struct Args {
     /// Output folder.
     #[arg(long, default_value = "demo-out")]
     out: PathBuf,
-    /// The bundled sample folder (default: datasets/sample of this checkout).
+    /// The bundled sample folder, holding list_train.txt and list_test.txt (default:
+    /// datasets/sample of the current folder, else of the checkout this binary was built from).
     #[arg(long)]
     data: Option<PathBuf>,
     /// Regressor hyper-parameter search.
@@ -26,8 +27,16 @@ pub(crate) struct Args {
 }
 
 pub(crate) fn run(args: Args) -> Result<()> {
+    let given = args.data.is_some();
     let data = args.data.unwrap_or_else(bundled_sample);
     if !data.join("list_train.txt").is_file() {
+        if given {
+            bail!(
+                "{}: no list_train.txt here: --data takes a folder laid out as the bundled \
+                 sample (list_train.txt and list_test.txt beside the recordings they list)",
+                shown(&data)
+            );
+        }
         bail!(
             "no bundled sample at {} (give its folder with --data)",
             shown(&data)

@@ -1,7 +1,7 @@
 //! `ridi eval`: RIDI and the baselines on labelled recordings, into a report folder; and the
 //! printing of an evaluation, which `ridi demo` shares.
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 use anyhow::Result;
 use indicatif::ProgressBar;
@@ -33,7 +33,7 @@ pub(crate) struct Args {
         value_delimiter = ',',
         default_value = "ridi,raw,pdr,ridi_mag,ridi_ori,velocity,still"
     )]
-    methods: Vec<String>,
+    methods: Vec<Method>,
     /// Group placement labels as at training (`tyrex4` or a `label,class` file).
     #[arg(long)]
     placement_map: Option<String>,
@@ -64,8 +64,7 @@ pub(crate) fn run(args: Args) -> Result<()> {
     crate::set_jobs(args.jobs)?;
     let folder = EvalFolder::new(&args.out, args.plots.into())?;
     let mut methods: Vec<Method> = Vec::new();
-    for m in &args.methods {
-        let m = m.parse::<Method>().map_err(anyhow::Error::msg)?;
+    for &m in &args.methods {
         if !methods.contains(&m) {
             methods.push(m);
         }
@@ -122,14 +121,19 @@ pub(crate) fn print_written(report: &Report, written: &EvalWritten, folder: &Eva
     print_summary(report);
     let stale = written.stale_plots;
     outln!(
-        "wrote {} files into {} (report.md, report.json{}){}",
-        written.plots.len() + written.reports.len(),
+        "wrote {} files into {} (report.md, report.json{}{}){}",
+        written.plots.len() + written.reports.len() + usize::from(written.model.is_some()),
         shown(folder.dir()),
         if folder.plots() != EvalPlots::None {
             ", plots/"
         } else {
             ""
         },
+        written
+            .model
+            .as_deref()
+            .and_then(Path::file_name)
+            .map_or(String::new(), |m| format!(", {}", shown(m))),
         if stale > 0 {
             format!("; removed {stale} plots of an earlier evaluation from plots/")
         } else {

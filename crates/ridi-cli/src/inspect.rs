@@ -11,7 +11,8 @@ use ridi::regress::MODEL_MAGIC;
 #[derive(clap::Args)]
 pub(crate) struct Args {
     /// A RIDI data.csv, data_plain.txt, RIDI raw folder, Tyrex sequence folder, Indoor
-    /// Location Competition path file, or a model file of `ridi train`.
+    /// Location Competition path file, RoNIN sequence folder (data.hdf5, info.json), or a
+    /// model file of `ridi train`.
     sequence: PathBuf,
     /// Print JSON instead of text: one object, or an array of the parts of a recording
     /// split at its gaps (each with the reader's warnings).

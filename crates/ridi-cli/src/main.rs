@@ -67,7 +67,8 @@ enum Command {
         ridi convert indoor-location-competition-20/data --from ilc --out converted\n  \
         ridi convert phone_at_100hz/ --out converted --rate 200   (train, track and eval need 200 Hz)\n\n\
         Writes <out>/<name>/processed/data.csv per sequence and list files \
-        (`path,placement` per line): for a Tyrex root, list_<subject>.txt per person and list_all.txt.")]
+        (`path,placement` per line): list_all.txt, list_<device>.txt per device (when the sources name \
+        theirs) and, for a Tyrex root, list_<person>.txt per person.")]
     Convert(convert::Args),
 
     /// Train the placement classifier and velocity regressors on labelled recordings.

@@ -12,8 +12,8 @@ use crate::{Heading, MAX_FRAMES_APART, count, non_negative, placement_smoothing,
 
 #[derive(clap::Args)]
 pub(crate) struct Args {
-    /// A RIDI data.csv, data_plain.txt, raw folder, Tyrex run, or Indoor Location
-    /// Competition path file.
+    /// A RIDI data.csv, data_plain.txt, raw folder, Tyrex run, Indoor Location Competition
+    /// path file, or RoNIN sequence folder (data.hdf5, info.json).
     sequence: PathBuf,
     /// Model file from `ridi train` [default: the bundled model, trained on every shared
     /// Tyrex run; docs/model-card.md].

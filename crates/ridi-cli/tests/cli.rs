@@ -546,9 +546,10 @@ fn convert_train_track_and_eval() {
         "--methods",
         "ridi,magic",
     ]);
-    assert!(!out.status.success());
+    // A usage error, as for any bad flag value: clap's message and exit code 2.
+    assert_eq!(out.status.code(), Some(2));
     assert!(
-        stderr(&out).contains("unknown method `magic`"),
+        stderr(&out).contains("invalid value 'magic' for '--methods <METHODS>'"),
         "{}",
         stderr(&out)
     );

@@ -149,7 +149,8 @@ pub(crate) fn locate(path: &Path) -> Result<(Format, PathBuf)> {
         Location::file(path),
         "not a known dataset folder: expected processed/data.csv, data.csv, data_plain.txt, \
          a RIDI raw folder (gyro.txt, acce.txt, ...), a Tyrex folder (accelerometer.txt, \
-         gyroscope-calibrated.txt or attitude.txt) or a RoNIN folder (data.hdf5, info.json)",
+         gyroscope-calibrated.txt or attitude.txt) or a RoNIN folder (data.hdf5, info.json); \
+         a folder of recordings (a dataset's root) is read by `ridi convert`",
     ))
 }
 

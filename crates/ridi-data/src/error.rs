@@ -42,6 +42,17 @@ impl Location {
     }
 }
 
+/// `n` and `noun` in agreement, for a message: `1 run`, `2 runs`, `3 stretches` (`noun` is
+/// singular; `-es` after s, x, ch and sh).
+pub fn counted(n: usize, noun: &str) -> String {
+    let ending = match n {
+        1 => "",
+        _ if ["s", "x", "ch", "sh"].iter().any(|e| noun.ends_with(e)) => "es",
+        _ => "s",
+    };
+    format!("{n} {noun}{ending}")
+}
+
 /// `text` (a path, a sequence name, a message) for a message, with control characters escaped
 /// (`\n`, `\u{1b}`; DEL and the C1 controls U+0080-U+009F too, `\u{9b}` being a CSI to some
 /// terminals): a file or sequence name may hold a line break or a terminal escape
@@ -109,8 +120,15 @@ pub enum DataError {
 }
 
 impl DataError {
-    /// An I/O error on `path`.
+    /// An I/O error on `path`. A missing file reads "no such file or folder", as the readers
+    /// say it for a path that names neither (the error's kind is kept).
     pub fn io(path: impl AsRef<Path>, error: std::io::Error) -> Self {
+        let error = match error.kind() {
+            std::io::ErrorKind::NotFound => {
+                std::io::Error::new(error.kind(), "no such file or folder")
+            }
+            _ => error,
+        };
         DataError::Io {
             path: path.as_ref().to_path_buf(),
             error,
@@ -138,7 +156,7 @@ impl DataError {
 pub type Result<T, E = DataError> = std::result::Result<T, E>;
 
 #[cfg(test)]
-mod escaping_tests {
+mod tests {
     use super::*;
 
     #[test]
@@ -175,5 +193,20 @@ mod escaping_tests {
             assert!(!once.chars().any(char::is_control), "{once:?}");
             assert_eq!(shown(&once), once);
         }
+    }
+
+    #[test]
+    fn counts_agree_with_their_nouns_and_missing_files_are_worded_as_the_readers_word_them() {
+        assert_eq!(counted(1, "run folder"), "1 run folder");
+        assert_eq!(counted(0, "frame step"), "0 frame steps");
+        assert_eq!(counted(2, "stretch"), "2 stretches");
+        assert_eq!(counted(3, "box"), "3 boxes");
+        let gone = std::io::Error::from(std::io::ErrorKind::NotFound);
+        let e = DataError::io("a/list.txt", gone);
+        assert_eq!(e.to_string(), "a/list.txt: no such file or folder");
+        let DataError::Io { error, .. } = e else {
+            panic!("{e:?}")
+        };
+        assert_eq!(error.kind(), std::io::ErrorKind::NotFound);
     }
 }

@@ -96,7 +96,7 @@ use std::path::{Path, PathBuf};
 use ridi_frames::{Frame, STANDARD_GRAVITY, Vec3, World, WorldFromDevice};
 
 use crate::android;
-use crate::error::{DataError, Location, Result};
+use crate::error::{DataError, Location, Result, counted};
 use crate::options::ReadOptions;
 use crate::resample::{interpolate_rot, interpolate_vec3, uniform_timeline};
 use crate::text::{self, Nan};
@@ -378,8 +378,8 @@ pub fn parse(bytes: &[u8], path: &Path, options: &IlcOptions) -> Result<IlcPath>
         return Err(DataError::format(
             Location::file(path).with_field(KINDS[WAYPOINT].name),
             format!(
-                "{} TYPE_WAYPOINT record(s): the ground truth needs at least 2",
-                wp.time.len()
+                "{}: the ground truth needs at least 2",
+                counted(wp.time.len(), "TYPE_WAYPOINT record")
             ),
         ));
     }
@@ -868,7 +868,7 @@ mod tests {
         });
         assert_eq!(
             err(&only_first),
-            "p/abc.txt: field `TYPE_WAYPOINT`: 1 TYPE_WAYPOINT record(s): the ground truth \
+            "p/abc.txt: field `TYPE_WAYPOINT`: 1 TYPE_WAYPOINT record: the ground truth \
              needs at least 2"
         );
         let same = good.replace(

@@ -110,7 +110,7 @@ mod write;
 
 pub use detect::{Format, detect, read_sequence, source_files};
 pub use device::{DeviceError, DeviceInfo};
-pub use error::{DataError, Location, Result, shown};
+pub use error::{DataError, Location, Result, counted, shown};
 pub use file_id::FileId;
 #[cfg(feature = "internals")]
 #[doc(hidden)]
@@ -131,6 +131,7 @@ pub use temporaries::{
     Temporary, hold_temporaries, register_temporary, remove_temporaries_for_exit, remove_temporary,
     stale_temporaries, temporary_prefix,
 };
+pub use text::read_text;
 pub use validation::{
     GYRO_SCALE_MIN_RATE, LINACCE_SCALE_MIN_RMS, MAX_JUMP_SHARE, ORIENTATION_JUMP_RATE,
     OrientationJump, Validation, bridge_orientation_jumps, orientation_jumps,

@@ -81,7 +81,7 @@ use std::path::{Path, PathBuf};
 use ridi_frames::{DeviceVec, QuatError, STANDARD_GRAVITY, WorldFromDevice, WorldVec};
 use serde_json::Value;
 
-use crate::error::{DataError, Location, Result};
+use crate::error::{DataError, Location, Result, counted};
 use crate::hdf5::Hdf5File;
 use crate::options::ReadOptions;
 use crate::text;
@@ -243,7 +243,7 @@ pub fn parse(
     if n < 2 {
         return Err(h5.error(
             "synced/time",
-            format!("{n} frame(s): a sequence needs at least 2"),
+            format!("{}: a sequence needs at least 2", counted(n, "frame")),
         ));
     }
     let start = info.start_frame;

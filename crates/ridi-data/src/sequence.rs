@@ -502,8 +502,8 @@ impl Sequence {
     }
 
     /// The sequence on a uniform timeline at `rate_hz` from its first frame to at most its
-    /// last: vectors (IMU and ground-truth positions) linearly interpolated, rotations by
-    /// slerp, step times and the device kept. For a recording at another rate than a model's (RIDI models
+    /// last: vectors (IMU and ground-truth positions) and the step count linearly
+    /// interpolated, rotations by slerp, the device kept. For a recording at another rate than a model's (RIDI models
     /// count frames of a 200 Hz stream); `ridi convert --rate` applies it.
     ///
     /// # Errors
@@ -511,7 +511,9 @@ impl Sequence {
     /// `max_gap_s` (interpolating would invent the frames of a gap: split the recording
     /// there first); the default validation of the result.
     pub fn resampled(&self, rate_hz: f64, max_gap_s: f64) -> Result<Sequence, SequenceError> {
-        use crate::resample::{interpolate_rot, interpolate_vec3, uniform_timeline};
+        use crate::resample::{
+            interpolate_rot, interpolate_scalar, interpolate_vec3, uniform_timeline,
+        };
         if !(rate_hz.is_finite() && rate_hz > 0.0) {
             return Err(SequenceError::InvalidRate { rate_hz });
         }
@@ -534,10 +536,34 @@ impl Sequence {
                 position: interpolate_vec3(t, &gt.position, &time),
                 orientation: interpolate_rot(t, &gt.orientation, &time),
             }),
-            steps: p.steps.clone(),
+            steps: p.steps.as_deref().map(|s| interpolate_scalar(t, s, &time)),
             device: p.device.clone(),
             time,
         })
+    }
+
+    /// The stretches between the gaps longer than `max_gap_s` (intervals between frames), in
+    /// order; the whole sequence when it has none. Several are named as the Tyrex reader names
+    /// the parts of a run it splits: `<name>_part1`, `<name>_part2`, ... A stretch may be as
+    /// short as one frame: what is too short to use is the caller's to drop.
+    pub fn split_at_gaps(&self, max_gap_s: f64) -> Vec<Sequence> {
+        let t = self.time();
+        let mut bounds: Vec<usize> = std::iter::once(0)
+            .chain((1..t.len()).filter(|&i| t[i] - t[i - 1] > max_gap_s))
+            .collect();
+        if bounds.len() == 1 {
+            return vec![self.clone()];
+        }
+        bounds.push(t.len());
+        bounds
+            .windows(2)
+            .enumerate()
+            .map(|(k, w)| {
+                let mut part = self.slice(w[0]..w[1]);
+                part.set_name(format!("{}_part{}", self.name(), k + 1));
+                part
+            })
+            .collect()
     }
 
     /// The frames in `range`, as a new sequence with the same name, labels and device.

@@ -31,6 +31,16 @@ pub(crate) fn read_file_bounded(path: &Path, max: u64) -> Result<Vec<u8>> {
     gunzip_if_gzip(bytes, path)
 }
 
+/// The text of a small file (a list, a placement map, a report): at most `max` bytes on disk,
+/// gzip-compressed or not, UTF-8 with or without a byte-order mark. What is not a regular file
+/// (a folder, `/dev/zero`, a pipe) is refused before reading; errors name the file (and the
+/// line that is not UTF-8).
+pub fn read_text(path: impl AsRef<Path>, max: u64) -> Result<String> {
+    let path = path.as_ref();
+    let bytes = read_file_bounded(path, max)?;
+    as_text(&bytes, path).map(str::to_owned)
+}
+
 /// The metadata of `path`, refused when it is not a regular file (a folder, `/dev/zero`, a
 /// pipe): a device can hand out bytes for ever.
 pub(crate) fn regular_file(path: &Path) -> Result<std::fs::Metadata> {

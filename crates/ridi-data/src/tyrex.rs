@@ -155,7 +155,7 @@ use ridi_frames::nalgebra::Matrix3;
 use ridi_frames::{DeviceVec, QuatError, STANDARD_GRAVITY, WorldFromDevice, WorldVec};
 
 use crate::android;
-use crate::error::{DataError, Location, Result, shown};
+use crate::error::{DataError, Location, Result, counted, shown};
 use crate::mat::{MatFile, MatValue, dims_text};
 use crate::options::ReadOptions;
 use crate::resample::{interpolate_rot, interpolate_vec3, uniform_timeline};
@@ -397,8 +397,8 @@ impl TyrexRuns {
         (!self.without_mocap.is_empty()).then(|| {
             let names: Vec<String> = self.without_mocap.iter().map(shown).collect();
             format!(
-                "{} run folder(s) without a Qualisys file in ../../qualisys/ skipped: {}",
-                names.len(),
+                "{} without a Qualisys file in ../../qualisys/ skipped: {}",
+                counted(names.len(), "run folder"),
                 names.join(", ")
             )
         })
@@ -1297,11 +1297,11 @@ pub fn read(dir: impl AsRef<Path>, options: &TyrexOptions) -> Result<TyrexRead> 
             warnings.push(format!(
                 "{}: the mocap's rotation contradicts the gyro's (by more than {} rad over \
                  {MOCAP_CHECK_WINDOW_S} s, or in its offset from the gyro's attitude) in {} \
-                 stretch(es) ({}, phone clock, with {MOCAP_PAD_S} s margins): the rigid body was \
+                 ({}, phone clock, with {MOCAP_PAD_S} s margins): the rigid body was \
                  solved flipped there; {} of {before} mocap frames treated as mocap losses",
                 shown(mat),
                 options.max_mocap_gyro_rad,
-                conflicts.len(),
+                counted(conflicts.len(), "stretch"),
                 spans_text(&conflicts),
                 before - t.len(),
             ));

@@ -7,6 +7,7 @@ use ridi_frames::{Device, DeviceVec, World, WorldFromDevice, WorldVec};
 /// A turn of the world frame.
 type WorldFromWorld = ridi_frames::Rot<World, World>;
 
+use crate::error::counted;
 use crate::sequence::{Channel, norm};
 use crate::sequence_error::{SequenceError, short};
 
@@ -532,10 +533,11 @@ pub(crate) fn orientation_jump_warning(file: &str, jumps: &[OrientationJump]) ->
     let at: Vec<(f64, f64)> = jumps.iter().map(|j| j.time).collect();
     (!jumps.is_empty()).then(|| {
         format!(
-            "{file}: the orientation jumps {} time(s) ({steps} frame steps turning at up to {} \
+            "{file}: the orientation jumps {} ({} turning at up to {} \
              rad/s, more than {ORIENTATION_JUMP_RATE} rad/s faster than the gyro) at {} (phone \
              clock): OS heading corrections or resets, left out of the gyro check",
-            jumps.len(),
+            counted(jumps.len(), "time"),
+            counted(steps, "frame step"),
             short(peak),
             spans_text(&at)
         )

@@ -149,6 +149,39 @@ fn slices_and_resampling_keep_the_device() {
     );
 }
 
+/// `split_at_gaps` cuts at each gap over the limit and only there, names the parts as the
+/// Tyrex reader does, and keeps every channel and the device; resampling interpolates the step
+/// counter with the rest (it kept the old timeline's steps, which the new one refused).
+#[test]
+fn splits_at_gaps_and_resampling_keep_every_channel() {
+    let seq = with_device("walk");
+    assert_eq!(seq.split_at_gaps(0.1), std::slice::from_ref(&seq));
+    let mut parts = seq.clone().into_parts();
+    let steps: Vec<f64> = (0..seq.len()).map(|i| (i / 40) as f64).collect();
+    parts.steps = Some(steps.clone());
+    // Gaps of 0.2 s before frames 100 and 250, a 0.05 s one before frame 200.
+    for (i, t) in parts.time.iter_mut().enumerate() {
+        *t += 0.2 * [100, 250].iter().filter(|&&g| i >= g).count() as f64
+            + 0.045 * f64::from(u8::from(i >= 200));
+    }
+    let gappy = Sequence::new(parts).unwrap();
+    let split = gappy.split_at_gaps(0.1);
+    let names: Vec<&str> = split.iter().map(Sequence::name).collect();
+    assert_eq!(names, ["walk_part1", "walk_part2", "walk_part3"]);
+    let lens: Vec<usize> = split.iter().map(Sequence::len).collect();
+    assert_eq!(lens, [100, 150, gappy.len() - 250]);
+    assert_eq!(split[1].time()[0], gappy.time()[100]);
+    assert_eq!(split[1].steps().unwrap(), &steps[100..250]);
+    assert_eq!(split[2].gyro(), &gappy.gyro()[250..]);
+    assert!(split.iter().all(|s| s.device() == Some(&iphone())));
+    assert_eq!(gappy.split_at_gaps(1.0).len(), 1);
+
+    let at_100 = split[1].resampled(100.0, 0.05).unwrap();
+    let counted = at_100.steps().unwrap();
+    assert_eq!(counted.len(), at_100.len());
+    assert_eq!((counted[0], counted[counted.len() - 1]), (2.0, 6.0));
+}
+
 #[test]
 fn a_bad_sidecar_names_its_file_line_and_key() {
     let dir = tempfile::tempdir().unwrap();

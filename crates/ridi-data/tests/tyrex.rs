@@ -350,7 +350,7 @@ fn lists_sequence_folders_from_the_root() {
     assert_eq!(found.without_mocap, std::slice::from_ref(&old));
     let warning = found.warning().unwrap();
     assert!(
-        warning.starts_with("1 run folder(s) without a Qualisys file")
+        warning.starts_with("1 run folder without a Qualisys file")
             && warning.ends_with(&format!("skipped: {}", old.display())),
         "{warning}"
     );
@@ -882,7 +882,7 @@ fn os_orientation_jumps_are_a_warning_not_a_gyro_unit_error() {
         .collect();
     assert_eq!(warning.len(), 1, "{:?}", read.warnings);
     assert!(
-        warning[0].contains("rotation-vector.txt: the orientation jumps 3 time(s)")
+        warning[0].contains("rotation-vector.txt: the orientation jumps 3 times")
             && warning[0].contains("at 5.00-5.03 s, 14.99-15.03 s, 25.00-25.02 s (phone clock)")
             && warning[0].contains("left out of the gyro check"),
         "{}",

@@ -54,8 +54,16 @@ fn file_kind(e: &PipelineError) -> Option<ErrorKind> {
     match e {
         PipelineError::Data(d) => data_kind(d),
         PipelineError::Regress(r) => regress_kind(r),
-        PipelineError::Output(OutputError::Io { error, .. }) => Some(error.kind()),
-        PipelineError::Output(_) => Some(ErrorKind::Other),
+        PipelineError::Output(o) => Some(match o {
+            OutputError::Io { error, .. } => error.kind(),
+            OutputError::NoFolder { .. } => ErrorKind::NotFound,
+            OutputError::IsFolder { .. } | OutputError::FolderName { .. } => {
+                ErrorKind::IsADirectory
+            }
+            OutputError::FolderNotWritable { kind, .. }
+            | OutputError::ParentNotWritable { kind, .. } => *kind,
+            _ => ErrorKind::Other,
+        }),
         // Reports and placement maps: a file that is not there is a file error, one that does
         // not parse a data error.
         PipelineError::File { path, .. } if !path.exists() => Some(ErrorKind::NotFound),
@@ -91,9 +99,11 @@ pub(crate) fn pipeline(e: PipelineError) -> PyErr {
 /// A pipeline error as a Python exception, its message prefixed with `context` when given
 /// (`cannot write m.ridi`, as the command line says it).
 pub(crate) fn pipeline_in(e: PipelineError, context: Option<String>) -> PyErr {
+    let line = one_line(&e);
+    // An output's own error says "cannot write <path>" already.
     let message = match context {
-        Some(c) => format!("{c}: {}", one_line(&e)),
-        None => one_line(&e),
+        Some(c) if !line.starts_with(&c) => format!("{c}: {line}"),
+        _ => line,
     };
     match file_kind(&e) {
         Some(kind) => os_error(kind, message),

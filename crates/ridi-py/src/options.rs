@@ -126,14 +126,8 @@ pub(crate) fn track_options(
 
 /// `placement_map`: `"tyrex4"` or a file of `label,class` lines, as `--placement-map`.
 pub(crate) fn placement_map(map: Option<PathBuf>) -> PyResult<Option<PlacementMap>> {
-    map.map(|m| {
-        if m.as_os_str() == "tyrex4" {
-            Ok(PlacementMap::tyrex_groups())
-        } else {
-            PlacementMap::read(&m).map_err(errors::pipeline)
-        }
-    })
-    .transpose()
+    map.map(|m| PlacementMap::from_arg(m).map_err(errors::pipeline))
+        .transpose()
 }
 
 /// The `ReadOptions` every command reads with.

@@ -295,6 +295,24 @@ impl Sequence {
         Self::of(inner, self.format)
     }
 
+    /// The stretches between the gaps longer than ``max_gap_s`` seconds, in order (a list of
+    /// one, the sequence itself, without such a gap), named ``<name>_part1``, ``_part2``, ...
+    /// as ``ridi convert --split-at-gaps`` names them: ``ridi.track`` refuses a gap over
+    /// 0.1 s. A stretch may be a single frame; drop what is too short for you.
+    fn split_at_gaps(&self, max_gap_s: f64) -> PyResult<Vec<Self>> {
+        if !(max_gap_s.is_finite() && max_gap_s > 0.0) {
+            return Err(errors::value(format!(
+                "max_gap_s {max_gap_s}: a number of seconds above 0"
+            )));
+        }
+        Ok(self
+            .inner
+            .split_at_gaps(max_gap_s)
+            .into_iter()
+            .map(|s| Self::of(s, self.format))
+            .collect())
+    }
+
     fn __len__(&self) -> usize {
         self.inner.len()
     }
@@ -358,7 +376,7 @@ fn read_sequences(
 ///
 /// >>> seq = ridi.read("datasets/sample/Jakob_Nexus5_NoDist_Texting")  # doctest: +SKIP
 /// >>> seq.gyro.shape                                                    # doctest: +SKIP
-/// (4801, 3)
+/// (4800, 3)
 #[pyfunction]
 #[pyo3(signature = (path, format=None))]
 pub(crate) fn read(py: Python<'_>, path: PathBuf, format: Option<&str>) -> PyResult<Sequence> {

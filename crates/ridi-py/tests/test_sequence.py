@@ -232,3 +232,21 @@ def test_the_docstring_examples_run():
         for test in finder.find(obj, obj.__name__, module=False, globs={"ridi": ridi}):
             runner.run(test)
     assert runner.tries > 0 and runner.failures == 0
+
+
+def test_a_gap_ridi_track_refuses_is_split_into_parts_that_track(seq):
+    args = arrays_of(seq)
+    args["time"] = seq.time + np.where(np.arange(len(seq)) >= 2000, 0.3, 0.0)
+    gappy = ridi.Sequence(**args)
+    with pytest.raises(ValueError, match=r"a gap of 0\.30\d s between frames 1999 and 2000"):
+        ridi.track(gappy, ridi.bundled_model())
+    parts = gappy.split_at_gaps(0.1)
+    assert [p.name for p in parts] == [f"{seq.name}_part1", f"{seq.name}_part2"]
+    assert [len(p) for p in parts] == [2000, len(seq) - 2000]
+    np.testing.assert_array_equal(parts[1].gyro, seq.gyro[2000:])
+    assert parts[1].placement == seq.placement
+    for p in parts:
+        assert len(ridi.track(p, ridi.bundled_model())) == len(p)
+    assert [p.name for p in gappy.split_at_gaps(0.5)] == [seq.name]
+    with pytest.raises(ValueError, match="max_gap_s"):
+        gappy.split_at_gaps(float("nan"))

@@ -2,13 +2,14 @@
 online) within 1e-9, the live tracker's poses equal to online tracking, the GIL released, and
 refused inputs."""
 
+import subprocess
 import threading
 
 import numpy as np
 import pytest
 
 import ridi
-from conftest import SAMPLE, arrays_of
+from conftest import RIDI_BIN, SAMPLE, arrays_of
 
 RUN = SAMPLE / "Thibaud_Nexus5_NoDist_Texting"
 COLUMNS = "time,pos_x,pos_y,pos_z,vel_x,vel_y,vel_z,placement,bias_x,bias_y,bias_z"
@@ -173,3 +174,32 @@ def test_tracking_releases_the_gil(seq, model):
     worker.join()
     # Held by the tracking, the GIL would let this loop run only before and after it.
     assert spins > 10_000 and len(result[0]) == len(seq)
+
+
+def test_outputs_that_cannot_be_written_say_why_as_the_command_line(seq, model, ridi_bin,
+                                                                   tmp_path):
+    ridi_bin("--version")  # fails the test, saying why, without a binary
+    track = ridi.track(seq, model)
+    missing = tmp_path / "nodir" / "t.csv"
+    cli = subprocess.run([str(RIDI_BIN), "track", str(RUN), "--out", str(missing)],
+                         capture_output=True, text=True)
+    assert cli.returncode == 1
+    with pytest.raises(FileNotFoundError) as e:
+        track.write_csv(missing)
+    # The command's message after `error: `, once: no OS error number, no temporary file.
+    assert str(e.value) in cli.stderr, (str(e.value), cli.stderr)
+    assert str(e.value) == f"cannot write {missing}: the folder {missing.parent} does not exist"
+    with pytest.raises(FileNotFoundError, match="does not exist"):
+        model.save(tmp_path / "nodir" / "m.ridi")
+    with pytest.raises(IsADirectoryError, match=r"t\.csv: it is a folder$"):
+        (tmp_path / "t.csv").mkdir()
+        track.write_csv(tmp_path / "t.csv")
+    assert not list(tmp_path.glob("**/.ridi-tmp*"))
+
+
+def test_placement_maps_that_are_not_there_are_named_as_missing(tmp_path):
+    with pytest.raises(FileNotFoundError, match=r"tyrex5: no such file or folder \(a placement "
+                                                r"map is `tyrex4`"):
+        ridi.read_list(SAMPLE / "list_test.txt", placement_map="tyrex5")
+    with pytest.raises(FileNotFoundError, match=r"nolist\.txt: no such file or folder$"):
+        ridi.read_list(tmp_path / "nolist.txt")

@@ -1,12 +1,13 @@
 //! `ridi convert`: any supported source to the RIDI processed layout, with list files.
 
+use std::borrow::Cow;
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
 use rayon::prelude::*;
 use ridi_data::{
-    DataError, DeviceInfo, Format, Location, ReadOptions, detect, sidecar_path, unlistable_name,
-    write_atomically, write_ridi_csv,
+    DataError, DeviceInfo, Format, Location, ReadOptions, Sequence, SequenceError, counted, detect,
+    sidecar_path, unlistable_name, write_atomically, write_ridi_csv,
 };
 use ridi_data::{ilc, tyrex};
 
@@ -52,7 +53,16 @@ pub struct ConvertOptions {
     ///
     /// [`Sequence::resampled`]: ridi_data::Sequence::resampled
     pub rate_hz: Option<f64>,
+    /// Cut every sequence at each gap longer than this many seconds, before resampling
+    /// ([`Sequence::split_at_gaps`]): parts `<name>_part1`, `_part2`, ...; a part shorter than
+    /// [`SPLIT_MIN_PART_S`] is dropped with a warning. `None` keeps sequences whole. What
+    /// `ridi track` (a gap over 0.1 s) and `rate_hz` (over 5 frame intervals) refuse.
+    pub split_gaps_s: Option<f64>,
 }
+
+/// Shortest part [`ConvertOptions::split_gaps_s`] keeps, seconds: one feature window of the
+/// paper's models (200 frames at 200 Hz), the least anything can be tracked on.
+pub const SPLIT_MIN_PART_S: f64 = 1.0;
 
 /// The rates a conversion resamples to, Hz, both included: 1.001 to 9,990. The readers (with
 /// the default [`ridi_data::Validation`]) refuse frames 1 s apart or more (`max_gap_s`) and a
@@ -64,6 +74,46 @@ pub const CONVERT_RATE_HZ: (f64, f64) = (1.001, 9990.0);
 /// Longest gap `--rate` interpolates across, in frame intervals of the source: longer ones
 /// would be filled with invented frames, so the recording has to be split there first.
 const RESAMPLE_MAX_GAP_FRAMES: f64 = 5.0;
+
+/// The parts of `seqs` between their gaps longer than `max_gap_s`
+/// ([`ConvertOptions::split_gaps_s`]), each at least [`SPLIT_MIN_PART_S`] long; a warning per
+/// sequence split and per part dropped. An error when no part is left.
+fn split(
+    seqs: &[Sequence],
+    max_gap_s: f64,
+    warnings: &mut Vec<String>,
+) -> std::result::Result<Vec<Sequence>, String> {
+    let mut kept = Vec::new();
+    for seq in seqs {
+        let parts = seq.split_at_gaps(max_gap_s);
+        if parts.len() > 1 {
+            warnings.push(format!(
+                "sequence `{}`: split at {} longer than {max_gap_s} s into {}",
+                seq.name(),
+                counted(parts.len() - 1, "gap"),
+                counted(parts.len(), "part")
+            ));
+        }
+        for part in parts {
+            let (first, last) = (part.time()[0], part.time()[part.len() - 1]);
+            if last - first < SPLIT_MIN_PART_S {
+                warnings.push(format!(
+                    "sequence `{}`: {first:.3}..{last:.3} s is shorter than {SPLIT_MIN_PART_S} \
+                     s: dropped",
+                    part.name()
+                ));
+            } else {
+                kept.push(part);
+            }
+        }
+    }
+    if kept.is_empty() {
+        return Err(format!(
+            "no part of at least {SPLIT_MIN_PART_S} s between gaps longer than {max_gap_s} s"
+        ));
+    }
+    Ok(kept)
+}
 
 /// What converting one source produced: the sequences written and the warnings.
 type Written = (Vec<Converted>, Vec<String>);
@@ -94,9 +144,9 @@ fn tyrex_sources(source: &Path) -> Result<Sources, DataError> {
         // there is to convert is the phone data.
         return Ok(Sources {
             skipped: Some(format!(
-                "no run has a Qualisys file in ../../qualisys/: the {} run(s) are converted \
-                 without ground truth",
-                runs.without_mocap.len()
+                "no run has a Qualisys file in ../../qualisys/: the {} converted without \
+                 ground truth",
+                counted(runs.without_mocap.len(), "run")
             )),
             paths: runs.without_mocap,
         });
@@ -145,9 +195,9 @@ fn sources(source: &Path, from: Option<Format>) -> Result<Sources, DataError> {
             DataError::format(
                 Location::file(source),
                 format!(
-                    "no {want} here, but {} source(s) of another format (the first, {}, is \
-                     {what}): convert without --from, or with that format",
-                    other.len(),
+                    "no {want} here, but {} of another format (the first, {}, is {what}): \
+                     convert without --from, or with that format",
+                    counted(other.len(), "source"),
                     ridi_data::shown(&other[0])
                 ),
             )
@@ -317,9 +367,9 @@ fn device_lists<'a>(
         if let Some(clash) = clash {
             let model = entries[0].device.as_ref().map_or("", |d| d.model());
             warnings.push(format!(
-                "{} sequence(s) of the device `{model}` get no list_{key}.txt: list_{clash}.txt \
-                 is another list",
-                entries.len()
+                "{} of the device `{model}` get no list_{key}.txt: list_{clash}.txt is another \
+                 list",
+                counted(entries.len(), "sequence")
             ));
         }
         clash.is_none()
@@ -360,14 +410,28 @@ pub fn convert(
             let loaded = read_any(dir, from, &opts.read)?;
             let mut written = Vec::new();
             let listed = dir.canonicalize().ok().and_then(|d| labels.get(&d));
-            for seq in &loaded.sequences {
+            let mut warnings = Vec::new();
+            let parts: Vec<Cow<'_, Sequence>> = match opts.split_gaps_s {
+                None => loaded.sequences.iter().map(Cow::Borrowed).collect(),
+                Some(max_gap) => split(&loaded.sequences, max_gap, &mut warnings)
+                    .map_err(|message| DataError::format(Location::file(dir), message))?
+                    .into_iter()
+                    .map(Cow::Owned)
+                    .collect(),
+            };
+            for seq in &parts {
+                let seq = seq.as_ref();
                 let resampled = match opts.rate_hz {
                     Some(rate) => {
                         let max_gap = RESAMPLE_MAX_GAP_FRAMES / seq.median_rate_hz();
-                        Some(
-                            seq.resampled(rate, max_gap)
-                                .map_err(|e| DataError::sequence(dir, e))?,
-                        )
+                        Some(seq.resampled(rate, max_gap).map_err(|e| match e {
+                            // Interpolating would invent the gap's frames.
+                            SequenceError::Gap { .. } => DataError::format(
+                                Location::file(dir),
+                                format!("{e}: split the recording there first (--split-at-gaps)"),
+                            ),
+                            e => DataError::sequence(dir, e),
+                        })?)
                     }
                     None => None,
                 };
@@ -398,6 +462,7 @@ pub fn convert(
             let warnings = loaded
                 .warnings
                 .into_iter()
+                .chain(warnings)
                 .map(|w| format!("{}: {w}", dir.display()))
                 .collect();
             Ok((written, warnings))

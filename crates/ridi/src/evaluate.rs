@@ -474,12 +474,16 @@ impl Report {
                 out,
                 "**Weakly determined alignment** in {} of {} sequences: the ground truth moves \
                  less than {} m within the alignment window, so the fitted heading rests on \
-                 little motion and every metric inherits its error: {}. \
-                 `ridi eval --align all` shows them without it.\n",
+                 little motion and every metric inherits its error: {}.{}\n",
                 weak.len(),
                 self.sequences.len(),
                 ridi_eval::WEAK_ALIGNMENT_EXTENT_M,
-                weak.join(", ")
+                weak.join(", "),
+                // Aligned on the whole trajectory already, there is no larger window to offer.
+                match self.config.align {
+                    ridi_eval::AlignWindow::All => "",
+                    _ => " `ridi eval --align all` shows them without it.",
+                }
             );
         }
         let _ = writeln!(out, "## Overall (mean over sequences)\n");
@@ -573,7 +577,8 @@ impl Report {
             path: path.to_path_buf(),
             message,
         };
-        let text = std::fs::read_to_string(path).map_err(|e| file(e.to_string()))?;
+        // Bounded: a report holds figures per sequence, far below this for any dataset.
+        let text = ridi_data::read_text(path, 1 << 30)?;
         serde_json::from_str(&text).map_err(|e| file(e.to_string()))
     }
 
@@ -755,6 +760,25 @@ mod tests {
         let json = serde_json::to_string(&r).unwrap();
         let back: Report = serde_json::from_str(&json).unwrap();
         assert_eq!(back.sequences[1].device.as_deref(), Some("iPhone 4S"));
+    }
+
+    #[test]
+    fn a_weak_alignment_is_flagged_and_the_whole_run_offered_unless_already_used() {
+        let mut weak = result("still", None, 1.0);
+        weak.alignment_extent_m = 0.4;
+        let mut r = report(vec![weak, result("walk", None, 1.0)]);
+        let md = r.to_markdown();
+        assert!(
+            md.contains("**Weakly determined alignment** in 1 of 2 sequences")
+                && md.contains("still (0.40 m). `ridi eval --align all` shows them"),
+            "{md}"
+        );
+        r.config.align = ridi_eval::AlignWindow::All;
+        let md = r.to_markdown();
+        assert!(
+            md.contains("still (0.40 m).\n") && !md.contains("--align all"),
+            "{md}"
+        );
     }
 
     #[test]

@@ -106,7 +106,9 @@ mod train;
 pub use baselines::{Method, baseline_trajectory, device_heading};
 #[cfg(feature = "bundled-model")]
 pub use bundled::{BUNDLED_MODEL_SUMMARY, bundled_model};
-pub use convert::{CONVERT_RATE_HZ, ConvertOptions, ConvertSummary, Converted, convert};
+pub use convert::{
+    CONVERT_RATE_HZ, ConvertOptions, ConvertSummary, Converted, SPLIT_MIN_PART_S, convert,
+};
 pub use demo::Demo;
 pub use error::{PipelineError, Result};
 pub use evaluate::{

@@ -49,7 +49,7 @@ pub enum OutputError {
     /// An output file's path ends in `/` (or `.`, `..`): it names a folder, even one that does
     /// not exist, which no file can be written as.
     #[error(
-        "cannot write {}: a path ending in `/` names a folder; give a file name",
+        "cannot write {}: a path ending in `/`, `.` or `..` names a folder; give a file name",
         ridi_data::shown(path)
     )]
     FolderName {
@@ -299,6 +299,7 @@ pub fn check_not_input(
 /// Writes `model`'s file ([`Cascade::to_bytes`]) to `path` through
 /// [`ridi_data::write_atomically`], as every output of ridi-rs is written.
 pub fn save_model(model: &Cascade, path: &Path) -> Result<()> {
+    check_output_file(path)?;
     let bytes = model.to_bytes()?;
     ridi_data::write_atomically(path, |w| w.write_all(&bytes))?;
     Ok(())

@@ -8,6 +8,9 @@ use ridi_data::{DataError, Location, Sequence};
 
 use crate::error::{PipelineError, Result};
 
+/// Largest placement map file, bytes: a map names labels, not data.
+const MAX_MAP_BYTES: u64 = 1 << 20;
+
 /// Maps placement labels to class names. Every label in use must be in the map, or be one of
 /// its classes: [`PlacementMap::class_at`] is an error for any other.
 #[derive(Debug, Clone, Default, PartialEq, Eq)]
@@ -45,11 +48,12 @@ impl PlacementMap {
     /// different classes, and a file without any entry, are errors.
     pub fn read(path: impl AsRef<Path>) -> Result<Self> {
         let path = path.as_ref();
-        let error = |message: String| PipelineError::File {
-            path: path.to_path_buf(),
-            message,
+        // At the file and line, as every reader's error is.
+        let error = |line: Option<usize>, message: String| {
+            let at = line.map_or_else(|| Location::file(path), |l| Location::line(path, l));
+            PipelineError::Data(DataError::format(at, message))
         };
-        let text = std::fs::read_to_string(path).map_err(|e| error(e.to_string()))?;
+        let text = ridi_data::read_text(path, MAX_MAP_BYTES)?;
         let mut map: BTreeMap<String, (String, usize)> = BTreeMap::new();
         for (i, line) in text.lines().enumerate() {
             let line = line.trim();
@@ -60,19 +64,22 @@ impl PlacementMap {
                 .split_once(',')
                 .map(|(a, b)| (a.trim(), b.trim()))
                 .filter(|(a, b)| !a.is_empty() && !b.is_empty() && !b.contains(','))
-                .ok_or_else(|| error(format!("line {}: expected `label,class`", i + 1)))?;
+                .ok_or_else(|| error(Some(i + 1), "expected `label,class`".into()))?;
             if let Some((first, at)) = map.get(label)
                 && first != class
             {
-                return Err(error(format!(
-                    "line {}: `{label}` is mapped to `{class}` here but to `{first}` on line {at}",
-                    i + 1
-                )));
+                return Err(error(
+                    Some(i + 1),
+                    format!("`{label}` is mapped to `{class}` here but to `{first}` on line {at}"),
+                ));
             }
             map.insert(label.to_string(), (class.to_string(), i + 1));
         }
         if map.is_empty() {
-            return Err(error("no `label,class` entry in the placement map".into()));
+            return Err(error(
+                None,
+                "no `label,class` entry in the placement map".into(),
+            ));
         }
         Ok(Self {
             map: map.into_iter().map(|(l, (c, _))| (l, c)).collect(),
@@ -80,13 +87,22 @@ impl PlacementMap {
         })
     }
 
-    /// `tyrex4` for [`Self::tyrex_groups`], otherwise a file for [`Self::read`].
-    pub fn from_arg(arg: &str) -> Result<Self> {
-        if arg == "tyrex4" {
-            Ok(Self::tyrex_groups())
-        } else {
-            Self::read(Path::new(arg))
+    /// `tyrex4` for [`Self::tyrex_groups`], otherwise a file for [`Self::read`] (a missing
+    /// one is named with the `tyrex4` alternative: a mistyped group name reads as a path).
+    pub fn from_arg(arg: impl AsRef<Path>) -> Result<Self> {
+        let arg = arg.as_ref();
+        if arg.as_os_str() == "tyrex4" {
+            return Ok(Self::tyrex_groups());
         }
+        if !arg.exists() {
+            return Err(PipelineError::File {
+                path: arg.to_path_buf(),
+                message: "no such file or folder (a placement map is `tyrex4` or a file of \
+                          `label,class` lines)"
+                    .into(),
+            });
+        }
+        Self::read(arg)
     }
 
     /// The classes of the map, sorted.
@@ -182,10 +198,10 @@ mod tests {
 
         let bad = dir.path().join("bad.txt");
         for (text, want) in [
-            ("Texting\n", "bad.txt: line 1: expected `label,class`"),
+            ("Texting\n", "bad.txt:1: expected `label,class`"),
             (
                 "Texting,hand\nBackPocket,pocket\nTexting,pocket\n",
-                "bad.txt: line 3: `Texting` is mapped to `pocket` here but to `hand` on line 1",
+                "bad.txt:3: `Texting` is mapped to `pocket` here but to `hand` on line 1",
             ),
             ("", "bad.txt: no `label,class` entry"),
             ("# nothing\n\n", "bad.txt: no `label,class` entry"),
@@ -194,5 +210,29 @@ mod tests {
             let err = PlacementMap::read(&bad).unwrap_err().to_string();
             assert!(err.contains(want), "{text:?}: {err}");
         }
+
+        // What is not a readable map file: named as the readers name it, a typo of `tyrex4`
+        // with what a map may be.
+        let missing = dir.path().join("tyrex5");
+        for (arg, want) in [
+            (
+                missing.clone(),
+                "tyrex5: no such file or folder (a placement map is `tyrex4` or a file of \
+                 `label,class` lines)",
+            ),
+            (
+                dir.path().to_path_buf(),
+                ": is a folder: it is not a regular file",
+            ),
+        ] {
+            let err = PlacementMap::from_arg(&arg).unwrap_err().to_string();
+            assert!(err.ends_with(want), "{arg:?}: {err}");
+        }
+        let err = PlacementMap::read(&missing).unwrap_err().to_string();
+        assert!(err.ends_with("tyrex5: no such file or folder"), "{err}");
+        assert_eq!(
+            PlacementMap::from_arg("tyrex4").unwrap(),
+            PlacementMap::tyrex_groups()
+        );
     }
 }

@@ -47,6 +47,9 @@ impl Track {
     /// before the first). Written atomically ([`write_atomically`]); [`crate::TrackOutput`]
     /// writes it together with a plot.
     pub fn write_csv(&self, path: impl AsRef<Path>) -> Result<()> {
+        // Checked first, so that a missing folder is named as such rather than as the system's
+        // error on the temporary file beside the output.
+        crate::output::check_output_file(path.as_ref())?;
         write_atomically(path.as_ref(), |w| self.csv(w))?;
         Ok(())
     }
@@ -332,7 +335,7 @@ fn gap_error(name: &str, i: usize, t: (f64, f64), t0: f64, max_dt: f64) -> Pipel
         format!(
             "a gap of {:.3} s between frames {i} and {} ({:.3} s and {:.3} s from the \
              start) is longer than the {max_dt} s the correction integrates across; split \
-             the recording at its gaps",
+             the recording at its gaps (`ridi convert --split-at-gaps {max_dt}`)",
             t.1 - t.0,
             i + 1,
             t.0 - t0,

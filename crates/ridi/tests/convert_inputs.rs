@@ -276,8 +276,7 @@ fn list_labels_in_the_source_carry_over_and_a_folder_of_another_format_is_named(
         .unwrap_err()
         .to_string();
         assert!(
-            e.contains("but 3 source(s) of another format")
-                && e.contains("is a RIDI processed csv"),
+            e.contains("but 3 sources of another format") && e.contains("is a RIDI processed csv"),
             "{e}"
         );
     }
@@ -356,6 +355,75 @@ fn rate_resamples_every_sequence_and_refuses_to_fill_gaps() {
         .unwrap_err()
         .to_string();
     assert!(e.contains("gap of 0.110 s") && e.contains("walk"), "{e}");
+
+    // Split there first, it converts: two parts, each resampled, tracked as they are, the
+    // frames on either side of the gap where they were.
+    let split = ConvertOptions {
+        split_gaps_s: Some(0.1),
+        ..to_200.clone()
+    };
+    let out3 = dir.path().join("out3");
+    let summary = convert(&dir.path().join("src"), &out3, &split).unwrap();
+    let names: Vec<&str> = summary.sequences.iter().map(|c| c.name.as_str()).collect();
+    assert_eq!(names, ["walk_part1", "walk_part2"]);
+    assert!(
+        summary
+            .warnings
+            .iter()
+            .any(|w| w.ends_with("sequence `walk`: split at 1 gap longer than 0.1 s into 2 parts")),
+        "{:?}",
+        summary.warnings
+    );
+    let (a, b) = (
+        read_sequence(out3.join("walk_part1"), &opts).unwrap(),
+        read_sequence(out3.join("walk_part2"), &opts).unwrap(),
+    );
+    let gap_from = (full.time()[998], full.time()[1020]);
+    assert!(
+        (a.time()[a.len() - 1] - gap_from.0).abs() < 0.005,
+        "{}",
+        a.time()[a.len() - 1]
+    );
+    assert!((b.time()[0] - gap_from.1).abs() < 1e-6, "{}", b.time()[0]);
+    for s in [&a, &b] {
+        assert!((s.median_rate_hz() - 200.0).abs() < 0.01);
+        ridi::track(
+            s,
+            &ridi::bundled_model().unwrap(),
+            &ridi::TrackOptions::default(),
+        )
+        .unwrap();
+    }
+    // A part shorter than a second is dropped, saying so; nothing left is an error.
+    let short: Vec<usize> = gappy.iter().copied().filter(|&i| i >= 900).collect();
+    write_ridi_csv(&at_100(&short), src.join("data.csv")).unwrap();
+    let summary = convert(&dir.path().join("src"), &dir.path().join("out4"), &split).unwrap();
+    let names: Vec<&str> = summary.sequences.iter().map(|c| c.name.as_str()).collect();
+    assert_eq!(names, ["walk_part2"]);
+    assert!(
+        summary
+            .warnings
+            .iter()
+            .any(|w| w.contains("sequence `walk_part1`: ")
+                && w.ends_with("s is shorter than 1 s: dropped")),
+        "{:?}",
+        summary.warnings
+    );
+    let split_hard = ConvertOptions {
+        split_gaps_s: Some(0.001),
+        ..split.clone()
+    };
+    let e = convert(
+        &dir.path().join("src"),
+        &dir.path().join("out5"),
+        &split_hard,
+    )
+    .unwrap_err()
+    .to_string();
+    assert!(
+        e.contains("no part of at least 1 s between gaps longer than 0.001 s"),
+        "{e}"
+    );
     assert!(matches!(
         slow.resampled(0.0, 1.0),
         Err(SequenceError::InvalidRate { .. })
@@ -461,7 +529,7 @@ fn devices_are_kept_with_one_list_per_device() {
     let summary = convert(&src, &dir.path().join("out2"), &ConvertOptions::default()).unwrap();
     assert_eq!(
         summary.warnings,
-        ["1 sequence(s) of the device `ANN` get no list_ann.txt: list_Ann.txt is another list"]
+        ["1 sequence of the device `ANN` get no list_ann.txt: list_Ann.txt is another list"]
     );
 }
 
@@ -515,7 +583,8 @@ fn tyrex_runs_without_motion_capture_are_skipped_or_converted_with_a_warning() {
             summary
                 .warnings
                 .iter()
-                .any(|w| w.contains("no run has a Qualisys file") && w.contains("the 2 run(s)")),
+                .any(|w| w.contains("no run has a Qualisys file")
+                    && w.contains("the 2 runs converted")),
             "{from:?}: {:?}",
             summary.warnings
         );

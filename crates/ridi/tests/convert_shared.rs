@@ -42,7 +42,7 @@ fn the_whole_tyrex_root_converts_with_one_list_per_person_and_device() {
         .collect();
     assert_eq!(skipped.len(), 1, "{:?}", summary.warnings);
     assert!(
-        skipped[0].contains("1 run folder(s)")
+        skipped[0].contains("1 run folder without")
             && skipped[0].ends_with("Jakob_Nexus5_Dist_Swinging_old"),
         "{}",
         skipped[0]

@@ -13,7 +13,7 @@ the same numbers.
 >>> seq = ridi.read("datasets/sample/Thibaud_Nexus5_NoDist_Texting")  # doctest: +SKIP
 >>> track = ridi.track(seq, model)                                  # doctest: +SKIP
 >>> track.position.shape                                            # doctest: +SKIP
-(4801, 3)
+(4800, 3)
 >>> report = ridi.evaluate("datasets/sample/list_test.txt", model,
 ...                        placement_map="tyrex4")                   # doctest: +SKIP
 >>> report["summary"]["ridi"]["rte_5s_m"]                           # doctest: +SKIP
