@@ -5,7 +5,7 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{Result, bail};
 
-use ridi::data::shown;
+use ridi::data::{counted, shown};
 
 use crate::{Grid, Plots, eval, train};
 
@@ -45,8 +45,8 @@ pub(crate) fn run(args: Args) -> Result<()> {
     let demo = ridi::Demo::prepare(&data, &args.out, args.grid.into(), args.plots.into())?;
     let train = demo.train_sequences();
     outln!(
-        "demo: training on {} sequences ({:.0} s), testing on {} held-out sequences",
-        train.len(),
+        "demo: training on {} ({:.0} s), testing on {} held out",
+        counted(train.len(), "sequence"),
         train.iter().map(|s| s.duration()).sum::<f64>(),
         demo.test_sequences().len()
     );

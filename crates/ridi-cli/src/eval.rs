@@ -7,7 +7,7 @@ use anyhow::Result;
 use indicatif::ProgressBar;
 
 use ridi::ReadFiles;
-use ridi::data::{ListEntry, shown};
+use ridi::data::{ListEntry, counted, shown};
 use ridi::eval::{AlignWindow, EvalConfig};
 use ridi::{
     EvalFolder, EvalOptions, EvalPlots, EvalWritten, Method, Purpose, Report, TrackOptions,
@@ -105,7 +105,7 @@ pub(crate) fn run(args: Args) -> Result<()> {
 /// Runs `evaluate` (of `n` sequences) with a spinner on stderr.
 pub(crate) fn with_spinner<T>(n: usize, evaluate: impl FnOnce() -> T) -> T {
     let spinner = ProgressBar::new_spinner();
-    spinner.set_message(format!("evaluating {n} sequences"));
+    spinner.set_message(format!("evaluating {}", counted(n, "sequence")));
     spinner.enable_steady_tick(std::time::Duration::from_millis(200));
     let result = evaluate();
     spinner.finish_and_clear();
@@ -135,7 +135,10 @@ pub(crate) fn print_written(report: &Report, written: &EvalWritten, folder: &Eva
             .and_then(Path::file_name)
             .map_or(String::new(), |m| format!(", {}", shown(m))),
         if stale > 0 {
-            format!("; removed {stale} plots of an earlier evaluation from plots/")
+            format!(
+                "; removed {} of an earlier evaluation from plots/",
+                counted(stale, "plot")
+            )
         } else {
             String::new()
         }
@@ -153,15 +156,15 @@ fn print_summary(report: &Report) {
         .count();
     if weak > 0 {
         eprintln!(
-            "warning: in {weak} of {} sequences the ground truth moves less than {} m within the \
+            "warning: in {weak} of {} the ground truth moves less than {} m within the \
              alignment window, so their fitted heading is weakly determined (listed in report.md)",
-            report.sequences.len(),
+            counted(report.sequences.len(), "sequence"),
             ridi::eval::WEAK_ALIGNMENT_EXTENT_M
         );
     }
     outln!(
-        "\n{} sequences; velocity MSE S-x {:.3} S-z {:.3} (m/s)^2; placement accuracy {}",
-        report.sequences.len(),
+        "\n{}; velocity MSE S-x {:.3} S-z {:.3} (m/s)^2; placement accuracy {}",
+        counted(report.sequences.len(), "sequence"),
         report.velocity_mse[0],
         report.velocity_mse[1],
         report
@@ -203,11 +206,10 @@ fn print_summary(report: &Report) {
                     Some(format!("{key} {:.3}", m.rte_5s_m))
                 })
                 .collect();
-            let plural = if d.sequences == 1 { "" } else { "s" };
             outln!(
-                "  {} ({} sequence{plural}): {}",
+                "  {} ({}): {}",
                 shown(&d.group),
-                d.sequences,
+                counted(d.sequences, "sequence"),
                 methods.join(", ")
             );
         }

@@ -249,12 +249,17 @@ fn model_or_bundled(path: Option<&Path>) -> Result<Cascade> {
 }
 
 /// One line: the outermost context and every cause, as users asked for. Errors that already
-/// print their source in their own message are not repeated.
+/// print their source in their own message are not repeated, nor a context its cause repeats
+/// ("cannot write m.ridi" over "cannot write m.ridi: the folder . does not exist").
 fn one_line(e: &anyhow::Error) -> String {
     let mut line = String::new();
     for cause in e.chain() {
         let text = cause.to_string();
         if line.contains(&text) {
+            continue;
+        }
+        if !line.is_empty() && text.starts_with(&format!("{line}: ")) {
+            line = text;
             continue;
         }
         if !line.is_empty() {
@@ -343,5 +348,11 @@ mod tests {
         );
         let plain = anyhow::anyhow!("inner").context("outer");
         assert_eq!(one_line(&plain), "outer: inner");
+        let repeated = anyhow::anyhow!("cannot write m.ridi: the folder x does not exist")
+            .context("cannot write m.ridi");
+        assert_eq!(
+            one_line(&repeated),
+            "cannot write m.ridi: the folder x does not exist"
+        );
     }
 }

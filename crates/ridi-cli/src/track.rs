@@ -5,7 +5,7 @@ use std::path::PathBuf;
 use anyhow::{Context, Result, bail};
 
 use ridi::ReadFiles;
-use ridi::data::{ReadOptions, shown};
+use ridi::data::{ReadOptions, counted, shown};
 use ridi::{PipelineError, TrackOptions, TrackOutput, apply_orientation};
 
 use crate::{Heading, MAX_FRAMES_APART, count, non_negative, placement_smoothing, positive};
@@ -101,9 +101,10 @@ pub(crate) fn run(args: Args) -> Result<()> {
 /// Prints what was tracked, `frames` frames of `name` with `n` regressions, and where it went.
 fn print_tracked(args: &Args, name: &str, frames: usize, n: usize) {
     outln!(
-        "{}: {frames} frames, {n} regression{} -> {}",
+        "{}: {}, {} -> {}",
         shown(name),
-        if n == 1 { "" } else { "s" },
+        counted(frames, "frame"),
+        counted(n, "regression"),
         shown(&args.out)
     );
     if let Some(plot) = &args.plot {

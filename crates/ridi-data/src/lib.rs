@@ -122,8 +122,10 @@ pub use list::{ListEntry, Listed, unlistable_name};
 pub use options::ReadOptions;
 pub use processed::PROCESSED_COLUMNS;
 pub use ridi_frames;
-pub use sequence::{Channel, GroundTruth, OrientationSource, Sequence, SequenceParts};
-pub use sequence_error::SequenceError;
+pub use sequence::{
+    Channel, GroundTruth, OrientationSource, Sequence, SequenceParts, SplitParts, part_name,
+};
+pub use sequence_error::{SequenceError, short};
 pub use sidecar::{SIDECAR_SUFFIX, sidecar_path};
 pub use stream::{MedianTest, Row, RowReader, median_interval};
 pub use temporaries::{

@@ -227,6 +227,26 @@ fn check_len(field: &'static str, expected: usize, found: usize) -> Result<(), S
     }
 }
 
+/// A sequence cut at its gaps ([`Sequence::split_at_gaps`]).
+#[derive(Debug, Clone, PartialEq)]
+pub struct SplitParts {
+    /// The parts kept, in order.
+    pub parts: Vec<Sequence>,
+    /// The (first, last) frame times of each part dropped as too short, in order.
+    pub dropped: Vec<(f64, f64)>,
+}
+
+/// The name of part `index` (from 0) of the `parts` a recording named `name` is split into:
+/// `name` itself when it is the only one, else `<name>_part1`, `<name>_part2`, ... (the
+/// Tyrex reader at a motion-capture loss, [`Sequence::split_at_gaps`] at a gap).
+pub fn part_name(name: &str, index: usize, parts: usize) -> String {
+    if parts == 1 {
+        name.to_owned()
+    } else {
+        format!("{name}_part{}", index + 1)
+    }
+}
+
 /// `time` strictly increasing, with no step longer than `max_gap_s`.
 fn check_steps(time: &[f64], max_gap_s: f64) -> Result<(), SequenceError> {
     for (i, w) in time.windows(2).enumerate() {
@@ -542,28 +562,48 @@ impl Sequence {
         })
     }
 
-    /// The stretches between the gaps longer than `max_gap_s` (intervals between frames), in
-    /// order; the whole sequence when it has none. Several are named as the Tyrex reader names
-    /// the parts of a run it splits: `<name>_part1`, `<name>_part2`, ... A stretch may be as
-    /// short as one frame: what is too short to use is the caller's to drop.
-    pub fn split_at_gaps(&self, max_gap_s: f64) -> Vec<Sequence> {
+    /// The sequence cut at every gap longer than `max_gap_s` (an interval between frames),
+    /// for what cannot cross one (`ridi track` refuses a gap over 0.1 s): the parts at least
+    /// `min_duration_s` long, named as the readers name the parts of a recording they split
+    /// ([`part_name`]), and the (first, last) frame times of the parts dropped as shorter.
+    /// Without such a gap, the sequence itself, whatever its duration.
+    ///
+    /// # Errors
+    /// A `max_gap_s` that is not a finite number above 0 (every frame would be a part).
+    pub fn split_at_gaps(
+        &self,
+        max_gap_s: f64,
+        min_duration_s: f64,
+    ) -> Result<SplitParts, SequenceError> {
+        if !(max_gap_s.is_finite() && max_gap_s > 0.0) {
+            return Err(SequenceError::InvalidGap { max_gap_s });
+        }
         let t = self.time();
         let mut bounds: Vec<usize> = std::iter::once(0)
             .chain((1..t.len()).filter(|&i| t[i] - t[i - 1] > max_gap_s))
             .collect();
         if bounds.len() == 1 {
-            return vec![self.clone()];
+            return Ok(SplitParts {
+                parts: vec![self.clone()],
+                dropped: Vec::new(),
+            });
         }
         bounds.push(t.len());
-        bounds
+        let (kept, dropped): (Vec<_>, Vec<_>) = bounds
             .windows(2)
+            .map(|w| w[0]..w[1])
+            .partition(|r| t[r.end - 1] - t[r.start] >= min_duration_s);
+        let parts = kept
+            .iter()
             .enumerate()
-            .map(|(k, w)| {
-                let mut part = self.slice(w[0]..w[1]);
-                part.set_name(format!("{}_part{}", self.name(), k + 1));
+            .map(|(k, r)| {
+                let mut part = self.slice(r.clone());
+                part.set_name(part_name(self.name(), k, kept.len()));
                 part
             })
-            .collect()
+            .collect();
+        let dropped = dropped.iter().map(|r| (t[r.start], t[r.end - 1])).collect();
+        Ok(SplitParts { parts, dropped })
     }
 
     /// The frames in `range`, as a new sequence with the same name, labels and device.

@@ -4,7 +4,7 @@ use crate::sequence::Channel;
 
 /// A number for a message: plain with at most 3 decimals, or in scientific notation when very
 /// large or small (`1e308`, not 309 digits).
-pub(crate) fn short(v: f64) -> String {
+pub fn short(v: f64) -> String {
     let a = v.abs();
     if a != 0.0 && !(1e-3..1e6).contains(&a) {
         let s = format!("{v:.3e}");
@@ -100,6 +100,15 @@ pub enum SequenceError {
         /// Length of the gap.
         gap_s: f64,
         /// The limit.
+        max_gap_s: f64,
+    },
+    /// A gap to split at that is not a finite number of seconds above 0
+    /// ([`Sequence::split_at_gaps`](crate::Sequence::split_at_gaps)).
+    #[error(
+        "cannot split at gaps longer than {max_gap_s} s: the limit must be a finite number above 0"
+    )]
+    InvalidGap {
+        /// The limit asked for.
         max_gap_s: f64,
     },
     /// A resampling rate that is not a finite number above 0 ([`Sequence::resampled`](crate::Sequence::resampled)).

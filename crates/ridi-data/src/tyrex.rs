@@ -163,7 +163,7 @@ use crate::text::{self, Nan};
 use crate::validation::{orientation_jump_warning, spans_text};
 use crate::{
     Channel, DeviceInfo, GroundTruth, OrientationJump, OrientationSource, Sequence, SequenceError,
-    SequenceParts, Validation, bridge_orientation_jumps,
+    SequenceParts, Validation, bridge_orientation_jumps, part_name,
 };
 
 mod ios;
@@ -1363,13 +1363,8 @@ pub fn read(dir: impl AsRef<Path>, options: &TyrexOptions) -> Result<TyrexRead> 
             position: interpolate_vec3(t, p, &time),
             orientation: interpolate_rot(t, q, &time),
         });
-        let part_name = if kept.len() == 1 {
-            name.clone()
-        } else {
-            format!("{name}_part{}", k + 1)
-        };
         let parts = SequenceParts {
-            name: part_name,
+            name: part_name(&name, k, kept.len()),
             placement: placement.map(str::to_owned),
             gyro: interpolate_vec3(&gyro.time, &gyro.values, &time),
             acce: acce_i,

@@ -5,8 +5,8 @@ mod common;
 
 use common::sample_sequence;
 use ridi_data::{
-    DeviceInfo, OrientationSource, ReadOptions, Sequence, read_sequence, ridi_csv, ridi_plain,
-    sidecar_path, source_files, write_ridi_csv, write_ridi_plain,
+    DeviceInfo, OrientationSource, ReadOptions, Sequence, SplitParts, read_sequence, ridi_csv,
+    ridi_plain, sidecar_path, source_files, write_ridi_csv, write_ridi_plain,
 };
 use ridi_test_support::assert_names_file;
 
@@ -155,7 +155,8 @@ fn slices_and_resampling_keep_the_device() {
 #[test]
 fn splits_at_gaps_and_resampling_keep_every_channel() {
     let seq = with_device("walk");
-    assert_eq!(seq.split_at_gaps(0.1), std::slice::from_ref(&seq));
+    let whole = seq.split_at_gaps(0.1, 1.0).unwrap();
+    assert_eq!((whole.parts, whole.dropped), (vec![seq.clone()], vec![]));
     let mut parts = seq.clone().into_parts();
     let steps: Vec<f64> = (0..seq.len()).map(|i| (i / 40) as f64).collect();
     parts.steps = Some(steps.clone());
@@ -165,7 +166,11 @@ fn splits_at_gaps_and_resampling_keep_every_channel() {
             + 0.045 * f64::from(u8::from(i >= 200));
     }
     let gappy = Sequence::new(parts).unwrap();
-    let split = gappy.split_at_gaps(0.1);
+    let SplitParts {
+        parts: split,
+        dropped,
+    } = gappy.split_at_gaps(0.1, 0.0).unwrap();
+    assert!(dropped.is_empty());
     let names: Vec<&str> = split.iter().map(Sequence::name).collect();
     assert_eq!(names, ["walk_part1", "walk_part2", "walk_part3"]);
     let lens: Vec<usize> = split.iter().map(Sequence::len).collect();
@@ -174,7 +179,30 @@ fn splits_at_gaps_and_resampling_keep_every_channel() {
     assert_eq!(split[1].steps().unwrap(), &steps[100..250]);
     assert_eq!(split[2].gyro(), &gappy.gyro()[250..]);
     assert!(split.iter().all(|s| s.device() == Some(&iphone())));
-    assert_eq!(gappy.split_at_gaps(1.0).len(), 1);
+    assert_eq!(gappy.split_at_gaps(1.0, 0.0).unwrap().parts.len(), 1);
+    // Parts shorter than the minimum go, and the rest are numbered as the Tyrex reader numbers
+    // what it keeps: one part left keeps the plain name.
+    // (0.495 s, 0.79 s and 0.245 s long)
+    let SplitParts {
+        parts: kept,
+        dropped,
+    } = gappy.split_at_gaps(0.1, 0.3).unwrap();
+    let names: Vec<&str> = kept.iter().map(Sequence::name).collect();
+    assert_eq!(names, ["walk_part1", "walk_part2"]);
+    assert_eq!(kept[1].time()[0], gappy.time()[100]);
+    assert_eq!(dropped, [(gappy.time()[250], gappy.time()[299])]);
+    let SplitParts {
+        parts: kept,
+        dropped,
+    } = gappy.split_at_gaps(0.1, 0.6).unwrap();
+    assert_eq!((kept.len(), kept[0].name(), dropped.len()), (1, "walk", 2));
+    assert_eq!(kept[0].time()[0], gappy.time()[100]);
+    for bad in [0.0, -1.0, f64::NAN, f64::INFINITY] {
+        assert!(matches!(
+            gappy.split_at_gaps(bad, 1.0),
+            Err(ridi_data::SequenceError::InvalidGap { .. })
+        ));
+    }
 
     let at_100 = split[1].resampled(100.0, 0.05).unwrap();
     let counted = at_100.steps().unwrap();

@@ -24,7 +24,9 @@ pub(crate) fn one_line(e: &(dyn Error + 'static)) -> String {
     let mut next: Option<&(dyn Error + 'static)> = Some(e);
     while let Some(cause) = next {
         let text = cause.to_string();
-        if !line.contains(&text) {
+        if !line.is_empty() && text.starts_with(&format!("{line}: ")) {
+            line = text;
+        } else if !line.contains(&text) {
             if !line.is_empty() {
                 line.push_str(": ");
             }
@@ -64,8 +66,8 @@ fn file_kind(e: &PipelineError) -> Option<ErrorKind> {
             | OutputError::ParentNotWritable { kind, .. } => *kind,
             _ => ErrorKind::Other,
         }),
-        // Reports and placement maps: a file that is not there is a file error, one that does
-        // not parse a data error.
+        // A placement map that is not there (`PlacementMap::from_arg`); maps and reports that
+        // do not parse are data errors.
         PipelineError::File { path, .. } if !path.exists() => Some(ErrorKind::NotFound),
         PipelineError::Listed { source, .. } => file_kind(source),
         _ => None,

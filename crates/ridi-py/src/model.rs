@@ -6,7 +6,7 @@ use std::sync::{Arc, Mutex};
 use pyo3::exceptions::PyRuntimeError;
 use pyo3::prelude::*;
 use pyo3::types::{PyBytes, PyDict};
-use ridi::data::ListEntry;
+use ridi::data::{ListEntry, shown};
 use ridi::features::FeatureConfig;
 use ridi::features::Orientation;
 use ridi::frames::UpAxis;
@@ -64,7 +64,7 @@ impl Model {
     fn save(&self, py: Python<'_>, path: PathBuf) -> PyResult<()> {
         let model = &self.inner;
         py.detach(|| ridi::save_model(model, &path))
-            .map_err(|e| errors::pipeline_in(e, Some(format!("cannot write {}", path.display()))))
+            .map_err(|e| errors::pipeline_in(e, Some(format!("cannot write {}", shown(&path)))))
     }
 
     /// The placement classes, in the order of the classifier.

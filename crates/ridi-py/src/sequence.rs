@@ -295,19 +295,18 @@ impl Sequence {
         Self::of(inner, self.format)
     }
 
-    /// The stretches between the gaps longer than ``max_gap_s`` seconds, in order (a list of
-    /// one, the sequence itself, without such a gap), named ``<name>_part1``, ``_part2``, ...
-    /// as ``ridi convert --split-at-gaps`` names them: ``ridi.track`` refuses a gap over
-    /// 0.1 s. A stretch may be a single frame; drop what is too short for you.
-    fn split_at_gaps(&self, max_gap_s: f64) -> PyResult<Vec<Self>> {
-        if !(max_gap_s.is_finite() && max_gap_s > 0.0) {
-            return Err(errors::value(format!(
-                "max_gap_s {max_gap_s}: a number of seconds above 0"
-            )));
-        }
-        Ok(self
+    /// The sequence cut at every gap longer than ``max_gap_s`` seconds (``ridi.track``
+    /// refuses one over 0.1 s): the parts at least ``min_duration_s`` long, in order, named as
+    /// ``ridi convert --split-at-gaps`` names them (``<name>_part1``, ``_part2``, ...; the
+    /// plain name when one is left). Without such a gap, a list of the sequence itself.
+    #[pyo3(signature = (max_gap_s, min_duration_s=0.0))]
+    fn split_at_gaps(&self, max_gap_s: f64, min_duration_s: f64) -> PyResult<Vec<Self>> {
+        let split = self
             .inner
-            .split_at_gaps(max_gap_s)
+            .split_at_gaps(max_gap_s, min_duration_s)
+            .map_err(|e| errors::value(e.to_string()))?;
+        Ok(split
+            .parts
             .into_iter()
             .map(|s| Self::of(s, self.format))
             .collect())

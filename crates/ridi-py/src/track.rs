@@ -6,6 +6,7 @@ use numpy::{IntoPyArray, PyArray1, PyArray2};
 use pyo3::prelude::*;
 use ridi::PipelineError;
 use ridi::correct::FrameVelocity;
+use ridi::data::shown;
 
 use crate::arrays::{rows_out, vecs_out, vector_out};
 use crate::errors;
@@ -125,7 +126,7 @@ impl Track {
     fn write_csv(&self, py: Python<'_>, path: PathBuf) -> PyResult<()> {
         let track = &self.inner;
         py.detach(|| track.write_csv(&path))
-            .map_err(|e| errors::pipeline_in(e, Some(format!("cannot write {}", path.display()))))
+            .map_err(|e| errors::pipeline_in(e, Some(format!("cannot write {}", shown(&path)))))
     }
 
     fn __len__(&self) -> usize {

@@ -2,12 +2,13 @@
 
 use std::borrow::Cow;
 use std::collections::BTreeMap;
+use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
 use rayon::prelude::*;
 use ridi_data::{
     DataError, DeviceInfo, Format, Location, ReadOptions, Sequence, SequenceError, counted, detect,
-    sidecar_path, unlistable_name, write_atomically, write_ridi_csv,
+    short, sidecar_path, unlistable_name, write_atomically, write_ridi_csv,
 };
 use ridi_data::{ilc, tyrex};
 
@@ -28,6 +29,8 @@ pub struct Converted {
     /// The phone it was recorded with, when the source says; kept in the sidecar beside the
     /// `data.csv` ([`ridi_data::sidecar_path`]).
     pub device: Option<DeviceInfo>,
+    /// The source it was read from (a file or a folder).
+    pub source: PathBuf,
 }
 
 /// What [`convert`] wrote.
@@ -75,41 +78,61 @@ pub const CONVERT_RATE_HZ: (f64, f64) = (1.001, 9990.0);
 /// would be filled with invented frames, so the recording has to be split there first.
 const RESAMPLE_MAX_GAP_FRAMES: f64 = 5.0;
 
-/// The parts of `seqs` between their gaps longer than `max_gap_s`
-/// ([`ConvertOptions::split_gaps_s`]), each at least [`SPLIT_MIN_PART_S`] long; a warning per
-/// sequence split and per part dropped. An error when no part is left.
-fn split(
-    seqs: &[Sequence],
+/// `seqs` cut at their gaps longer than `max_gap_s` ([`Sequence::split_at_gaps`]), parts
+/// under [`SPLIT_MIN_PART_S`] dropped, with one warning per sequence cut; a sequence without
+/// such a gap is borrowed as it is. An error when no part is left.
+fn split<'a>(
+    seqs: &'a [Sequence],
     max_gap_s: f64,
     warnings: &mut Vec<String>,
-) -> std::result::Result<Vec<Sequence>, String> {
+) -> std::result::Result<Vec<Cow<'a, Sequence>>, String> {
     let mut kept = Vec::new();
     for seq in seqs {
-        let parts = seq.split_at_gaps(max_gap_s);
-        if parts.len() > 1 {
-            warnings.push(format!(
-                "sequence `{}`: split at {} longer than {max_gap_s} s into {}",
-                seq.name(),
-                counted(parts.len() - 1, "gap"),
-                counted(parts.len(), "part")
-            ));
+        let t = seq.time();
+        let gaps = t.windows(2).filter(|w| w[1] - w[0] > max_gap_s).count();
+        if gaps == 0 && max_gap_s.is_finite() && max_gap_s > 0.0 {
+            kept.push(Cow::Borrowed(seq));
+            continue;
         }
-        for part in parts {
-            let (first, last) = (part.time()[0], part.time()[part.len() - 1]);
-            if last - first < SPLIT_MIN_PART_S {
-                warnings.push(format!(
-                    "sequence `{}`: {first:.3}..{last:.3} s is shorter than {SPLIT_MIN_PART_S} \
-                     s: dropped",
-                    part.name()
-                ));
-            } else {
-                kept.push(part);
-            }
+        let ridi_data::SplitParts { parts, dropped } = seq
+            .split_at_gaps(max_gap_s, SPLIT_MIN_PART_S)
+            .map_err(|e| e.to_string())?;
+        let mut warning = format!(
+            "sequence `{}`: split at {} longer than {} s",
+            seq.name(),
+            counted(gaps, "gap"),
+            short(max_gap_s)
+        );
+        if !dropped.is_empty() {
+            const SHOWN: usize = 5;
+            let spans: Vec<String> = dropped
+                .iter()
+                .take(SHOWN)
+                .map(|(a, b)| format!("{a:.3}-{b:.3} s"))
+                .collect();
+            let _ = write!(
+                warning,
+                "; {} shorter than {SPLIT_MIN_PART_S} s dropped ({}{})",
+                counted(dropped.len(), "part"),
+                spans.join(", "),
+                match dropped.len().saturating_sub(SHOWN) {
+                    0 => String::new(),
+                    more => format!(", and {more} more"),
+                }
+            );
         }
+        warning.push_str(&match parts.len() {
+            0 => "; nothing left".to_string(),
+            1 => format!("; 1 part kept, named `{}`", parts[0].name()),
+            n => format!("; {} kept", counted(n, "part")),
+        });
+        warnings.push(warning);
+        kept.extend(parts.into_iter().map(Cow::Owned));
     }
     if kept.is_empty() {
         return Err(format!(
-            "no part of at least {SPLIT_MIN_PART_S} s between gaps longer than {max_gap_s} s"
+            "no part of at least {SPLIT_MIN_PART_S} s between gaps longer than {} s",
+            short(max_gap_s)
         ));
     }
     Ok(kept)
@@ -367,7 +390,7 @@ fn device_lists<'a>(
         if let Some(clash) = clash {
             let model = entries[0].device.as_ref().map_or("", |d| d.model());
             warnings.push(format!(
-                "{} of the device `{model}` get no list_{key}.txt: list_{clash}.txt is another \
+                "{} of the device `{model}`: no list_{key}.txt, as list_{clash}.txt is another \
                  list",
                 counted(entries.len(), "sequence")
             ));
@@ -414,10 +437,7 @@ pub fn convert(
             let parts: Vec<Cow<'_, Sequence>> = match opts.split_gaps_s {
                 None => loaded.sequences.iter().map(Cow::Borrowed).collect(),
                 Some(max_gap) => split(&loaded.sequences, max_gap, &mut warnings)
-                    .map_err(|message| DataError::format(Location::file(dir), message))?
-                    .into_iter()
-                    .map(Cow::Owned)
-                    .collect(),
+                    .map_err(|message| DataError::format(Location::file(dir), message))?,
             };
             for seq in &parts {
                 let seq = seq.as_ref();
@@ -428,7 +448,12 @@ pub fn convert(
                             // Interpolating would invent the gap's frames.
                             SequenceError::Gap { .. } => DataError::format(
                                 Location::file(dir),
-                                format!("{e}: split the recording there first (--split-at-gaps)"),
+                                format!(
+                                    "sequence `{}`: {e}: split the recording there first \
+                                     (--split-at-gaps {})",
+                                    seq.name(),
+                                    short(max_gap)
+                                ),
                             ),
                             e => DataError::sequence(dir, e),
                         })?)
@@ -457,6 +482,7 @@ pub fn convert(
                     path: out.join(rel),
                     frames: seq.len(),
                     device: seq.device().cloned(),
+                    source: dir.clone(),
                 });
             }
             let warnings = loaded
@@ -477,6 +503,22 @@ pub fn convert(
         summary.warnings.extend(warnings);
     }
     summary.sequences.sort_by(|a, b| a.name.cmp(&b.name));
+    // Two sequences of one name would be written to one folder, the last one winning.
+    if let Some(w) = summary
+        .sequences
+        .windows(2)
+        .find(|w| w[0].name == w[1].name)
+    {
+        return Err(DataError::format(
+            Location::file(&w[1].source),
+            format!(
+                "gives a sequence named `{}`, as {} does: an output folder holds one sequence \
+                 per name (rename one source)",
+                w[1].name,
+                ridi_data::shown(&w[0].source)
+            ),
+        ));
+    }
     for c in summary.sequences.iter().filter(|c| c.device.is_none()) {
         // A sequence without a device replaces one that had it: its old sidecar must go too.
         let rel = Path::new(&c.name).join("processed").join("data.csv");

@@ -431,8 +431,8 @@ impl Report {
         let _ = writeln!(out, "# RIDI evaluation\n");
         let _ = writeln!(
             out,
-            "{} sequences; trajectories aligned on {} (2D rigid, no scale); RTE window {} s, short RTE {} s.\n",
-            self.sequences.len(),
+            "{}; trajectories aligned on {} (2D rigid, no scale); RTE window {} s, short RTE {} s.\n",
+            ridi_data::counted(self.sequences.len(), "sequence"),
             match self.config.align {
                 ridi_eval::AlignWindow::Seconds(s) => format!("the first {s} s"),
                 ridi_eval::AlignWindow::Frames(n) => format!("the first {n} frames"),
@@ -472,11 +472,11 @@ impl Report {
         if !weak.is_empty() {
             let _ = writeln!(
                 out,
-                "**Weakly determined alignment** in {} of {} sequences: the ground truth moves \
+                "**Weakly determined alignment** in {} of {}: the ground truth moves \
                  less than {} m within the alignment window, so the fitted heading rests on \
                  little motion and every metric inherits its error: {}.{}\n",
                 weak.len(),
-                self.sequences.len(),
+                ridi_data::counted(self.sequences.len(), "sequence"),
                 ridi_eval::WEAK_ALIGNMENT_EXTENT_M,
                 weak.join(", "),
                 // Aligned on the whole trajectory already, there is no larger window to offer.

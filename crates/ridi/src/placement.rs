@@ -94,15 +94,19 @@ impl PlacementMap {
         if arg.as_os_str() == "tyrex4" {
             return Ok(Self::tyrex_groups());
         }
-        if !arg.exists() {
-            return Err(PipelineError::File {
-                path: arg.to_path_buf(),
-                message: "no such file or folder (a placement map is `tyrex4` or a file of \
-                          `label,class` lines)"
-                    .into(),
-            });
-        }
-        Self::read(arg)
+        Self::read(arg).map_err(|e| match e {
+            PipelineError::Data(DataError::Io { path, error })
+                if error.kind() == std::io::ErrorKind::NotFound =>
+            {
+                PipelineError::File {
+                    path,
+                    message: format!(
+                        "{error} (a placement map is `tyrex4` or a file of `label,class` lines)"
+                    ),
+                }
+            }
+            e => e,
+        })
     }
 
     /// The classes of the map, sorted.

@@ -370,7 +370,7 @@ fn rate_resamples_every_sequence_and_refuses_to_fill_gaps() {
         summary
             .warnings
             .iter()
-            .any(|w| w.ends_with("sequence `walk`: split at 1 gap longer than 0.1 s into 2 parts")),
+            .any(|w| w.ends_with("sequence `walk`: split at 1 gap longer than 0.1 s; 2 parts kept")),
         "{:?}",
         summary.warnings
     );
@@ -399,16 +399,17 @@ fn rate_resamples_every_sequence_and_refuses_to_fill_gaps() {
     write_ridi_csv(&at_100(&short), src.join("data.csv")).unwrap();
     let summary = convert(&dir.path().join("src"), &dir.path().join("out4"), &split).unwrap();
     let names: Vec<&str> = summary.sequences.iter().map(|c| c.name.as_str()).collect();
-    assert_eq!(names, ["walk_part2"]);
+    assert_eq!(names, ["walk"]);
     assert!(
-        summary
-            .warnings
-            .iter()
-            .any(|w| w.contains("sequence `walk_part1`: ")
-                && w.ends_with("s is shorter than 1 s: dropped")),
+        summary.warnings.iter().any(|w| w.contains(
+            "sequence `walk`: split at 1 gap longer than 0.1 s; 1 part shorter than 1 s dropped ("
+        ) && w.ends_with("; 1 part kept, named `walk`")),
         "{:?}",
         summary.warnings
     );
+    // The list names what was written.
+    let listed = std::fs::read_to_string(dir.path().join("out4/list_all.txt")).unwrap();
+    assert!(listed.ends_with("\nwalk,\n"), "{listed}");
     let split_hard = ConvertOptions {
         split_gaps_s: Some(0.001),
         ..split.clone()
@@ -529,7 +530,7 @@ fn devices_are_kept_with_one_list_per_device() {
     let summary = convert(&src, &dir.path().join("out2"), &ConvertOptions::default()).unwrap();
     assert_eq!(
         summary.warnings,
-        ["1 sequence of the device `ANN` get no list_ann.txt: list_Ann.txt is another list"]
+        ["1 sequence of the device `ANN`: no list_ann.txt, as list_Ann.txt is another list"]
     );
 }
 
@@ -617,4 +618,42 @@ fn names_a_list_file_cannot_hold_are_refused_before_writing() {
         assert!(!e.contains('\n'), "the name is escaped: {e:?}");
         assert!(!out.exists(), "{name:?}");
     }
+}
+
+/// Two sources that give one sequence name (here a split part and a folder of that name) would
+/// be written to one folder: refused, naming both, before anything is written.
+#[test]
+fn two_sequences_of_one_name_are_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let src = sources_named(dir.path(), &["walk_part1"]);
+    let opts = ReadOptions::default();
+    let full = read_sequence(seq("Thibaud_Nexus5_NoDist_Texting"), &opts).unwrap();
+    let mut parts = full.clone().into_parts();
+    for (i, t) in parts.time.iter_mut().enumerate() {
+        *t += if i >= 2000 { 0.3 } else { 0.0 };
+    }
+    parts.name = "walk".into();
+    let folder = src.join("walk").join("processed");
+    std::fs::create_dir_all(&folder).unwrap();
+    write_ridi_csv(&Sequence::new(parts).unwrap(), folder.join("data.csv")).unwrap();
+    let out = dir.path().join("out");
+    let split = ConvertOptions {
+        split_gaps_s: Some(0.1),
+        ..ConvertOptions::default()
+    };
+    let e = convert(&src, &out, &split).unwrap_err().to_string();
+    assert!(
+        e.contains("gives a sequence named `walk_part1`, as ")
+            && e.contains("an output folder holds one sequence per name"),
+        "{e}"
+    );
+    assert!(!out.exists());
+    // Without the split, both convert.
+    assert_eq!(
+        convert(&src, &out, &ConvertOptions::default())
+            .unwrap()
+            .sequences
+            .len(),
+        2
+    );
 }
