@@ -387,6 +387,8 @@ fn rate_resamples_every_sequence_and_refuses_to_fill_gaps() {
     assert!((b.time()[0] - gap_from.1).abs() < 1e-6, "{}", b.time()[0]);
     for s in [&a, &b] {
         assert!((s.median_rate_hz() - 200.0).abs() < 0.01);
+        assert!(s.time().windows(2).all(|w| w[1] - w[0] < 0.006));
+        #[cfg(feature = "bundled-model")]
         ridi::track(
             s,
             &ridi::bundled_model().unwrap(),
