@@ -49,8 +49,15 @@ pub(crate) fn parse_header(header_line: usize, header: &str, path: &Path) -> Res
         return Err(DataError::format(
             Location::line(path, header_line),
             format!(
-                "expected `N 27` (row and column counts), found `{}`",
-                text::snippet(header)
+                "expected `N 27` (row and column counts), found `{}`{}",
+                text::snippet(header),
+                // What else a `.txt` of commas or comments may be.
+                if header.starts_with('#') || header.contains(',') {
+                    ": a list file (`path,placement` lines) goes to `--list` of ridi train and \
+                     ridi eval"
+                } else {
+                    ""
+                }
             ),
         ));
     };
