@@ -53,8 +53,8 @@ pub(crate) fn parse_header(header_line: usize, header: &str, path: &Path) -> Res
                 text::snippet(header),
                 // What else a `.txt` of commas or comments may be.
                 if header.starts_with('#') || header.contains(',') {
-                    ": a list file (`path,placement` lines) goes to `--list` of ridi train and \
-                     ridi eval"
+                    ": if this is a list file (`path,placement` lines), it goes to `--list` of \
+                     ridi train and ridi eval"
                 } else {
                     ""
                 }

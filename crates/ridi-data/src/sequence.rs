@@ -569,14 +569,18 @@ impl Sequence {
     /// Without such a gap, the sequence itself, whatever its duration.
     ///
     /// # Errors
-    /// A `max_gap_s` that is not a finite number above 0 (every frame would be a part).
+    /// A `max_gap_s` that is not a finite number above 0 (every frame would be a part), a
+    /// `min_duration_s` below 0 or NaN.
     pub fn split_at_gaps(
         &self,
         max_gap_s: f64,
         min_duration_s: f64,
     ) -> Result<SplitParts, SequenceError> {
-        if !(max_gap_s.is_finite() && max_gap_s > 0.0) {
-            return Err(SequenceError::InvalidGap { max_gap_s });
+        if !(max_gap_s.is_finite() && max_gap_s > 0.0 && min_duration_s >= 0.0) {
+            return Err(SequenceError::InvalidGap {
+                max_gap_s,
+                min_duration_s,
+            });
         }
         let t = self.time();
         let mut bounds: Vec<usize> = std::iter::once(0)

@@ -6,7 +6,9 @@ use crate::sequence::Channel;
 /// large or small (`1e308`, not 309 digits).
 pub fn short(v: f64) -> String {
     let a = v.abs();
-    if a != 0.0 && !(1e-3..1e6).contains(&a) {
+    if !v.is_finite() {
+        v.to_string()
+    } else if a != 0.0 && !(1e-3..1e6).contains(&a) {
         let s = format!("{v:.3e}");
         let (mantissa, exp) = s.split_once('e').unwrap_or((&s, "0"));
         let mantissa = mantissa.trim_end_matches('0').trim_end_matches('.');
@@ -102,14 +104,20 @@ pub enum SequenceError {
         /// The limit.
         max_gap_s: f64,
     },
-    /// A gap to split at that is not a finite number of seconds above 0
+    /// A gap to split at that is not a finite number of seconds above 0, or a shortest part
+    /// that is not a number of at least 0
     /// ([`Sequence::split_at_gaps`](crate::Sequence::split_at_gaps)).
     #[error(
-        "cannot split at gaps longer than {max_gap_s} s: the limit must be a finite number above 0"
+        "cannot split at gaps longer than {} s into parts of at least {} s: the gap must be a \
+         finite number above 0, the duration a number of at least 0",
+        short(*max_gap_s),
+        short(*min_duration_s)
     )]
     InvalidGap {
-        /// The limit asked for.
+        /// The gap asked for.
         max_gap_s: f64,
+        /// The shortest part asked for.
+        min_duration_s: f64,
     },
     /// A resampling rate that is not a finite number above 0 ([`Sequence::resampled`](crate::Sequence::resampled)).
     #[error("cannot resample to {rate_hz} Hz: the rate must be a finite number above 0")]
@@ -271,5 +279,9 @@ mod tests {
         assert_eq!(short(2000.0), "2000");
         assert_eq!(short(1e6), "1e6");
         assert_eq!(short(0.0), "0");
+        assert_eq!(
+            (short(f64::NAN), short(f64::NEG_INFINITY)),
+            ("NaN".into(), "-inf".into())
+        );
     }
 }

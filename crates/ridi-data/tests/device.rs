@@ -197,9 +197,16 @@ fn splits_at_gaps_and_resampling_keep_every_channel() {
     } = gappy.split_at_gaps(0.1, 0.6).unwrap();
     assert_eq!((kept.len(), kept[0].name(), dropped.len()), (1, "walk", 2));
     assert_eq!(kept[0].time()[0], gappy.time()[100]);
-    for bad in [0.0, -1.0, f64::NAN, f64::INFINITY] {
+    for (gap, min) in [
+        (0.0, 1.0),
+        (-1.0, 1.0),
+        (f64::NAN, 1.0),
+        (f64::INFINITY, 1.0),
+        (0.1, -1.0),
+        (0.1, f64::NAN),
+    ] {
         assert!(matches!(
-            gappy.split_at_gaps(bad, 1.0),
+            gappy.split_at_gaps(gap, min),
             Err(ridi_data::SequenceError::InvalidGap { .. })
         ));
     }

@@ -104,7 +104,7 @@ pub(crate) fn pipeline_in(e: PipelineError, context: Option<String>) -> PyErr {
     let line = one_line(&e);
     // An output's own error says "cannot write <path>" already.
     let message = match context {
-        Some(c) if !line.starts_with(&c) => format!("{c}: {line}"),
+        Some(c) if line != c && !line.starts_with(&format!("{c}: ")) => format!("{c}: {line}"),
         _ => line,
     };
     match file_kind(&e) {

@@ -248,7 +248,7 @@ def test_a_gap_ridi_track_refuses_is_split_into_parts_that_track(seq):
     for p in parts:
         assert len(ridi.track(p, ridi.bundled_model())) == len(p)
     assert [p.name for p in gappy.split_at_gaps(0.5)] == [seq.name]
-    with pytest.raises(ValueError, match="cannot split at gaps longer than NaN s"):
+    with pytest.raises(ValueError, match="cannot split at gaps longer than NaN s into parts"):
         gappy.split_at_gaps(float("nan"))
     # Parts shorter than asked go; one left keeps the plain name.
     # (10 s and 14 s long)

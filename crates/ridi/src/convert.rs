@@ -57,8 +57,9 @@ pub struct ConvertOptions {
     /// [`Sequence::resampled`]: ridi_data::Sequence::resampled
     pub rate_hz: Option<f64>,
     /// Cut every sequence at each gap longer than this many seconds, before resampling
-    /// ([`Sequence::split_at_gaps`]): parts `<name>_part1`, `_part2`, ...; a part shorter than
-    /// [`SPLIT_MIN_PART_S`] is dropped with a warning. `None` keeps sequences whole. What
+    /// ([`Sequence::split_at_gaps`]): parts `<name>_part1`, `_part2`, ... (the plain name when
+    /// one is left); a part shorter than [`SPLIT_MIN_PART_S`] is dropped with a warning, and a
+    /// conversion left without any sequence is an error. `None` keeps sequences whole. What
     /// `ridi track` (a gap over 0.1 s) and `rate_hz` (over 5 frame intervals) refuse.
     pub split_gaps_s: Option<f64>,
 }
@@ -80,7 +81,8 @@ const RESAMPLE_MAX_GAP_FRAMES: f64 = 5.0;
 
 /// `seqs` cut at their gaps longer than `max_gap_s` ([`Sequence::split_at_gaps`]), parts
 /// under [`SPLIT_MIN_PART_S`] dropped, with one warning per sequence cut; a sequence without
-/// such a gap is borrowed as it is. An error when no part is left.
+/// such a gap is borrowed as it is. A source may be left without any part (its warning says
+/// so); [`convert`] fails only when every source is.
 fn split<'a>(
     seqs: &'a [Sequence],
     max_gap_s: f64,
@@ -108,7 +110,7 @@ fn split<'a>(
             let spans: Vec<String> = dropped
                 .iter()
                 .take(SHOWN)
-                .map(|(a, b)| format!("{a:.3}-{b:.3} s"))
+                .map(|(a, b)| format!("{a:.3}..{b:.3} s"))
                 .collect();
             let _ = write!(
                 warning,
@@ -128,12 +130,6 @@ fn split<'a>(
         });
         warnings.push(warning);
         kept.extend(parts.into_iter().map(Cow::Owned));
-    }
-    if kept.is_empty() {
-        return Err(format!(
-            "no part of at least {SPLIT_MIN_PART_S} s between gaps longer than {} s",
-            short(max_gap_s)
-        ));
     }
     Ok(kept)
 }
@@ -359,10 +355,14 @@ fn check_overwrites(
 /// The person of a Tyrex run name `<Person>_<Phone>_<Dist>_<Motion>`, also for the parts
 /// of a split run (`..._<Motion>_part2`).
 fn tyrex_subject(name: &str) -> Option<&str> {
-    let run = match name.rsplit_once("_part") {
-        Some((run, n)) if !n.is_empty() && n.bytes().all(|b| b.is_ascii_digit()) => run,
-        _ => name,
-    };
+    // A reader's part (`_part2`), split again at a gap (`_part2_part1`).
+    let mut run = name;
+    while let Some((before, n)) = run.rsplit_once("_part") {
+        if n.is_empty() || !n.bytes().all(|b| b.is_ascii_digit()) {
+            break;
+        }
+        run = before;
+    }
     tyrex::motion_of(run)?;
     let mut parts = run.split('_');
     let person = parts.next();
@@ -452,7 +452,8 @@ pub fn convert(
                                     "sequence `{}`: {e}: split the recording there first \
                                      (--split-at-gaps {})",
                                     seq.name(),
-                                    short(max_gap)
+                                    // Down: a limit rounded up would leave the gap in.
+                                    short((max_gap * 1000.0).floor() / 1000.0)
                                 ),
                             ),
                             e => DataError::sequence(dir, e),
@@ -503,19 +504,30 @@ pub fn convert(
         summary.warnings.extend(warnings);
     }
     summary.sequences.sort_by(|a, b| a.name.cmp(&b.name));
-    // Two sequences of one name would be written to one folder, the last one winning.
-    if let Some(w) = summary
-        .sequences
-        .windows(2)
-        .find(|w| w[0].name == w[1].name)
-    {
+    // Two sequences of one name would be written to one folder, the last one winning; names
+    // differing in case too, as some file systems do not tell them apart.
+    let mut seen: BTreeMap<String, &Converted> = BTreeMap::new();
+    for c in &summary.sequences {
+        if let Some(first) = seen.insert(c.name.to_lowercase(), c) {
+            return Err(DataError::format(
+                Location::file(&c.source),
+                format!(
+                    "gives a sequence named `{}`, as {} gives `{}`: an output folder holds one \
+                     sequence per name, whatever its case (rename one source)",
+                    c.name,
+                    ridi_data::shown(&first.source),
+                    first.name
+                ),
+            ));
+        }
+    }
+    if summary.sequences.is_empty() {
         return Err(DataError::format(
-            Location::file(&w[1].source),
+            Location::file(source),
             format!(
-                "gives a sequence named `{}`, as {} does: an output folder holds one sequence \
-                 per name (rename one source)",
-                w[1].name,
-                ridi_data::shown(&w[0].source)
+                "no part of at least {SPLIT_MIN_PART_S} s between gaps longer than {} s in any \
+                 sequence",
+                short(opts.split_gaps_s.unwrap_or(f64::NAN))
             ),
         ));
     }
@@ -562,6 +574,11 @@ mod tests {
         assert_eq!(tyrex_subject("Jakob_Nexus5_NoDist_Texting"), Some("Jakob"));
         assert_eq!(
             tyrex_subject("Thibaud_Nexus5_NoDist_Phoning_part3"),
+            Some("Thibaud")
+        );
+        // A reader's part split again at a gap.
+        assert_eq!(
+            tyrex_subject("Thibaud_Nexus5_NoDist_Phoning_part1_part2"),
             Some("Thibaud")
         );
         assert_eq!(tyrex_subject("dan_body1"), None);

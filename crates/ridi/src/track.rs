@@ -335,8 +335,8 @@ fn gap_error(name: &str, i: usize, t: (f64, f64), t0: f64, max_dt: f64) -> Pipel
         format!(
             "a gap of {:.3} s between frames {i} and {} ({:.3} s and {:.3} s from the \
              start) is longer than the {max_dt} s the correction integrates across; split \
-             the recording at its gaps (`ridi convert --split-at-gaps {max_dt}`, or the \
-             sequence's `split_at_gaps`)",
+             the recording at its gaps (`ridi convert --split-at-gaps {max_dt}`; in Python \
+             `Sequence.split_at_gaps`)",
             t.1 - t.0,
             i + 1,
             t.0 - t0,

@@ -412,6 +412,24 @@ fn rate_resamples_every_sequence_and_refuses_to_fill_gaps() {
     // The list names what was written.
     let listed = std::fs::read_to_string(dir.path().join("out4/list_all.txt")).unwrap();
     assert!(listed.ends_with("\nwalk,\n"), "{listed}");
+    // A source left without any part is a warning while another converts.
+    let tiny: Vec<usize> = keep
+        .iter()
+        .copied()
+        .filter(|&i| i < 60 || (100..150).contains(&i))
+        .collect();
+    let tiny_dir = dir.path().join("src/tiny/processed");
+    std::fs::create_dir_all(&tiny_dir).unwrap();
+    write_ridi_csv(&at_100(&tiny), tiny_dir.join("data.csv")).unwrap();
+    let summary = convert(&dir.path().join("src"), &dir.path().join("out6"), &split).unwrap();
+    let names: Vec<&str> = summary.sequences.iter().map(|c| c.name.as_str()).collect();
+    assert_eq!(names, ["walk"]);
+    assert!(
+        summary.warnings.iter().any(|w| w.contains("sequence `tiny`: split at 1 gap")
+            && w.ends_with("; nothing left")),
+        "{:?}",
+        summary.warnings
+    );
     let split_hard = ConvertOptions {
         split_gaps_s: Some(0.001),
         ..split.clone()
@@ -644,9 +662,13 @@ fn two_sequences_of_one_name_are_refused() {
         ..ConvertOptions::default()
     };
     let e = convert(&src, &out, &split).unwrap_err().to_string();
+    let (at_walk, at_part) = (src.join("walk"), src.join("walk_part1"));
     assert!(
         e.contains("gives a sequence named `walk_part1`, as ")
-            && e.contains("an output folder holds one sequence per name"),
+            && e.contains("an output folder holds one sequence per name")
+            && [&at_walk, &at_part]
+                .iter()
+                .all(|p| e.contains(p.to_str().unwrap())),
         "{e}"
     );
     assert!(!out.exists());
@@ -658,4 +680,10 @@ fn two_sequences_of_one_name_are_refused() {
             .len(),
         2
     );
+    // Names that differ in case alone are one folder on some file systems: refused too.
+    let src2 = sources_named(&dir.path().join("two"), &["Walk", "walk"]);
+    let e = convert(&src2, &dir.path().join("out2"), &ConvertOptions::default())
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("whatever its case"), "{e}");
 }
