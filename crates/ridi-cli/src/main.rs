@@ -248,26 +248,10 @@ fn model_or_bundled(path: Option<&Path>) -> Result<Cascade> {
     }
 }
 
-/// One line: the outermost context and every cause, as users asked for. Errors that already
-/// print their source in their own message are not repeated, nor a context its cause repeats
-/// ("cannot write m.ridi" over "cannot write m.ridi: the folder . does not exist").
+/// One line: the outermost context and every cause, as users asked for
+/// ([`ridi::data::one_line`], which the Python package prints too).
 fn one_line(e: &anyhow::Error) -> String {
-    let mut line = String::new();
-    for cause in e.chain() {
-        let text = cause.to_string();
-        if line.contains(&text) {
-            continue;
-        }
-        if !line.is_empty() && text.starts_with(&format!("{line}: ")) {
-            line = text;
-            continue;
-        }
-        if !line.is_empty() {
-            line.push_str(": ");
-        }
-        line.push_str(&text);
-    }
-    line
+    ridi::data::one_line(e.as_ref())
 }
 
 /// Ctrl-C (SIGINT), SIGTERM and SIGHUP: the temporary files and staging folders of the run are

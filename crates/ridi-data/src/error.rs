@@ -53,6 +53,43 @@ pub fn counted(n: usize, noun: &str) -> String {
     format!("{n} {noun}{ending}")
 }
 
+/// The first few of `spans`, `a-b s`, and how many more there are: where a warning's findings
+/// are.
+pub fn spans_text(spans: &[(f64, f64)]) -> String {
+    const SHOWN: usize = 5;
+    let mut text: Vec<String> = spans
+        .iter()
+        .take(SHOWN)
+        .map(|(a, b)| format!("{a:.2}-{b:.2} s"))
+        .collect();
+    if spans.len() > SHOWN {
+        text.push(format!("and {} more", spans.len() - SHOWN));
+    }
+    text.join(", ")
+}
+
+/// An error and its causes on one line, as the `ridi` command and the Python package print
+/// them: each cause once (one whose text the line holds already is left out), and a context
+/// its cause repeats ("cannot write m.ridi" over "cannot write m.ridi: the folder . does not
+/// exist") replaced by the cause.
+pub fn one_line(e: &(dyn std::error::Error + 'static)) -> String {
+    let mut line = String::new();
+    let mut next = Some(e);
+    while let Some(cause) = next {
+        let text = cause.to_string();
+        if !line.is_empty() && text.starts_with(&format!("{line}: ")) {
+            line = text;
+        } else if !line.contains(&text) {
+            if !line.is_empty() {
+                line.push_str(": ");
+            }
+            line.push_str(&text);
+        }
+        next = cause.source();
+    }
+    line
+}
+
 /// `text` (a path, a sequence name, a message) for a message, with control characters escaped
 /// (`\n`, `\u{1b}`; DEL and the C1 controls U+0080-U+009F too, `\u{9b}` being a CSI to some
 /// terminals): a file or sequence name may hold a line break or a terminal escape

@@ -566,13 +566,14 @@ impl Sequence {
     /// for what cannot cross one (`ridi track` refuses a gap over 0.1 s): the parts at least
     /// `min_duration_s` long, named as the readers name the parts of a recording they split
     /// ([`part_name`]), and the (first, last) frame times of the parts dropped as shorter.
-    /// Without such a gap, the sequence itself, whatever its duration.
+    /// Without such a gap, the sequence itself, whatever its duration (taken by value, so that
+    /// it is not copied then).
     ///
     /// # Errors
     /// A `max_gap_s` that is not a finite number above 0 (every frame would be a part), a
     /// `min_duration_s` below 0 or NaN.
     pub fn split_at_gaps(
-        &self,
+        self,
         max_gap_s: f64,
         min_duration_s: f64,
     ) -> Result<SplitParts, SequenceError> {
@@ -588,7 +589,7 @@ impl Sequence {
             .collect();
         if bounds.len() == 1 {
             return Ok(SplitParts {
-                parts: vec![self.clone()],
+                parts: vec![self],
                 dropped: Vec::new(),
             });
         }

@@ -155,12 +155,12 @@ use ridi_frames::nalgebra::Matrix3;
 use ridi_frames::{DeviceVec, QuatError, STANDARD_GRAVITY, WorldFromDevice, WorldVec};
 
 use crate::android;
-use crate::error::{DataError, Location, Result, counted, shown};
+use crate::error::{DataError, Location, Result, counted, shown, spans_text};
 use crate::mat::{MatFile, MatValue, dims_text};
 use crate::options::ReadOptions;
 use crate::resample::{interpolate_rot, interpolate_vec3, uniform_timeline};
 use crate::text::{self, Nan};
-use crate::validation::{orientation_jump_warning, spans_text};
+use crate::validation::orientation_jump_warning;
 use crate::{
     Channel, DeviceInfo, GroundTruth, OrientationJump, OrientationSource, Sequence, SequenceError,
     SequenceParts, Validation, bridge_orientation_jumps, part_name,

@@ -7,7 +7,7 @@ use ridi_frames::{Device, DeviceVec, World, WorldFromDevice, WorldVec};
 /// A turn of the world frame.
 type WorldFromWorld = ridi_frames::Rot<World, World>;
 
-use crate::error::counted;
+use crate::error::{counted, spans_text};
 use crate::sequence::{Channel, norm};
 use crate::sequence_error::{SequenceError, short};
 
@@ -542,21 +542,6 @@ pub(crate) fn orientation_jump_warning(file: &str, jumps: &[OrientationJump]) ->
             spans_text(&at)
         )
     })
-}
-
-/// The first few of `spans`, `a-b s`, and how many more there are: where a warning's findings
-/// are.
-pub(crate) fn spans_text(spans: &[(f64, f64)]) -> String {
-    const SHOWN: usize = 5;
-    let mut text: Vec<String> = spans
-        .iter()
-        .take(SHOWN)
-        .map(|(a, b)| format!("{a:.2}-{b:.2} s"))
-        .collect();
-    if spans.len() > SHOWN {
-        text.push(format!("and {} more", spans.len() - SHOWN));
-    }
-    text.join(", ")
 }
 
 /// Smallest RMS rotation rate of the orientation, rad/s, at which

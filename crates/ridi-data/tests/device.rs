@@ -155,7 +155,7 @@ fn slices_and_resampling_keep_the_device() {
 #[test]
 fn splits_at_gaps_and_resampling_keep_every_channel() {
     let seq = with_device("walk");
-    let whole = seq.split_at_gaps(0.1, 1.0).unwrap();
+    let whole = seq.clone().split_at_gaps(0.1, 1.0).unwrap();
     assert_eq!((whole.parts, whole.dropped), (vec![seq.clone()], vec![]));
     let mut parts = seq.clone().into_parts();
     let steps: Vec<f64> = (0..seq.len()).map(|i| (i / 40) as f64).collect();
@@ -169,7 +169,7 @@ fn splits_at_gaps_and_resampling_keep_every_channel() {
     let SplitParts {
         parts: split,
         dropped,
-    } = gappy.split_at_gaps(0.1, 0.0).unwrap();
+    } = gappy.clone().split_at_gaps(0.1, 0.0).unwrap();
     assert!(dropped.is_empty());
     let names: Vec<&str> = split.iter().map(Sequence::name).collect();
     assert_eq!(names, ["walk_part1", "walk_part2", "walk_part3"]);
@@ -179,14 +179,17 @@ fn splits_at_gaps_and_resampling_keep_every_channel() {
     assert_eq!(split[1].steps().unwrap(), &steps[100..250]);
     assert_eq!(split[2].gyro(), &gappy.gyro()[250..]);
     assert!(split.iter().all(|s| s.device() == Some(&iphone())));
-    assert_eq!(gappy.split_at_gaps(1.0, 0.0).unwrap().parts.len(), 1);
+    assert_eq!(
+        gappy.clone().split_at_gaps(1.0, 0.0).unwrap().parts.len(),
+        1
+    );
     // Parts shorter than the minimum go, and the rest are numbered as the Tyrex reader numbers
     // what it keeps: one part left keeps the plain name.
     // (0.495 s, 0.79 s and 0.245 s long)
     let SplitParts {
         parts: kept,
         dropped,
-    } = gappy.split_at_gaps(0.1, 0.3).unwrap();
+    } = gappy.clone().split_at_gaps(0.1, 0.3).unwrap();
     let names: Vec<&str> = kept.iter().map(Sequence::name).collect();
     assert_eq!(names, ["walk_part1", "walk_part2"]);
     assert_eq!(kept[1].time()[0], gappy.time()[100]);
@@ -194,7 +197,7 @@ fn splits_at_gaps_and_resampling_keep_every_channel() {
     let SplitParts {
         parts: kept,
         dropped,
-    } = gappy.split_at_gaps(0.1, 0.6).unwrap();
+    } = gappy.clone().split_at_gaps(0.1, 0.6).unwrap();
     assert_eq!((kept.len(), kept[0].name(), dropped.len()), (1, "walk", 2));
     assert_eq!(kept[0].time()[0], gappy.time()[100]);
     for (gap, min) in [
@@ -206,7 +209,7 @@ fn splits_at_gaps_and_resampling_keep_every_channel() {
         (0.1, f64::NAN),
     ] {
         assert!(matches!(
-            gappy.split_at_gaps(gap, min),
+            gappy.clone().split_at_gaps(gap, min),
             Err(ridi_data::SequenceError::InvalidGap { .. })
         ));
     }

@@ -5,7 +5,6 @@
 //! ([`ridi::data::shown`]): a file name holding a line break or a terminal escape sequence does
 //! not split the message or reach the user's terminal raw.
 
-use std::error::Error;
 use std::io::ErrorKind;
 use std::path::Path;
 
@@ -14,28 +13,9 @@ use pyo3::exceptions::{
     PyFileExistsError, PyFileNotFoundError, PyIsADirectoryError, PyNotADirectoryError, PyOSError,
     PyPermissionError, PyValueError,
 };
-use ridi::data::{DataError, shown};
+use ridi::data::{DataError, one_line, shown};
 use ridi::regress::RegressError;
 use ridi::{OutputError, PipelineError};
-
-/// The error and its causes on one line, each cause once: the command line's `one_line`.
-pub(crate) fn one_line(e: &(dyn Error + 'static)) -> String {
-    let mut line = String::new();
-    let mut next: Option<&(dyn Error + 'static)> = Some(e);
-    while let Some(cause) = next {
-        let text = cause.to_string();
-        if !line.is_empty() && text.starts_with(&format!("{line}: ")) {
-            line = text;
-        } else if !line.contains(&text) {
-            if !line.is_empty() {
-                line.push_str(": ");
-            }
-            line.push_str(&text);
-        }
-        next = cause.source();
-    }
-    line
-}
 
 /// The `OSError` subclass Python raises for `kind`.
 fn os_error(kind: ErrorKind, message: String) -> PyErr {

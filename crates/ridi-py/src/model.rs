@@ -219,7 +219,7 @@ impl Callback {
             return errors::value(format!(
                 "the grid search cross-validates over each placement's sequences (`grid=\"none\"` \
                  trains without it): {}",
-                errors::one_line(&e)
+                ridi::data::one_line(&e)
             ));
         }
         errors::pipeline(e)

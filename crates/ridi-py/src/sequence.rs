@@ -303,6 +303,7 @@ impl Sequence {
     fn split_at_gaps(&self, max_gap_s: f64, min_duration_s: f64) -> PyResult<Vec<Self>> {
         let split = self
             .inner
+            .clone()
             .split_at_gaps(max_gap_s, min_duration_s)
             .map_err(|e| errors::value(e.to_string()))?;
         Ok(split

@@ -1,14 +1,14 @@
 //! `ridi convert`: any supported source to the RIDI processed layout, with list files.
 
-use std::borrow::Cow;
 use std::collections::BTreeMap;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
 use rayon::prelude::*;
 use ridi_data::{
-    DataError, DeviceInfo, Format, Location, ReadOptions, Sequence, SequenceError, counted, detect,
-    short, sidecar_path, unlistable_name, write_atomically, write_ridi_csv,
+    DataError, DeviceInfo, Format, Location, ReadOptions, Sequence, SequenceError, SplitParts,
+    counted, detect, short, sidecar_path, spans_text, unlistable_name, write_atomically,
+    write_ridi_csv,
 };
 use ridi_data::{ilc, tyrex};
 
@@ -80,56 +80,41 @@ pub const CONVERT_RATE_HZ: (f64, f64) = (1.001, 9990.0);
 const RESAMPLE_MAX_GAP_FRAMES: f64 = 5.0;
 
 /// `seqs` cut at their gaps longer than `max_gap_s` ([`Sequence::split_at_gaps`]), parts
-/// under [`SPLIT_MIN_PART_S`] dropped, with one warning per sequence cut; a sequence without
-/// such a gap is borrowed as it is. A source may be left without any part (its warning says
-/// so); [`convert`] fails only when every source is.
-fn split<'a>(
-    seqs: &'a [Sequence],
+/// under [`SPLIT_MIN_PART_S`] dropped, with one warning per sequence cut. A source may be left
+/// without any part (its warning says so); [`convert`] fails only when every source is.
+fn split(
+    seqs: Vec<Sequence>,
     max_gap_s: f64,
     warnings: &mut Vec<String>,
-) -> std::result::Result<Vec<Cow<'a, Sequence>>, String> {
+) -> std::result::Result<Vec<Sequence>, SequenceError> {
     let mut kept = Vec::new();
     for seq in seqs {
-        let t = seq.time();
-        let gaps = t.windows(2).filter(|w| w[1] - w[0] > max_gap_s).count();
-        if gaps == 0 && max_gap_s.is_finite() && max_gap_s > 0.0 {
-            kept.push(Cow::Borrowed(seq));
-            continue;
-        }
-        let ridi_data::SplitParts { parts, dropped } = seq
-            .split_at_gaps(max_gap_s, SPLIT_MIN_PART_S)
-            .map_err(|e| e.to_string())?;
-        let mut warning = format!(
-            "sequence `{}`: split at {} longer than {} s",
-            seq.name(),
-            counted(gaps, "gap"),
-            short(max_gap_s)
-        );
-        if !dropped.is_empty() {
-            const SHOWN: usize = 5;
-            let spans: Vec<String> = dropped
-                .iter()
-                .take(SHOWN)
-                .map(|(a, b)| format!("{a:.3}..{b:.3} s"))
-                .collect();
-            let _ = write!(
-                warning,
-                "; {} shorter than {SPLIT_MIN_PART_S} s dropped ({}{})",
-                counted(dropped.len(), "part"),
-                spans.join(", "),
-                match dropped.len().saturating_sub(SHOWN) {
-                    0 => String::new(),
-                    more => format!(", and {more} more"),
-                }
+        let name = seq.name().to_owned();
+        let SplitParts { parts, dropped } = seq.split_at_gaps(max_gap_s, SPLIT_MIN_PART_S)?;
+        // One stretch more than gaps, each kept or dropped.
+        let gaps = parts.len() + dropped.len() - 1;
+        if gaps > 0 {
+            let mut warning = format!(
+                "sequence `{name}`: split at {} longer than {} s",
+                counted(gaps, "gap"),
+                short(max_gap_s)
             );
+            if !dropped.is_empty() {
+                let _ = write!(
+                    warning,
+                    "; {} shorter than {SPLIT_MIN_PART_S} s dropped ({})",
+                    counted(dropped.len(), "part"),
+                    spans_text(&dropped)
+                );
+            }
+            warning.push_str(&match parts.len() {
+                0 => "; nothing left".to_string(),
+                1 => format!("; 1 part kept, named `{}`", parts[0].name()),
+                n => format!("; {} kept", counted(n, "part")),
+            });
+            warnings.push(warning);
         }
-        warning.push_str(&match parts.len() {
-            0 => "; nothing left".to_string(),
-            1 => format!("; 1 part kept, named `{}`", parts[0].name()),
-            n => format!("; {} kept", counted(n, "part")),
-        });
-        warnings.push(warning);
-        kept.extend(parts.into_iter().map(Cow::Owned));
+        kept.extend(parts);
     }
     Ok(kept)
 }
@@ -434,13 +419,12 @@ pub fn convert(
             let mut written = Vec::new();
             let listed = dir.canonicalize().ok().and_then(|d| labels.get(&d));
             let mut warnings = Vec::new();
-            let parts: Vec<Cow<'_, Sequence>> = match opts.split_gaps_s {
-                None => loaded.sequences.iter().map(Cow::Borrowed).collect(),
-                Some(max_gap) => split(&loaded.sequences, max_gap, &mut warnings)
-                    .map_err(|message| DataError::format(Location::file(dir), message))?,
+            let sequences = match opts.split_gaps_s {
+                None => loaded.sequences,
+                Some(max_gap) => split(loaded.sequences, max_gap, &mut warnings)
+                    .map_err(|e| DataError::sequence(dir, e))?,
             };
-            for seq in &parts {
-                let seq = seq.as_ref();
+            for seq in &sequences {
                 let resampled = match opts.rate_hz {
                     Some(rate) => {
                         let max_gap = RESAMPLE_MAX_GAP_FRAMES / seq.median_rate_hz();
@@ -521,13 +505,15 @@ pub fn convert(
             ));
         }
     }
-    if summary.sequences.is_empty() {
+    if let Some(max_gap) = opts.split_gaps_s
+        && summary.sequences.is_empty()
+    {
         return Err(DataError::format(
             Location::file(source),
             format!(
                 "no part of at least {SPLIT_MIN_PART_S} s between gaps longer than {} s in any \
                  sequence",
-                short(opts.split_gaps_s.unwrap_or(f64::NAN))
+                short(max_gap)
             ),
         ));
     }
