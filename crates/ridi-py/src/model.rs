@@ -226,6 +226,9 @@ impl Callback {
     }
 }
 
+// A literal, so that `inspect.signature` shows the value (a path shows as `...`).
+const _: () = assert!(Nystrom::DEFAULT_LANDMARKS == 2048);
+
 /// Trains a model, as ``ridi train`` does, with its options and defaults.
 ///
 /// ``data`` is a list file (``path,placement`` per line), several, or a list of
@@ -252,7 +255,7 @@ impl Callback {
 #[pyfunction]
 #[pyo3(signature = (
     data, *, grid="paper", placement_map=None, orientation="estimated", storage="projected",
-    solver="exact", landmarks=Nystrom::DEFAULT_LANDMARKS, seed=0, turned_copies=1, step=None,
+    solver="exact", landmarks=2048, seed=0, turned_copies=1, step=None,
     window=None, speed=true, up_axis="plus-or-minus-y", standardize=true, classifier_c=10.0,
     jobs=None, progress=None,
 ))]

@@ -70,7 +70,7 @@ impl Sequence {
 impl Sequence {
     #[new]
     #[pyo3(signature = (
-        time, gyro, acce, gravity, orientation, *, linacce=None, name="sequence".to_string(),
+        time, gyro, acce, gravity, orientation, *, linacce=None, name="sequence",
         placement=None, magnet=None, ground_truth_position=None, ground_truth_orientation=None,
         steps=None, orientation_source=None, device=None, device_imu_rate_hz=None,
     ))]
@@ -82,7 +82,7 @@ impl Sequence {
         gravity: &Bound<'_, PyAny>,
         orientation: &Bound<'_, PyAny>,
         linacce: Option<&Bound<'_, PyAny>>,
-        name: String,
+        name: &str,
         placement: Option<String>,
         magnet: Option<&Bound<'_, PyAny>>,
         ground_truth_position: Option<&Bound<'_, PyAny>>,
@@ -159,7 +159,7 @@ impl Sequence {
                 .transpose()?,
             device,
             placement,
-            name,
+            name: name.to_string(),
         };
         let name = parts.name.clone();
         let inner = RidiSequence::new(parts)
