@@ -869,7 +869,14 @@ fn raw_folder(dir: &Path, g: f64, skip: &[&str]) {
         ("acce.txt", rows("t x y z", &format!("0 {g} 0"))),
         ("linacce.txt", rows("t x y z", "0 0 0")),
         ("gravity.txt", rows("t x y z", &format!("0 {g} 0"))),
-        ("orientation.txt", rows("t x y z w", "0 0 0 1")),
+        // Upright: a turn by 90 degrees about x takes the y axis, along gravity, up.
+        (
+            "orientation.txt",
+            rows(
+                "t x y z w",
+                &format!("{r} 0 0 {r}", r = std::f64::consts::FRAC_1_SQRT_2),
+            ),
+        ),
         ("pose.txt", rows("t tx ty tz qx qy qz qw", "0 0 0 0 0 0 1")),
     ];
     for (name, text) in files {

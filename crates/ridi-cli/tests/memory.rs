@@ -35,6 +35,10 @@ fn phone() -> Vec<[[f64; 3]; 4]> {
         .collect()
 }
 
+/// The quaternion components of the upright phone's orientation (a turn by 90 degrees about
+/// x, taking its y axis, along gravity, up).
+const UPRIGHT: f64 = std::f64::consts::FRAC_1_SQRT_2;
+
 /// The time of the long recordings' frame `i` at 200 Hz, nanoseconds.
 fn ns(i: usize) -> u64 {
     1_000_000_000 + 5_000_000 * i as u64
@@ -55,7 +59,8 @@ fn create(path: &Path) -> std::io::BufWriter<std::fs::File> {
 fn long_recording(path: &Path, rows: usize) {
     let bodies: Vec<String> = phone()
         .iter()
-        .map(|f| format!("{},1,0,0,0\n", cells(&f.concat(), ",")))
+        // Upright (y up, along gravity): rv_w rv_x rv_y rv_z of a turn by 90 degrees about x.
+        .map(|f| format!("{},{UPRIGHT},{UPRIGHT},0,0\n", cells(&f.concat(), ",")))
         .collect();
     let mut w = create(path);
     w.write_all(
@@ -84,9 +89,14 @@ fn long_raw_folder(folder: &Path, rows: usize) {
         }
         w.flush().unwrap();
     }
+    let upright_xyzw = format!("{UPRIGHT} 0 0 {UPRIGHT}");
     for (name, header, values) in [
-        ("orientation.txt", "# t x y z w", "0 0 0 1"),
-        ("pose.txt", "# t tx ty tz qx qy qz qw", "1.5 -2 1.2 0 0 0 1"),
+        ("orientation.txt", "# t x y z w", upright_xyzw),
+        (
+            "pose.txt",
+            "# t tx ty tz qx qy qz qw",
+            "1.5 -2 1.2 0 0 0 1".into(),
+        ),
     ] {
         let mut w = create(&folder.join(name));
         writeln!(w, "{header}").unwrap();

@@ -60,9 +60,10 @@
 //!     name: "walk1".into(),
 //!     time: (0..n).map(|i| (1_000_000_000 + 5_000_000 * i) as f64 / 1e9).collect(),
 //!     gyro: vec![DeviceVec::new(0.01, -0.02, 0.03); n],
-//!     acce: vec![DeviceVec::new(0.1, 9.9, 0.2); n],
+//!     // Lying flat: gravity along the device's z axis, the orientation's up.
+//!     acce: vec![DeviceVec::new(0.1, 0.1, 10.0); n],
 //!     linacce: vec![DeviceVec::new(0.1, 0.1, 0.2); n],
-//!     gravity: vec![DeviceVec::new(0.0, 9.8, 0.0); n],
+//!     gravity: vec![DeviceVec::new(0.0, 0.0, 9.8); n],
 //!     orientation: vec![WorldFromDevice::identity(); n],
 //!     orientation_source: Some(OrientationSource::GameRotationVector),
 //!     ..Default::default()

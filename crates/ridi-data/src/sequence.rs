@@ -311,7 +311,11 @@ impl Sequence {
                 index,
             });
         }
-        check_steps(&parts.time, limits.max_gap_s)?;
+        check_steps(&parts.time, limits.max_gap_s).map_err(|e| match e {
+            // Every step a gap: a time in milliseconds, say, which the median step names.
+            SequenceError::Gap { .. } => limits.check_time_step(&parts.time).err().unwrap_or(e),
+            e => e,
+        })?;
         check_vecs("gyro", n, &parts.gyro)?;
         check_vecs("acce", n, &parts.acce)?;
         check_vecs("linacce", n, &parts.linacce)?;
@@ -360,6 +364,7 @@ impl Sequence {
         if !(min..=max).contains(&mean) {
             return Err(SequenceError::Gravity { mean, min, max });
         }
+        limits.check_orientation_gravity(&parts.orientation, &parts.gravity)?;
         limits.check_acce_scale(mean_norm(arrays(&parts.acce)), mean)?;
         limits.check_gyro_scale(&parts.time, &parts.gyro, &parts.orientation)?;
         limits.check_linacce_scale(
@@ -566,8 +571,8 @@ impl Sequence {
     /// for what cannot cross one (`ridi track` refuses a gap over 0.1 s): the parts at least
     /// `min_duration_s` long, named as the readers name the parts of a recording they split
     /// ([`part_name`]), and the (first, last) frame times of the parts dropped as shorter.
-    /// Without such a gap, the sequence itself, whatever its duration (taken by value, so that
-    /// it is not copied then).
+    /// Without such a gap, the sequence itself (taken by value, so that it is not copied then),
+    /// or nothing kept when it is shorter than `min_duration_s`.
     ///
     /// # Errors
     /// A `max_gap_s` that is not a finite number above 0 (every frame would be a part), a
@@ -588,9 +593,17 @@ impl Sequence {
             .chain((1..t.len()).filter(|&i| t[i] - t[i - 1] > max_gap_s))
             .collect();
         if bounds.len() == 1 {
-            return Ok(SplitParts {
-                parts: vec![self],
-                dropped: Vec::new(),
+            let (first, last) = (t[0], t[t.len() - 1]);
+            return Ok(if last - first >= min_duration_s {
+                SplitParts {
+                    parts: vec![self],
+                    dropped: Vec::new(),
+                }
+            } else {
+                SplitParts {
+                    parts: Vec::new(),
+                    dropped: vec![(first, last)],
+                }
             });
         }
         bounds.push(t.len());

@@ -19,6 +19,27 @@ pub fn short(v: f64) -> String {
     }
 }
 
+/// Which unit a timeline stepping by `median` "seconds" is in, where one divisor takes the
+/// step to a phone's 10 Hz..1 kHz: a time in milliseconds, say, steps by 5 at 200 Hz.
+fn time_unit_guess(median: f64) -> String {
+    [
+        (1e3, "milliseconds"),
+        (1e6, "microseconds"),
+        (1e9, "nanoseconds"),
+    ]
+    .into_iter()
+    .find(|(divisor, _)| (1e-3..=0.1).contains(&(median / divisor)))
+    .map_or_else(
+        || "time in the wrong unit?".to_owned(),
+        |(divisor, unit)| {
+            format!(
+                "time in {unit} instead of seconds (divide by {})?",
+                short(divisor)
+            )
+        },
+    )
+}
+
 /// Axis names of the 3-vector channels.
 pub(crate) const AXES: [&str; 3] = ["x", "y", "z"];
 
@@ -239,10 +260,11 @@ pub enum SequenceError {
     },
     /// The median interval between timestamps is outside [`Validation::time_step_range`](crate::Validation::time_step_range).
     #[error(
-        "timestamps step by {} s (median), outside {}..{} s: time in the wrong unit?",
+        "timestamps step by {} s (median), outside {}..{} s: {}",
         short(*median),
         short(*min),
-        short(*max)
+        short(*max),
+        time_unit_guess(*median)
     )]
     TimeStep {
         /// Median interval, seconds.
@@ -251,6 +273,20 @@ pub enum SequenceError {
         min: f64,
         /// Upper limit.
         max: f64,
+    },
+    /// Gravity is far from the up axis the orientation gives, over most frames.
+    #[error(
+        "gravity is {} degrees from the up axis the orientation gives (median over frames), \
+         more than {}: an orientation given as [x, y, z, w] for [w, x, y, z], or \
+         device-from-world for world-from-device?",
+        short(*median_deg),
+        short(*max_deg)
+    )]
+    OrientationGravity {
+        /// Median angle, degrees.
+        median_deg: f64,
+        /// The limit ([`Validation::max_orientation_gravity_deg`](crate::Validation::max_orientation_gravity_deg)).
+        max_deg: f64,
     },
     /// Mean gravity magnitude outside the plausible range: wrong units or a wrong column.
     #[error(

@@ -119,12 +119,15 @@ enum Quantity {
     GyroNorm,
     /// The ground truth's speed from the previous row, m/s.
     Speed,
+    /// The angle between gravity and the orientation's up axis, degrees.
+    UpAngle,
 }
 
 impl Quantity {
     fn of(self, previous: Option<&Row>, row: &Row) -> Option<f64> {
         match self {
             Quantity::GyroNorm => Some(norm(row.gyro.to_array())),
+            Quantity::UpAngle => crate::validation::up_angle_deg(row.orientation, row.gravity),
             Quantity::Interval => previous.map(|p| row.time - p.time),
             Quantity::Speed => {
                 let (p, r) = (previous?.ground_truth?.0, row.ground_truth?.0);
@@ -385,6 +388,9 @@ struct Sums {
     gyro: MedianTest,
     /// Ground-truth speed above [`Validation::max_median_speed`].
     speed: MedianTest,
+    /// Angle of gravity from the orientation's up axis above
+    /// [`Validation::max_orientation_gravity_deg`].
+    up: MedianTest,
     /// The first too fast ground-truth step: its index, vector and interval; and whether a
     /// later step (from frame 2 on) is too fast.
     jump: Option<(usize, [f64; 3], f64)>,
@@ -436,9 +442,10 @@ struct Sums {
 ///     name: "walk".into(),
 ///     time: (0..n).map(|i| (1_000_000_000 + 5_000_000 * i) as f64 / 1e9).collect(),
 ///     gyro: vec![DeviceVec::new(0.01, -0.02, 0.03); n],
-///     acce: vec![DeviceVec::new(0.1, 9.9, 0.2); n],
+///     // Lying flat: gravity along the device's z axis, the orientation's up.
+///     acce: vec![DeviceVec::new(0.1, 0.1, 10.0); n],
 ///     linacce: vec![DeviceVec::new(0.1, 0.1, 0.2); n],
-///     gravity: vec![DeviceVec::new(0.0, 9.8, 0.0); n],
+///     gravity: vec![DeviceVec::new(0.0, 0.0, 9.8); n],
 ///     orientation: vec![WorldFromDevice::identity(); n],
 ///     ..Default::default()
 /// })?;
@@ -714,6 +721,14 @@ impl RowReader {
                 max: gmax,
             }));
         }
+        if s.up.median_high() {
+            let median_deg = self.median(Quantity::UpAngle, s.up.len())?;
+            return Err(self.error(SequenceError::OrientationGravity {
+                median_deg,
+                max_deg: limits.max_orientation_gravity_deg,
+            }));
+        }
+        let s = &self.sums;
         let checks = limits
             .check_acce_scale(s.acce_norms / n, mean)
             .and_then(|()| {
@@ -881,6 +896,9 @@ impl RowReader {
             d.steps = Some(source.error(path, e, at));
         }
         s.gravity_norms += norm(row.gravity.to_array());
+        if let Some(angle) = crate::validation::up_angle_deg(row.orientation, row.gravity) {
+            s.up.push(false, angle > limits.max_orientation_gravity_deg);
+        }
         s.acce_norms += norm(row.acce.to_array());
         let (a, g, l) = (
             row.acce.to_array(),

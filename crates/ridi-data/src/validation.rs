@@ -20,6 +20,16 @@ fn median(v: &mut [f64]) -> f64 {
     *v.select_nth_unstable_by(mid, f64::total_cmp).1
 }
 
+/// The angle between `gravity` and the up axis of `orientation` in the device frame, degrees;
+/// `None` for a zero gravity, which has no direction.
+pub(crate) fn up_angle_deg(orientation: WorldFromDevice, gravity: DeviceVec) -> Option<f64> {
+    let g = gravity.norm();
+    (g > 0.0).then(|| {
+        let up = ridi_frames::gravity_in_device(orientation, 1.0);
+        (up.dot(gravity) / g).clamp(-1.0, 1.0).acos().to_degrees()
+    })
+}
+
 /// Limits applied when a sequence is built, and by the readers to each stream they parse (so
 /// that a bad value is reported on its own line, before any resampling).
 ///
@@ -41,6 +51,7 @@ fn median(v: &mut [f64]) -> f64 {
 /// | median interval between timestamps | 5-20 ms | 0.1 ms..1 s |
 /// | median ground-truth speed per Tyrex run | 0.17..2.33 m/s | 20 m/s |
 /// | largest ground-truth speed between consecutive frames (also over 2-20 frames) | 5.7 m/s | 100 m/s |
+/// | median angle of gravity from the orientation's up axis | 0 degrees | 45 degrees |
 ///
 /// Not caught: a gyro in deg/s on a phone that hardly turns (median |gyro| under 0.17 rad/s
 /// and the orientation turning at under [`GYRO_SCALE_MIN_RATE`] RMS), and a linear
@@ -107,6 +118,13 @@ pub struct Validation {
     /// position jumps metres to kilometres within a step, which the median and the bound on
     /// single positions cannot see.
     pub max_speed: f64,
+    /// Largest accepted median angle between gravity and the up axis of the orientation
+    /// (world-from-device) in the device frame, degrees: 45. Android's gravity sensor and
+    /// rotation vectors are one fusion's, and the readers derive gravity from the orientation
+    /// where a format has none: every shared recording gives 0. A quaternion read in the wrong
+    /// order or inverted turns a phone held upright by 90-180 degrees; a placeholder
+    /// (identity) orientation beside a measured gravity disagrees as much.
+    pub max_orientation_gravity_deg: f64,
 }
 
 impl Default for Validation {
@@ -126,6 +144,7 @@ impl Default for Validation {
             time_step_range: (1e-4, 1.0),
             max_median_speed: 20.0,
             max_speed: 100.0,
+            max_orientation_gravity_deg: 45.0,
         }
     }
 }
@@ -260,6 +279,33 @@ impl Validation {
             distance: norm(step),
             dt,
             max: self.max_speed,
+        }
+    }
+
+    /// Checks that `gravity` points along the up axis each `orientation` gives in the device
+    /// frame, by the median angle over frames ([`Self::max_orientation_gravity_deg`]); frames
+    /// with a zero gravity do not count.
+    pub fn check_orientation_gravity(
+        &self,
+        orientation: &[WorldFromDevice],
+        gravity: &[DeviceVec],
+    ) -> Result<(), SequenceError> {
+        let mut angles: Vec<f64> = orientation
+            .iter()
+            .zip(gravity)
+            .filter_map(|(&q, &g)| up_angle_deg(q, g))
+            .collect();
+        if angles.is_empty() {
+            return Ok(());
+        }
+        let median_deg = median(&mut angles);
+        if median_deg <= self.max_orientation_gravity_deg {
+            Ok(())
+        } else {
+            Err(SequenceError::OrientationGravity {
+                median_deg,
+                max_deg: self.max_orientation_gravity_deg,
+            })
         }
     }
 
@@ -585,6 +631,43 @@ mod tests {
             })
             .collect();
         (time, gyro, truth, recorded)
+    }
+
+    /// Gravity along the up axis the orientation gives passes; the same orientation read in
+    /// the wrong order, inverted, or a placeholder beside a measured gravity does not.
+    #[test]
+    fn orientation_and_gravity_must_agree() {
+        let v = Validation::default();
+        let r = std::f64::consts::FRAC_1_SQRT_2;
+        // Upright (device y up) and turned about the vertical by 0.3 rad.
+        let (c, s) = (0.15f64.cos(), 0.15f64.sin());
+        let wxyz = [r * c, r * c, r * s, r * s];
+        let q = |c: [f64; 4]| WorldFromDevice::from_wxyz(c).unwrap();
+        let gravity = vec![DeviceVec::new(0.0, 9.8, 0.0); 10];
+        let check = |o: WorldFromDevice| v.check_orientation_gravity(&vec![o; 10], &gravity);
+        assert!(check(q(wxyz)).is_ok());
+        let [w, x, y, z] = wxyz;
+        for wrong in [
+            q([x, y, z, w]),
+            q([w, -x, -y, -z]),
+            WorldFromDevice::identity(),
+        ] {
+            let e = check(wrong).unwrap_err();
+            assert!(
+                matches!(e, SequenceError::OrientationGravity { median_deg, .. } if median_deg > 45.0)
+                    && e.to_string().contains("[x, y, z, w] for [w, x, y, z]"),
+                "{e}"
+            );
+        }
+        // A few frames off do not move the median; a zero gravity has no direction.
+        let mut mostly = vec![q(wxyz); 10];
+        mostly[..4].fill(WorldFromDevice::identity());
+        assert!(v.check_orientation_gravity(&mostly, &gravity).is_ok());
+        assert!(check(WorldFromDevice::identity()).is_err());
+        assert!(
+            v.check_orientation_gravity(&[WorldFromDevice::identity()], &[DeviceVec::ZERO])
+                .is_ok()
+        );
     }
 
     #[test]

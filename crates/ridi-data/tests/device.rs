@@ -157,6 +157,10 @@ fn splits_at_gaps_and_resampling_keep_every_channel() {
     let seq = with_device("walk");
     let whole = seq.clone().split_at_gaps(0.1, 1.0).unwrap();
     assert_eq!((whole.parts, whole.dropped), (vec![seq.clone()], vec![]));
+    // Without a gap too, nothing shorter than the minimum is kept.
+    let (first, last) = (seq.time()[0], seq.time()[seq.len() - 1]);
+    let none = seq.clone().split_at_gaps(0.1, last - first + 0.01).unwrap();
+    assert_eq!((none.parts, none.dropped), (vec![], vec![(first, last)]));
     let mut parts = seq.clone().into_parts();
     let steps: Vec<f64> = (0..seq.len()).map(|i| (i / 40) as f64).collect();
     parts.steps = Some(steps.clone());

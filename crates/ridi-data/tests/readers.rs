@@ -330,9 +330,10 @@ fn raw_folder_is_synchronized_on_the_trimmed_pose_timeline() {
         assert!((gt.position[k].x() - 0.01 * (5 + k) as f64).abs() < 1e-12);
         let [w, ..] = gt.orientation[k].to_wxyz();
         assert_eq!(w, 1.0);
-        // The rotation vector turns about z by 2 * 0.001 rad per 5 ms record.
-        let rv_angle =
-            seq.orientation()[k].angle_to(&ridi_data::ridi_frames::WorldFromDevice::identity());
+        // The rotation vector, upright, turns about z by 2 * 0.001 rad per 5 ms record.
+        let r = std::f64::consts::FRAC_1_SQRT_2;
+        let upright = ridi_data::ridi_frames::WorldFromDevice::from_wxyz([r, r, 0.0, 0.0]).unwrap();
+        let rv_angle = seq.orientation()[k].angle_to(&upright);
         assert!(
             (rv_angle - 0.002 * since_start / 0.005).abs() < 1e-6,
             "{rv_angle}"
@@ -424,7 +425,7 @@ fn raw_bad_files_name_file_line_and_field() {
     assert_err(r, &["acce.txt:31: field `t`: gap of 3.00"]);
     let (_d, r) = raw_with(|f| {
         edit_file(f, "orientation.txt", |s| {
-            s.replacen(" 0 0 0 1\n", " 0 0 0 3\n", 1)
+            s.replacen(" 0.7071067811865476\n", " 3\n", 1)
         })
     });
     assert_err(r, &["orientation.txt:2: field `x..w`", "not a rotation"]);

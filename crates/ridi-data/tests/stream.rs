@@ -36,13 +36,14 @@ fn walk(n: usize) -> Sequence {
         gyro: (0..n)
             .map(|i| DeviceVec::new(0.01 * wobble(i), 0.02, 0.4))
             .collect(),
+        // Flat, turning about its z axis: gravity along z, the orientation's up.
         acce: (0..n)
-            .map(|i| DeviceVec::new(0.3 * wobble(i), 9.8, 0.1))
+            .map(|i| DeviceVec::new(0.3 * wobble(i), 0.0, 9.9))
             .collect(),
         linacce: (0..n)
             .map(|i| DeviceVec::new(0.3 * wobble(i), 0.0, 0.1))
             .collect(),
-        gravity: vec![DeviceVec::new(0.0, 9.8, 0.0); n],
+        gravity: vec![DeviceVec::new(0.0, 0.0, 9.8); n],
         magnet: Some(vec![DeviceVec::new(20.0, -5.0, 40.0); n]),
         orientation: orientation.clone(),
         orientation_source: Some(OrientationSource::GameRotationVector),
@@ -380,6 +381,10 @@ fn a_raw_folder_with_one_fault_gets_the_whole_readers_error() {
         (
             "gravity in g",
             Box::new(|files| edit_file(files, "gravity.txt", |t| t.replace(" 9.8 ", " 1 "))),
+        ),
+        (
+            "the rotation vector as w x y z",
+            every("orientation.txt", |_, c| c[1..5].rotate_right(1)),
         ),
         (
             "steps beyond any number once interpolated",

@@ -554,7 +554,8 @@ fn implausible_values_and_units_name_file_line_and_field() {
         &fx,
         &[
             "accelerometer.txt: field `t`: timestamps step by 5 s (median), outside 1e-4..1 s: \
-           time in the wrong unit? (this format expects seconds)",
+           time in milliseconds instead of seconds (divide by 1000)? (this format expects \
+           seconds)",
         ],
     );
 

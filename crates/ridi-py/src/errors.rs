@@ -82,7 +82,7 @@ pub(crate) fn pipeline(e: PipelineError) -> PyErr {
 /// (`cannot write m.ridi`, as the command line says it).
 pub(crate) fn pipeline_in(e: PipelineError, context: Option<String>) -> PyErr {
     let line = one_line(&e);
-    // An output's own error says "cannot write <path>" already.
+    // An output's own error says "cannot write <path>" already, a sequence's its name.
     let message = match context {
         Some(c) if line != c && !line.starts_with(&format!("{c}: ")) => format!("{c}: {line}"),
         _ => line,
@@ -91,6 +91,12 @@ pub(crate) fn pipeline_in(e: PipelineError, context: Option<String>) -> PyErr {
         Some(kind) => os_error(kind, message),
         None => value(message),
     }
+}
+
+/// An error of `doing` (`"cannot track"`) with sequence `name`: the sequence named once.
+pub(crate) fn of_sequence(e: PipelineError, doing: &str, name: &str) -> PyErr {
+    let names_it = matches!(&e, PipelineError::Sequence { sequence, .. } if sequence == name);
+    pipeline_in(e, (!names_it).then(|| format!("{doing} {name}")))
 }
 
 /// A reader's error as a Python exception.

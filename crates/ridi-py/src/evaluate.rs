@@ -14,10 +14,11 @@ use crate::options::{self, Inputs};
 /// Evaluates RIDI and its baselines against ground truth, as ``ridi eval`` does, and returns
 /// the report as a dict with the keys of its ``report.json`` (``sequences``, ``summary``,
 /// ``velocity_mse``, ``placement_accuracy``, ``placement_confusion``, ``config``, ``methods``,
-/// ``warnings``; a NaN is None, as ``null`` in the file). Nothing is written.
+/// ``warnings``; a NaN is None, as ``null`` in the file). Nothing is written. The report's
+/// warnings are also emitted as ``UserWarning``\ s.
 ///
 /// ``data`` is a list file, several, or a list of ``ridi.Sequence`` with ground truth.
-/// ``methods`` are keys of ``ridi.METHODS`` (default: all, in that order); ``placement_map``,
+/// ``methods`` are keys of ``ridi.METHODS``, one or a list (default: all, in that order); ``placement_map``,
 /// ``placement_window`` (seconds, 0 for the paper's per-window labels), ``align`` (seconds,
 /// or ``"all"``), ``heading`` (``"corrected"`` or ``"gyro"``, as ``ridi.track``'s) and
 /// ``jobs`` are ``ridi eval``'s options with its defaults.
@@ -36,17 +37,32 @@ pub(crate) fn evaluate<'py>(
     py: Python<'py>,
     data: &Bound<'py, PyAny>,
     model: &Bound<'py, Model>,
-    methods: Option<Vec<String>>,
+    methods: Option<&Bound<'py, PyAny>>,
     placement_map: Option<PathBuf>,
     placement_window: f64,
     align: Option<&Bound<'py, PyAny>>,
     heading: &str,
-    jobs: Option<usize>,
+    jobs: Option<i64>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let inputs = Inputs::extract(data)?;
     let methods = match methods {
         None => Method::ALL.to_vec(),
         Some(names) => {
+            // One name alone, as a str is no list of names.
+            let names: Vec<String> = match names.extract::<String>() {
+                Ok(one) => vec![one],
+                Err(_) => names.extract().map_err(|_| {
+                    errors::value(format!(
+                        "`methods` is {}; expected a list of the names in ridi.METHODS",
+                        names.repr().map_or_else(|_| "?".into(), |r| r.to_string())
+                    ))
+                })?,
+            };
+            if names.is_empty() {
+                return Err(errors::value(
+                    "`methods` is empty; give one of ridi.METHODS at least, or None for all",
+                ));
+            }
             let mut methods: Vec<Method> = Vec::new();
             for m in &names {
                 let m = m.parse::<Method>().map_err(errors::value)?;
@@ -101,6 +117,8 @@ pub(crate) fn evaluate<'py>(
             })
         })?
         .map_err(errors::pipeline)?;
+    // Also in the report's `warnings`, but a caller reading one figure would not see them.
+    crate::sequence::warn(py, &report.warnings)?;
     let json = serde_json::to_string(&report).map_err(|e| errors::value(e.to_string()))?;
     json_dict(py, &json)
 }

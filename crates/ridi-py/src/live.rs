@@ -2,6 +2,7 @@
 
 use std::sync::{Arc, Mutex, MutexGuard};
 
+use pyo3::exceptions::PyTypeError;
 use pyo3::prelude::*;
 use ridi::correct::Update as RidiUpdate;
 use ridi::features::Orientation;
@@ -110,7 +111,7 @@ impl LiveTracker {
     ))]
     fn new(
         model: &Bound<'_, Model>,
-        regress_every: usize,
+        regress_every: i64,
         lambda_: f64,
         estimate_initial_velocity: bool,
         placement_window: f64,
@@ -148,13 +149,25 @@ impl LiveTracker {
     fn push(
         &self,
         py: Python<'_>,
-        time: f64,
-        gyro: [f64; 3],
-        acce: [f64; 3],
-        orientation: Option<[f64; 4]>,
-        gravity: Option<[f64; 3]>,
-        linacce: Option<[f64; 3]>,
+        time: &Bound<'_, PyAny>,
+        gyro: &Bound<'_, PyAny>,
+        acce: &Bound<'_, PyAny>,
+        orientation: Option<&Bound<'_, PyAny>>,
+        gravity: Option<&Bound<'_, PyAny>>,
+        linacce: Option<&Bound<'_, PyAny>>,
     ) -> PyResult<Vec<Update>> {
+        let time: f64 = time.extract().map_err(|_| {
+            PyTypeError::new_err(format!(
+                "`time` must be one number, seconds (push takes one sample), not {}",
+                described(time)
+            ))
+        })?;
+        let (gyro, acce) = (values::<3>(gyro, "gyro")?, values::<3>(acce, "acce")?);
+        let orientation = orientation
+            .map(|o| values::<4>(o, "orientation"))
+            .transpose()?;
+        let gravity = gravity.map(|g| values::<3>(g, "gravity")).transpose()?;
+        let linacce = linacce.map(|l| values::<3>(l, "linacce")).transpose()?;
         let estimated = self.model.feature_config().orientation == Orientation::Estimated;
         let quaternion = |q: [f64; 4]| {
             rotation(q).map_err(|e| errors::value(format!("`orientation` at t = {time} s: {e}")))
@@ -217,5 +230,32 @@ impl LiveTracker {
         let live = self.lock();
         let (velocities, placements) = live.regressions();
         Regressions::of(velocities, placements, self.model.placements())
+    }
+}
+
+/// `N` numbers of one sample for argument `name`, or a `TypeError` that says so (pyo3's own
+/// names neither the argument nor what it wants).
+fn values<const N: usize>(obj: &Bound<'_, PyAny>, name: &str) -> PyResult<[f64; N]> {
+    obj.extract().map_err(|_| {
+        PyTypeError::new_err(format!(
+            "`{name}` must be {N} numbers (push takes one sample; push a chunk row by row), not \
+             {}",
+            described(obj)
+        ))
+    })
+}
+
+/// What `obj` is, for a message: its type, and its shape when it has one.
+fn described(obj: &Bound<'_, PyAny>) -> String {
+    let kind = obj
+        .get_type()
+        .name()
+        .map_or_else(|_| "?".to_owned(), |n| n.to_string());
+    match obj.getattr("shape") {
+        Ok(shape) => format!("{kind} of shape {shape}"),
+        Err(_) => match obj.len() {
+            Ok(n) => format!("{kind} of length {n}"),
+            Err(_) => kind,
+        },
     }
 }

@@ -268,16 +268,16 @@ pub(crate) fn train(
     orientation: &str,
     storage: &str,
     solver: &str,
-    landmarks: usize,
-    seed: u64,
-    turned_copies: usize,
-    step: Option<usize>,
-    window: Option<usize>,
+    landmarks: i64,
+    seed: i64,
+    turned_copies: i64,
+    step: Option<i64>,
+    window: Option<i64>,
     speed: bool,
     up_axis: &str,
     standardize: bool,
     classifier_c: f64,
-    jobs: Option<usize>,
+    jobs: Option<i64>,
     progress: Option<Py<PyAny>>,
 ) -> PyResult<Model> {
     let inputs = Inputs::extract(data)?;
@@ -323,7 +323,11 @@ pub(crate) fn train(
             .map_err(|e| errors::value(e.to_string()))?,
         ),
     };
-    opts.cascade.set_seed(seed);
+    opts.cascade.set_seed(u64::try_from(seed).map_err(|_| {
+        errors::value(format!(
+            "`seed` is {seed}; expected a whole number of at least 0"
+        ))
+    })?);
     let projected = Storage::projected_for(&opts.cascade.method);
     opts.cascade.storage = choice(
         "storage",

@@ -39,14 +39,14 @@ pub(crate) fn choice<T: Copy>(name: &str, value: &str, choices: &[(&str, T)]) ->
     }
 }
 
-/// A whole number in `min..=max` for option `name`.
-pub(crate) fn count(name: &str, value: usize, min: usize, max: usize) -> PyResult<usize> {
-    if (min..=max).contains(&value) {
-        Ok(value)
-    } else {
-        Err(errors::value(format!(
+/// A whole number in `min..=max` for option `name` (taken as `i64`, so that a negative one
+/// gets this error rather than an `OverflowError` that names no option).
+pub(crate) fn count(name: &str, value: i64, min: usize, max: usize) -> PyResult<usize> {
+    match usize::try_from(value) {
+        Ok(v) if (min..=max).contains(&v) => Ok(v),
+        _ => Err(errors::value(format!(
             "`{name}` is {value}; expected a whole number from {min} to {max}"
-        )))
+        ))),
     }
 }
 
@@ -104,7 +104,7 @@ pub(crate) fn align(value: &Bound<'_, PyAny>) -> PyResult<AlignWindow> {
 /// defaults with the flags given.
 pub(crate) fn track_options(
     online: bool,
-    regress_every: usize,
+    regress_every: i64,
     lambda: f64,
     estimate_initial_velocity: bool,
     placement_window: f64,
@@ -178,7 +178,7 @@ impl Inputs {
 }
 
 /// Runs `f` on `jobs` worker threads (all cores when `None`), as `--jobs` does for a command.
-pub(crate) fn with_jobs<T: Send>(jobs: Option<usize>, f: impl FnOnce() -> T + Send) -> PyResult<T> {
+pub(crate) fn with_jobs<T: Send>(jobs: Option<i64>, f: impl FnOnce() -> T + Send) -> PyResult<T> {
     match jobs {
         None => Ok(f()),
         Some(n) => {

@@ -7,9 +7,12 @@ use pyo3::exceptions::PyUserWarning;
 use pyo3::prelude::*;
 use ridi::data::{
     DeviceInfo, Format, GroundTruth, ListEntry, Listed, OrientationSource,
-    Sequence as RidiSequence, SequenceParts,
+    Sequence as RidiSequence, SequenceError, SequenceParts, Validation,
 };
-use ridi::frames::{Frame, Vec3};
+use ridi::frames::{
+    DeviceVec, FilterConfig, Frame, STANDARD_GRAVITY, Vec3, WorldFromDevice, estimate_orientation,
+    gravity_and_linacce, gravity_in_device,
+};
 use ridi::{Purpose, load_listed};
 
 use crate::arrays::{matrix, rotations, rotations_out, vecs, vecs_out, vector, vector_out};
@@ -40,9 +43,14 @@ fn format_name(format: Format) -> String {
 ///
 /// Read one with ``ridi.read(path)``, or build one from arrays: the arrays are validated as any
 /// reader's input is (equal lengths, finite values, increasing time without long gaps,
-/// plausible units), and an error names the array and the frame. Frames: the device frame is
-/// Android's sensor frame, orientations are Hamilton world-from-device quaternions in
-/// ``[w, x, y, z]`` order, the world frame has z up.
+/// plausible units, time in seconds, gravity along the orientation's up axis), and an error
+/// names the array and the frame. Frames: the device frame is Android's sensor frame,
+/// orientations are Hamilton world-from-device quaternions in ``[w, x, y, z]`` order, the world
+/// frame has z up, gravity points up (as Android's gravity sensor reports it). Without
+/// ``gravity`` it is the orientation's up axis; without either, both are estimated from gyro
+/// and accelerometer (``orientation_source`` ``"estimated"``, the heading the gyro's alone), as
+/// models on the estimated orientation (the bundled one, ``ridi train``'s default) estimate
+/// them anyway. A phone at another rate than 200 Hz: ``resampled(ridi.RATE_HZ)``.
 ///
 /// Example:
 ///
@@ -54,6 +62,9 @@ fn format_name(format: Format) -> String {
 /// >>> seq = ridi.Sequence(t, np.zeros((n, 3)), up, up, q, name="still")
 /// >>> seq.gravity.shape, round(seq.duration, 3)
 /// ((400, 3), 1.995)
+/// >>> bare = ridi.Sequence(t, np.zeros((n, 3)), up)   # no orientation: estimated
+/// >>> bare.orientation_source, np.round(bare.gravity[-1], 2)
+/// ('estimated', array([0.  , 9.81, 0.  ]))
 #[pyclass(frozen, module = "ridi")]
 pub(crate) struct Sequence {
     pub(crate) inner: RidiSequence,
@@ -70,7 +81,7 @@ impl Sequence {
 impl Sequence {
     #[new]
     #[pyo3(signature = (
-        time, gyro, acce, gravity, orientation, *, linacce=None, name="sequence",
+        time, gyro, acce, gravity=None, orientation=None, *, linacce=None, name="sequence",
         placement=None, magnet=None, ground_truth_position=None, ground_truth_orientation=None,
         steps=None, orientation_source=None, device=None, device_imu_rate_hz=None,
     ))]
@@ -79,8 +90,8 @@ impl Sequence {
         time: &Bound<'_, PyAny>,
         gyro: &Bound<'_, PyAny>,
         acce: &Bound<'_, PyAny>,
-        gravity: &Bound<'_, PyAny>,
-        orientation: &Bound<'_, PyAny>,
+        gravity: Option<&Bound<'_, PyAny>>,
+        orientation: Option<&Bound<'_, PyAny>>,
         linacce: Option<&Bound<'_, PyAny>>,
         name: &str,
         placement: Option<String>,
@@ -100,11 +111,36 @@ impl Sequence {
         let four = |obj: &Bound<'_, PyAny>, name: &str| {
             matrix(obj, name, 4, Some(n)).and_then(|a| rotations(a.as_array(), name))
         };
-        let (gyro, acce, gravity) = (
-            three(gyro, "gyro", n)?,
-            three(acce, "acce", n)?,
-            three(gravity, "gravity", n)?,
-        );
+        let (gyro, acce) = (three(gyro, "gyro", n)?, three(acce, "acce", n)?);
+        let time = time.as_array().to_vec();
+        let (orientation, gravity, estimated) = match (orientation, gravity) {
+            (Some(q), Some(g)) => (four(q, "orientation")?, three(g, "gravity", n)?, false),
+            // Gravity as Android's gravity sensor gives it: the orientation's up axis.
+            (Some(q), None) => {
+                let q = four(q, "orientation")?;
+                let g = q
+                    .iter()
+                    .map(|&q| gravity_in_device(q, STANDARD_GRAVITY))
+                    .collect();
+                (q, g, false)
+            }
+            (None, None) => {
+                let q = estimated_orientation(&time, &gyro, &acce, name)?;
+                let g = q
+                    .iter()
+                    .zip(&acce)
+                    .map(|(&q, &a)| gravity_and_linacce(q, a).0)
+                    .collect();
+                (q, g, true)
+            }
+            (None, Some(_)) => {
+                return Err(errors::value(
+                    "`gravity` without `orientation`: give both, the orientation alone \
+                     (gravity is then its up axis), or neither (both are then estimated from \
+                     gyro and accelerometer)",
+                ));
+            }
+        };
         // Accelerometer minus gravity, as the RIDI files define it, unless given.
         let linacce = match linacce {
             Some(l) => three(l, "linacce", n)?,
@@ -131,7 +167,8 @@ impl Sequence {
                     .collect();
                 choice("orientation_source", key, &keys)
             })
-            .transpose()?;
+            .transpose()?
+            .or(estimated.then_some(OrientationSource::Estimated));
         let device = match device {
             None => None,
             Some(model) => {
@@ -145,13 +182,13 @@ impl Sequence {
             }
         };
         let parts = SequenceParts {
-            time: time.as_array().to_vec(),
+            time,
             gyro,
             acce,
             linacce,
             gravity,
             magnet: magnet.map(|m| three(m, "magnet", n)).transpose()?,
-            orientation: four(orientation, "orientation")?,
+            orientation,
             orientation_source,
             ground_truth,
             steps: steps
@@ -162,8 +199,11 @@ impl Sequence {
             name: name.to_string(),
         };
         let name = parts.name.clone();
-        let inner = RidiSequence::new(parts)
-            .map_err(|e| errors::value(format!("sequence `{name}`: {e}")))?;
+        let inner = RidiSequence::new(parts).map_err(|e| {
+            // The Rust field `ground_truth.position` is the keyword `ground_truth_position` here.
+            let e = e.to_string().replace("`ground_truth.", "`ground_truth_");
+            errors::value(format!("sequence `{name}`: {e}"))
+        })?;
         Ok(Self::of(inner, None))
     }
 
@@ -298,7 +338,8 @@ impl Sequence {
     /// The sequence cut at every gap longer than ``max_gap_s`` seconds (``ridi.track``
     /// refuses one over 0.1 s): the parts at least ``min_duration_s`` long, in order, named as
     /// ``ridi convert --split-at-gaps`` names them (``<name>_part1``, ``_part2``, ...; the
-    /// plain name when one is left). Without such a gap, a list of the sequence itself.
+    /// plain name when one is left). Without such a gap, a list of the sequence itself (empty
+    /// when it is shorter than ``min_duration_s``).
     #[pyo3(signature = (max_gap_s, min_duration_s=0.0))]
     fn split_at_gaps(&self, max_gap_s: f64, min_duration_s: f64) -> PyResult<Vec<Self>> {
         let split = self
@@ -311,6 +352,33 @@ impl Sequence {
             .into_iter()
             .map(|s| Self::of(s, self.format))
             .collect())
+    }
+
+    /// The sequence on a uniform timeline at ``rate_hz`` (models take 200 Hz, ``ridi.RATE_HZ``),
+    /// as ``ridi convert --rate`` resamples: vectors linearly interpolated, orientations by
+    /// slerp, from the first frame to at most the last. A gap longer than ``max_gap_s``
+    /// (default: 5 of the sequence's median frame intervals) is refused rather than filled
+    /// with invented frames: cut the sequence there first (``split_at_gaps``).
+    ///
+    /// >>> seq50 = ridi.Sequence(t, gyro, acce, gravity, orientation)  # doctest: +SKIP
+    /// >>> seq = seq50.resampled(ridi.RATE_HZ)                          # doctest: +SKIP
+    #[pyo3(signature = (rate_hz, max_gap_s=None))]
+    fn resampled(&self, rate_hz: f64, max_gap_s: Option<f64>) -> PyResult<Self> {
+        let max_gap =
+            max_gap_s.unwrap_or(ridi::RESAMPLE_MAX_GAP_FRAMES / self.inner.median_rate_hz());
+        let resampled = self
+            .inner
+            .resampled(rate_hz, max_gap)
+            .map_err(|e| match e {
+                SequenceError::Gap { .. } => errors::value(format!(
+                    "sequence `{}`: {e}: cut it there first (`split_at_gaps({})`), or give a \
+                 larger `max_gap_s` to interpolate across",
+                    self.inner.name(),
+                    ridi::data::short((max_gap * 1000.0).floor() / 1000.0)
+                )),
+                e => errors::value(format!("sequence `{}`: {e}", self.inner.name())),
+            })?;
+        Ok(Self::of(resampled, self.format))
     }
 
     fn __len__(&self) -> usize {
@@ -335,8 +403,30 @@ impl Sequence {
     }
 }
 
-/// Emits the readers' warnings as Python `UserWarning`s, as the command line prints them.
-fn warn(py: Python<'_>, warnings: &[String]) -> PyResult<()> {
+/// The orientation of a sequence given without one: the estimate of gyro and accelerometer
+/// that models on the estimated orientation make themselves (`ridi train`'s default), its
+/// heading the gyro's alone. Time is checked first, so that time in milliseconds is named as
+/// such and not by the estimator.
+fn estimated_orientation(
+    time: &[f64],
+    gyro: &[DeviceVec],
+    acce: &[DeviceVec],
+    name: &str,
+) -> PyResult<Vec<WorldFromDevice>> {
+    let failed = |e: String| errors::value(format!("sequence `{name}`: {e}"));
+    Validation::default()
+        .check_time_step(time)
+        .map_err(|e| failed(e.to_string()))?;
+    estimate_orientation(time, gyro, acce, &FilterConfig::default()).map_err(|e| {
+        failed(format!(
+            "cannot estimate the orientation (none was given) from gyro and accelerometer: {e}"
+        ))
+    })
+}
+
+/// Emits the readers' (or an evaluation's) warnings as Python `UserWarning`s, as the command
+/// line prints them.
+pub(crate) fn warn(py: Python<'_>, warnings: &[String]) -> PyResult<()> {
     let category = py.get_type::<PyUserWarning>();
     for w in warnings {
         // Escaped as the command line prints them; `shown` escapes NUL too.

@@ -175,7 +175,7 @@ pub(crate) fn track(
     sequence: &Bound<'_, Sequence>,
     model: &Bound<'_, Model>,
     online: bool,
-    regress_every: usize,
+    regress_every: i64,
     lambda_: f64,
     estimate_initial_velocity: bool,
     placement_window: f64,
@@ -193,7 +193,7 @@ pub(crate) fn track(
     // `ridi::track` gives the sequence the model's orientation itself.
     py.detach(|| ridi::track(seq, model, &opts))
         .map(|inner| Track { inner })
-        .map_err(|e| errors::pipeline_in(e, Some(format!("cannot track {}", seq.name()))))
+        .map_err(|e| errors::of_sequence(e, "cannot track", seq.name()))
 }
 
 /// The velocities `model` regresses for `sequence` every ``regress_every`` frames from the
@@ -205,7 +205,7 @@ pub(crate) fn regress(
     py: Python<'_>,
     sequence: &Bound<'_, Sequence>,
     model: &Bound<'_, Model>,
-    regress_every: usize,
+    regress_every: i64,
     placement_window: f64,
 ) -> PyResult<Regressions> {
     let opts = ridi::TrackOptions {
@@ -216,9 +216,7 @@ pub(crate) fn regress(
     let (seq, model) = (&sequence.get().inner, &model.get().inner);
     let (velocities, placements) = py
         .detach(|| ridi::regress_sequence(seq, model, &opts))
-        .map_err(|e: PipelineError| {
-            errors::pipeline_in(e, Some(format!("cannot regress {}", seq.name())))
-        })?;
+        .map_err(|e: PipelineError| errors::of_sequence(e, "cannot regress", seq.name()))?;
     Ok(Regressions::of(
         &velocities,
         &placements,

@@ -60,6 +60,12 @@ def test_evaluate_sequences_equals_the_list(model, test_list):
 def test_bad_evaluations_are_refused(model, test_list, tmp_path):
     with pytest.raises(ValueError, match="unknown method"):
         ridi.evaluate(test_list, model, methods=["ridi", "magic"])
+    with pytest.raises(ValueError, match="`methods` is empty"):
+        ridi.evaluate(test_list, model, methods=[])
+    with pytest.raises(ValueError, match=r"`methods` is 5; expected a list"):
+        ridi.evaluate(test_list, model, methods=5)
+    with pytest.raises(ValueError, match=r"`jobs` is -1; expected a whole number from 1"):
+        ridi.evaluate(test_list, model, jobs=-1)
     with pytest.raises(ValueError, match=r"`align` is 'half'"):
         ridi.evaluate(test_list, model, align="half")
     with pytest.raises(ValueError, match=r"`align` is -1"):
@@ -72,3 +78,12 @@ def test_bad_evaluations_are_refused(model, test_list, tmp_path):
     args = {k: getattr(no_truth, k) for k in ("time", "gyro", "acce", "gravity", "orientation")}
     with pytest.raises(ValueError, match="ground truth"):
         ridi.evaluate([ridi.Sequence(**args, name="bare")], model)
+
+
+def test_one_method_by_name_and_warnings_as_python_warnings(model, test_list):
+    # Labels the model does not know (no placement map): the report says so, and so does Python.
+    with pytest.warns(UserWarning, match=r"is not one of the model's classes"):
+        one = ridi.evaluate(test_list, model, methods="ridi")
+    assert one["methods"] == ["ridi"] and one["warnings"]
+    with pytest.warns(UserWarning):
+        assert same(one, ridi.evaluate(test_list, model, methods=["ridi"]))

@@ -200,6 +200,14 @@ def test_linacce_defaults_to_acce_minus_gravity(seq):
          r"accelerometer in g"),
         (lambda a: a.update(orientation_source="compass"), ValueError,
          r"`orientation_source` is 'compass'"),
+        (lambda a: a.update(time=a["time"] * 1000), ValueError,
+         r"time in milliseconds instead of seconds \(divide by 1000\)"),
+        (lambda a: a.update(time=a["time"] * 1e9), ValueError,
+         r"time in nanoseconds instead of seconds \(divide by 1e9\)"),
+        (lambda a: a["ground_truth_position"].__setitem__((5, 0), np.nan), ValueError,
+         r"`ground_truth_position` is not finite at frame 5"),
+        (lambda a: a.update(orientation=a["orientation"][:, [1, 2, 3, 0]]), ValueError,
+         r"an orientation given as \[x, y, z, w\] for \[w, x, y, z\]"),
     ],
 )
 def test_bad_arrays_are_refused_by_name(seq, change, error, message):
@@ -254,3 +262,24 @@ def test_a_gap_ridi_track_refuses_is_split_into_parts_that_track(seq):
     # (10 s and 14 s long)
     (only,) = gappy.split_at_gaps(0.1, min_duration_s=12.0)
     assert (only.name, len(only)) == (seq.name, len(seq) - 2000)
+
+
+def test_gravity_and_orientation_left_out_are_derived_or_estimated(seq, model):
+    args = arrays_of(seq)
+    # The orientation alone: gravity is its up axis, as the readers derive it.
+    no_gravity = ridi.Sequence(**{**args, "gravity": None, "linacce": None})
+    np.testing.assert_allclose(no_gravity.gravity, seq.gravity, atol=1e-3)
+    # Neither: both from gyro and accelerometer, as the model on the estimated orientation
+    # makes them, and tracked with the gyro's heading alone.
+    bare = ridi.Sequence(seq.time, seq.gyro, seq.acce, name=seq.name)
+    assert bare.orientation_source == "estimated"
+    tilt = np.degrees(np.arccos(np.clip(
+        np.sum(bare.gravity * seq.gravity, axis=1)
+        / np.linalg.norm(bare.gravity, axis=1) / np.linalg.norm(seq.gravity, axis=1), -1, 1)))
+    assert np.median(tilt) < 5.0
+    np.testing.assert_allclose(ridi.track(bare, model).position,
+                               ridi.track(seq, model, heading="gyro").position, atol=1e-6)
+    with pytest.raises(ValueError, match="`gravity` without `orientation`"):
+        ridi.Sequence(seq.time, seq.gyro, seq.acce, seq.gravity)
+    with pytest.raises(ValueError, match="time in milliseconds"):
+        ridi.Sequence(seq.time * 1000, seq.gyro, seq.acce)

@@ -4,6 +4,7 @@ editors show comes from the extension, what type checkers see from the stub)."""
 
 import ast
 import inspect
+import re
 from pathlib import Path
 
 import pytest
@@ -97,3 +98,17 @@ def test_every_public_name_has_its_docstring(name):
     obj = getattr(ridi, name)
     if callable(obj):
         assert (obj.__doc__ or "").strip(), f"ridi.{name} has no docstring for help()"
+
+
+def test_the_stubs_orientation_sources_are_the_ones_taken(seq):
+    init = dict(stub_functions())["Sequence.__init__"]
+    arg = next(a for a in init.args.kwonlyargs if a.arg == "orientation_source")
+    stubbed = {c.value for c in ast.walk(arg.annotation) if isinstance(c, ast.Constant)}
+    args = {
+        "time": seq.time, "gyro": seq.gyro, "acce": seq.acce, "gravity": seq.gravity,
+        "orientation": seq.orientation,
+    }
+    with pytest.raises(ValueError) as refused:
+        ridi.Sequence(**args, orientation_source="compass")
+    taken = set(re.findall(r"'([a-z-]+)'", str(refused.value).split("expected one of")[1]))
+    assert stubbed == taken

@@ -131,16 +131,71 @@ def test_live_tracker_refuses_bad_samples_and_stays_usable(seq, recorded_model):
     assert second.frame == 1
     with pytest.raises(ValueError, match="`regress_every` is 0"):
         ridi.LiveTracker(recorded_model, regress_every=0)
+    with pytest.raises(ValueError, match="`regress_every` is -5"):
+        ridi.LiveTracker(recorded_model, regress_every=-5)
+    # What a chunk of samples or a missing one gets: the argument and what it wants.
+    with pytest.raises(TypeError, match=r"`gyro` must be 3 numbers .* not NoneType"):
+        live.push(seq.time[2], None, seq.acce[2], **recorded)
+    with pytest.raises(TypeError, match=r"`time` must be one number.*ndarray of shape \(5,\)"):
+        live.push(seq.time[2:7], seq.gyro[2:7], seq.acce[2:7], **recorded)
+    with pytest.raises(ValueError, match=r"`time` of sample 2 is NaN"):
+        live.push(float("nan"), seq.gyro[2], seq.acce[2], **recorded)
+    live.finish()
+    with pytest.raises(ValueError, match="finished"):
+        live.push(seq.time[2], seq.gyro[2], seq.acce[2], **recorded)
+
+
+@pytest.mark.parametrize(
+    "change, message",
+    [
+        (lambda t, g, a: (t[::4], g[::4], a[::4]), r"a rate of 50.0 Hz .* resample the stream"),
+        (lambda t, g, a: (t * 1000, g, a), r"time in milliseconds instead of seconds"),
+        (lambda t, g, a: (t, np.degrees(g) + 1, a), r"gyroscope in deg/s instead of rad/s"),
+        (lambda t, g, a: (t, g, a / 9.81), r"accelerometer in g instead of m/s\^2"),
+    ],
+)
+def test_a_live_stream_at_a_wrong_rate_or_unit_is_refused_within_a_second(seq, model, change,
+                                                                         message):
+    t, g, a = change(seq.time, seq.gyro, seq.acce)
+    live = ridi.LiveTracker(model)
+    with pytest.raises(ValueError, match=r"the stream's last 200 samples: .*" + message):
+        for i in range(len(t)):
+            live.push(t[i], g[i], a[i], orientation=seq.orientation[i])
+    assert i == 200 and len(live.regressions) == 0
 
 
 def test_untrackable_sequences_are_named(seq, model):
     args = arrays_of(seq)
     short = {k: (v[:150] if isinstance(v, np.ndarray) else v) for k, v in args.items()}
-    with pytest.raises(ValueError, match=r"cannot track .*Texting.*no velocity can be regressed"):
-        ridi.track(ridi.Sequence(**short), model)
-    slow = {k: (v[::2] if isinstance(v, np.ndarray) else v) for k, v in args.items()}
-    with pytest.raises(ValueError, match=r"rate of 100.0 Hz"):
-        ridi.track(ridi.Sequence(**slow), model)
+    # Named once, by the sequence's own error.
+    named = r"^sequence `Thibaud_Nexus5_NoDist_Texting`: has 150 frames"
+    for f in (ridi.track, ridi.regress):
+        with pytest.raises(ValueError, match=named + r".*at least 201 frames are needed"):
+            f(ridi.Sequence(**short), model)
+    slow = ridi.Sequence(**{k: (v[::2] if isinstance(v, np.ndarray) else v)
+                            for k, v in args.items()})
+    for f in (ridi.track, ridi.regress):
+        with pytest.raises(ValueError, match=r"rate of 100.0 Hz.*`resampled`"):
+            f(slow, model)
+    # Resampled to the models' rate it tracks, close to the recording at 200 Hz.
+    again = slow.resampled(ridi.RATE_HZ)
+    assert abs(again.median_rate_hz - ridi.RATE_HZ) < 1e-6
+    assert (again.name, again.placement) == (seq.name, seq.placement)
+    end = ridi.track(again, model).position[-1]
+    assert np.linalg.norm(end - ridi.track(seq, model).position[-1]) < 1.0
+
+
+def test_resampling_refuses_to_fill_a_gap(seq):
+    args = arrays_of(seq)
+    t = args["time"].copy()
+    t[3000:] += 0.5
+    gappy = ridi.Sequence(**{**args, "time": t})
+    with pytest.raises(ValueError, match=r"gap of 0.505 s.*exceeds 0.025 s: cut it there first \(`split_at_gaps\(0.02"):
+        gappy.resampled(100.0)
+    assert len(gappy.resampled(100.0, max_gap_s=1.0)) == pytest.approx(
+        (t[-1] - t[0]) * 100, abs=1)
+    with pytest.raises(ValueError, match="rate"):
+        seq.resampled(-1.0)
 
 
 @pytest.mark.parametrize(

@@ -75,9 +75,10 @@ pub const SPLIT_MIN_PART_S: f64 = 1.0;
 /// and written as whole nanoseconds, so the range keeps 0.1 % from each.
 pub const CONVERT_RATE_HZ: (f64, f64) = (1.001, 9990.0);
 
-/// Longest gap `--rate` interpolates across, in frame intervals of the source: longer ones
-/// would be filled with invented frames, so the recording has to be split there first.
-const RESAMPLE_MAX_GAP_FRAMES: f64 = 5.0;
+/// Longest gap `--rate` (and Python's `Sequence.resampled`) interpolates across, in frame
+/// intervals of the source (its median): longer ones would be filled with invented frames, so
+/// the recording has to be split there first.
+pub const RESAMPLE_MAX_GAP_FRAMES: f64 = 5.0;
 
 /// `seqs` cut at their gaps longer than `max_gap_s` ([`Sequence::split_at_gaps`]), parts
 /// under [`SPLIT_MIN_PART_S`] dropped, with one warning per sequence cut. A source may be left
@@ -113,6 +114,11 @@ fn split(
                 n => format!("; {} kept", counted(n, "part")),
             });
             warnings.push(warning);
+        } else if parts.is_empty() {
+            warnings.push(format!(
+                "sequence `{name}`: shorter than {SPLIT_MIN_PART_S} s ({}), dropped",
+                spans_text(&dropped)
+            ));
         }
         kept.extend(parts);
     }

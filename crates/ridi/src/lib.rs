@@ -107,7 +107,8 @@ pub use baselines::{Method, baseline_trajectory, device_heading};
 #[cfg(feature = "bundled-model")]
 pub use bundled::{BUNDLED_MODEL_SUMMARY, bundled_model};
 pub use convert::{
-    CONVERT_RATE_HZ, ConvertOptions, ConvertSummary, Converted, SPLIT_MIN_PART_S, convert,
+    CONVERT_RATE_HZ, ConvertOptions, ConvertSummary, Converted, RESAMPLE_MAX_GAP_FRAMES,
+    SPLIT_MIN_PART_S, convert,
 };
 pub use demo::Demo;
 pub use error::{PipelineError, Result};
@@ -120,7 +121,9 @@ pub use inspect::{
     inspect_model, inspect_stream,
 };
 pub use lists::{Purpose, load_listed};
-pub use live::{CascadeRegressor, LiveTracker, Recorded, SensorReading};
+pub use live::{
+    CascadeRegressor, LiveTracker, Recorded, STREAM_ACCE_G, STREAM_CHECK_SAMPLES, SensorReading,
+};
 pub use orientation::{apply_orientation, oriented, with_estimated_orientation};
 pub use output::{
     EvalFolder, EvalPlots, EvalWritten, OutputError, TrackOutput, check_not_input,

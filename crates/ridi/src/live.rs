@@ -185,7 +185,14 @@ impl SensorReading {
 ///
 /// A refused sample (a non-finite field, a value no phone sensor gives as the readers'
 /// [`Validation::limit`]s define it, a time not after the previous sample's) leaves the
-/// tracker as it was. A gap longer than the correction integrates across (its `max_dt`, 0.1 s:
+/// tracker as it was. So does one refused because the stream's last second (its last
+/// [`STREAM_CHECK_SAMPLES`]) has a median rate off [`TRACK_RATE_HZ`](crate::TRACK_RATE_HZ) by
+/// more than [`TRACK_RATE_TOLERANCE`](crate::TRACK_RATE_TOLERANCE) (a 50 Hz stream, or time
+/// in milliseconds), a median |gyro| of a gyro in deg/s, or a median |acce| of an
+/// accelerometer in g ([`STREAM_ACCE_G`]): such a stream is refused before its first velocity
+/// is regressed, but the refused samples count towards its last second, so that samples are
+/// taken again once a second of them is right. Pushing after [`finish`](Self::finish) is
+/// refused too. A gap longer than the correction integrates across (its `max_dt`, 0.1 s:
 /// a dropped sensor buffer, say) starts a new segment ([`GapPolicy::Restart`]): the position is
 /// held, velocity and bias start over, and the update says
 /// [`restarted`](Update::restarted). (`ridi track` refuses such a gap in a recording instead.)
@@ -222,6 +229,8 @@ pub struct LiveTracker<'m> {
     tracker: Tracker<CascadeRegressor<'m>>,
     estimator: Option<Estimator>,
     limits: Validation,
+    stream: StreamCheck,
+    finished: bool,
 }
 
 type Waiting = (f64, DeviceVec, DeviceVec, Option<WorldFromDevice>);
@@ -268,6 +277,8 @@ impl<'m> LiveTracker<'m> {
             tracker,
             estimator,
             limits: Validation::default(),
+            stream: StreamCheck::default(),
+            finished: false,
         })
     }
 
@@ -289,7 +300,13 @@ impl<'m> LiveTracker<'m> {
     /// A refused sample ([`TrackError`], [`ridi_frames::EstimateError`]), or a recorded model
     /// given a sample without its recorded orientation; the tracker is unchanged.
     pub fn push(&mut self, sample: &SensorReading, out: &mut Vec<Update>) -> Result<()> {
+        if self.finished {
+            return Err(PipelineError::Live(
+                "the stream was finished: a new stream needs a new tracker".into(),
+            ));
+        }
         self.check_values(sample)?;
+        self.stream.push(sample, &self.limits)?;
         let Some(est) = &mut self.estimator else {
             let r = sample.recorded.ok_or_else(|| {
                 PipelineError::Live(
@@ -337,6 +354,7 @@ impl<'m> LiveTracker<'m> {
     /// [`ridi_frames::EstimateError::NoGravity`] when every sample waiting has a zero
     /// accelerometer reading.
     pub fn finish(&mut self, out: &mut Vec<Update>) -> Result<()> {
+        self.finished = true;
         if let Some(est) = &mut self.estimator {
             est.filter.finish(&mut est.orientations)?;
         }
@@ -348,6 +366,23 @@ impl<'m> LiveTracker<'m> {
     /// here and is refused, by field, where it would be used.
     fn check_values(&self, sample: &SensorReading) -> Result<()> {
         let index = self.accepted();
+        let not_finite = |field: String, value: f64| {
+            PipelineError::Live(format!(
+                "`{field}` of sample {index} is {value}, not a finite number (t = {} s)",
+                sample.time
+            ))
+        };
+        if !sample.time.is_finite() {
+            return Err(not_finite("time".into(), sample.time));
+        }
+        for (name, v) in [("gyro", sample.gyro), ("acce", sample.acce)] {
+            if let Some(axis) = (0..3).find(|&a| !v.to_array()[a].is_finite()) {
+                return Err(not_finite(
+                    format!("{name}.{}", ["x", "y", "z"][axis]),
+                    v.to_array()[axis],
+                ));
+            }
+        }
         let recorded = sample.recorded.as_ref();
         let vectors = [
             (Channel::Gyro, Some(sample.gyro)),
@@ -421,5 +456,132 @@ impl<'m> LiveTracker<'m> {
             })?);
         }
         Ok(())
+    }
+}
+
+/// Samples over which [`LiveTracker`] judges a stream's rate and units: a second at
+/// [`TRACK_RATE_HZ`](crate::TRACK_RATE_HZ), the length of a feature window, so that a stream
+/// at a wrong rate or in a wrong unit is refused by the time its first velocity would be
+/// regressed.
+pub const STREAM_CHECK_SAMPLES: usize = 200;
+
+/// Accepted range of the median |acce| over a stream's last [`STREAM_CHECK_SAMPLES`], in
+/// standard gravities: 0.35..10. Over every second of the shared Tyrex runs (both phones), the
+/// twelve Indoor Location Competition walks and the bundled sample it lies within 0.50..2.40
+/// (the upper end running with the phone in the hand); an accelerometer in g gives at most
+/// 0.25, one in mm/s^2 a thousand times too much. Wider than the readers' whole-recording
+/// bounds ([`Validation::acce_gravity_ratio`]): a second varies more than a recording.
+pub const STREAM_ACCE_G: (f64, f64) = (0.35, 10.0);
+
+/// The last [`STREAM_CHECK_SAMPLES`] of a stream, and how many of them lie beyond each bound
+/// (so that a median is judged in constant time per sample).
+#[derive(Debug, Default)]
+struct StreamCheck {
+    last_time: Option<f64>,
+    /// Per sample: the interval from the one before (seconds), |gyro|, |acce|.
+    recent: VecDeque<[f64; 3]>,
+    /// How many of `recent` are [`StreamCheck::beyond`] each bound.
+    beyond: [usize; 5],
+}
+
+impl StreamCheck {
+    /// The bounds `sample` (interval, |gyro|, |acce|) lies beyond: too fast a rate, too slow,
+    /// a gyro too fast, an accelerometer too weak, too strong.
+    fn beyond(sample: &[f64; 3], limits: &Validation) -> [bool; 5] {
+        let [interval, gyro, acce] = *sample;
+        let (fast, slow) = crate::track::rate_beyond(interval);
+        let g = ridi_frames::STANDARD_GRAVITY;
+        [
+            fast,
+            slow,
+            gyro > limits.max_median_gyro,
+            acce < STREAM_ACCE_G.0 * g,
+            acce > STREAM_ACCE_G.1 * g,
+        ]
+    }
+
+    /// Counts `sample` (a finite time after the last one's; others are refused where they are
+    /// used) and judges the last second.
+    fn push(&mut self, sample: &SensorReading, limits: &Validation) -> Result<()> {
+        let previous = self.last_time;
+        if previous.is_some_and(|t| sample.time <= t) {
+            // The tracker refuses it: its interval says nothing.
+            return Ok(());
+        }
+        self.last_time = Some(sample.time);
+        let Some(previous) = previous else {
+            return Ok(());
+        };
+        let entry = [
+            sample.time - previous,
+            sample.gyro.norm(),
+            sample.acce.norm(),
+        ];
+        for (n, b) in self.beyond.iter_mut().zip(Self::beyond(&entry, limits)) {
+            *n += usize::from(b);
+        }
+        self.recent.push_back(entry);
+        if self.recent.len() > STREAM_CHECK_SAMPLES {
+            let old = self.recent.pop_front().unwrap_or(entry);
+            for (n, b) in self.beyond.iter_mut().zip(Self::beyond(&old, limits)) {
+                *n -= usize::from(b);
+            }
+        }
+        if self.recent.len() < STREAM_CHECK_SAMPLES {
+            return Ok(());
+        }
+        // The median is beyond a bound when more than half of the values are.
+        let Some(bound) = self.beyond.iter().position(|&n| 2 * n > self.recent.len()) else {
+            return Ok(());
+        };
+        Err(PipelineError::Live(self.verdict(bound, limits)))
+    }
+
+    /// Why the last second lies beyond `bound` ([`Self::beyond`]'s order).
+    fn verdict(&self, bound: usize, limits: &Validation) -> String {
+        let column = match bound {
+            0 | 1 => 0,
+            2 => 1,
+            _ => 2,
+        };
+        let mut values: Vec<f64> = self.recent.iter().map(|e| e[column]).collect();
+        values.sort_by(f64::total_cmp);
+        let median = values[values.len() / 2];
+        let n = self.recent.len();
+        let g = ridi_frames::STANDARD_GRAVITY;
+        let why = match column {
+            0 => {
+                let (min, max) = limits.time_step_range;
+                if (min..=max).contains(&median) {
+                    format!(
+                        "a rate of {:.1} Hz (median interval); models count windows and knots \
+                         in frames of a {} Hz stream (within {:.0} %): resample the stream",
+                        1.0 / median,
+                        crate::TRACK_RATE_HZ,
+                        crate::TRACK_RATE_TOLERANCE * 100.0
+                    )
+                } else {
+                    ridi_data::SequenceError::TimeStep { median, min, max }.to_string()
+                }
+            }
+            1 => ridi_data::SequenceError::GyroUnits {
+                median,
+                max: limits.max_median_gyro,
+            }
+            .to_string(),
+            _ => format!(
+                "median |acce| {} m/s^2 is {} g, outside {}..{} g: accelerometer in {}?",
+                ridi_data::short(median),
+                ridi_data::short(median / g),
+                STREAM_ACCE_G.0,
+                STREAM_ACCE_G.1,
+                if median < g {
+                    "g instead of m/s^2"
+                } else {
+                    "another unit than m/s^2"
+                }
+            ),
+        };
+        format!("the stream's last {n} samples: {why}")
     }
 }

@@ -241,11 +241,18 @@ fn csv_row(
 /// the placement it was regressed for: a cascade [`Prediction`](ridi_regress::Prediction) at a
 /// frame, kept as the two things its users take apart ([`Track::regressions`] and
 /// [`Track::placements`]).
+///
+/// # Errors
+/// As [`track`]'s: a sequence at another rate than [`TRACK_RATE_HZ`], shorter than one feature
+/// window, or with a gap longer than the correction's `max_dt` (a window across it would mix
+/// two stretches of the walk); besides the stages' own.
 pub fn regress_sequence(
     seq: &Sequence,
     model: &Cascade,
     opts: &TrackOptions,
 ) -> Result<(Vec<FrameVelocity>, Vec<usize>)> {
+    // A window across a gap, or counted at another rate, is no window the model knows.
+    check_trackable(seq, model.feature_config(), opts.correction.max_dt)?;
     let seq = oriented(
         seq,
         model.feature_config().orientation,
@@ -376,10 +383,13 @@ fn too_short(name: &str, n: usize, duration: f64, config: &FeatureConfig) -> Pip
     PipelineError::sequence(
         name,
         format!(
-            "has {n} frames ({duration:.2} s): no velocity can be regressed before a whole \
-             feature window of {} frames ({:.1} s at {TRACK_RATE_HZ} Hz)",
+            "has {n} frames ({duration:.2} s): the first velocity is regressed after a whole \
+             feature window of {} frames ({:.1} s at {TRACK_RATE_HZ} Hz), at frame {}, so \
+             at least {} frames are needed",
             config.window,
-            config.window as f64 / TRACK_RATE_HZ
+            config.window as f64 / TRACK_RATE_HZ,
+            config.window,
+            config.window + 1
         ),
     )
 }
@@ -390,8 +400,9 @@ fn wrong_rate(name: &str, rate: f64) -> PipelineError {
         name,
         format!(
             "has a rate of {rate:.1} Hz (median frame interval); models count windows and \
-             knots in frames of a {TRACK_RATE_HZ} Hz stream (within {:.0} %): resample it with \
-             `ridi convert <recording> --out <folder> --rate {TRACK_RATE_HZ}`",
+             knots in frames of a {TRACK_RATE_HZ} Hz stream (within {:.0} %): resample it \
+             (`ridi convert <recording> --out <folder> --rate {TRACK_RATE_HZ}`, or the \
+             sequence's `resampled` in Rust and Python)",
             TRACK_RATE_TOLERANCE * 100.0
         ),
     )
@@ -401,9 +412,16 @@ fn wrong_rate(name: &str, rate: f64) -> PipelineError {
 /// `low`, a rate above [`TRACK_RATE_HZ`] beyond the tolerance, holds for short intervals, `high` for
 /// long ones.
 pub(crate) fn count_rate(test: &mut ridi_data::MedianTest, interval: f64) {
+    let (fast, slow) = rate_beyond(interval);
+    test.push(fast, slow);
+}
+
+/// Whether a frame `interval` (seconds) is that of a rate above [`TRACK_RATE_HZ`] beyond
+/// [`TRACK_RATE_TOLERANCE`], and whether of one below.
+pub(crate) fn rate_beyond(interval: f64) -> (bool, bool) {
     let off = 1.0 / interval - TRACK_RATE_HZ;
     let tolerance = TRACK_RATE_TOLERANCE * TRACK_RATE_HZ;
-    test.push(off > tolerance, -off > tolerance);
+    (off > tolerance, -off > tolerance)
 }
 
 /// The median rate of the recording at `path` when [`count_rate`] says it is off, Hz.

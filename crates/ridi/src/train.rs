@@ -165,7 +165,8 @@ pub fn training_data(seqs: &[Sequence], config: &FeatureConfig) -> Result<Traini
             s.placement().ok_or_else(|| {
                 PipelineError::sequence(
                     s.name(),
-                    "has no placement label (give it in the list file)",
+                    "has no placement label (give it in the list file, or set it: `with_placement` in \
+                     Python, `Sequence::set_placement` in Rust)",
                 )
             })
         })

@@ -600,7 +600,12 @@ fn a_live_stream_gets_its_poses_sample_by_sample_dataset() {
             assert!(err.contains("not after"), "{err}");
             let mut nan = sample(i, false);
             nan.gyro = DeviceVec::new(f64::NAN, 0.0, 0.0);
-            assert!(live.push(&nan, &mut updates).is_err());
+            let err = live.push(&nan, &mut updates).unwrap_err().to_string();
+            assert!(err.contains("`gyro.x` of sample 500 is NaN"), "{err}");
+            nan.gyro = sample(i, false).gyro;
+            nan.time = f64::NAN;
+            let err = live.push(&nan, &mut updates).unwrap_err().to_string();
+            assert!(err.contains("`time` of sample 500 is NaN"), "{err}");
             let mut mm = sample(i, false);
             mm.acce = mm.acce * 1000.0;
             let err = live.push(&mm, &mut updates).unwrap_err().to_string();
@@ -620,10 +625,21 @@ fn a_live_stream_gets_its_poses_sample_by_sample_dataset() {
         assert_eq!(updates.len(), expected, "sample {i}");
         positions.extend(updates.iter().map(|u| u.pose.position));
     }
+    assert_eq!(positions, whole.position);
+    // A dropped second: a new segment from the position reached, nothing integrated across.
+    let mut late = sample(seq.len() - 1, false);
+    late.time += 1.0;
+    updates.clear();
+    live.push(&late, &mut updates).unwrap();
+    assert!(updates[0].restarted);
+    assert_eq!(updates[0].pose.position, *whole.position.last().unwrap());
     updates.clear();
     live.finish(&mut updates).unwrap();
     assert!(updates.is_empty());
-    assert_eq!(positions, whole.position);
+    // A finished stream takes no more samples.
+    late.time += 0.005;
+    let err = live.push(&late, &mut updates).unwrap_err().to_string();
+    assert!(err.contains("finished"), "{err}");
     // Without the recorded orientation the heading stays the gyro's: the poses of tracking
     // without `recorded_heading`, which differ.
     let gyro_heading = TrackOptions {
@@ -642,12 +658,6 @@ fn a_live_stream_gets_its_poses_sample_by_sample_dataset() {
     updates.clear();
     bare.finish(&mut updates).unwrap();
     assert_eq!(bare_positions, whole_gyro.position);
-    // A dropped second: a new segment from the position reached, nothing integrated across.
-    let mut late = sample(seq.len() - 1, false);
-    late.time += 1.0;
-    live.push(&late, &mut updates).unwrap();
-    assert!(updates[0].restarted);
-    assert_eq!(updates[0].pose.position, *whole.position.last().unwrap());
 
     // A stream shorter than the initial tilt needs comes out at the end.
     let mut live = LiveTracker::new(&model, &opts).unwrap();
@@ -659,6 +669,87 @@ fn a_live_stream_gets_its_poses_sample_by_sample_dataset() {
     live.finish(&mut updates).unwrap();
     assert_eq!(updates.len(), 10);
     assert!(updates.iter().all(|u| u.pose.position.is_finite()));
+}
+
+/// A stream at another rate, with time in milliseconds, a gyro in deg/s or an accelerometer in
+/// g is refused by the time its first velocity would be regressed, by what is wrong; the
+/// samples refused count towards the stream's last second, so a stream that comes right is
+/// taken again, in a new segment.
+#[test]
+fn a_live_stream_at_a_wrong_rate_or_unit_is_refused_by_its_first_window() {
+    let seq = load("list_Jakob.txt").swap_remove(7);
+    let model = quick_model(&load("list_Guillaume.txt"));
+    let opts = TrackOptions::default();
+    // Pushes frames 0.. of `seq`, each changed by `edit`, until one is refused: its index and
+    // the error.
+    let first_refused = |live: &mut LiveTracker, edit: &dyn Fn(usize, &mut SensorReading)| {
+        let mut updates = Vec::new();
+        for i in 0..seq.len() {
+            let mut s = SensorReading::of_frame(&seq, i);
+            edit(i, &mut s);
+            if let Err(e) = live.push(&s, &mut updates) {
+                return (i, e.to_string());
+            }
+        }
+        panic!("no sample refused");
+    };
+    let t0 = seq.time()[0];
+    type Edit<'a> = &'a dyn Fn(usize, &mut SensorReading);
+    let cases: [(Edit, &[&str]); 4] = [
+        // 100 Hz: the frames' times stretched twofold.
+        (
+            &|i, s| s.time = t0 + 2.0 * (seq.time()[i] - t0),
+            &["100.0 Hz", "resample"],
+        ),
+        (
+            &|_, s| s.time *= 1000.0,
+            &["milliseconds instead of seconds"],
+        ),
+        (
+            &|_, s| s.gyro = DeviceVec::new(0.3, -0.2, 0.1) * (180.0 / std::f64::consts::PI),
+            &["deg/s instead of rad/s"],
+        ),
+        (
+            &|_, s| s.acce = s.acce / ridi::frames::STANDARD_GRAVITY,
+            &["g instead of m/s^2"],
+        ),
+    ];
+    for (edit, words) in cases {
+        let mut live = LiveTracker::new(&model, &opts).unwrap();
+        let (i, err) = first_refused(&mut live, edit);
+        assert_eq!(i, ridi::STREAM_CHECK_SAMPLES, "{err}");
+        assert!(live.regressions().0.is_empty());
+        assert!(err.contains("last 200 samples"), "{err}");
+        for w in words {
+            assert!(err.contains(w), "{w}: {err}");
+        }
+    }
+
+    // Half a second at 100 Hz, then 200 Hz again: refused until most of the last second is
+    // right, then taken in a new segment.
+    let mut live = LiveTracker::new(&model, &opts).unwrap();
+    let mut updates = Vec::new();
+    let (mut refused, mut taken) = (0, 0);
+    for i in 0..1000 {
+        // Frames 0-399 at 100 Hz (stretched), the rest at 200 Hz after them.
+        let mut s = SensorReading::of_frame(&seq, i);
+        s.time = t0
+            + if i < 400 {
+                2.0 * (seq.time()[i] - t0)
+            } else {
+                seq.time()[i] - seq.time()[400] + 2.0 * (seq.time()[400] - t0)
+            };
+        updates.clear();
+        match live.push(&s, &mut updates) {
+            Err(_) => refused += 1,
+            Ok(()) if refused > 0 && taken == 0 => {
+                taken += 1;
+                assert!(i > 400 && updates[0].restarted, "sample {i}");
+            }
+            Ok(()) => {}
+        }
+    }
+    assert!(refused > 0 && taken == 1, "{refused} refused");
 }
 
 /// Every other frame: the same walk recorded at half the rate.

@@ -124,8 +124,12 @@ pub(crate) fn raw_files(n: usize, with_pose: bool) -> Vec<(&'static str, String)
     let mut steps = String::from("# t_ns count\n");
     for i in 0..n + 20 {
         let t_ns = T0_NS + 5_000_000 * i as i64;
+        // The phone upright (its y axis up, along gravity) and turning about the vertical:
+        // Rz(2 * half) * Rx(90 degrees), as x y z w.
         let half = 0.001 * i as f64;
-        let _ = writeln!(rv, "{t_ns} 0 0 {} {}", half.sin(), half.cos());
+        let (c, s) = (half.cos(), half.sin());
+        let r = std::f64::consts::FRAC_1_SQRT_2;
+        let _ = writeln!(rv, "{t_ns} {} {} {} {}", r * c, r * s, r * s, r * c);
         if i % 100 == 0 {
             let _ = writeln!(steps, "{t_ns} {}", i / 100);
         }

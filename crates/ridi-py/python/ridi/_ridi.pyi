@@ -31,8 +31,8 @@ class Sequence:
         time: Array,
         gyro: Array,
         acce: Array,
-        gravity: Array,
-        orientation: Array,
+        gravity: Optional[Array] = None,
+        orientation: Optional[Array] = None,
         *,
         linacce: Optional[Array] = None,
         name: str = "sequence",
@@ -48,6 +48,8 @@ class Sequence:
                 "core-motion-attitude",
                 "estimated",
                 "ground-truth",
+                "gyro-integration",
+                "ekf",
             ]
         ] = None,
         device: Optional[str] = None,
@@ -99,6 +101,7 @@ class Sequence:
     def median_rate_hz(self) -> float: ...
     def with_placement(self, placement: Optional[str]) -> "Sequence": ...
     def split_at_gaps(self, max_gap_s: float, min_duration_s: float = 0.0) -> List["Sequence"]: ...
+    def resampled(self, rate_hz: float, max_gap_s: Optional[float] = None) -> "Sequence": ...
     def __len__(self) -> int: ...
 
 class Model:
@@ -259,7 +262,7 @@ def evaluate(
     data: Inputs,
     model: Model,
     *,
-    methods: Optional[Seq[str]] = None,
+    methods: Union[str, Seq[str], None] = None,
     placement_map: Optional[StrPath] = None,
     placement_window: float = 10.0,
     align: Union[float, Literal["all"], None] = None,
