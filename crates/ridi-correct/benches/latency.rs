@@ -80,15 +80,8 @@ fn percentile(sorted: &[f64], p: f64) -> f64 {
 fn main() {
     // One-minute lap, replayed on a continuous clock.
     let lap = common::walk(12_000, 50, WorldVec::ZERO, true);
-    let lap_samples: Vec<ImuSample> = (0..lap.time.len())
-        .map(|f| ImuSample {
-            time: lap.time[f],
-            gyro: lap.gyro[f],
-            linacce: lap.linacce[f],
-            gravity: lap.gravity[f],
-            orientation: lap.orientation[f],
-        })
-        .collect();
+    let imu = lap.imu();
+    let lap_samples: Vec<ImuSample> = (0..imu.len()).map(|f| imu.sample(f)).collect();
     let regressor = || Replay {
         velocity: (0..lap.time.len())
             .map(|f| lap.target(f).velocity)

@@ -50,7 +50,7 @@ impl PlacementFilter {
         (0..labels.len())
             .map(|i| {
                 let lo = i.saturating_sub(self.radius);
-                let hi = (i + self.radius).min(labels.len() - 1);
+                let hi = i.saturating_add(self.radius).min(labels.len() - 1);
                 // Changes landing on indices lo+1..=hi happened inside the window; one landing
                 // on lo came from a label before the window.
                 changes[hi] - changes[lo] > self.max_changes
@@ -162,6 +162,16 @@ impl TrailingMajority {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_window_wider_than_any_slice_takes_the_whole_slice() {
+        let wide = PlacementFilter {
+            radius: usize::MAX,
+            max_changes: 0,
+        };
+        assert_eq!(wide.flags(&[Some(0), Some(1)]), [true, true]);
+        assert_eq!(wide.flags(&[Some(0), None, Some(0)]), [false; 3]);
+    }
 
     #[test]
     fn smoother_removes_scatter_and_keeps_lasting_changes() {

@@ -88,9 +88,15 @@ impl TrackerConfig {
                 "regress_every and correct_every must be at least 1, window at least 2",
             ));
         }
-        if self.window > MAX_BUFFER || self.apply_delay > MAX_BUFFER {
+        let radius = self.placement_filter.map_or(0, |f| f.radius);
+        if [self.window, self.apply_delay, self.regress_every, radius]
+            .iter()
+            .any(|&n| n > MAX_BUFFER)
+        {
+            // Also what keeps the count of targets the filter looks back on within u64.
             return Err(TrackError::InvalidConfig(
-                "window and apply_delay must be at most 2^22 frames",
+                "window, apply_delay, regress_every and the placement filter's radius must be \
+                 at most 2^22",
             ));
         }
         if self.apply_delay >= self.correct_every {

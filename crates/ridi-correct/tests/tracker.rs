@@ -60,15 +60,8 @@ impl VelocityRegressor for Truth {
 }
 
 fn samples(w: &Walk) -> Vec<ImuSample> {
-    (0..w.time.len())
-        .map(|f| ImuSample {
-            time: w.time[f],
-            gyro: w.gyro[f],
-            linacce: w.linacce[f],
-            gravity: w.gravity[f],
-            orientation: w.orientation[f],
-        })
-        .collect()
+    let imu = w.imu();
+    (0..imu.len()).map(|f| imu.sample(f)).collect()
 }
 
 #[test]
@@ -442,6 +435,18 @@ fn invalid_configurations_are_refused() {
         },
         TrackerConfig {
             window: 1,
+            ..Default::default()
+        },
+        // Counts that would overflow what the tracker keeps for the placement filter.
+        TrackerConfig {
+            placement_filter: Some(PlacementFilter {
+                radius: usize::MAX,
+                max_changes: 0,
+            }),
+            ..Default::default()
+        },
+        TrackerConfig {
+            regress_every: usize::MAX,
             ..Default::default()
         },
         TrackerConfig {

@@ -124,7 +124,8 @@ pub use options::ReadOptions;
 pub use processed::PROCESSED_COLUMNS;
 pub use ridi_frames;
 pub use sequence::{
-    Channel, GroundTruth, OrientationSource, Sequence, SequenceParts, SplitParts, part_name,
+    Channel, GroundTruth, OrientationSource, Sequence, SequenceParts, SplitParts,
+    heading_reference, part_name,
 };
 pub use sequence_error::{SequenceError, short};
 pub use sidecar::{SIDECAR_SUFFIX, sidecar_path};

@@ -3,7 +3,10 @@
 use std::fmt;
 use std::ops::Range;
 
-use ridi_frames::{DeviceVec, ImuFrames, WorldFromDevice, WorldVec};
+use ridi_frames::{
+    DeviceVec, FilterConfig, HeadingConfig, ImuFrames, WorldFromDevice, WorldVec,
+    estimate_orientation, gravity_and_linacce, with_reference_heading,
+};
 use serde::{Deserialize, Serialize};
 
 use crate::device::DeviceInfo;
@@ -247,6 +250,16 @@ pub fn part_name(name: &str, index: usize, parts: usize) -> String {
     }
 }
 
+/// Whether an orientation from `source` may correct an estimate's heading
+/// ([`Sequence::with_estimated_orientation`]): one a phone recorded, not an estimate, and not
+/// the ground truth (which would hand tracking the answer it is judged by).
+pub fn heading_reference(source: Option<OrientationSource>) -> bool {
+    !matches!(
+        source,
+        Some(OrientationSource::Estimated | OrientationSource::GroundTruth)
+    )
+}
+
 /// `time` strictly increasing, with no step longer than `max_gap_s`.
 fn check_steps(time: &[f64], max_gap_s: f64) -> Result<(), SequenceError> {
     for (i, w) in time.windows(2).enumerate() {
@@ -374,6 +387,54 @@ impl Sequence {
                 .map(|((a, g), l)| (a, g, l)),
         )?;
         Ok(Self { parts })
+    }
+
+    /// The sequence with its orientation replaced by a gyro + accelerometer estimate
+    /// ([`ridi_frames::estimate_orientation`]), gravity by the estimate's gravity (standard
+    /// magnitude) and linear acceleration by accelerometer minus that gravity: the orientation
+    /// models trained on [`Estimated`](OrientationSource::Estimated) orientation are fed (the
+    /// Android rotation vector bends with the magnetic field indoors, Core Motion's attitude
+    /// loses its tilt while running; the estimate's tilt does neither). With `heading`, the
+    /// estimate's heading drift is corrected by the slow heading of the sequence's own
+    /// orientation ([`ridi_frames::with_reference_heading`]), unless that orientation is no
+    /// [`heading_reference`]. Gravity and linear acceleration, and so features, are the same
+    /// with or without `heading`.
+    ///
+    /// # Errors
+    /// [`SequenceError::Estimate`] when the estimator refuses the input; the default
+    /// validation of the result.
+    pub fn with_estimated_orientation(
+        &self,
+        filter: &FilterConfig,
+        heading: Option<&HeadingConfig>,
+    ) -> Result<Sequence, SequenceError> {
+        let q = estimate_orientation(self.time(), self.gyro(), self.acce(), filter).map_err(
+            |error| SequenceError::Estimate {
+                what: "orientation estimate",
+                error,
+            },
+        )?;
+        let mut p = self.parts.clone();
+        // From the estimate itself: a turn about the vertical changes neither, and so the
+        // features are bit for bit those of training, which skips the heading.
+        (p.gravity, p.linacce) = q
+            .iter()
+            .zip(&p.acce)
+            .map(|(&q, &a)| gravity_and_linacce(q, a))
+            .unzip();
+        p.orientation = match heading {
+            Some(heading) if heading_reference(self.orientation_source()) => {
+                with_reference_heading(self.time(), &q, self.orientation(), heading).map_err(
+                    |error| SequenceError::Estimate {
+                        what: "heading from the recorded orientation",
+                        error,
+                    },
+                )?
+            }
+            _ => q,
+        };
+        p.orientation_source = Some(OrientationSource::Estimated);
+        Sequence::new(p)
     }
 
     /// Gives the parts back (to edit and re-validate).
@@ -532,14 +593,18 @@ impl Sequence {
     /// count frames of a 200 Hz stream); `ridi convert --rate` applies it.
     ///
     /// # Errors
-    /// A `rate_hz` that is not finite and positive; a gap between two frames longer than
+    /// A `rate_hz` that is not finite and positive, or above 10 kHz (the shortest step
+    /// [`Validation::time_step_range`] accepts); a gap between two frames longer than
     /// `max_gap_s` (interpolating would invent the frames of a gap: split the recording
     /// there first); the default validation of the result.
     pub fn resampled(&self, rate_hz: f64, max_gap_s: f64) -> Result<Sequence, SequenceError> {
         use crate::resample::{
             interpolate_rot, interpolate_scalar, interpolate_vec3, uniform_timeline,
         };
-        if !(rate_hz.is_finite() && rate_hz > 0.0) {
+        // Checked before the frames are made: a rate the time-step check refuses could first
+        // ask for billions of them.
+        let max_hz = 1.0 / Validation::default().time_step_range.0;
+        if !(rate_hz.is_finite() && rate_hz > 0.0 && rate_hz <= max_hz) {
             return Err(SequenceError::InvalidRate { rate_hz });
         }
         let p = &self.parts;

@@ -140,8 +140,12 @@ pub enum SequenceError {
         /// The shortest part asked for.
         min_duration_s: f64,
     },
-    /// A resampling rate that is not a finite number above 0 ([`Sequence::resampled`](crate::Sequence::resampled)).
-    #[error("cannot resample to {rate_hz} Hz: the rate must be a finite number above 0")]
+    /// A resampling rate that is not a finite number above 0, or above the 10 kHz a timeline
+    /// may step at ([`Sequence::resampled`](crate::Sequence::resampled)).
+    #[error(
+        "cannot resample to {rate_hz} Hz: the rate must be a finite number above 0 and at most \
+         10 kHz"
+    )]
     InvalidRate {
         /// The rate asked for.
         rate_hz: f64,
@@ -273,6 +277,15 @@ pub enum SequenceError {
         min: f64,
         /// Upper limit.
         max: f64,
+    },
+    /// The orientation estimate refused the sequence
+    /// ([`Sequence::with_estimated_orientation`](crate::Sequence::with_estimated_orientation)).
+    #[error("{what}: {error}")]
+    Estimate {
+        /// What was being estimated.
+        what: &'static str,
+        /// Why it failed.
+        error: ridi_frames::EstimateError,
     },
     /// Gravity is far from the up axis the orientation gives, over most frames.
     #[error(

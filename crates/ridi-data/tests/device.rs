@@ -5,8 +5,8 @@ mod common;
 
 use common::sample_sequence;
 use ridi_data::{
-    DeviceInfo, OrientationSource, ReadOptions, Sequence, SplitParts, read_sequence, ridi_csv,
-    ridi_plain, sidecar_path, source_files, write_ridi_csv, write_ridi_plain,
+    DeviceInfo, OrientationSource, ReadOptions, Sequence, SequenceError, SplitParts, read_sequence,
+    ridi_csv, ridi_plain, sidecar_path, source_files, write_ridi_csv, write_ridi_plain,
 };
 use ridi_test_support::assert_names_file;
 
@@ -222,6 +222,13 @@ fn splits_at_gaps_and_resampling_keep_every_channel() {
     let counted = at_100.steps().unwrap();
     assert_eq!(counted.len(), at_100.len());
     assert_eq!((counted[0], counted[counted.len() - 1]), (2.0, 6.0));
+    // A rate no timeline may step at is refused before any frame is made (1e9 Hz would be
+    // billions of them).
+    for rate in [0.0, -5.0, f64::NAN, 1e9] {
+        let e = split[1].resampled(rate, 0.05).unwrap_err();
+        assert!(matches!(e, SequenceError::InvalidRate { .. }), "{e}");
+    }
+    assert!(split[1].resampled(1e4, 0.05).is_ok());
 }
 
 #[test]

@@ -471,7 +471,7 @@ pub struct TrajectoryEval {
 /// # Errors
 /// [`EvalError::RateMismatch`] for a timeline at another rate than `config.rate_hz`, a
 /// non-positive `config.rate_hz`, a timeline of fewer than 2 frames or zero duration, and as
-/// [`crate::align::align_trajectory`] and [`trajectory_metrics`].
+/// [`align_trajectory`](crate::align_trajectory) and [`trajectory_metrics`].
 ///
 /// ```
 /// use ridi_eval::{EvalConfig, EvalError, estimate_rate_hz, evaluate_trajectory};

@@ -29,8 +29,9 @@ pub enum Orientation {
     /// Estimated from gyro and accelerometer
     /// ([`ridi_frames::estimate_orientation`] with the default filter), gravity and linear
     /// acceleration derived from each frame's estimate by [`ridi_frames::gravity_and_linacce`]
-    /// (what `ridi::oriented` and `ridi::LiveTracker` do). The extractor does not do it: give
-    /// it those streams.
+    /// (`ridi_data::Sequence::with_estimated_orientation` makes such a sequence; the `ridi`
+    /// facade's pipeline and `LiveTracker` do it themselves). The extractor does not do it:
+    /// give it those streams.
     Estimated,
 }
 

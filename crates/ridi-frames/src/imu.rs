@@ -136,6 +136,21 @@ impl<'a> ImuFrames<'a> {
         self.time.is_empty()
     }
 
+    /// Frame `i` of every stream, owned: as a stream delivers it (to play frames back through
+    /// a streaming tracker).
+    ///
+    /// # Panics
+    /// When `i` is out of bounds of a stream, as indexing does.
+    pub fn sample(&self, i: usize) -> ImuSample {
+        ImuSample {
+            time: self.time[i],
+            gyro: self.gyro[i],
+            linacce: self.linacce[i],
+            gravity: self.gravity[i],
+            orientation: self.orientation[i],
+        }
+    }
+
     /// Frames `range` of every stream.
     ///
     /// # Panics

@@ -124,7 +124,7 @@ pub use lists::{Purpose, load_listed};
 pub use live::{
     CascadeRegressor, LiveTracker, Recorded, STREAM_ACCE_G, STREAM_CHECK_SAMPLES, SensorReading,
 };
-pub use orientation::{apply_orientation, oriented, with_estimated_orientation};
+pub use orientation::{apply_orientation, oriented};
 pub use output::{
     EvalFolder, EvalPlots, EvalWritten, OutputError, TrackOutput, check_not_input,
     check_output_file, check_output_folder, save_model,

@@ -17,58 +17,11 @@
 use std::borrow::Cow;
 
 use ridi_data::{OrientationSource, Sequence};
-use ridi_frames::{FilterConfig, HeadingConfig, estimate_orientation, gravity_and_linacce};
+use ridi_frames::{FilterConfig, HeadingConfig};
 
 use crate::error::{PipelineError, Result};
 
 use ridi_features::Orientation;
-
-/// `seq` with its orientation replaced by a gyro + accelerometer estimate, gravity by the
-/// estimate's gravity (standard magnitude) and linear acceleration by accelerometer minus that
-/// gravity. With `heading`, the estimate's heading drift is corrected by the slow heading of
-/// `seq`'s own orientation ([`ridi_frames::with_reference_heading`]), unless that orientation
-/// is an estimate itself or the ground truth.
-///
-/// # Errors
-/// When the estimator rejects the input (non-finite samples) or the result fails validation.
-pub fn with_estimated_orientation(
-    seq: &Sequence,
-    filter: &FilterConfig,
-    heading: Option<&HeadingConfig>,
-) -> Result<Sequence> {
-    let failed = |what: &str, e: ridi_frames::EstimateError| {
-        PipelineError::sequence(seq.name(), format!("{what}: {e}"))
-    };
-    let q = estimate_orientation(seq.time(), seq.gyro(), seq.acce(), filter)
-        .map_err(|e| failed("orientation estimate", e))?;
-    let mut p = seq.clone().into_parts();
-    // From the estimate itself: a turn about the vertical changes neither, and so the
-    // features are bit for bit those of training, which skips the heading.
-    (p.gravity, p.linacce) = q
-        .iter()
-        .zip(&p.acce)
-        .map(|(&q, &a)| gravity_and_linacce(q, a))
-        .unzip();
-    p.orientation = match heading {
-        Some(heading) if heading_reference(seq.orientation_source()) => {
-            ridi_frames::with_reference_heading(seq.time(), &q, seq.orientation(), heading)
-                .map_err(|e| failed("heading from the recorded orientation", e))?
-        }
-        _ => q,
-    };
-    p.orientation_source = Some(OrientationSource::Estimated);
-    Sequence::new(p).map_err(|e| PipelineError::sequence(seq.name(), e.to_string()))
-}
-
-/// Whether an orientation from `source` may correct an estimate's heading: one a phone
-/// recorded, not an estimate, and not the ground truth (which would hand tracking the answer
-/// it is judged by).
-pub(crate) fn heading_reference(source: Option<OrientationSource>) -> bool {
-    !matches!(
-        source,
-        Some(OrientationSource::Estimated | OrientationSource::GroundTruth)
-    )
-}
 
 /// `seq` with the orientation `choice` asks for: `seq` itself when it has it already (a recorded
 /// one, or one estimated before), else a copy with the estimate swapped in, its heading
@@ -82,7 +35,8 @@ pub(crate) fn heading_reference(source: Option<OrientationSource>) -> bool {
 ///
 /// # Errors
 /// [`Orientation::Recorded`] for a sequence whose orientation was already replaced by an
-/// estimate (the recorded one is gone), and as [`with_estimated_orientation`].
+/// estimate (the recorded one is gone), and as
+/// [`Sequence::with_estimated_orientation`].
 pub fn oriented<'a>(
     seq: &'a Sequence,
     choice: Orientation,
@@ -91,11 +45,10 @@ pub fn oriented<'a>(
     let estimated = seq.orientation_source() == Some(OrientationSource::Estimated);
     match (choice, estimated) {
         (Orientation::Recorded, false) | (Orientation::Estimated, true) => Ok(Cow::Borrowed(seq)),
-        (Orientation::Estimated, false) => Ok(Cow::Owned(with_estimated_orientation(
-            seq,
-            &FilterConfig::default(),
-            heading,
-        )?)),
+        (Orientation::Estimated, false) => Ok(Cow::Owned(
+            seq.with_estimated_orientation(&FilterConfig::default(), heading)
+                .map_err(|e| PipelineError::sequence(seq.name(), e.to_string()))?,
+        )),
         (Orientation::Recorded, true) => Err(recorded_wanted(seq.name())),
     }
 }
@@ -198,9 +151,10 @@ mod tests {
             .into_sequences();
         let seq = &seqs[0];
         let filter = FilterConfig::default();
-        let gyro_only = with_estimated_orientation(seq, &filter, None).unwrap();
-        let corrected =
-            with_estimated_orientation(seq, &filter, Some(&HeadingConfig::default())).unwrap();
+        let gyro_only = seq.with_estimated_orientation(&filter, None).unwrap();
+        let corrected = seq
+            .with_estimated_orientation(&filter, Some(&HeadingConfig::default()))
+            .unwrap();
         assert_eq!(
             corrected.orientation_source(),
             Some(OrientationSource::Estimated)
@@ -223,14 +177,14 @@ mod tests {
         let mut parts = seq.clone().into_parts();
         parts.orientation_source = Some(OrientationSource::GroundTruth);
         let truth_sourced = Sequence::new(parts).unwrap();
-        let with_truth =
-            with_estimated_orientation(&truth_sourced, &filter, Some(&HeadingConfig::default()))
-                .unwrap();
+        let with_truth = truth_sourced
+            .with_estimated_orientation(&filter, Some(&HeadingConfig::default()))
+            .unwrap();
         assert_eq!(with_truth.orientation(), gyro_only.orientation());
         // An estimate is never the reference of another.
-        let again =
-            with_estimated_orientation(&gyro_only, &filter, Some(&HeadingConfig::default()))
-                .unwrap();
+        let again = gyro_only
+            .with_estimated_orientation(&filter, Some(&HeadingConfig::default()))
+            .unwrap();
         assert_eq!(again.orientation(), gyro_only.orientation());
     }
 }

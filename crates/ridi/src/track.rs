@@ -484,7 +484,7 @@ fn live_for<'m>(
 ) -> Result<LiveTracker<'m>> {
     if source == Some(ridi_data::OrientationSource::Estimated) {
         LiveTracker::with_given_orientation(model, opts)
-    } else if crate::orientation::heading_reference(source) {
+    } else if ridi_data::heading_reference(source) {
         LiveTracker::new(model, opts)
     } else {
         let opts = TrackOptions {

@@ -4,7 +4,6 @@ use ridi::CascadeRegressor;
 use ridi::correct::{Tracker, TrackerConfig};
 use ridi::data::{Listed, ReadOptions, Sequence};
 use ridi::features::Orientation;
-use ridi::frames::ImuSample;
 use ridi::frames::nalgebra::Vector3;
 use ridi::frames::{DeviceVec, Rot, UpAxis};
 use ridi::regress::{Cascade, NoProgress};
@@ -489,15 +488,7 @@ fn a_model_tracks_in_the_orientation_it_was_trained_with() {
     let mut tracker = Tracker::new(config, regressor).unwrap();
     let e = &pre[0];
     for i in 0..e.len() {
-        let u = tracker
-            .push(&ImuSample {
-                time: e.time()[i],
-                gyro: e.gyro()[i],
-                linacce: e.linacce()[i],
-                gravity: e.gravity()[i],
-                orientation: e.orientation()[i],
-            })
-            .unwrap();
+        let u = tracker.push(&e.imu().sample(i)).unwrap();
         assert_eq!(u.pose.position, a.position[i], "frame {i}");
         assert_eq!(u.bias, a.bias[i], "frame {i}");
     }
