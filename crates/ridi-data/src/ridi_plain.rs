@@ -54,7 +54,8 @@ pub(crate) fn parse_header(header_line: usize, header: &str, path: &Path) -> Res
                 // What else a `.txt` of commas or comments may be.
                 if header.starts_with('#') || header.contains(',') {
                     ": if this is a list file (`path,placement` lines), it goes to `--list` of \
-                     ridi train and ridi eval"
+                     ridi train and ridi eval (`ridi.read_list` in Python, `Listed::read` in \
+                     Rust)"
                 } else {
                     ""
                 }

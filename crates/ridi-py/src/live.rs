@@ -39,6 +39,10 @@ pub(crate) struct Update {
     restarted: bool,
 }
 
+/// What a pickled [`Update`] holds: its fields in order.
+type Triple = (f64, f64, f64);
+type UpdateState = (u64, f64, Triple, Triple, Triple, bool);
+
 fn triple(v: [f64; 3]) -> (f64, f64, f64) {
     (v[0], v[1], v[2])
 }
@@ -58,6 +62,33 @@ impl From<RidiUpdate> for Update {
 
 #[pymethods]
 impl Update {
+    /// Pickled as its fields (for ``multiprocessing``).
+    fn __reduce__<'py>(slf: &Bound<'py, Self>) -> PyResult<(Bound<'py, PyAny>, UpdateState)> {
+        let u = slf.get();
+        let state = (u.frame, u.time, u.position, u.velocity, u.bias, u.restarted);
+        Ok((slf.get_type().getattr("_from_state")?, state))
+    }
+
+    /// The update [`Self::__reduce__`] pickled.
+    #[staticmethod]
+    fn _from_state(
+        frame: u64,
+        time: f64,
+        position: (f64, f64, f64),
+        velocity: (f64, f64, f64),
+        bias: (f64, f64, f64),
+        restarted: bool,
+    ) -> Self {
+        Self {
+            frame,
+            time,
+            position,
+            velocity,
+            bias,
+            restarted,
+        }
+    }
+
     fn __repr__(&self) -> String {
         let p = self.position;
         format!(

@@ -177,16 +177,40 @@ impl Inputs {
     }
 }
 
-/// Runs `f` on `jobs` worker threads (all cores when `None`), as `--jobs` does for a command.
+/// The process the module was loaded in.
+static LOADED_IN: std::sync::OnceLock<u32> = std::sync::OnceLock::new();
+
+/// Notes the process the module is loaded in (at import).
+pub(crate) fn note_process() {
+    LOADED_IN.get_or_init(std::process::id);
+}
+
+/// Whether this is a child forked from the process the module was loaded in (`multiprocessing`'s
+/// default start method on Linux): rayon's global worker threads stayed in the parent, and work
+/// handed to them would wait for ever.
+fn forked() -> bool {
+    LOADED_IN
+        .get()
+        .is_some_and(|&pid| pid != std::process::id())
+}
+
+/// Runs `f` on `jobs` worker threads (all cores when `None`), as `--jobs` does for a command;
+/// in a forked child on threads of its own ([`forked`]).
 pub(crate) fn with_jobs<T: Send>(jobs: Option<i64>, f: impl FnOnce() -> T + Send) -> PyResult<T> {
-    match jobs {
-        None => Ok(f()),
-        Some(n) => {
-            let pool = rayon::ThreadPoolBuilder::new()
-                .num_threads(count("jobs", n, 1, MAX_JOBS)?)
-                .build()
-                .map_err(|e| errors::value(format!("cannot set up the worker threads: {e}")))?;
-            Ok(pool.install(f))
-        }
-    }
+    let threads = match jobs {
+        None if !forked() => return Ok(f()),
+        // rayon's default: as many as the cores.
+        None => 0,
+        Some(n) => count("jobs", n, 1, MAX_JOBS)?,
+    };
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .map_err(|e| errors::value(format!("cannot set up the worker threads: {e}")))?;
+    Ok(pool.install(f))
+}
+
+/// Runs `f` without the GIL, on the worker threads [`with_jobs`] gives by default.
+pub(crate) fn detached<T: Send>(py: Python<'_>, f: impl FnOnce() -> T + Send) -> PyResult<T> {
+    py.detach(|| with_jobs(None, f))
 }

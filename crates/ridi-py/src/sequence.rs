@@ -5,6 +5,7 @@ use std::path::PathBuf;
 use numpy::{PyArray1, PyArray2};
 use pyo3::exceptions::PyUserWarning;
 use pyo3::prelude::*;
+use pyo3::types::{PyDict, PyTuple};
 use ridi::data::{
     DeviceInfo, Format, GroundTruth, ListEntry, Listed, OrientationSource,
     Sequence as RidiSequence, SequenceError, SequenceParts, Validation,
@@ -385,6 +386,38 @@ impl Sequence {
         self.inner.len()
     }
 
+    /// Pickled (for ``multiprocessing``, ``copy``) as the constructor call that rebuilds it:
+    /// its arrays and metadata; the format it was read from is not kept.
+    fn __reduce__<'py>(
+        slf: &Bound<'py, Self>,
+    ) -> PyResult<(Bound<'py, PyAny>, Bound<'py, PyTuple>)> {
+        let py = slf.py();
+        let kwargs = PyDict::new(py);
+        for key in [
+            "linacce",
+            "name",
+            "placement",
+            "magnet",
+            "ground_truth_position",
+            "ground_truth_orientation",
+            "steps",
+            "orientation_source",
+            "device",
+            "device_imu_rate_hz",
+        ] {
+            kwargs.set_item(key, slf.getattr(key)?)?;
+        }
+        let mut args = vec![slf.get_type().into_any()];
+        for key in ["time", "gyro", "acce", "gravity", "orientation"] {
+            args.push(slf.getattr(key)?);
+        }
+        let rebuild = py
+            .import("functools")?
+            .getattr("partial")?
+            .call(PyTuple::new(py, args)?, Some(&kwargs))?;
+        Ok((rebuild, PyTuple::empty(py)))
+    }
+
     fn __repr__(&self) -> String {
         format!(
             "Sequence('{}', {} frames, {:.2} s, placement={}, ground truth: {})",
@@ -443,8 +476,7 @@ fn read_sequences(
     format: Option<&str>,
 ) -> PyResult<Vec<Sequence>> {
     let from = format.map(|f| choice("format", f, &FORMATS)).transpose()?;
-    let loaded = py
-        .detach(|| ridi::read_any(path, from, &options::read_options()))
+    let loaded = options::detached(py, || ridi::read_any(path, from, &options::read_options()))?
         .map_err(errors::data)?;
     warn(py, &loaded.warnings)?;
     let format = loaded.format;
@@ -532,30 +564,29 @@ pub(crate) fn read_list(
             )
         })
         .transpose()?;
-    let listed = py
-        .detach(|| -> ridi::Result<Listed> {
-            let entries = ListEntry::read(&lists)?;
-            let read = options::read_options();
-            match purpose {
-                Some(purpose) => load_listed(entries, map.as_ref(), purpose, &read),
-                None => {
-                    // The labels written in the lists, checked as `load_listed` checks them.
-                    if let Some(map) = &map {
-                        for e in &entries {
-                            if let Some(label) = &e.placement {
-                                map.class_at(label, e.location())?;
-                            }
+    let listed = options::detached(py, || -> ridi::Result<Listed> {
+        let entries = ListEntry::read(&lists)?;
+        let read = options::read_options();
+        match purpose {
+            Some(purpose) => load_listed(entries, map.as_ref(), purpose, &read),
+            None => {
+                // The labels written in the lists, checked as `load_listed` checks them.
+                if let Some(map) = &map {
+                    for e in &entries {
+                        if let Some(label) = &e.placement {
+                            map.class_at(label, e.location())?;
                         }
                     }
-                    let mut listed = Listed::load(entries, &read)?;
-                    if let Some(map) = &map {
-                        map.apply(listed.sequences_mut());
-                    }
-                    Ok(listed)
                 }
+                let mut listed = Listed::load(entries, &read)?;
+                if let Some(map) = &map {
+                    map.apply(listed.sequences_mut());
+                }
+                Ok(listed)
             }
-        })
-        .map_err(errors::pipeline)?;
+        }
+    })?
+    .map_err(errors::pipeline)?;
     Ok(listed
         .into_sequences()
         .into_iter()

@@ -4,9 +4,11 @@ use std::path::PathBuf;
 
 use numpy::{IntoPyArray, PyArray1, PyArray2};
 use pyo3::prelude::*;
+use pyo3::types::PyBytes;
 use ridi::PipelineError;
 use ridi::correct::FrameVelocity;
 use ridi::data::shown;
+use ridi::frames::{StabHorizontal, Vec3};
 
 use crate::arrays::{rows_out, vecs_out, vector_out};
 use crate::errors;
@@ -42,8 +44,35 @@ impl Regressions {
     }
 }
 
+/// What pickled [`Regressions`] hold: frames, velocities, placements.
+type RegressionsState = (Vec<usize>, Vec<[f64; 2]>, Vec<String>);
+
 #[pymethods]
 impl Regressions {
+    /// Pickled as its frames, velocities and placements (for ``multiprocessing``).
+    fn __reduce__<'py>(slf: &Bound<'py, Self>) -> PyResult<(Bound<'py, PyAny>, RegressionsState)> {
+        let r = slf.get();
+        let state = (r.frame.clone(), r.velocity.clone(), r.placement.clone());
+        Ok((slf.get_type().getattr("_from_state")?, state))
+    }
+
+    /// The regressions [`Self::__reduce__`] pickled.
+    #[staticmethod]
+    fn _from_state(
+        frame: Vec<usize>,
+        velocity: Vec<[f64; 2]>,
+        placement: Vec<String>,
+    ) -> PyResult<Self> {
+        if frame.len() != velocity.len() || frame.len() != placement.len() {
+            return Err(errors::value("not the state of pickled ridi.Regressions"));
+        }
+        Ok(Self {
+            frame,
+            velocity,
+            placement,
+        })
+    }
+
     /// Frame index of each regression, shape (M,), int64.
     #[getter]
     fn frame<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<i64>> {
@@ -78,6 +107,11 @@ impl Regressions {
 pub(crate) struct Track {
     inner: ridi::Track,
 }
+
+/// What a pickled [`Track`] holds: its numbers as little-endian f64 bytes (counts, time,
+/// position, velocity, bias, then frame, velocity and placement per regression), and the
+/// placement names.
+type TrackState<'py> = (Bound<'py, PyBytes>, Vec<String>);
 
 #[pymethods]
 impl Track {
@@ -131,6 +165,95 @@ impl Track {
 
     fn __len__(&self) -> usize {
         self.inner.time.len()
+    }
+
+    /// Pickled (for ``multiprocessing``, ``copy``) as its numbers, bit for bit.
+    fn __reduce__<'py>(slf: &Bound<'py, Self>) -> PyResult<(Bound<'py, PyAny>, TrackState<'py>)> {
+        let t = &slf.get().inner;
+        let mut bytes = Vec::new();
+        let mut put = |v: f64| bytes.extend_from_slice(&v.to_le_bytes());
+        for (n, m) in [
+            (t.time.len(), t.regressions.len()),
+            (t.position.len(), t.placements.len()),
+        ] {
+            put(n as f64);
+            put(m as f64);
+        }
+        t.time.iter().for_each(|&v| put(v));
+        for v in t.position.iter().chain(&t.velocity) {
+            v.to_array().into_iter().for_each(&mut put);
+        }
+        for v in &t.bias {
+            v.to_array().into_iter().for_each(&mut put);
+        }
+        for (r, &p) in t.regressions.iter().zip(&t.placements) {
+            put(r.frame as f64);
+            r.velocity.to_array().into_iter().for_each(&mut put);
+            put(p as f64);
+        }
+        let rebuild = slf.get_type().getattr("_from_state")?;
+        Ok((
+            rebuild,
+            (PyBytes::new(slf.py(), &bytes), t.placement_names.clone()),
+        ))
+    }
+
+    /// The track [`Self::__reduce__`] pickled.
+    #[staticmethod]
+    fn _from_state(bytes: &[u8], placement_names: Vec<String>) -> PyResult<Self> {
+        let corrupt = || errors::value("not the state of a pickled ridi.Track");
+        let v: Vec<f64> = bytes
+            .chunks_exact(8)
+            .map(|c| f64::from_le_bytes(c.try_into().unwrap_or_default()))
+            .collect();
+        let count = |x: f64| {
+            (x >= 0.0 && x.fract() == 0.0 && x <= v.len() as f64)
+                .then_some(x as usize)
+                .ok_or_else(corrupt)
+        };
+        if !bytes.len().is_multiple_of(8) || v.len() < 4 {
+            return Err(corrupt());
+        }
+        let (n, m) = (count(v[0])?, count(v[1])?);
+        if count(v[2])? != n || count(v[3])? != m || v.len() != 4 + n * 10 + m * 4 {
+            return Err(corrupt());
+        }
+        let time = v[4..4 + n].to_vec();
+        let triples = |from: usize| -> Vec<[f64; 3]> {
+            v[from..from + 3 * n]
+                .chunks_exact(3)
+                .map(|c| [c[0], c[1], c[2]])
+                .collect()
+        };
+        let position = triples(4 + n).into_iter().map(Vec3::from_array).collect();
+        let velocity = triples(4 + 4 * n)
+            .into_iter()
+            .map(Vec3::from_array)
+            .collect();
+        let bias = triples(4 + 7 * n)
+            .into_iter()
+            .map(Vec3::from_array)
+            .collect();
+        let mut regressions = Vec::with_capacity(m);
+        let mut placements = Vec::with_capacity(m);
+        for r in v[4 + 10 * n..].chunks_exact(4) {
+            regressions.push(FrameVelocity {
+                frame: count(r[0])?,
+                velocity: StabHorizontal::new(r[1], r[2]),
+            });
+            placements.push(count(r[3])?);
+        }
+        Ok(Self {
+            inner: ridi::Track {
+                time,
+                position,
+                velocity,
+                bias,
+                regressions,
+                placements,
+                placement_names,
+            },
+        })
     }
 
     fn __repr__(&self) -> String {
@@ -191,7 +314,7 @@ pub(crate) fn track(
     )?;
     let (seq, model) = (&sequence.get().inner, &model.get().inner);
     // `ridi::track` gives the sequence the model's orientation itself.
-    py.detach(|| ridi::track(seq, model, &opts))
+    options::detached(py, || ridi::track(seq, model, &opts))?
         .map(|inner| Track { inner })
         .map_err(|e| errors::of_sequence(e, "cannot track", seq.name()))
 }
@@ -214,9 +337,9 @@ pub(crate) fn regress(
         ..ridi::TrackOptions::default()
     };
     let (seq, model) = (&sequence.get().inner, &model.get().inner);
-    let (velocities, placements) = py
-        .detach(|| ridi::regress_sequence(seq, model, &opts))
-        .map_err(|e: PipelineError| errors::of_sequence(e, "cannot regress", seq.name()))?;
+    let (velocities, placements) =
+        options::detached(py, || ridi::regress_sequence(seq, model, &opts))?
+            .map_err(|e: PipelineError| errors::of_sequence(e, "cannot regress", seq.name()))?;
     Ok(Regressions::of(
         &velocities,
         &placements,

@@ -283,3 +283,29 @@ def test_gravity_and_orientation_left_out_are_derived_or_estimated(seq, model):
         ridi.Sequence(seq.time, seq.gyro, seq.acce, seq.gravity)
     with pytest.raises(ValueError, match="time in milliseconds"):
         ridi.Sequence(seq.time * 1000, seq.gyro, seq.acce)
+
+
+@pytest.mark.parametrize("start", ["spawn", "fork"])
+def test_sequences_pickle_for_other_processes(seq, model, start):
+    import multiprocessing
+    import pickle
+    from concurrent.futures import ProcessPoolExecutor
+
+    if start not in multiprocessing.get_all_start_methods():
+        pytest.skip(f"no {start} on this platform")
+    back = pickle.loads(pickle.dumps(seq))
+    for key in ("time", "gyro", "acce", "linacce", "gravity", "orientation",
+                "ground_truth_position", "ground_truth_orientation"):
+        np.testing.assert_array_equal(getattr(back, key), getattr(seq, key))
+    for key in ("name", "placement", "orientation_source", "device", "device_imu_rate_hz"):
+        assert getattr(back, key) == getattr(seq, key)
+    # This process has used ridi's worker threads already: a forked child has none of them,
+    # and ridi starts its own there (it waited for ever on the parent's before).
+    here = ridi.track(seq, model)
+    context = multiprocessing.get_context(start)
+    with ProcessPoolExecutor(max_workers=1, mp_context=context) as pool:
+        far = pool.submit(ridi.track, seq, model).result(timeout=120)
+        regressed = pool.submit(ridi.regress, seq, model).result(timeout=120)
+    np.testing.assert_array_equal(far.position, here.position)
+    np.testing.assert_array_equal(regressed.velocity, here.regressions.velocity)
+    assert regressed.placement == here.regressions.placement

@@ -92,6 +92,18 @@ def test_regress_is_what_track_corrects_with(seq, model):
     assert "frames" in repr(track)
 
 
+def test_updates_pickle(seq, model):
+    import pickle
+
+    live = ridi.LiveTracker(model)
+    for i in range(450):
+        updates = live.push(seq.time[i], seq.gyro[i], seq.acce[i], orientation=seq.orientation[i])
+    assert updates
+    back = pickle.loads(pickle.dumps(updates))
+    assert [(u.frame, u.time, u.position, u.velocity, u.bias, u.restarted) for u in back] == [
+        (u.frame, u.time, u.position, u.velocity, u.bias, u.restarted) for u in updates]
+
+
 def test_live_tracker_gives_the_online_poses(seq, model):
     online = ridi.track(seq, model, online=True)
     live = ridi.LiveTracker(model)
@@ -258,3 +270,18 @@ def test_placement_maps_that_are_not_there_are_named_as_missing(tmp_path):
         ridi.read_list(SAMPLE / "list_test.txt", placement_map="tyrex5")
     with pytest.raises(FileNotFoundError, match=r"nolist\.txt: no such file or folder$"):
         ridi.read_list(tmp_path / "nolist.txt")
+
+
+def test_tracks_pickle_bit_for_bit(seq, model):
+    import pickle
+
+    track = ridi.track(seq, model)
+    back = pickle.loads(pickle.dumps(track))
+    for key in ("time", "position", "velocity", "bias"):
+        np.testing.assert_array_equal(getattr(back, key), getattr(track, key))
+    np.testing.assert_array_equal(back.regressions.velocity, track.regressions.velocity)
+    np.testing.assert_array_equal(back.regressions.frame, track.regressions.frame)
+    assert back.regressions.placement == track.regressions.placement
+    assert back.placement_names == track.placement_names
+    with pytest.raises(ValueError, match="not the state of a pickled ridi.Track"):
+        ridi.Track._from_state(b"\0" * 12, [])
