@@ -128,6 +128,38 @@ pub struct SequenceParts {
     pub device: Option<DeviceInfo>,
 }
 
+impl SequenceParts {
+    /// Replaces the orientation by a gyro + accelerometer estimate
+    /// ([`ridi_frames::estimate_orientation`]), gravity by the estimate's (standard magnitude),
+    /// linear acceleration by accelerometer minus that gravity, and the source by
+    /// [`OrientationSource::Estimated`]: what
+    /// [`Sequence::with_estimated_orientation`] does before any heading correction, for parts
+    /// that have no orientation yet (a sequence built from gyro and accelerometer alone).
+    ///
+    /// # Errors
+    /// [`SequenceError::Estimate`] when the estimator refuses the input (non-finite samples,
+    /// time going back, streams of other lengths than `time`).
+    pub fn estimate_orientation(&mut self, filter: &FilterConfig) -> Result<(), SequenceError> {
+        let q =
+            estimate_orientation(&self.time, &self.gyro, &self.acce, filter).map_err(|error| {
+                SequenceError::Estimate {
+                    what: "orientation estimate",
+                    error,
+                }
+            })?;
+        // From the estimate itself: a turn about the vertical changes neither, and so the
+        // features are bit for bit those of training, which skips the heading.
+        (self.gravity, self.linacce) = q
+            .iter()
+            .zip(&self.acce)
+            .map(|(&q, &a)| gravity_and_linacce(q, a))
+            .unzip();
+        self.orientation = q;
+        self.orientation_source = Some(OrientationSource::Estimated);
+        Ok(())
+    }
+}
+
 /// A channel of a sequence, as named in a [`SequenceError`] and given to the checks of
 /// [`Validation`].
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -408,32 +440,16 @@ impl Sequence {
         filter: &FilterConfig,
         heading: Option<&HeadingConfig>,
     ) -> Result<Sequence, SequenceError> {
-        let q = estimate_orientation(self.time(), self.gyro(), self.acce(), filter).map_err(
-            |error| SequenceError::Estimate {
-                what: "orientation estimate",
-                error,
-            },
-        )?;
         let mut p = self.parts.clone();
-        // From the estimate itself: a turn about the vertical changes neither, and so the
-        // features are bit for bit those of training, which skips the heading.
-        (p.gravity, p.linacce) = q
-            .iter()
-            .zip(&p.acce)
-            .map(|(&q, &a)| gravity_and_linacce(q, a))
-            .unzip();
-        p.orientation = match heading {
-            Some(heading) if heading_reference(self.orientation_source()) => {
-                with_reference_heading(self.time(), &q, self.orientation(), heading).map_err(
-                    |error| SequenceError::Estimate {
+        p.estimate_orientation(filter)?;
+        if let Some(heading) = heading.filter(|_| heading_reference(self.orientation_source())) {
+            p.orientation =
+                with_reference_heading(self.time(), &p.orientation, self.orientation(), heading)
+                    .map_err(|error| SequenceError::Estimate {
                         what: "heading from the recorded orientation",
                         error,
-                    },
-                )?
-            }
-            _ => q,
-        };
-        p.orientation_source = Some(OrientationSource::Estimated);
+                    })?;
+        }
         Sequence::new(p)
     }
 

@@ -87,6 +87,17 @@ impl MedianTest {
         self.high += usize::from(high);
     }
 
+    /// Uncounts one value counted before with these properties (for a sliding window of
+    /// values).
+    ///
+    /// # Panics
+    /// When no value with them is counted, as no caller that pushed it first can do.
+    pub fn pop(&mut self, low: bool, high: bool) {
+        self.values -= 1;
+        self.low -= usize::from(low);
+        self.high -= usize::from(high);
+    }
+
     /// Values counted.
     pub fn len(&self) -> usize {
         self.values

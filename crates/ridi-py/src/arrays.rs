@@ -41,8 +41,14 @@ fn float64<'py>(obj: &Bound<'py, PyAny>, name: &str) -> PyResult<Bound<'py, PyUn
     };
     let found = array.dtype();
     if !found.is_equiv_to(&dtype::<f64>(obj.py())) {
+        // Timestamps as numpy dates: a cast to float64 would give nanoseconds, not seconds.
+        let convert = if found.kind() == b'M' {
+            format!("seconds as float64: ({name} - {name}[0]) / np.timedelta64(1, 's')")
+        } else {
+            format!("np.asarray({name}, dtype=np.float64)")
+        };
         return Err(PyTypeError::new_err(format!(
-            "`{name}` has dtype {found}; ridi takes float64 (np.asarray({name}, dtype=np.float64))"
+            "`{name}` has dtype {found}; ridi takes float64 ({convert})"
         )));
     }
     Ok(array.clone())

@@ -63,7 +63,7 @@ impl Model {
     /// Writes the model file to `path` (atomically, as ``ridi train --out`` does).
     fn save(&self, py: Python<'_>, path: PathBuf) -> PyResult<()> {
         let model = &self.inner;
-        py.detach(|| ridi::save_model(model, &path))
+        options::detached(py, || ridi::save_model(model, &path))?
             .map_err(|e| errors::pipeline_in(e, Some(format!("cannot write {}", shown(&path)))))
     }
 
@@ -101,17 +101,17 @@ impl Model {
 
     /// The bytes of the model file.
     fn to_bytes<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyBytes>> {
-        let bytes = self
-            .inner
-            .to_bytes()
+        let model = &self.inner;
+        let bytes = options::detached(py, || model.to_bytes())?
             .map_err(|e| errors::value(e.to_string()))?;
         Ok(PyBytes::new(py, &bytes))
     }
 
     /// A model from the bytes of a model file (checked as ``ridi.load`` checks a file).
     #[staticmethod]
-    fn from_bytes(data: &[u8]) -> PyResult<Self> {
-        Cascade::from_bytes(data)
+    fn from_bytes(py: Python<'_>, data: &[u8]) -> PyResult<Self> {
+        // Decoding half-precision rows runs on worker threads.
+        options::detached(py, || Cascade::from_bytes(data))?
             .map(Self::of)
             .map_err(|e| errors::value(format!("cannot load model: {e}")))
     }
@@ -142,7 +142,7 @@ impl Model {
 /// Raises ``OSError`` when the file cannot be read, ``ValueError`` when it is no valid model.
 #[pyfunction]
 pub(crate) fn load(py: Python<'_>, path: PathBuf) -> PyResult<Model> {
-    py.detach(|| Cascade::load(&path))
+    options::detached(py, || Cascade::load(&path))?
         .map(Model::of)
         .map_err(|e| errors::model_file(e, "cannot load model", &path))
 }
@@ -151,8 +151,8 @@ pub(crate) fn load(py: Python<'_>, path: PathBuf) -> PyResult<Model> {
 /// 4S, three people), for phones of your own without training (its card:
 /// ``docs/model-card.md``); what ``ridi track`` uses without ``--model``.
 #[pyfunction]
-pub(crate) fn bundled_model() -> PyResult<Model> {
-    ridi::bundled_model()
+pub(crate) fn bundled_model(py: Python<'_>) -> PyResult<Model> {
+    options::detached(py, ridi::bundled_model)?
         .map(Model::of)
         .map_err(|e| errors::value(format!("cannot decode the bundled model: {e}")))
 }

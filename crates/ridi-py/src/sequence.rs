@@ -10,10 +10,7 @@ use ridi::data::{
     DeviceInfo, Format, GroundTruth, ListEntry, Listed, OrientationSource,
     Sequence as RidiSequence, SequenceError, SequenceParts, Validation,
 };
-use ridi::frames::{
-    DeviceVec, FilterConfig, Frame, STANDARD_GRAVITY, Vec3, WorldFromDevice, estimate_orientation,
-    gravity_and_linacce, gravity_in_device,
-};
+use ridi::frames::{FilterConfig, Frame, STANDARD_GRAVITY, Vec3, gravity_in_device};
 use ridi::{Purpose, load_listed};
 
 use crate::arrays::{matrix, rotations, rotations_out, vecs, vecs_out, vector, vector_out};
@@ -125,15 +122,8 @@ impl Sequence {
                     .collect();
                 (q, g, false)
             }
-            (None, None) => {
-                let q = estimated_orientation(&time, &gyro, &acce, name)?;
-                let g = q
-                    .iter()
-                    .zip(&acce)
-                    .map(|(&q, &a)| gravity_and_linacce(q, a).0)
-                    .collect();
-                (q, g, true)
-            }
+            // Estimated below, once the parts are whole.
+            (None, None) => (Vec::new(), Vec::new(), true),
             (None, Some(_)) => {
                 return Err(errors::value(
                     "`gravity` without `orientation`: give both, the orientation alone \
@@ -143,10 +133,10 @@ impl Sequence {
             }
         };
         // Accelerometer minus gravity, as the RIDI files define it, unless given.
-        let linacce = match linacce {
-            Some(l) => three(l, "linacce", n)?,
-            None => acce.iter().zip(&gravity).map(|(&a, &g)| a - g).collect(),
-        };
+        let linacce = linacce.map(|l| three(l, "linacce", n)).transpose()?;
+        let given_linacce = linacce.is_some();
+        let linacce =
+            linacce.unwrap_or_else(|| acce.iter().zip(&gravity).map(|(&a, &g)| a - g).collect());
         let ground_truth = match (ground_truth_position, ground_truth_orientation) {
             (None, None) => None,
             (Some(p), Some(q)) => Some(GroundTruth {
@@ -168,8 +158,13 @@ impl Sequence {
                     .collect();
                 choice("orientation_source", key, &keys)
             })
-            .transpose()?
-            .or(estimated.then_some(OrientationSource::Estimated));
+            .transpose()?;
+        if estimated && orientation_source.is_some_and(|s| s != OrientationSource::Estimated) {
+            return Err(errors::value(
+                "`orientation_source` names a recorded orientation, but none was given: the \
+                 one estimated from gyro and accelerometer is 'estimated'",
+            ));
+        }
         let device = match device {
             None => None,
             Some(model) => {
@@ -182,7 +177,7 @@ impl Sequence {
                 })
             }
         };
-        let parts = SequenceParts {
+        let mut parts = SequenceParts {
             time,
             gyro,
             acce,
@@ -199,6 +194,13 @@ impl Sequence {
             placement,
             name: name.to_string(),
         };
+        if estimated {
+            let given = given_linacce.then(|| parts.linacce.clone());
+            estimate_into(&mut parts)?;
+            if let Some(l) = given {
+                parts.linacce = l;
+            }
+        }
         let name = parts.name.clone();
         let inner = RidiSequence::new(parts).map_err(|e| {
             // The Rust field `ground_truth.position` is the keyword `ground_truth_position` here.
@@ -271,7 +273,8 @@ impl Sequence {
     }
 
     /// Where the orientation comes from (`game-rotation-vector`, `rotation-vector`,
-    /// `core-motion-attitude`, `estimated`, `ground-truth`), or None.
+    /// `core-motion-attitude`, `estimated`, `ground-truth`, `gyro-integration`, `ekf`), or
+    /// None.
     #[getter]
     fn orientation_source(&self) -> Option<&'static str> {
         self.inner.orientation_source().map(|s| s.key())
@@ -436,25 +439,23 @@ impl Sequence {
     }
 }
 
-/// The orientation of a sequence given without one: the estimate of gyro and accelerometer
-/// that models on the estimated orientation make themselves (`ridi train`'s default), its
-/// heading the gyro's alone. Time is checked first, so that time in milliseconds is named as
-/// such and not by the estimator.
-fn estimated_orientation(
-    time: &[f64],
-    gyro: &[DeviceVec],
-    acce: &[DeviceVec],
-    name: &str,
-) -> PyResult<Vec<WorldFromDevice>> {
-    let failed = |e: String| errors::value(format!("sequence `{name}`: {e}"));
+/// Gives `parts` without an orientation the estimate of gyro and accelerometer that models on
+/// the estimated orientation make themselves (`ridi train`'s default), its heading the gyro's
+/// alone. Time is checked first, so that time in milliseconds is named as such and not by the
+/// estimator.
+fn estimate_into(parts: &mut SequenceParts) -> PyResult<()> {
+    let failed = |name: &str, e: String| errors::value(format!("sequence `{name}`: {e}"));
     Validation::default()
-        .check_time_step(time)
-        .map_err(|e| failed(e.to_string()))?;
-    estimate_orientation(time, gyro, acce, &FilterConfig::default()).map_err(|e| {
-        failed(format!(
-            "cannot estimate the orientation (none was given) from gyro and accelerometer: {e}"
-        ))
-    })
+        .check_time_step(&parts.time)
+        .map_err(|e| failed(&parts.name, e.to_string()))?;
+    parts
+        .estimate_orientation(&FilterConfig::default())
+        .map_err(|e| {
+            failed(
+                &parts.name,
+                format!("no orientation was given, and it cannot be estimated: {e}"),
+            )
+        })
 }
 
 /// Emits the readers' (or an evaluation's) warnings as Python `UserWarning`s, as the command

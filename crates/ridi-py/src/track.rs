@@ -237,11 +237,15 @@ impl Track {
         let mut regressions = Vec::with_capacity(m);
         let mut placements = Vec::with_capacity(m);
         for r in v[4 + 10 * n..].chunks_exact(4) {
+            let (frame, placement) = (count(r[0])?, count(r[3])?);
+            if frame >= n || placement >= placement_names.len() {
+                return Err(corrupt());
+            }
             regressions.push(FrameVelocity {
-                frame: count(r[0])?,
+                frame,
                 velocity: StabHorizontal::new(r[1], r[2]),
             });
-            placements.push(count(r[3])?);
+            placements.push(placement);
         }
         Ok(Self {
             inner: ridi::Track {

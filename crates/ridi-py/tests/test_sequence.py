@@ -178,6 +178,10 @@ def test_linacce_defaults_to_acce_minus_gravity(seq):
     [
         (lambda a: a.update(gyro=a["gyro"].astype(np.float32)), TypeError,
          r"`gyro` has dtype float32; ridi takes float64"),
+        (lambda a: a.update(time=np.datetime64("2026-11-27") + (a["time"] * 1e9).astype(
+            "timedelta64[ns]")), TypeError,
+         r"`time` has dtype datetime64\[ns\]; ridi takes float64 \(seconds as float64: "
+         r"\(time - time\[0\]\) / np.timedelta64\(1, 's'\)\)"),
         (lambda a: a.update(acce=a["acce"].tolist()), TypeError,
          r"`acce` must be a numpy array of float64, not list"),
         (lambda a: a.update(gyro=a["gyro"][:, :2]), ValueError,
@@ -281,8 +285,38 @@ def test_gravity_and_orientation_left_out_are_derived_or_estimated(seq, model):
                                ridi.track(seq, model, heading="gyro").position, atol=1e-6)
     with pytest.raises(ValueError, match="`gravity` without `orientation`"):
         ridi.Sequence(seq.time, seq.gyro, seq.acce, seq.gravity)
+    with pytest.raises(ValueError, match="names a recorded orientation, but none was given"):
+        ridi.Sequence(seq.time, seq.gyro, seq.acce, orientation_source="rotation-vector")
     with pytest.raises(ValueError, match="time in milliseconds"):
         ridi.Sequence(seq.time * 1000, seq.gyro, seq.acce)
+
+
+def same_sequence(a, b):
+    """Every constructor argument of `a` and `b` agrees (so a new argument the pickling misses
+    fails here)."""
+    import inspect
+
+    for key in inspect.signature(ridi.Sequence).parameters:
+        x, y = getattr(a, key), getattr(b, key)
+        if isinstance(x, np.ndarray):
+            np.testing.assert_array_equal(x, y, err_msg=key)
+        else:
+            assert x == y, key
+
+
+def test_every_kind_of_sequence_pickles(seq):
+    import pickle
+
+    bare = ridi.Sequence(seq.time, seq.gyro, seq.acce, name="bare")
+    args = arrays_of(seq)
+    n = len(seq)
+    full = ridi.Sequence(**{**args, "magnet": np.tile([20.0, -5.0, 40.0], (n, 1)),
+                            "steps": np.arange(n) / 100.0, "device": "Pixel 7",
+                            "device_imu_rate_hz": 400.0, "orientation_source": "ekf"})
+    for s in (seq, bare, full):
+        same_sequence(pickle.loads(pickle.dumps(s)), s)
+    assert full.device == "Pixel 7" and full.device_imu_rate_hz == 400.0
+    assert bare.orientation_source == "estimated"
 
 
 @pytest.mark.parametrize("start", ["spawn", "fork"])
@@ -293,19 +327,18 @@ def test_sequences_pickle_for_other_processes(seq, model, start):
 
     if start not in multiprocessing.get_all_start_methods():
         pytest.skip(f"no {start} on this platform")
-    back = pickle.loads(pickle.dumps(seq))
-    for key in ("time", "gyro", "acce", "linacce", "gravity", "orientation",
-                "ground_truth_position", "ground_truth_orientation"):
-        np.testing.assert_array_equal(getattr(back, key), getattr(seq, key))
-    for key in ("name", "placement", "orientation_source", "device", "device_imu_rate_hz"):
-        assert getattr(back, key) == getattr(seq, key)
+    same_sequence(pickle.loads(pickle.dumps(seq)), seq)
     # This process has used ridi's worker threads already: a forked child has none of them,
-    # and ridi starts its own there (it waited for ever on the parent's before).
-    here = ridi.track(seq, model)
+    # and ridi starts its own there (it waited for ever on the parent's before). A model in
+    # half precision decodes on worker threads too, as it arrives in the child.
+    half = ridi.train(ridi.read_list(SAMPLE / "list_Guillaume.txt", placement_map="tyrex4")[:4],
+                      grid="none", storage="half")
+    here = [ridi.track(seq, m) for m in (model, half)]
     context = multiprocessing.get_context(start)
     with ProcessPoolExecutor(max_workers=1, mp_context=context) as pool:
-        far = pool.submit(ridi.track, seq, model).result(timeout=120)
+        far = [pool.submit(ridi.track, seq, m).result(timeout=120) for m in (model, half)]
         regressed = pool.submit(ridi.regress, seq, model).result(timeout=120)
-    np.testing.assert_array_equal(far.position, here.position)
-    np.testing.assert_array_equal(regressed.velocity, here.regressions.velocity)
-    assert regressed.placement == here.regressions.placement
+    for a, b in zip(far, here):
+        np.testing.assert_array_equal(a.position, b.position)
+    np.testing.assert_array_equal(regressed.velocity, here[0].regressions.velocity)
+    assert regressed.placement == here[0].regressions.placement

@@ -14,7 +14,7 @@ use ridi_correct::{
     FrameVelocity, FrameWindow, GapPolicy, PlacementSmoother, RegressorOutput, TrackError, Tracker,
     TrackerConfig, TrailingMajority, Update, VelocityRegressor,
 };
-use ridi_data::{Channel, Sequence, Validation};
+use ridi_data::{Channel, MedianTest, Sequence, Validation};
 use ridi_features::{FeatureExtractor, FeatureMatrixRef, Orientation};
 use ridi_frames::{
     DeviceVec, FilterConfig, HeadingCorrector, ImuSample, OrientationFilter, WorldFromDevice,
@@ -185,14 +185,15 @@ impl SensorReading {
 ///
 /// A refused sample (a non-finite field, a value no phone sensor gives as the readers'
 /// [`Validation::limit`]s define it, a time not after the previous sample's) leaves the
-/// tracker as it was. So does one refused because the stream's last second (its last
+/// tracking as it was. So does one refused because the stream's last second (its last
 /// [`STREAM_CHECK_SAMPLES`]) has a median rate off [`TRACK_RATE_HZ`](crate::TRACK_RATE_HZ) by
 /// more than [`TRACK_RATE_TOLERANCE`](crate::TRACK_RATE_TOLERANCE) (a 50 Hz stream, or time
 /// in milliseconds), a median |gyro| of a gyro in deg/s, or a median |acce| of an
 /// accelerometer in g ([`STREAM_ACCE_G`]): such a stream is refused before its first velocity
-/// is regressed, but the refused samples count towards its last second, so that samples are
-/// taken again once a second of them is right. Pushing after [`finish`](Self::finish) is
-/// refused too. A gap longer than the correction integrates across (its `max_dt`, 0.1 s:
+/// is regressed. The samples with a new time count towards that second whether they are
+/// tracked or refused, so that samples are taken again once a second of them is right (a
+/// sample given again is refused again). Pushing after [`finish`](Self::finish) is refused
+/// too. A gap longer than the correction integrates across (its `max_dt`, 0.1 s:
 /// a dropped sensor buffer, say) starts a new segment ([`GapPolicy::Restart`]): the position is
 /// held, velocity and bias start over, and the update says
 /// [`restarted`](Update::restarted). (`ridi track` refuses such a gap in a recording instead.)
@@ -298,7 +299,8 @@ impl<'m> LiveTracker<'m> {
     ///
     /// # Errors
     /// A refused sample ([`TrackError`], [`ridi_frames::EstimateError`]), or a recorded model
-    /// given a sample without its recorded orientation; the tracker is unchanged.
+    /// given a sample without its recorded orientation; the tracking is unchanged (the
+    /// sample still counts towards the stream's last second, as the type's docs say).
     pub fn push(&mut self, sample: &SensorReading, out: &mut Vec<Update>) -> Result<()> {
         if self.finished {
             return Err(PipelineError::Live(
@@ -361,26 +363,29 @@ impl<'m> LiveTracker<'m> {
         self.drain(out)
     }
 
-    /// Refuses a value no phone sensor gives (the readers' [`Validation::limit`]s: a corrupt
-    /// sample, or mm/s^2 for m/s^2), naming the field, the sample and its time. NaN passes
-    /// here and is refused, by field, where it would be used.
+    /// Refuses a non-finite time, gyro or accelerometer, and a value no phone sensor gives (the
+    /// readers' [`Validation::limit`]s: a corrupt sample, or mm/s^2 for m/s^2), naming the
+    /// field, the sample and its time. A recorded orientation's non-finite fields are refused
+    /// where they are used.
     fn check_values(&self, sample: &SensorReading) -> Result<()> {
         let index = self.accepted();
-        let not_finite = |field: String, value: f64| {
-            PipelineError::Live(format!(
-                "`{field}` of sample {index} is {value}, not a finite number (t = {} s)",
-                sample.time
-            ))
-        };
         if !sample.time.is_finite() {
-            return Err(not_finite("time".into(), sample.time));
+            return Err(PipelineError::Live(format!(
+                "`time` of sample {index} is {}, not a finite number",
+                sample.time
+            )));
         }
-        for (name, v) in [("gyro", sample.gyro), ("acce", sample.acce)] {
-            if let Some(axis) = (0..3).find(|&a| !v.to_array()[a].is_finite()) {
-                return Err(not_finite(
-                    format!("{name}.{}", ["x", "y", "z"][axis]),
-                    v.to_array()[axis],
-                ));
+        for (name, v) in [
+            ("gyro", sample.gyro.to_array()),
+            ("acce", sample.acce.to_array()),
+        ] {
+            if let Some(axis) = (0..3).find(|&a| !v[a].is_finite()) {
+                return Err(PipelineError::Live(format!(
+                    "`{name}.{}` of sample {index} is {}, not a finite number (t = {} s)",
+                    ["x", "y", "z"][axis],
+                    v[axis],
+                    sample.time
+                )));
             }
         }
         let recorded = sample.recorded.as_ref();
@@ -473,40 +478,44 @@ pub const STREAM_CHECK_SAMPLES: usize = 200;
 /// bounds ([`Validation::acce_gravity_ratio`]): a second varies more than a recording.
 pub const STREAM_ACCE_G: (f64, f64) = (0.35, 10.0);
 
-/// The last [`STREAM_CHECK_SAMPLES`] of a stream, and how many of them lie beyond each bound
-/// (so that a median is judged in constant time per sample).
+/// The last [`STREAM_CHECK_SAMPLES`] of a stream, and whether the median of each quantity
+/// lies beyond its bounds, from counts ([`MedianTest`], as the readers judge a recording), so
+/// that a median is judged in constant time per sample.
 #[derive(Debug, Default)]
 struct StreamCheck {
     last_time: Option<f64>,
     /// Per sample: the interval from the one before (seconds), |gyro|, |acce|.
     recent: VecDeque<[f64; 3]>,
-    /// How many of `recent` are [`StreamCheck::beyond`] each bound.
-    beyond: [usize; 5],
+    /// Each quantity's properties: low, a rate too fast, a gyro (none), an accelerometer too
+    /// weak; high, a rate too slow, a gyro too fast, an accelerometer too strong.
+    medians: [MedianTest; 3],
+    /// Why the last sample judged was refused, while the stream stays refused: a sample given
+    /// again (its time not after the last one) gets the same answer.
+    refused: Option<String>,
 }
 
 impl StreamCheck {
-    /// The bounds `sample` (interval, |gyro|, |acce|) lies beyond: too fast a rate, too slow,
-    /// a gyro too fast, an accelerometer too weak, too strong.
-    fn beyond(sample: &[f64; 3], limits: &Validation) -> [bool; 5] {
+    /// The (low, high) properties of each of `sample`'s quantities (interval, |gyro|, |acce|).
+    fn properties(sample: &[f64; 3], limits: &Validation) -> [(bool, bool); 3] {
         let [interval, gyro, acce] = *sample;
-        let (fast, slow) = crate::track::rate_beyond(interval);
         let g = ridi_frames::STANDARD_GRAVITY;
         [
-            fast,
-            slow,
-            gyro > limits.max_median_gyro,
-            acce < STREAM_ACCE_G.0 * g,
-            acce > STREAM_ACCE_G.1 * g,
+            crate::track::rate_beyond(interval),
+            (false, gyro > limits.max_median_gyro),
+            (acce < STREAM_ACCE_G.0 * g, acce > STREAM_ACCE_G.1 * g),
         ]
     }
 
-    /// Counts `sample` (a finite time after the last one's; others are refused where they are
-    /// used) and judges the last second.
+    /// Counts `sample` and judges the last second. A sample whose time is not after the last
+    /// one's is no new interval: the tracker refuses it, or this check again when the last one
+    /// judged was refused (a sample retried is no way round it).
     fn push(&mut self, sample: &SensorReading, limits: &Validation) -> Result<()> {
         let previous = self.last_time;
         if previous.is_some_and(|t| sample.time <= t) {
-            // The tracker refuses it: its interval says nothing.
-            return Ok(());
+            return match &self.refused {
+                Some(why) => Err(PipelineError::Live(why.clone())),
+                None => Ok(()),
+            };
         }
         self.last_time = Some(sample.time);
         let Some(previous) = previous else {
@@ -517,33 +526,40 @@ impl StreamCheck {
             sample.gyro.norm(),
             sample.acce.norm(),
         ];
-        for (n, b) in self.beyond.iter_mut().zip(Self::beyond(&entry, limits)) {
-            *n += usize::from(b);
+        for (m, (low, high)) in self
+            .medians
+            .iter_mut()
+            .zip(Self::properties(&entry, limits))
+        {
+            m.push(low, high);
         }
         self.recent.push_back(entry);
-        if self.recent.len() > STREAM_CHECK_SAMPLES {
-            let old = self.recent.pop_front().unwrap_or(entry);
-            for (n, b) in self.beyond.iter_mut().zip(Self::beyond(&old, limits)) {
-                *n -= usize::from(b);
+        if self.recent.len() > STREAM_CHECK_SAMPLES
+            && let Some(old) = self.recent.pop_front()
+        {
+            for (m, (low, high)) in self.medians.iter_mut().zip(Self::properties(&old, limits)) {
+                m.pop(low, high);
             }
         }
+        self.refused = None;
         if self.recent.len() < STREAM_CHECK_SAMPLES {
             return Ok(());
         }
-        // The median is beyond a bound when more than half of the values are.
-        let Some(bound) = self.beyond.iter().position(|&n| 2 * n > self.recent.len()) else {
+        let Some(column) = self
+            .medians
+            .iter()
+            .position(|m| m.median_low() || m.median_high())
+        else {
             return Ok(());
         };
-        Err(PipelineError::Live(self.verdict(bound, limits)))
+        let why = self.verdict(column, limits);
+        self.refused = Some(why.clone());
+        Err(PipelineError::Live(why))
     }
 
-    /// Why the last second lies beyond `bound` ([`Self::beyond`]'s order).
-    fn verdict(&self, bound: usize, limits: &Validation) -> String {
-        let column = match bound {
-            0 | 1 => 0,
-            2 => 1,
-            _ => 2,
-        };
+    /// Why the last second's median of quantity `column` ([`Self::properties`]' order) lies
+    /// beyond its bounds.
+    fn verdict(&self, column: usize, limits: &Validation) -> String {
         let mut values: Vec<f64> = self.recent.iter().map(|e| e[column]).collect();
         values.sort_by(f64::total_cmp);
         let median = values[values.len() / 2];

@@ -654,8 +654,14 @@ fn track_rows(
         };
         times.push_back(row.time);
         if let Err(e) = live.push(&reading, &mut updates) {
-            // What reading refuses comes first, as when the recording is read whole.
+            let (path, read_opts) = (rows.path().to_path_buf(), rows.options().clone());
+            // What reading refuses comes first, as when the recording is read whole; then a
+            // rate off as `track` words it (the live tracker's check of its last second
+            // refuses such a stream by its 201st frame).
             rows.finish()?;
+            if let Some(r) = rate_off(&rate, &path, &read_opts)? {
+                return Err(wrong_rate(&name, r));
+            }
             return Err(PipelineError::sequence(&name, format!("frame {i}: {e}")));
         }
         write(&mut updates, &mut live, &mut times).map_err(&mut *written)?;

@@ -716,8 +716,9 @@ fn a_live_stream_at_a_wrong_rate_or_unit_is_refused_by_its_first_window() {
         }
     }
 
-    // Half a second at 100 Hz, then 200 Hz again: refused until most of the last second is
-    // right, then taken in a new segment.
+    // Two seconds at 100 Hz (frames 0-399 stretched twofold), then 200 Hz again: refused
+    // until most of the last second is right (at most 101 samples later), then taken in a new
+    // segment; a refused sample given again is refused again.
     let mut live = LiveTracker::new(&model, &opts).unwrap();
     let mut updates = Vec::new();
     let (mut refused, mut taken) = (0, 0);
@@ -732,10 +733,15 @@ fn a_live_stream_at_a_wrong_rate_or_unit_is_refused_by_its_first_window() {
             };
         updates.clear();
         match live.push(&s, &mut updates) {
-            Err(_) => refused += 1,
+            Err(e) => {
+                refused += 1;
+                let again = live.push(&s, &mut updates).unwrap_err().to_string();
+                assert_eq!(again, e.to_string());
+            }
             Ok(()) if refused > 0 && taken == 0 => {
                 taken += 1;
-                assert!(i > 400 && updates[0].restarted, "sample {i}");
+                assert!(i > 400 && i <= 400 + 101, "sample {i}");
+                assert!(updates[0].restarted, "sample {i}");
             }
             Ok(()) => {}
         }

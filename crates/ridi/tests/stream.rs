@@ -157,3 +157,34 @@ fn streamed_recordings_track_plot_and_inspect_as_read_whole() {
     assert_eq!(lines, seq.len() + 1);
     assert!(streamed == whole, "the streamed track or plot differs");
 }
+
+/// A streamed recording at another rate gets `track`'s error for it (with `ridi convert
+/// --rate`), not the live tracker's check of its first second.
+#[test]
+fn a_streamed_recording_at_another_rate_gets_tracks_error() {
+    let dir = tempfile::tempdir().unwrap();
+    let model = small_model();
+    let seq = &sample(&["Thibaud_Nexus5_NoDist_Swinging"])[0];
+    let half = seq.resampled(100.0, 0.1).unwrap();
+    let path = dir.path().join("half.csv");
+    write_ridi_csv(&half, &path).unwrap();
+    let opts = TrackOptions {
+        online: true,
+        ..TrackOptions::default()
+    };
+    let whole = ridi::track(&half, &model, &opts).unwrap_err().to_string();
+    let inputs = ReadFiles::of([&path]);
+    let rows = RowReader::open(&path, &ReadOptions::default()).unwrap();
+    let out = dir.path().join("t.csv");
+    let streamed = TrackOutput::new(&out, &inputs)
+        .unwrap()
+        .write_stream(rows, &model, &opts)
+        .unwrap_err()
+        .to_string();
+    assert!(
+        streamed.contains("has a rate of 100.0 Hz") && streamed.contains("ridi convert"),
+        "{streamed}"
+    );
+    assert!(whole.contains("has a rate of 100.0 Hz"), "{whole}");
+    assert!(!out.exists());
+}
