@@ -269,7 +269,7 @@ pub(crate) fn train(
     storage: &str,
     solver: &str,
     landmarks: i64,
-    seed: i64,
+    seed: i128,
     turned_copies: i64,
     step: Option<i64>,
     window: Option<i64>,
@@ -325,7 +325,8 @@ pub(crate) fn train(
     };
     opts.cascade.set_seed(u64::try_from(seed).map_err(|_| {
         errors::value(format!(
-            "`seed` is {seed}; expected a whole number of at least 0"
+            "`seed` is {seed}; expected a whole number from 0 to {}",
+            u64::MAX
         ))
     })?);
     let projected = Storage::projected_for(&opts.cascade.method);

@@ -93,6 +93,10 @@ def test_progress_reports_each_stage_and_can_cancel():
         (dict(orientation="magnetic"), r"`orientation` is 'magnetic'"),
         (dict(up_axis="z"), r"`up_axis` is 'z'"),
         (dict(jobs=0), r"`jobs` is 0"),
+        (dict(jobs=-1), r"`jobs` is -1; expected a whole number from 1"),
+        (dict(turned_copies=-1), r"`turned_copies` is -1; expected a whole number from 0"),
+        (dict(seed=-1), r"`seed` is -1; expected a whole number from 0 to 18446744073709551615"),
+        (dict(seed=2**64), r"`seed` is 18446744073709551616"),
         (dict(placement_map="no-such-map.txt"), r"no-such-map.txt"),
     ],
 )
