@@ -20,7 +20,8 @@ use crate::ring::FrameRing;
 use crate::solve::{Correction, Corrector, Trajectory};
 
 /// Largest number of frames a window, a regressor view or the apply delay may span (about
-/// 5.8 hours at 200 Hz): the buffers are allocated up front.
+/// 5.8 hours at 200 Hz): the buffers are allocated up front. It also bounds `regress_every`
+/// and the placement filter's radius, whose product counts the targets kept.
 pub const MAX_BUFFER: usize = 1 << 22;
 
 /// What to do when the time step to a new sample exceeds `correction.max_dt`.

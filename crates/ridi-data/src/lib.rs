@@ -4,7 +4,9 @@
 //! acceleration and gravity, the device orientation (world-from-device, see `ridi-frames`),
 //! and optional ground truth and step counter. It is validated when built, so code that takes
 //! a `Sequence` can rely on equal lengths, finite values, increasing time, values within physical
-//! bounds and channels in plausible units ([`Validation`]).
+//! bounds, channels in plausible units and gravity along the orientation's up axis
+//! ([`Validation`]). [`Sequence::with_estimated_orientation`] swaps in the gyro + accelerometer
+//! estimate that models on the estimated orientation take.
 //!
 //! Readers and writers turn files into sequences and back; every error names the file, and
 //! parse errors the line and field too. No reader panics on malformed input.

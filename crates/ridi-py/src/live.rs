@@ -109,8 +109,11 @@ impl Update {
 /// stream leaves); given the phone's ``orientation`` too, it corrects the gyro's heading drift
 /// by that orientation's slow heading (``heading="corrected"``, the default; ``"gyro"`` keeps
 /// the gyro's). A refused sample (non-finite, beyond any phone sensor, not after the
-/// previous one) raises ``ValueError`` and leaves the tracker as it was; a gap longer than
-/// 0.1 s starts a new segment (``Update.restarted``).
+/// previous one) raises ``ValueError`` and leaves the tracking as it was; from the 201st
+/// sample on, the last 200 samples' median rate (200 Hz within 10 %), |gyro| and |acce| are
+/// judged, so a stream in milliseconds, deg/s or g is refused by then (refused samples count
+/// towards the last 200). A gap longer than 0.1 s starts a new segment
+/// (``Update.restarted``); pushing after ``finish()`` raises.
 ///
 /// >>> live = ridi.LiveTracker(model)                      # doctest: +SKIP
 /// >>> for i in range(len(seq)):                           # doctest: +SKIP

@@ -489,8 +489,8 @@ fn read_sequences(
 }
 
 /// Reads the recording at `path`: a RIDI ``data.csv`` (or ``.csv.gz``), ``data_plain.txt``,
-/// RIDI raw recorder folder, Tyrex run folder or Indoor Location Competition path file, as
-/// ``ridi track`` reads it. ``format`` forces one (``ridi-csv``, ``ridi-plain``, ``ridi-raw``,
+/// RIDI raw recorder folder, Tyrex run folder, Indoor Location Competition path file or RoNIN
+/// sequence folder, as ``ridi track`` reads it. ``format`` forces one (``ridi-csv``, ``ridi-plain``, ``ridi-raw``,
 /// ``tyrex``, ``ilc``, ``ronin``) instead of detecting it. The readers' warnings are ``UserWarning``\ s.
 ///
 /// Raises ``OSError`` when the file cannot be read, ``ValueError`` naming the file, line and

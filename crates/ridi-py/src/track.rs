@@ -285,8 +285,9 @@ impl Track {
 /// estimated orientation takes the recorded orientation's slow heading to correct the gyro's
 /// drift; ``"gyro"``: the gyro's alone) are the command's options, with its defaults.
 ///
-/// Raises ``ValueError`` naming the sequence for one at another rate than 200 Hz, shorter than
-/// the model's window or with a gap longer than 0.1 s.
+/// Raises ``ValueError`` naming the sequence for one at another rate than 200 Hz, no longer
+/// than the model's window or with a gap longer than 0.1 s; with ``online=True`` also for a
+/// second of it in another rate or unit (``LiveTracker``'s check).
 ///
 /// >>> track = ridi.track(seq, model)          # doctest: +SKIP
 /// >>> track.position[-1]                     # doctest: +SKIP
@@ -325,7 +326,8 @@ pub(crate) fn track(
 
 /// The velocities `model` regresses for `sequence` every ``regress_every`` frames from the
 /// first whole window, each with the majority placement within ``placement_window`` seconds:
-/// what ``ridi.track`` corrects with, without the correction.
+/// what ``ridi.track`` corrects with, without the correction. Raises ``ValueError`` naming
+/// the sequence for what ``ridi.track`` refuses.
 #[pyfunction]
 #[pyo3(signature = (sequence, model, *, regress_every=50, placement_window=10.0))]
 pub(crate) fn regress(

@@ -191,8 +191,8 @@ impl SensorReading {
 /// in milliseconds), a median |gyro| of a gyro in deg/s, or a median |acce| of an
 /// accelerometer in g ([`STREAM_ACCE_G`]): such a stream is refused before its first velocity
 /// is regressed. The samples with a new time count towards that second whether they are
-/// tracked or refused, so that samples are taken again once a second of them is right (a
-/// sample given again is refused again). Pushing after [`finish`](Self::finish) is refused
+/// tracked or refused, so that samples are taken again once most of the last
+/// [`STREAM_CHECK_SAMPLES`] are right (a sample given again is refused again). Pushing after [`finish`](Self::finish) is refused
 /// too. A gap longer than the correction integrates across (its `max_dt`, 0.1 s:
 /// a dropped sensor buffer, say) starts a new segment ([`GapPolicy::Restart`]): the position is
 /// held, velocity and bias start over, and the update says

@@ -22,8 +22,10 @@ class Sequence:
     """One recording on one timeline, as numpy arrays (each property a new float64 array).
 
     Built from arrays, it is validated as any reader's input (equal lengths, finite values,
-    increasing time, plausible units); an error names the array and the frame. Orientations are
-    world-from-device quaternions ``[w, x, y, z]``; the device frame is Android's.
+    increasing time in seconds, plausible units, gravity along the orientation's up axis); an
+    error names the array and the frame. Orientations are world-from-device quaternions
+    ``[w, x, y, z]``; the device frame is Android's. ``gravity`` defaults to the orientation's
+    up axis; without both, they are estimated from gyro and accelerometer.
     """
 
     def __init__(
