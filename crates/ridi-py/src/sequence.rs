@@ -132,11 +132,7 @@ impl Sequence {
                 ));
             }
         };
-        // Accelerometer minus gravity, as the RIDI files define it, unless given.
         let linacce = linacce.map(|l| three(l, "linacce", n)).transpose()?;
-        let given_linacce = linacce.is_some();
-        let linacce =
-            linacce.unwrap_or_else(|| acce.iter().zip(&gravity).map(|(&a, &g)| a - g).collect());
         let ground_truth = match (ground_truth_position, ground_truth_orientation) {
             (None, None) => None,
             (Some(p), Some(q)) => Some(GroundTruth {
@@ -181,7 +177,8 @@ impl Sequence {
             time,
             gyro,
             acce,
-            linacce,
+            // Set below, once gravity is known.
+            linacce: Vec::new(),
             gravity,
             magnet: magnet.map(|m| three(m, "magnet", n)).transpose()?,
             orientation,
@@ -195,12 +192,13 @@ impl Sequence {
             name: name.to_string(),
         };
         if estimated {
-            let given = given_linacce.then(|| parts.linacce.clone());
             estimate_into(&mut parts)?;
-            if let Some(l) = given {
-                parts.linacce = l;
-            }
         }
+        // Accelerometer minus gravity, as the RIDI files define it, unless given.
+        parts.linacce = linacce.unwrap_or_else(|| {
+            let (a, g) = (&parts.acce, &parts.gravity);
+            a.iter().zip(g).map(|(&a, &g)| a - g).collect()
+        });
         let name = parts.name.clone();
         let inner = RidiSequence::new(parts).map_err(|e| {
             // The Rust field `ground_truth.position` is the keyword `ground_truth_position` here.
@@ -368,8 +366,7 @@ impl Sequence {
     /// >>> seq = seq50.resampled(ridi.RATE_HZ)                          # doctest: +SKIP
     #[pyo3(signature = (rate_hz, max_gap_s=None))]
     fn resampled(&self, rate_hz: f64, max_gap_s: Option<f64>) -> PyResult<Self> {
-        let max_gap =
-            max_gap_s.unwrap_or(ridi::RESAMPLE_MAX_GAP_FRAMES / self.inner.median_rate_hz());
+        let max_gap = max_gap_s.unwrap_or_else(|| ridi::resample_max_gap(&self.inner));
         let resampled = self
             .inner
             .resampled(rate_hz, max_gap)
@@ -378,7 +375,7 @@ impl Sequence {
                     "sequence `{}`: {e}: cut it there first (`split_at_gaps({})`), or give a \
                  larger `max_gap_s` to interpolate across",
                     self.inner.name(),
-                    ridi::data::short((max_gap * 1000.0).floor() / 1000.0)
+                    ridi::data::short(ridi::split_limit(max_gap))
                 )),
                 e => errors::value(format!("sequence `{}`: {e}", self.inner.name())),
             })?;

@@ -2,15 +2,16 @@
 
 use std::path::PathBuf;
 
+use numpy::ndarray::ArrayView2;
 use numpy::{IntoPyArray, PyArray1, PyArray2};
 use pyo3::prelude::*;
 use pyo3::types::PyBytes;
 use ridi::PipelineError;
 use ridi::correct::FrameVelocity;
 use ridi::data::shown;
-use ridi::frames::{StabHorizontal, Vec3};
+use ridi::frames::StabHorizontal;
 
-use crate::arrays::{rows_out, vecs_out, vector_out};
+use crate::arrays::{rows_out, vecs, vecs_out, vector_out};
 use crate::errors;
 use crate::model::Model;
 use crate::options::{self, MAX_FRAMES_APART};
@@ -108,9 +109,9 @@ pub(crate) struct Track {
     inner: ridi::Track,
 }
 
-/// What a pickled [`Track`] holds: its numbers as little-endian f64 bytes (counts, time,
-/// position, velocity, bias, then frame, velocity and placement per regression), and the
-/// placement names.
+/// What a pickled [`Track`] holds: its numbers as little-endian f64 bytes (frames and
+/// regressions, time, position, velocity, bias, then frame, velocity and placement per
+/// regression), and the placement names.
 type TrackState<'py> = (Bound<'py, PyBytes>, Vec<String>);
 
 #[pymethods]
@@ -172,19 +173,12 @@ impl Track {
         let t = &slf.get().inner;
         let mut bytes = Vec::new();
         let mut put = |v: f64| bytes.extend_from_slice(&v.to_le_bytes());
-        for (n, m) in [
-            (t.time.len(), t.regressions.len()),
-            (t.position.len(), t.placements.len()),
-        ] {
-            put(n as f64);
-            put(m as f64);
-        }
+        put(t.time.len() as f64);
+        put(t.regressions.len() as f64);
         t.time.iter().for_each(|&v| put(v));
-        for v in t.position.iter().chain(&t.velocity) {
-            v.to_array().into_iter().for_each(&mut put);
-        }
-        for v in &t.bias {
-            v.to_array().into_iter().for_each(&mut put);
+        let vectors = t.position.iter().chain(&t.velocity).map(|v| v.to_array());
+        for v in vectors.chain(t.bias.iter().map(|v| v.to_array())) {
+            v.into_iter().for_each(&mut put);
         }
         for (r, &p) in t.regressions.iter().zip(&t.placements) {
             put(r.frame as f64);
@@ -211,32 +205,23 @@ impl Track {
                 .then_some(x as usize)
                 .ok_or_else(corrupt)
         };
-        if !bytes.len().is_multiple_of(8) || v.len() < 4 {
+        if !bytes.len().is_multiple_of(8) || v.len() < 2 {
             return Err(corrupt());
         }
         let (n, m) = (count(v[0])?, count(v[1])?);
-        if count(v[2])? != n || count(v[3])? != m || v.len() != 4 + n * 10 + m * 4 {
+        if v.len() != 2 + n * 10 + m * 4 {
             return Err(corrupt());
         }
-        let time = v[4..4 + n].to_vec();
-        let triples = |from: usize| -> Vec<[f64; 3]> {
-            v[from..from + 3 * n]
-                .chunks_exact(3)
-                .map(|c| [c[0], c[1], c[2]])
-                .collect()
+        let time = v[2..2 + n].to_vec();
+        // Position, velocity and bias: `n` rows of 3 each, in that order.
+        let rows = |k: usize| {
+            let from = 2 + n + 3 * n * k;
+            ArrayView2::from_shape((n, 3), &v[from..from + 3 * n]).map_err(|_| corrupt())
         };
-        let position = triples(4 + n).into_iter().map(Vec3::from_array).collect();
-        let velocity = triples(4 + 4 * n)
-            .into_iter()
-            .map(Vec3::from_array)
-            .collect();
-        let bias = triples(4 + 7 * n)
-            .into_iter()
-            .map(Vec3::from_array)
-            .collect();
+        let (position, velocity, bias) = (vecs(rows(0)?), vecs(rows(1)?), vecs(rows(2)?));
         let mut regressions = Vec::with_capacity(m);
         let mut placements = Vec::with_capacity(m);
-        for r in v[4 + 10 * n..].chunks_exact(4) {
+        for r in v[2 + 10 * n..].chunks_exact(4) {
             let (frame, placement) = (count(r[0])?, count(r[3])?);
             if frame >= n || placement >= placement_names.len() {
                 return Err(corrupt());

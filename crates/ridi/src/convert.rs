@@ -75,10 +75,23 @@ pub const SPLIT_MIN_PART_S: f64 = 1.0;
 /// and written as whole nanoseconds, so the range keeps 0.1 % from each.
 pub const CONVERT_RATE_HZ: (f64, f64) = (1.001, 9990.0);
 
-/// Longest gap `--rate` (and Python's `Sequence.resampled`) interpolates across, in frame
-/// intervals of the source (its median): longer ones would be filled with invented frames, so
-/// the recording has to be split there first.
-pub const RESAMPLE_MAX_GAP_FRAMES: f64 = 5.0;
+/// Longest gap `--rate` interpolates across, in frame intervals of the source (its median):
+/// longer ones would be filled with invented frames, so the recording has to be split there
+/// first.
+const RESAMPLE_MAX_GAP_FRAMES: f64 = 5.0;
+
+/// The longest gap in `seq` that `ridi convert --rate` (and Python's `Sequence.resampled`)
+/// interpolates across, seconds: 5 of its median frame intervals.
+pub fn resample_max_gap(seq: &Sequence) -> f64 {
+    RESAMPLE_MAX_GAP_FRAMES / seq.median_rate_hz()
+}
+
+/// A split limit (`--split-at-gaps`, `split_at_gaps`) that cuts every gap longer than
+/// `max_gap_s`, for a message: rounded down to the millisecond, as one rounded up would leave
+/// the gap in.
+pub fn split_limit(max_gap_s: f64) -> f64 {
+    (max_gap_s * 1000.0).floor() / 1000.0
+}
 
 /// `seqs` cut at their gaps longer than `max_gap_s` ([`Sequence::split_at_gaps`]), parts
 /// under [`SPLIT_MIN_PART_S`] dropped, with one warning per sequence cut. A source may be left
@@ -433,7 +446,7 @@ pub fn convert(
             for seq in &sequences {
                 let resampled = match opts.rate_hz {
                     Some(rate) => {
-                        let max_gap = RESAMPLE_MAX_GAP_FRAMES / seq.median_rate_hz();
+                        let max_gap = resample_max_gap(seq);
                         Some(seq.resampled(rate, max_gap).map_err(|e| match e {
                             // Interpolating would invent the gap's frames.
                             SequenceError::Gap { .. } => DataError::format(
@@ -442,8 +455,7 @@ pub fn convert(
                                     "sequence `{}`: {e}: split the recording there first \
                                      (--split-at-gaps {})",
                                     seq.name(),
-                                    // Down: a limit rounded up would leave the gap in.
-                                    short((max_gap * 1000.0).floor() / 1000.0)
+                                    short(split_limit(max_gap))
                                 ),
                             ),
                             e => DataError::sequence(dir, e),

@@ -27,7 +27,7 @@ use serde::{Deserialize, Deserializer, Serialize};
 use crate::baselines::{Method, baseline_trajectory};
 use crate::error::{PipelineError, Result};
 use crate::orientation::oriented;
-use crate::track::{check_trackable, regress_sequence};
+use crate::track::{check_trackable, regressed};
 use crate::track_options::TrackOptions;
 use crate::train::ground_truth_view;
 
@@ -154,7 +154,7 @@ fn evaluate_one(seq: &Sequence, model: &Cascade, opts: &EvalOptions) -> Result<E
         .ok_or_else(|| PipelineError::sequence(seq.name(), "has no ground truth to evaluate"))?;
     let gt2 = gt.horizontal();
     let (regressions, placements) = if opts.methods.iter().any(|m| m.needs_model()) {
-        regress_sequence(seq, model, &opts.track)?
+        regressed(seq, model, &opts.track)?
     } else {
         Default::default()
     };

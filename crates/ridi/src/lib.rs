@@ -107,8 +107,8 @@ pub use baselines::{Method, baseline_trajectory, device_heading};
 #[cfg(feature = "bundled-model")]
 pub use bundled::{BUNDLED_MODEL_SUMMARY, bundled_model};
 pub use convert::{
-    CONVERT_RATE_HZ, ConvertOptions, ConvertSummary, Converted, RESAMPLE_MAX_GAP_FRAMES,
-    SPLIT_MIN_PART_S, convert,
+    CONVERT_RATE_HZ, ConvertOptions, ConvertSummary, Converted, SPLIT_MIN_PART_S, convert,
+    resample_max_gap, split_limit,
 };
 pub use demo::Demo;
 pub use error::{PipelineError, Result};

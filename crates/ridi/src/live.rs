@@ -570,11 +570,8 @@ impl StreamCheck {
                 let (min, max) = limits.time_step_range;
                 if (min..=max).contains(&median) {
                     format!(
-                        "a rate of {:.1} Hz (median interval); models count windows and knots \
-                         in frames of a {} Hz stream (within {:.0} %): resample the stream",
-                        1.0 / median,
-                        crate::TRACK_RATE_HZ,
-                        crate::TRACK_RATE_TOLERANCE * 100.0
+                        "{}: resample the stream",
+                        crate::track::rate_text(1.0 / median)
                     )
                 } else {
                     ridi_data::SequenceError::TimeStep { median, min, max }.to_string()

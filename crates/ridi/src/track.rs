@@ -253,6 +253,16 @@ pub fn regress_sequence(
 ) -> Result<(Vec<FrameVelocity>, Vec<usize>)> {
     // A window across a gap, or counted at another rate, is no window the model knows.
     check_trackable(seq, model.feature_config(), opts.correction.max_dt)?;
+    regressed(seq, model, opts)
+}
+
+/// [`regress_sequence`] of a sequence [`check_trackable`] passed already (tracking and
+/// evaluation check every sequence first).
+pub(crate) fn regressed(
+    seq: &Sequence,
+    model: &Cascade,
+    opts: &TrackOptions,
+) -> Result<(Vec<FrameVelocity>, Vec<usize>)> {
     let seq = oriented(
         seq,
         model.feature_config().orientation,
@@ -399,12 +409,20 @@ fn wrong_rate(name: &str, rate: f64) -> PipelineError {
     PipelineError::sequence(
         name,
         format!(
-            "has a rate of {rate:.1} Hz (median frame interval); models count windows and \
-             knots in frames of a {TRACK_RATE_HZ} Hz stream (within {:.0} %): resample it \
-             (`ridi convert <recording> --out <folder> --rate {TRACK_RATE_HZ}`, or the \
-             sequence's `resampled` in Rust and Python)",
-            TRACK_RATE_TOLERANCE * 100.0
+            "has {}: resample it (`ridi convert <recording> --out <folder> --rate \
+             {TRACK_RATE_HZ}`, or the sequence's `resampled` in Rust and Python)",
+            rate_text(rate)
         ),
+    )
+}
+
+/// What is wrong with a median `rate` off [`TRACK_RATE_HZ`], for a recording's error and a
+/// live stream's.
+pub(crate) fn rate_text(rate: f64) -> String {
+    format!(
+        "a rate of {rate:.1} Hz (median frame interval); models count windows and knots in \
+         frames of a {TRACK_RATE_HZ} Hz stream (within {:.0} %)",
+        TRACK_RATE_TOLERANCE * 100.0
     )
 }
 
@@ -463,7 +481,7 @@ pub fn track(seq: &Sequence, model: &Cascade, opts: &TrackOptions) -> Result<Tra
         opts.recorded_heading.as_ref(),
     )?;
     let seq = seq.as_ref();
-    let (regressions, placements) = regress_sequence(seq, model, opts)?;
+    let (regressions, placements) = regressed(seq, model, opts)?;
     correct_with(
         seq,
         regressions,
