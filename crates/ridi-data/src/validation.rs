@@ -121,7 +121,7 @@ pub struct Validation {
     /// Largest accepted median angle between gravity and the up axis of the orientation
     /// (world-from-device) in the device frame, degrees: 45. Android's gravity sensor and
     /// rotation vectors are one fusion's, and the readers derive gravity from the orientation
-    /// where a format has none: every shared recording gives 0. A quaternion read in the wrong
+    /// where a format has none: every shared recording gives 0 (`benchmarks/stream_bounds.py`). A quaternion read in the wrong
     /// order or inverted turns a phone held upright by 90-180 degrees; a placeholder
     /// (identity) orientation beside a measured gravity disagrees as much.
     pub max_orientation_gravity_deg: f64,

@@ -473,8 +473,8 @@ pub const STREAM_CHECK_SAMPLES: usize = 200;
 /// Accepted range of the median |acce| over a stream's last [`STREAM_CHECK_SAMPLES`], in
 /// standard gravities: 0.35..10. Over every second of the shared Tyrex runs (both phones), the
 /// twelve Indoor Location Competition walks and the bundled sample it lies within 0.50..2.40
-/// (the upper end running with the phone in the hand); an accelerometer in g gives at most
-/// 0.25, one in mm/s^2 a thousand times too much. Wider than the readers' whole-recording
+/// (the upper end running with the phone in the hand; `benchmarks/stream_bounds.py`); an
+/// accelerometer in g gives at most 0.25, one in mm/s^2 a thousand times too much. Wider than the readers' whole-recording
 /// bounds ([`Validation::acce_gravity_ratio`]): a second varies more than a recording.
 pub const STREAM_ACCE_G: (f64, f64) = (0.35, 10.0);
 
