@@ -169,8 +169,9 @@ impl From<UpAxisArg> for UpAxis {
 }
 
 /// Rows above which `ridi train` points the exact solver's user to `--solver nystrom`: the
-/// exact solver took 82 s on 50,392 rows and 891 s on 96,000 (2 cores; docs/benchmarks.md,
-/// "Training at scale: the Nyström solver").
+/// exact solver took 80 s on 49,884 rows and 34-37 min on 99,716 (2 cores, the latter with
+/// other work running; docs/benchmarks.md, "Training at scale: the Nyström solver" and the
+/// sample step's lever row).
 const EXACT_SOLVER_NOTE_ROWS: usize = 60_000;
 
 /// The one-line note for `windows` training rows on the exact solver, if they are many.
@@ -178,8 +179,9 @@ fn exact_solver_note(windows: usize) -> Option<String> {
     (windows > EXACT_SOLVER_NOTE_ROWS).then(|| {
         format!(
             "note: {windows} training windows: the exact solver's time grows faster than their \
-             square (96000 took 891 s on 2 cores); `--solver nystrom` trains in time linear in \
-             them (100742 in 37 s), as accurate on the Tyrex protocol (docs/benchmarks.md)"
+             square (on 2 cores 49884 took 80 s, 99716 over 30 min); `--solver nystrom` trains \
+             in time linear in them (99716 in 40 s) for 0.03-0.08 m more RTE 5 s on the Tyrex \
+             protocol (docs/benchmarks.md)"
         )
     })
 }
@@ -282,8 +284,8 @@ mod tests {
     #[test]
     fn the_exact_solver_note_names_the_rows_and_the_way_out_only_past_the_bound() {
         assert_eq!(exact_solver_note(EXACT_SOLVER_NOTE_ROWS), None);
-        let note = exact_solver_note(100_742).unwrap();
-        assert!(note.starts_with("note: 100742 training windows"), "{note}");
+        let note = exact_solver_note(99_716).unwrap();
+        assert!(note.starts_with("note: 99716 training windows"), "{note}");
         assert!(
             note.contains("`--solver nystrom`") && !note.contains('\n'),
             "{note}"
