@@ -263,7 +263,7 @@ impl LiveTracker {
     fn regressions(&self) -> Regressions {
         let live = self.lock();
         let (velocities, placements) = live.regressions();
-        Regressions::of(velocities, placements, self.model.placements())
+        Regressions::of(velocities, placements, self.model.placement_names())
     }
 }
 

@@ -24,7 +24,7 @@ use crate::options::{self, Inputs, MAX_FRAMES_APART, MAX_TURNED_COPIES, WINDOW_R
 /// their file).
 ///
 /// >>> model = ridi.load("model.ridi")   # doctest: +SKIP
-/// >>> model.placements                  # doctest: +SKIP
+/// >>> model.placement_names             # doctest: +SKIP
 /// ['hand', 'pocket', 'running', 'swing']
 #[pyclass(frozen, module = "ridi")]
 pub(crate) struct Model {
@@ -69,8 +69,8 @@ impl Model {
 
     /// The placement classes, in the order of the classifier.
     #[getter]
-    fn placements(&self) -> Vec<String> {
-        self.inner.placements().to_vec()
+    fn placement_names(&self) -> Vec<String> {
+        self.inner.placement_names().to_vec()
     }
 
     /// Frames per feature window (200, 1 s at 200 Hz, unless trained with ``window``).
@@ -130,7 +130,7 @@ impl Model {
     fn __repr__(&self) -> String {
         format!(
             "Model(placements={:?}, window={}, orientation='{}')",
-            self.inner.placements(),
+            self.inner.placement_names(),
             self.window(),
             self.orientation()
         )

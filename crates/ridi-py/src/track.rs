@@ -334,6 +334,6 @@ pub(crate) fn regress(
     Ok(Regressions::of(
         &velocities,
         &placements,
-        model.placements(),
+        model.placement_names(),
     ))
 }

@@ -19,7 +19,7 @@ def test_train_gives_the_cli_model_bytes(model, ridi_bin, tmp_path):
     # A bool, not the bytes: pytest's explanation of two differing models takes minutes.
     same = model.to_bytes() == out.read_bytes()
     assert same, "the model differs from the one `ridi train` writes"
-    assert model.placements == ["hand", "pocket", "running", "swing"]
+    assert model.placement_names == ["hand", "pocket", "running", "swing"]
     assert (model.window, model.orientation, model.up_axis) == (200, "estimated", "plus-or-minus-y")
 
 
@@ -142,7 +142,7 @@ def test_model_files(tmp_path, model):
 
 def test_the_bundled_model_is_the_one_ridi_track_uses_without_a_model(ridi_bin, tmp_path):
     model = ridi.bundled_model()
-    assert model.placements == ["hand", "pocket", "running", "swing"]
+    assert model.placement_names == ["hand", "pocket", "running", "swing"]
     assert model.describe()["landmarks"] is not None
     seq = ridi.read(SAMPLE / "Thibaud_Nexus5_NoDist_Texting")
     out = tmp_path / "t.csv"

@@ -87,8 +87,8 @@ def test_regress_is_what_track_corrects_with(seq, model):
     np.testing.assert_array_equal(regs.velocity, track.regressions.velocity)
     assert regs.placement == track.regressions.placement
     assert regs.velocity.shape == (len(regs), 2) and regs.frame.dtype == np.int64
-    assert set(regs.placement) <= set(model.placements)
-    assert track.placement_names == model.placements
+    assert set(regs.placement) <= set(model.placement_names)
+    assert track.placement_names == model.placement_names
     assert "frames" in repr(track)
 
 

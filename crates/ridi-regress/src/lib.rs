@@ -18,7 +18,7 @@
 //! batches. Gradients and dual variables are `f64`, and so are targets and predictions: the
 //! velocities in S ([`StabHorizontal`](ridi_features::ridi_frames::StabHorizontal)) of
 //! ridi-features' targets and ridi-correct's regressions, with
-//! placements as `usize` indices into [`Cascade::placements`]. On x86-64 the hot loops (kernel
+//! placements as `usize` indices into [`Cascade::placement_names`]. On x86-64 the hot loops (kernel
 //! values, the solver's selection and gradient update, half-precision dot products) take AVX2
 //! code paths when the running CPU has AVX2 and FMA, checked once per process.
 //!

@@ -99,7 +99,7 @@ fn cascade_classifies_regresses_and_batches_consistently() {
         true
     };
     let model = Cascade::train(&data.set(), &small_grid(), &mut progress).unwrap();
-    assert_eq!(model.placements(), &data.names[..]);
+    assert_eq!(model.placement_names(), &data.names[..]);
     // Grid table: 3 placements × 2 channels × 4 points.
     assert_eq!(model.grid_results().len(), 24);
     for p in 0..3 {

@@ -60,7 +60,7 @@ fn main() -> Result<(), Error> {
         "{model_path}: {:.1} MB, {:?}, stored samples {:?}",
         bytes as f64 / 1e6,
         model.stored_as(),
-        (0..model.placements().len())
+        (0..model.placement_names().len())
             .map(|p| model.stored_samples(p))
             .collect::<Vec<_>>()
     );

@@ -169,7 +169,7 @@ fn evaluate_one(seq: &Sequence, model: &Cascade, opts: &EvalOptions) -> Result<E
     };
     let names: Vec<String> = placements
         .iter()
-        .map(|&p| model.placements().get(p).cloned().unwrap_or_default())
+        .map(|&p| model.placement_names().get(p).cloned().unwrap_or_default())
         .collect();
     let placement_accuracy = match (seq.placement(), names.is_empty()) {
         (Some(p), false) => {
@@ -224,7 +224,7 @@ fn evaluate_one(seq: &Sequence, model: &Cascade, opts: &EvalOptions) -> Result<E
 /// worth evaluating). For example: "placement `swing` of Thibaud_Nexus5_NoDist_Swinging is not
 /// one of the model's classes (hand, pocket): its placement accuracy is 0".
 pub fn placement_warnings(seqs: &[Sequence], model: &Cascade) -> Vec<String> {
-    let classes = model.placements();
+    let classes = model.placement_names();
     seqs.iter()
         .filter_map(|s| {
             let label = s.placement()?;
@@ -263,7 +263,8 @@ pub fn check_evaluable(seq: &Sequence, config: &FeatureConfig, opts: &EvalOption
                 seq.name(),
                 format!(
                     "averages {timeline_hz:.1} Hz ({cause}), but the RTE windows are counted at \
-                     {config_hz} Hz: resample it with `ridi convert --rate {config_hz}`"
+                     {config_hz} Hz: resample it with `ridi convert --rate {config_hz}` (in \
+                     Python `Sequence.resampled({config_hz})`)"
                 ),
             ))
         }
@@ -321,7 +322,7 @@ pub fn evaluate(
         (None, None)
     } else {
         let classes: BTreeSet<&str> = model
-            .placements()
+            .placement_names()
             .iter()
             .map(String::as_str)
             .chain(truth.iter().copied())

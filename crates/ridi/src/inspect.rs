@@ -489,7 +489,7 @@ pub fn inspect_model(model: &Cascade) -> ModelInspection {
         StoredAs::Projected { components, energy } => (Some(components), energy),
     };
     let placements = model
-        .placements()
+        .placement_names()
         .iter()
         .enumerate()
         .map(|(p, name)| {

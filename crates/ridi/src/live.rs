@@ -58,7 +58,7 @@ impl<'m> CascadeRegressor<'m> {
             model,
             extractor,
             row,
-            majority: smoothing.map(|s| s.trailing(model.placements().len())),
+            majority: smoothing.map(|s| s.trailing(model.placement_names().len())),
             made: Vec::new(),
             placements: Vec::new(),
         })
@@ -313,7 +313,8 @@ impl<'m> LiveTracker<'m> {
             let r = sample.recorded.ok_or_else(|| {
                 PipelineError::Live(
                     "the model was trained on the recorded orientation, but the sample has \
-                     none (give `recorded`, or train with --orientation estimated)"
+                     none (give `recorded`, or train with `--orientation estimated`; in Python \
+                     `orientation=\"estimated\"`)"
                         .into(),
                 )
             })?;

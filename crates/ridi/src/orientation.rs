@@ -59,7 +59,8 @@ pub(crate) fn recorded_wanted(name: &str) -> PipelineError {
     PipelineError::sequence(
         name,
         "carries an orientation estimated from gyro and accelerometer, but the model or \
-         training options expect the recorded one (train with --orientation estimated)",
+         training options expect the recorded one (train with `--orientation estimated`; in \
+         Python `orientation=\"estimated\"`)",
     )
 }
 

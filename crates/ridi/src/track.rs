@@ -289,8 +289,8 @@ pub(crate) fn regressed(
         return Ok((velocities, labels));
     };
     let times: Vec<f64> = frames.iter().map(|&f| seq.time()[f]).collect();
-    let smoothed = smoother.smooth(&times, &labels, model.placements().len());
-    for p in 0..model.placements().len() {
+    let smoothed = smoother.smooth(&times, &labels, model.placement_names().len());
+    for p in 0..model.placement_names().len() {
         let moved: Vec<usize> = (0..velocities.len())
             .filter(|&i| smoothed[i] == p && labels[i] != p)
             .collect();
@@ -487,7 +487,7 @@ pub fn track(seq: &Sequence, model: &Cascade, opts: &TrackOptions) -> Result<Tra
         regressions,
         placements,
         opts.correction_for(model),
-        model.placements(),
+        model.placement_names(),
     )
 }
 
@@ -536,7 +536,7 @@ fn track_online(seq: &Sequence, model: &Cascade, opts: &TrackOptions) -> Result<
         bias: updates.iter().map(|u| u.bias).collect(),
         regressions: live.regressions().0.to_vec(),
         placements: live.regressions().1.to_vec(),
-        placement_names: model.placements().to_vec(),
+        placement_names: model.placement_names().to_vec(),
     })
 }
 
@@ -598,7 +598,7 @@ fn track_rows(
         PipelineError::Live(message)
     };
     let written = &mut written;
-    let names = model.placements();
+    let names = model.placement_names();
     let mut live = live_for(model, opts, rows.orientation_source())?;
     csv_header(out).map_err(&mut *written)?;
     let max_dt = opts.correction.max_dt;

@@ -28,7 +28,10 @@ fn the_bundled_model_decodes_with_this_builds_format_and_defaults() {
         panic!("stored in half precision")
     };
     assert!((0.9..0.9999).contains(&energy), "{energy}");
-    assert_eq!(model.placements(), ["hand", "pocket", "running", "swing"]);
+    assert_eq!(
+        model.placement_names(),
+        ["hand", "pocket", "running", "swing"]
+    );
     // The scaling issue's bound, and crates.io's package limit with room for the rest.
     let size = model.to_bytes().unwrap().len();
     assert!(size <= 10 << 20, "{size}");

@@ -242,7 +242,7 @@ fn labels_the_model_does_not_know_are_a_warning_in_the_report() {
     let mut opts = TrainOptions::default();
     opts.cascade.regressors = GridChoice::None.regressors();
     let model = ridi::train(&train, &opts, &mut NoProgress).unwrap();
-    assert_eq!(model.placements(), ["hand", "pocket"]);
+    assert_eq!(model.placement_names(), ["hand", "pocket"]);
 
     let t = list(
         dir.path(),

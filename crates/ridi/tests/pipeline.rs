@@ -74,7 +74,10 @@ fn train_track_and_evaluate_on_the_sample_dataset() {
     );
     assert_eq!(load("list_nexus5.txt").len(), 24);
     let model = quick_model(&train);
-    assert_eq!(model.placements(), ["hand", "pocket", "running", "swing"]);
+    assert_eq!(
+        model.placement_names(),
+        ["hand", "pocket", "running", "swing"]
+    );
 
     // The model file round-trips and keeps the feature configuration (with standardization).
     let dir = tempfile::tempdir().unwrap();
@@ -230,7 +233,7 @@ fn placement_smoothing_takes_the_window_majority_and_its_regressors() {
         let (raw, raw_p) = ridi::regress_sequence(seq, &model, &off).unwrap();
         let (smoothed, smoothed_p) = ridi::regress_sequence(seq, &model, &on).unwrap();
         let times: Vec<f64> = raw.iter().map(|r| seq.time()[r.frame]).collect();
-        let want = smoother.smooth(&times, &raw_p, model.placements().len());
+        let want = smoother.smooth(&times, &raw_p, model.placement_names().len());
         assert_eq!(raw.len(), smoothed.len());
         assert_eq!((raw.len(), smoothed.len()), (raw_p.len(), smoothed_p.len()));
         assert_eq!(smoothed_p, want);
@@ -263,7 +266,7 @@ fn online_smoothing_takes_the_majority_of_the_labels_before() {
     let smoother = TrackOptions::default().placement_smoothing.unwrap();
     let raw = ridi::track(seq, &model, &online(None)).unwrap();
     let smoothed = ridi::track(seq, &model, &online(Some(smoother))).unwrap();
-    let mut live = smoother.trailing(model.placements().len());
+    let mut live = smoother.trailing(model.placement_names().len());
     let mut changed = 0;
     assert_eq!(raw.regressions.len(), smoothed.regressions.len());
     assert_eq!(raw.placements.len(), smoothed.placements.len());

@@ -145,7 +145,7 @@ impl ClassModel {
 
 impl Cascade {
     /// Placement names, in class-index order.
-    pub fn placements(&self) -> &[String] {
+    pub fn placement_names(&self) -> &[String] {
         &self.placements
     }
 

@@ -24,7 +24,7 @@ const WIDEN_ROWS: usize = 2048;
 /// Output for one query.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Prediction {
-    /// Placement index (into [`Cascade::placements`]).
+    /// Placement index (into [`Cascade::placement_names`]).
     pub placement: usize,
     /// Velocity in S (same components as the targets). With a speed regressor
     /// ([`CascadeParams::speed`](crate::CascadeParams::speed)) the regressed components `v`
