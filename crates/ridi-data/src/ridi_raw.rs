@@ -639,7 +639,7 @@ fn stream_file(e: &SequenceError) -> Option<&'static str> {
         SequenceError::Gravity { .. } => "gravity",
         SequenceError::AcceScale { .. } => "acce",
         SequenceError::LinacceScale { .. } => "linacce",
-        SequenceError::GyroScale { .. } => "gyro",
+        SequenceError::GyroScale { .. } | SequenceError::GyroDirection { .. } => "gyro",
         SequenceError::NonFinite { what, .. } | SequenceError::LengthMismatch { what, .. } => what,
         _ => return None,
     };

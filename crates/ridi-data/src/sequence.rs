@@ -137,9 +137,16 @@ impl SequenceParts {
     /// that have no orientation yet (a sequence built from gyro and accelerometer alone).
     ///
     /// # Errors
-    /// [`SequenceError::Estimate`] when the estimator refuses the input (non-finite samples,
-    /// time going back, streams of other lengths than `time`).
+    /// The errors [`Sequence::new`] gives for an empty or non-finite time, time that does not
+    /// increase, and a gyro or accelerometer of another length or with a non-finite value
+    /// (checked first, so that they are named as a sequence's are); [`SequenceError::Estimate`]
+    /// when the estimator refuses the input otherwise.
     pub fn estimate_orientation(&mut self, filter: &FilterConfig) -> Result<(), SequenceError> {
+        let n = self.time.len();
+        // Gaps are judged by the validation that follows, with its limits.
+        check_time(&self.time, f64::INFINITY)?;
+        check_vecs("gyro", n, &self.gyro)?;
+        check_vecs("acce", n, &self.acce)?;
         let q =
             estimate_orientation(&self.time, &self.gyro, &self.acce, filter).map_err(|error| {
                 SequenceError::Estimate {
@@ -292,6 +299,20 @@ pub fn heading_reference(source: Option<OrientationSource>) -> bool {
     )
 }
 
+/// `time` not empty, finite, strictly increasing, with no step longer than `max_gap_s`.
+fn check_time(time: &[f64], max_gap_s: f64) -> Result<(), SequenceError> {
+    if time.is_empty() {
+        return Err(SequenceError::Empty);
+    }
+    if let Some(index) = time.iter().position(|t| !t.is_finite()) {
+        return Err(SequenceError::NonFinite {
+            what: "time",
+            index,
+        });
+    }
+    check_steps(time, max_gap_s)
+}
+
 /// `time` strictly increasing, with no step longer than `max_gap_s`.
 fn check_steps(time: &[f64], max_gap_s: f64) -> Result<(), SequenceError> {
     for (i, w) in time.windows(2).enumerate() {
@@ -347,16 +368,7 @@ impl Sequence {
         limits: &Validation,
     ) -> Result<Self, SequenceError> {
         let n = parts.time.len();
-        if n == 0 {
-            return Err(SequenceError::Empty);
-        }
-        if let Some(index) = parts.time.iter().position(|t| !t.is_finite()) {
-            return Err(SequenceError::NonFinite {
-                what: "time",
-                index,
-            });
-        }
-        check_steps(&parts.time, limits.max_gap_s).map_err(|e| match e {
+        check_time(&parts.time, limits.max_gap_s).map_err(|e| match e {
             // Every step a gap: a time in milliseconds, say, which the median step names.
             SequenceError::Gap { .. } => limits.check_time_step(&parts.time).err().unwrap_or(e),
             e => e,
@@ -609,19 +621,20 @@ impl Sequence {
     /// count frames of a 200 Hz stream); `ridi convert --rate` applies it.
     ///
     /// # Errors
-    /// A `rate_hz` that is not finite and positive, or above 10 kHz (the shortest step
-    /// [`Validation::time_step_range`] accepts); a gap between two frames longer than
-    /// `max_gap_s` (interpolating would invent the frames of a gap: split the recording
-    /// there first); the default validation of the result.
+    /// [`SequenceError::InvalidRate`] for a `rate_hz` outside 1 Hz..10 kHz (the steps
+    /// [`Validation::time_step_range`] accepts) or a `max_gap_s` that is not above 0 (infinity
+    /// interpolates across every gap); a gap between two frames longer than `max_gap_s`
+    /// (interpolating would invent the frames of a gap: split the recording there first); the
+    /// default validation of the result.
     pub fn resampled(&self, rate_hz: f64, max_gap_s: f64) -> Result<Sequence, SequenceError> {
         use crate::resample::{
             interpolate_rot, interpolate_scalar, interpolate_vec3, uniform_timeline,
         };
         // Checked before the frames are made: a rate the time-step check refuses could first
-        // ask for billions of them.
-        let max_hz = 1.0 / Validation::default().time_step_range.0;
-        if !(rate_hz.is_finite() && rate_hz > 0.0 && rate_hz <= max_hz) {
-            return Err(SequenceError::InvalidRate { rate_hz });
+        // ask for billions of them. An infinite gap limit interpolates across every gap.
+        let (min_step, max_step) = Validation::default().time_step_range;
+        if !((1.0 / max_step..=1.0 / min_step).contains(&rate_hz) && max_gap_s > 0.0) {
+            return Err(SequenceError::InvalidRate { rate_hz, max_gap_s });
         }
         let p = &self.parts;
         let t = &p.time;

@@ -140,15 +140,20 @@ pub enum SequenceError {
         /// The shortest part asked for.
         min_duration_s: f64,
     },
-    /// A resampling rate that is not a finite number above 0, or above the 10 kHz a timeline
-    /// may step at ([`Sequence::resampled`](crate::Sequence::resampled)).
+    /// A resampling rate outside the 1 Hz to 10 kHz a timeline may step at
+    /// ([`Validation::time_step_range`](crate::Validation::time_step_range)), or a gap limit
+    /// that is not a number above 0 ([`Sequence::resampled`](crate::Sequence::resampled)).
     #[error(
-        "cannot resample to {rate_hz} Hz: the rate must be a finite number above 0 and at most \
-         10 kHz"
+        "cannot resample to {} Hz across gaps of up to {} s: the rate must be from 1 Hz to \
+         10 kHz (the steps a sequence may have), the gap limit a number above 0",
+        short(*rate_hz),
+        short(*max_gap_s)
     )]
     InvalidRate {
         /// The rate asked for.
         rate_hz: f64,
+        /// The longest gap to interpolate across, seconds.
+        max_gap_s: f64,
     },
     /// A value beyond the hard physical bound of its channel ([`Validation::limit`](crate::Validation::limit)): a
     /// corrupt value or a wrong unit.
@@ -213,6 +218,20 @@ pub enum SequenceError {
         min: f64,
         /// Highest accepted scale.
         max: f64,
+    },
+    /// The gyro turns about other axes than the orientation (`crate::MIN_GYRO_AGREEMENT`).
+    #[error(
+        "the gyro turns against the orientation: their rotation rates agree in direction by {} \
+         (1 when alike, -1 when opposite; at least {min} expected): a gyro with its sign \
+         flipped or its axes swapped, or an orientation quaternion in another component order \
+         (x, y, z, w where w, x, y, z is expected) or of another device frame?",
+        short(*agreement)
+    )]
+    GyroDirection {
+        /// Sum of the rate vectors' dot products over the sum of their magnitudes' products.
+        agreement: f64,
+        /// Lowest accepted agreement.
+        min: f64,
     },
     /// The linear acceleration does not match accelerometer minus gravity in size.
     #[error(

@@ -414,8 +414,8 @@ struct Sums {
     /// Gyro scale sums of every step and of the steps that are no orientation jump.
     rates: usize,
     jumps: usize,
-    all: (f64, f64, usize),
-    kept: (f64, f64, usize),
+    all: crate::validation::GyroFit,
+    kept: crate::validation::GyroFit,
     /// Linear acceleration scale sums.
     linacce: (f64, f64, f64, usize),
     magnet_seen: bool,
@@ -744,8 +744,7 @@ impl RowReader {
             .check_acce_scale(s.acce_norms / n, mean)
             .and_then(|()| {
                 let leave_out = s.jumps as f64 <= crate::MAX_JUMP_SHARE * s.rates as f64;
-                let (gw, ww, k) = if leave_out { s.kept } else { s.all };
-                limits.gyro_scale_verdict(gw, ww, k)
+                limits.gyro_verdict(if leave_out { &s.kept } else { &s.all })
             })
             .and_then(|()| {
                 let (dl, ll, dd, k) = s.linacce;
@@ -851,13 +850,13 @@ impl RowReader {
             s.interval.push(dt < min, dt > max);
             let (time, gyro) = ([p.time, row.time], [p.gyro, row.gyro]);
             let orientation = [p.orientation, row.orientation];
-            for (_, _, w, g) in crate::validation::step_rates(&time, &gyro, &orientation) {
+            for (_, _, w, g, dot) in crate::validation::step_rates(&time, &gyro, &orientation) {
                 s.rates += 1;
-                s.all = (s.all.0 + g * w, s.all.1 + w * w, s.all.2 + 1);
+                s.all.add(w, g, dot);
                 if w - g > crate::ORIENTATION_JUMP_RATE {
                     s.jumps += 1;
                 } else {
-                    s.kept = (s.kept.0 + g * w, s.kept.1 + w * w, s.kept.2 + 1);
+                    s.kept.add(w, g, dot);
                 }
             }
             if let (Some((pp, _)), Some((rp, _))) = (p.ground_truth, row.ground_truth) {

@@ -384,7 +384,9 @@ pub(crate) fn sequence_error_at(
             fields.field(Channel::Position, Some(axis)),
             jump(distance, dt, max),
         ),
-        SequenceError::GyroUnits { .. } | SequenceError::GyroScale { .. } => {
+        SequenceError::GyroUnits { .. }
+        | SequenceError::GyroScale { .. }
+        | SequenceError::GyroDirection { .. } => {
             return whole(Channel::Gyro, e.to_string());
         }
         SequenceError::AcceScale { .. } => return whole(Channel::Acce, e.to_string()),

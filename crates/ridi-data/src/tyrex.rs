@@ -1314,28 +1314,42 @@ pub fn read(dir: impl AsRef<Path>, options: &TyrexOptions) -> Result<TyrexRead> 
                  a `timeAlignment.txt` off by a tenth of a second, fails them all)",
             ));
         }
+        // One warning for all the losses: a running run loses the body dozens of times.
+        let mut losses = Vec::new();
         let gt_spans = intervals(&t, options.max_mocap_gap_s, |i| {
-            warnings.push(format!(
-                "{}: mocap lost the body for {:.3} s from {:.3} s (phone clock): recording split",
-                shown(mat),
-                t[i] - t[i - 1],
-                t[i - 1]
-            ));
+            losses.push((t[i - 1], t[i]))
         });
+        if !losses.is_empty() {
+            let longest = losses.iter().map(|(a, b)| b - a).fold(0.0, f64::max);
+            warnings.push(format!(
+                "{}: mocap lost the body {} (up to {longest:.3} s; {}, phone clock): recording \
+                 split there",
+                shown(mat),
+                match losses.len() {
+                    1 => "once".to_owned(),
+                    n => format!("{n} times"),
+                },
+                spans_text(&losses),
+            ));
+        }
         spans = intersect(&spans, &gt_spans);
         truth = Some((t, p, q));
     }
 
-    let mut kept = Vec::new();
-    for &(start, end) in &spans {
-        if end - start >= options.min_part_s {
-            kept.push((start, end));
-        } else if end > start {
-            warnings.push(format!(
-                "part {start:.3}..{end:.3} s (phone clock) is shorter than {} s: dropped",
-                options.min_part_s
-            ));
-        }
+    let (kept, short): (Vec<_>, Vec<_>) = spans
+        .iter()
+        .copied()
+        .filter(|(start, end)| end > start)
+        .partition(|(start, end)| end - start >= options.min_part_s);
+    if !short.is_empty() {
+        warnings.push(format!(
+            "{}: {} shorter than {} s dropped ({:.3} s in all; {}, phone clock)",
+            shown(dir),
+            counted(short.len(), "part"),
+            options.min_part_s,
+            short.iter().map(|(a, b)| b - a).sum::<f64>(),
+            spans_text(&short),
+        ));
     }
     if kept.is_empty() {
         return Err(DataError::format(
@@ -1382,7 +1396,7 @@ pub fn read(dir: impl AsRef<Path>, options: &TyrexOptions) -> Result<TyrexRead> 
             // The accelerometer's scale is the one check the streams could not make alone.
             let path = match e {
                 SequenceError::AcceScale { .. } => &acce.path,
-                SequenceError::GyroScale { .. } => &gyro.path,
+                SequenceError::GyroScale { .. } | SequenceError::GyroDirection { .. } => &gyro.path,
                 _ => dir,
             };
             text::sequence_error(path, None, &TyrexFields, e)

@@ -224,11 +224,17 @@ fn splits_at_gaps_and_resampling_keep_every_channel() {
     assert_eq!((counted[0], counted[counted.len() - 1]), (2.0, 6.0));
     // A rate no timeline may step at is refused before any frame is made (1e9 Hz would be
     // billions of them).
-    for rate in [0.0, -5.0, f64::NAN, 1e9] {
+    for rate in [0.0, -5.0, f64::NAN, 1e9, 0.5] {
         let e = split[1].resampled(rate, 0.05).unwrap_err();
         assert!(matches!(e, SequenceError::InvalidRate { .. }), "{e}");
     }
+    // A gap limit that is no number above 0 would refuse every step, or (NaN) none.
+    for gap in [0.0, -1.0, f64::NAN] {
+        let e = split[1].resampled(100.0, gap).unwrap_err().to_string();
+        assert!(e.contains("the gap limit a number above 0"), "{e}");
+    }
     assert!(split[1].resampled(1e4, 0.05).is_ok());
+    assert!(split[1].resampled(100.0, f64::INFINITY).is_ok());
 }
 
 #[test]

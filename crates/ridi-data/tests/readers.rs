@@ -322,10 +322,10 @@ fn raw_folder_is_synchronized_on_the_trimmed_pose_timeline() {
         let since_start = (1_000_000 + 5_000_000 * (5 + k) as i64) as f64 / 1e9;
         let g = seq.gyro()[k];
         assert!(
-            (g.x() - 0.05 * since_start).abs() < 1e-6,
+            (g.x() - 0.005 * since_start).abs() < 1e-6,
             "gyro x at {k}: {g:?}"
         );
-        assert!((g.z() + 0.05 * since_start).abs() < 1e-6);
+        assert!((g.z() + 0.005 * since_start).abs() < 1e-6);
         let gt = seq.ground_truth().unwrap();
         assert!((gt.position[k].x() - 0.01 * (5 + k) as f64).abs() < 1e-12);
         let [w, ..] = gt.orientation[k].to_wxyz();

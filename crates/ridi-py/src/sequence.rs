@@ -202,7 +202,7 @@ impl Sequence {
         let name = parts.name.clone();
         let inner = RidiSequence::new(parts).map_err(|e| {
             // The Rust field `ground_truth.position` is the keyword `ground_truth_position` here.
-            let e = e.to_string().replace("`ground_truth.", "`ground_truth_");
+            let e = with_remedy(&e).replace("`ground_truth.", "`ground_truth_");
             errors::value(format!("sequence `{name}`: {e}"))
         })?;
         Ok(Self::of(inner, None))
@@ -442,17 +442,42 @@ impl Sequence {
 /// estimator.
 fn estimate_into(parts: &mut SequenceParts) -> PyResult<()> {
     let failed = |name: &str, e: String| errors::value(format!("sequence `{name}`: {e}"));
-    Validation::default()
-        .check_time_step(&parts.time)
-        .map_err(|e| failed(&parts.name, e.to_string()))?;
+    // Time that goes back is named as such by the estimate's own checks, not as a unit.
+    if parts.time.windows(2).all(|w| w[1] > w[0]) {
+        Validation::default()
+            .check_time_step(&parts.time)
+            .map_err(|e| failed(&parts.name, e.to_string()))?;
+    }
     parts
         .estimate_orientation(&FilterConfig::default())
-        .map_err(|e| {
-            failed(
+        .map_err(|e| match e {
+            SequenceError::Estimate { .. } => failed(
                 &parts.name,
                 format!("no orientation was given, and it cannot be estimated: {e}"),
-            )
+            ),
+            e => failed(&parts.name, with_remedy(&e)),
         })
+}
+
+/// `e` with what to do about it in numpy, where the arrays (not a sequence) are at fault: a
+/// `Sequence` cannot be built to be split or cleaned.
+fn with_remedy(e: &SequenceError) -> String {
+    let remedy = match e {
+        SequenceError::TimeNotIncreasing { previous, next, .. } if previous == next => {
+            ": a repeated timestamp; drop the repeated rows first (`keep = np.r_[True, \
+             np.diff(time) > 0]`, then index every array with `keep`)"
+        }
+        SequenceError::TimeNotIncreasing { .. } => {
+            ": time goes back; if the rows are merely out of order, sort every array by \
+             `np.argsort(time, kind=\"stable\")` first"
+        }
+        SequenceError::Gap { .. } => {
+            ": build a Sequence of each side (the arrays before that frame and from it on); \
+             `split_at_gaps` cuts the shorter gaps of a Sequence"
+        }
+        _ => "",
+    };
+    format!("{e}{remedy}")
 }
 
 /// Emits the readers' (or an evaluation's) warnings as Python `UserWarning`s, as the command

@@ -197,7 +197,19 @@ def test_linacce_defaults_to_acce_minus_gravity(seq):
         (lambda a: a["orientation"].__setitem__(3, [2.0, 0.0, 0.0, 0.0]), ValueError,
          r"`orientation` at frame 3"),
         (lambda a: a["time"].__setitem__(4, a["time"][2]), ValueError,
-         r"time does not increase at frame 4"),
+         r"time does not increase at frame 4: .*: time goes back; if the rows are merely out of "
+         r"order, sort every array by `np.argsort\(time, kind=\"stable\"\)` first"),
+        (lambda a: a["time"].__setitem__(4, a["time"][3]), ValueError,
+         r"a repeated timestamp; drop the repeated rows first \(`keep = np.r_\[True, "),
+        (lambda a: a.update(time=a["time"] + np.where(np.arange(len(a["time"])) >= 1000, 1.5, 0)),
+         ValueError, r"gap of 1.50\d s before frame 1000 .* exceeds 1 s: build a Sequence of each "
+         r"side \(the arrays before that frame and from it on\)"),
+        (lambda a: a.update(gyro=-a["gyro"]), ValueError,
+         r"the gyro turns against the orientation: their rotation rates agree in direction by "
+         r"-0.9\d+ .*sign flipped"),
+        (lambda a: a.update(orientation=a["orientation"][:, [1, 2, 3, 0]], gravity=None,
+                            linacce=None), ValueError,
+         r"the gyro turns against the orientation: .*another component order"),
         (lambda a: a.update(ground_truth_orientation=None), ValueError,
          r"ground truth needs both"),
         (lambda a: a.update(acce=a["acce"] / 9.81, linacce=None), ValueError,
@@ -219,6 +231,25 @@ def test_bad_arrays_are_refused_by_name(seq, change, error, message):
     change(args)
     with pytest.raises(error, match=message):
         ridi.Sequence(**args)
+
+
+def test_arrays_without_orientation_are_checked_before_the_estimate(seq):
+    gyro = seq.gyro.copy()
+    gyro[100, 1] = np.nan
+    with pytest.raises(ValueError, match=r"`Thibaud_Nexus5_NoDist_Texting`: `gyro` is not finite at "
+                                         r"frame 100$"):
+        ridi.Sequence(seq.time, gyro, seq.acce, name=seq.name)
+    with pytest.raises(ValueError, match=r"time does not increase at frame 1: .*time goes back"):
+        ridi.Sequence(seq.time[::-1].copy(), seq.gyro, seq.acce)
+
+
+def test_resampling_refuses_rates_and_gap_limits_no_sequence_may_have(seq):
+    with pytest.raises(ValueError, match=r"cannot resample to 0.5 Hz .*from 1 Hz to 10 kHz"):
+        seq.resampled(0.5)
+    for gap in (0.0, -1.0, float("nan")):
+        with pytest.raises(ValueError, match=r"the gap limit a number above 0"):
+            seq.resampled(100.0, max_gap_s=gap)
+    assert len(seq.resampled(100.0, max_gap_s=float("inf"))) == pytest.approx(len(seq) / 2, abs=1)
 
 
 def test_with_placement_and_len(seq):

@@ -46,7 +46,17 @@ pub(crate) fn sample_sequence(name: &str, n: usize, ground_truth: bool, magnet: 
     Sequence::new(SequenceParts {
         name: name.to_owned(),
         placement: None,
-        gyro: (0..n).map(|i| wave(i, 0.37)).collect(),
+        // The orientation's own rotation rate (the readers check the gyro against it), with a
+        // wave on top so that no two channels are alike.
+        gyro: (0..n)
+            .map(|i| {
+                let (a, b) = if i + 1 < n { (i, i + 1) } else { (i - 1, i) };
+                let [w, x, y, z] = (orientation[a].inverse() * orientation[b]).to_wxyz();
+                let v = Vector3::new(x, y, z) * w.signum();
+                let rate = v * (2.0 * v.norm().atan2(w.abs()) / v.norm().max(1e-300) * 200.0);
+                DeviceVec::new(rate.x, rate.y, rate.z) + wave(i, 0.37) * 0.2
+            })
+            .collect(),
         acce: linacce.iter().zip(&gravity).map(|(a, g)| *a + *g).collect(),
         linacce,
         gravity,
@@ -113,8 +123,9 @@ pub(crate) fn raw_files(n: usize, with_pose: bool) -> Vec<(&'static str, String)
         (name, s)
     };
     let mut files = vec![
-        // About the rate the rotation vector below turns at (0.4 rad/s), as the readers check.
-        sensor("gyro.txt", 0.05, [0.0, 0.4, 0.0]),
+        // About the rate and axis the rotation vector below turns at (0.4 rad/s about y, slowly
+        // drifting), as the readers check.
+        sensor("gyro.txt", 0.005, [0.0, 0.4, 0.0]),
         sensor("acce.txt", 0.2, [0.0, 9.9, 0.3]),
         sensor("linacce.txt", 0.2, [0.0, 0.1, 0.3]),
         sensor("gravity.txt", 0.0, [0.0, 9.8, 0.0]),
