@@ -6,9 +6,13 @@ recorded orientation, as `Validation::check_gyro_scale` computes it (the sum ove
 two rate vectors' dot product over the sum of their magnitudes' product, the steps of
 orientation jumps left out), as recorded, with the gyro's sign flipped, and with the
 quaternion's components read in the other orders a user may give (x, y, z, w read as
-w, x, y, z, and the reverse). Needs the Python package (`pip install ./crates/ridi-py`).
+w, x, y, z, and the reverse). With `--stream`, instead, the lowest agreement from the start of
+each recording as `ridi::LiveTracker` sums it, once 5 s and once 10 s
+(`ridi::STREAM_GYRO_CHECK_S`) have passed. Needs the Python package (`pip install
+./crates/ridi-py`).
 
-    python benchmarks/gyro_direction.py ../shared/data/raw/tyrex-attitude-smartphones/datasets/*/* \
+    python benchmarks/gyro_direction.py [--stream] \
+        ../shared/data/raw/tyrex-attitude-smartphones/datasets/*/* \
         ../shared/data/raw/indoor-location-competition-20/data/*/*/path_data_files/*
 """
 import sys
@@ -30,8 +34,9 @@ def qmul(a, b):
                      w1 * z2 + x1 * y2 - y1 * x2 + z1 * w2], axis=1)
 
 
-def agreement(t, gyro, q):
-    """The check's agreement, or NaN where the orientation hardly turns."""
+def step_sums(t, gyro, q):
+    """Per step: the rate vectors' dot product, the magnitudes' product, the orientation rate
+    squared, and whether the step is no orientation jump."""
     step = qmul(q[:-1] * np.array([1, -1, -1, -1]), q[1:])  # q_{k-1}^-1 q_k, device frame
     step *= np.where(step[:, :1] < 0, -1.0, 1.0)
     v = step[:, 1:]
@@ -41,13 +46,33 @@ def agreement(t, gyro, q):
     rate = v / np.maximum(s, 1e-300)[:, None] * (angle / dt)[:, None]
     g = 0.5 * (gyro[1:] + gyro[:-1])
     w, gn = angle / dt, np.linalg.norm(g, axis=1)
-    jump = w - gn > JUMP_RATE
-    keep = ~jump if jump.mean() <= 0.05 else np.ones_like(jump)
-    return np.sum(np.sum(g * rate, axis=1)[keep]) / np.sum((gn * w)[keep])
+    return np.sum(g * rate, axis=1), gn * w, w * w, ~(w - gn > JUMP_RATE)
+
+
+def agreement(t, gyro, q):
+    """The whole recording's agreement, as `Validation::check_gyro_scale` sums it."""
+    dot, gw, _, kept = step_sums(t, gyro, q)
+    keep = kept if (~kept).mean() <= 0.05 else np.ones_like(kept)
+    return np.sum(dot[keep]) / np.sum(gw[keep])
+
+
+def stream_agreement(t, gyro, q, after_s):
+    """The agreement from the start, as the live tracker sums it, at every step once `after_s`
+    seconds have passed and the orientation turns at 0.1 rad/s RMS."""
+    dot, gw, ww, kept = step_sums(t, gyro, q)
+    dot, gw, ww, n = (np.cumsum(x * kept) for x in (dot, gw, ww, np.ones_like(dot)))
+    judged = (t[1:] - t[0] >= after_s) & (np.sqrt(ww / np.maximum(n, 1)) >= 0.1) & (gw > 0)
+    return dot[judged] / gw[judged]
+
+
+def extreme(values, pick):
+    return pick(values) if values.size else np.nan
 
 
 def main(paths):
     warnings.simplefilter("ignore")
+    stream = "--stream" in paths
+    paths = [p for p in paths if p != "--stream"]
     rows = []
     for path in paths:
         try:
@@ -57,11 +82,21 @@ def main(paths):
             continue
         for s in seqs:
             t, g, q = s.time, s.gyro, s.orientation
-            row = (agreement(t, g, q), agreement(t, -g, q),
-                   agreement(t, g, q[:, [1, 2, 3, 0]]), agreement(t, g, q[:, [3, 0, 1, 2]]))
+            if stream:
+                row = (extreme(stream_agreement(t, g, q, 5.0), np.min),
+                       extreme(stream_agreement(t, g, q, 10.0), np.min),
+                       extreme(stream_agreement(t, -g, q, 1.0), np.max))
+            else:
+                row = (agreement(t, g, q), agreement(t, -g, q),
+                       agreement(t, g, q[:, [1, 2, 3, 0]]), agreement(t, g, q[:, [3, 0, 1, 2]]))
             rows.append(row)
             print(f"{s.name:48s} " + " ".join(f"{x:+.2f}" for x in row))
     a = np.array(rows)
+    if stream:
+        print(f"\n{len(rows)} sequences, lowest agreement from the start: after 5 s "
+              f"{np.nanmin(a[:, 0]):+.2f}, after 10 s {np.nanmin(a[:, 1]):+.2f}; sign flipped, "
+              f"after 1 s, at most {np.nanmax(a[:, 2]):+.2f}")
+        return
     print(f"\n{len(rows)} sequences: as recorded {a[:, 0].min():+.2f}..{a[:, 0].max():+.2f}; "
           f"sign flipped {a[:, 1].min():+.2f}..{a[:, 1].max():+.2f}; other quaternion orders "
           f"{a[:, 2:].min():+.2f}..{a[:, 2:].max():+.2f}, "

@@ -139,7 +139,7 @@ pub use temporaries::{
 };
 pub use text::read_text;
 pub use validation::{
-    GYRO_SCALE_MIN_RATE, LINACCE_SCALE_MIN_RMS, MAX_JUMP_SHARE, MIN_GYRO_AGREEMENT,
+    GYRO_SCALE_MIN_RATE, GyroFit, LINACCE_SCALE_MIN_RMS, MAX_JUMP_SHARE, MIN_GYRO_AGREEMENT,
     ORIENTATION_JUMP_RATE, OrientationJump, Validation, bridge_orientation_jumps,
     orientation_jumps,
 };

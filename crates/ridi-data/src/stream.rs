@@ -414,8 +414,8 @@ struct Sums {
     /// Gyro scale sums of every step and of the steps that are no orientation jump.
     rates: usize,
     jumps: usize,
-    all: crate::validation::GyroFit,
-    kept: crate::validation::GyroFit,
+    all: crate::GyroFit,
+    kept: crate::GyroFit,
     /// Linear acceleration scale sums.
     linacce: (f64, f64, f64, usize),
     magnet_seen: bool,

@@ -355,7 +355,7 @@ impl Validation {
 
     /// [`Self::check_gyro_scale`] of the sums of its steps.
     pub(crate) fn gyro_verdict(&self, fit: &GyroFit) -> Result<(), SequenceError> {
-        let GyroFit { gw, ww, dot, n } = *fit;
+        let GyroFit { gw, ww, n, .. } = *fit;
         if n == 0 || (ww / n as f64).sqrt() < GYRO_SCALE_MIN_RATE {
             return Ok(());
         }
@@ -364,15 +364,15 @@ impl Validation {
         if !(min..=max).contains(&scale) {
             return Err(SequenceError::GyroScale { scale, min, max });
         }
-        // gw > 0 here: the orientation turns and the scale is positive.
-        let agreement = dot / gw;
-        if agreement < MIN_GYRO_AGREEMENT {
-            return Err(SequenceError::GyroDirection {
-                agreement,
-                min: MIN_GYRO_AGREEMENT,
-            });
+        match fit.agreement() {
+            Some(agreement) if agreement < MIN_GYRO_AGREEMENT => {
+                Err(SequenceError::GyroDirection {
+                    agreement,
+                    min: MIN_GYRO_AGREEMENT,
+                })
+            }
+            _ => Ok(()),
         }
-        Ok(())
     }
 
     /// Checks the linear acceleration's scale against accelerometer minus gravity (all in the
@@ -418,14 +418,18 @@ impl Validation {
     }
 }
 
-/// Sums over the steps of a recording that [`Validation::check_gyro_scale`] fits: gyro rate
-/// times orientation rate (`gw`, magnitudes), orientation rate squared (`ww`), the dot product
-/// of the two rate vectors (`dot`), and the number of steps.
+/// The sums [`Validation::check_gyro_scale`] fits the gyro to an orientation with, over the
+/// steps of a recording, or of a stream as it arrives (`ridi::LiveTracker` judges the
+/// direction of its samples' gyro with [`Self::agreement`]).
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
-pub(crate) struct GyroFit {
+pub struct GyroFit {
+    /// Gyro rate times orientation rate (magnitudes), summed.
     pub(crate) gw: f64,
+    /// Orientation rate squared, summed.
     pub(crate) ww: f64,
+    /// Dot product of the two rate vectors, summed.
     pub(crate) dot: f64,
+    /// Steps.
     pub(crate) n: usize,
 }
 
@@ -436,6 +440,27 @@ impl GyroFit {
         self.ww += w * w;
         self.dot += dot;
         self.n += 1;
+    }
+
+    /// Adds the steps between consecutive frames of `time`, `gyro` (rad/s) and `orientation`,
+    /// but for those of an orientation jump (turning more than [`ORIENTATION_JUMP_RATE`] faster
+    /// than the gyro) and those whose time does not increase.
+    pub fn add_steps(&mut self, time: &[f64], gyro: &[DeviceVec], orientation: &[WorldFromDevice]) {
+        for (_, _, w, g, dot) in step_rates(time, gyro, orientation) {
+            if w - g <= ORIENTATION_JUMP_RATE {
+                self.add(w, g, dot);
+            }
+        }
+    }
+
+    /// How the gyro agrees in direction with the orientation's rotation rate over the steps
+    /// added: the sum of the rate vectors' dot products over the sum of their magnitudes'
+    /// products, 1 when they turn about the same axes, -1 when opposite
+    /// ([`MIN_GYRO_AGREEMENT`]). `None` while the orientation turns too little to judge
+    /// ([`GYRO_SCALE_MIN_RATE`] RMS) or the gyro reads nothing.
+    pub fn agreement(&self) -> Option<f64> {
+        let turns = self.n > 0 && (self.ww / self.n as f64).sqrt() >= GYRO_SCALE_MIN_RATE;
+        (turns && self.gw > 0.0).then(|| self.dot / self.gw)
     }
 }
 

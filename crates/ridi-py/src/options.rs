@@ -160,10 +160,22 @@ impl Inputs {
             .map_err(|_| wrong())?
             .collect::<PyResult<_>>()?;
         if items.iter().all(|i| i.cast::<Sequence>().is_ok()) && !items.is_empty() {
-            let seqs = items
+            let seqs: Vec<RidiSequence> = items
                 .iter()
                 .map(|i| Ok(i.cast::<Sequence>()?.get().inner.clone()))
                 .collect::<PyResult<_>>()?;
+            // Errors, warnings and reports name sequences by their names, as lists do by
+            // their entries: two of one name (arrays built without `name=`) could not be told
+            // apart.
+            for (j, later) in seqs.iter().enumerate() {
+                if let Some(i) = seqs[..j].iter().position(|s| s.name() == later.name()) {
+                    return Err(errors::value(format!(
+                        "sequences {i} and {j} are both named `{}`: give each its own name \
+                         (`ridi.Sequence(..., name=...)`), by which errors and reports name them",
+                        later.name()
+                    )));
+                }
+            }
             return Ok(Inputs::Sequences(seqs));
         }
         let lists = items

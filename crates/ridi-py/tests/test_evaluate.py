@@ -78,6 +78,18 @@ def test_bad_evaluations_are_refused(model, test_list, tmp_path):
     args = {k: getattr(no_truth, k) for k in ("time", "gyro", "acce", "gravity", "orientation")}
     with pytest.raises(ValueError, match="ground truth"):
         ridi.evaluate([ridi.Sequence(**args, name="bare")], model)
+    # Sequences built without a name share the default one: errors and reports could not
+    # tell them apart, in evaluation as in training.
+    seqs = ridi.read_list(test_list, placement_map="tyrex4", purpose="evaluation")
+    unnamed = [ridi.Sequence(s.time, s.gyro, s.acce, s.gravity, s.orientation,
+                             placement=s.placement, ground_truth_position=s.ground_truth_position,
+                             ground_truth_orientation=s.ground_truth_orientation)
+               for s in seqs[:3]]
+    with pytest.raises(ValueError, match=r"sequences 0 and 1 are both named `sequence`: give each "
+                                         r"its own name \(`ridi.Sequence\(..., name=...\)`\)"):
+        ridi.evaluate(unnamed, model)
+    with pytest.raises(ValueError, match=r"sequences 0 and 1 are both named `sequence`"):
+        ridi.train(unnamed, grid="none")
 
 
 def test_one_method_by_name_and_warnings_as_python_warnings(model, test_list):

@@ -121,6 +121,25 @@ def test_live_tracker_gives_the_online_poses(seq, model):
     assert "Update(frame=0" in repr(updates[0])
 
 
+def test_live_tracker_refuses_a_gyro_turning_against_the_orientation(seq, model):
+    # The quaternion given x, y, z, w: it turns about other axes than the gyro; refused from
+    # 10 s into the stream on.
+    live = ridi.LiveTracker(model)
+    reordered = seq.orientation[:, [1, 2, 3, 0]]
+    t, g, a = seq.time, seq.gyro, seq.acce
+    for i in range(len(seq)):
+        try:
+            live.push(t[i], g[i], a[i], orientation=reordered[i])
+        except ValueError as e:
+            assert "the stream since its start (10" in str(e) and "component order" in str(e)
+            assert t[i] - t[0] == pytest.approx(10.0, abs=0.01)
+            break
+    else:
+        pytest.fail("no sample refused")
+    with pytest.raises(ValueError, match="the gyro turns against the orientation"):
+        live.push(t[i + 1], g[i + 1], a[i + 1], orientation=reordered[i + 1])
+
+
 def test_live_tracker_refuses_bad_samples_and_stays_usable(seq, recorded_model):
     live = ridi.LiveTracker(recorded_model)
     recorded = dict(orientation=seq.orientation[0], gravity=seq.gravity[0],

@@ -122,7 +122,8 @@ pub use inspect::{
 };
 pub use lists::{Purpose, load_listed};
 pub use live::{
-    CascadeRegressor, LiveTracker, Recorded, STREAM_ACCE_G, STREAM_CHECK_SAMPLES, SensorReading,
+    CascadeRegressor, LiveTracker, Recorded, STREAM_ACCE_G, STREAM_CHECK_SAMPLES,
+    STREAM_GYRO_CHECK_S, SensorReading,
 };
 pub use orientation::{apply_orientation, oriented};
 pub use output::{

@@ -192,7 +192,10 @@ impl SensorReading {
 /// accelerometer in g ([`STREAM_ACCE_G`]): such a stream is refused before its first velocity
 /// is regressed. The samples with a new time count towards that second whether they are
 /// tracked or refused, so that samples are taken again once most of the last
-/// [`STREAM_CHECK_SAMPLES`] are right (a sample given again is refused again). Pushing after [`finish`](Self::finish) is refused
+/// [`STREAM_CHECK_SAMPLES`] are right (a sample given again is refused again). A stream whose
+/// gyro turns against the recorded orientation pushed with it (a sign flipped, a quaternion's
+/// components in another order) is refused once it is [`STREAM_GYRO_CHECK_S`] long, and from
+/// then on. Pushing after [`finish`](Self::finish) is refused
 /// too. A gap longer than the correction integrates across (its `max_dt`, 0.1 s:
 /// a dropped sensor buffer, say) starts a new segment ([`GapPolicy::Restart`]): the position is
 /// held, velocity and bias start over, and the update says
@@ -471,6 +474,15 @@ impl<'m> LiveTracker<'m> {
 /// regressed.
 pub const STREAM_CHECK_SAMPLES: usize = 200;
 
+/// Seconds of a stream after which [`LiveTracker`] judges the direction of its gyro against
+/// the recorded orientation pushed with it, from the stream's start
+/// ([`ridi_data::GyroFit::agreement`] against [`ridi_data::MIN_GYRO_AGREEMENT`]): a gyro with
+/// its sign flipped, or a quaternion given in another component order, is refused from then
+/// on. Over the 127 shared sequences the agreement from the start is at least 0.71 once 10 s
+/// have passed, but 0.44 at 5 s (`benchmarks/gyro_direction.py --stream`); a flipped gyro
+/// gives its negation, at most -0.71 from 10 s on.
+pub const STREAM_GYRO_CHECK_S: f64 = 10.0;
+
 /// Accepted range of the median |acce| over a stream's last [`STREAM_CHECK_SAMPLES`], in
 /// standard gravities: 0.35..10. Over every second of the shared Tyrex runs (both phones), the
 /// twelve Indoor Location Competition walks and the bundled sample it lies within 0.50..2.40
@@ -484,7 +496,12 @@ pub const STREAM_ACCE_G: (f64, f64) = (0.35, 10.0);
 /// that a median is judged in constant time per sample.
 #[derive(Debug, Default)]
 struct StreamCheck {
+    first_time: Option<f64>,
     last_time: Option<f64>,
+    /// The last sample's time, gyro and recorded orientation, when it had one.
+    last_recorded: Option<(f64, DeviceVec, WorldFromDevice)>,
+    /// The gyro against the recorded orientation since the stream's start.
+    gyro_fit: ridi_data::GyroFit,
     /// Per sample: the interval from the one before (seconds), |gyro|, |acce|.
     recent: VecDeque<[f64; 3]>,
     /// Each quantity's properties: low, a rate too fast, a gyro (none), an accelerometer too
@@ -519,7 +536,15 @@ impl StreamCheck {
             };
         }
         self.last_time = Some(sample.time);
+        let recorded = sample
+            .recorded
+            .map(|r| (sample.time, sample.gyro, r.orientation));
+        if let (Some((t0, g0, q0)), Some((t1, g1, q1))) = (self.last_recorded, recorded) {
+            self.gyro_fit.add_steps(&[t0, t1], &[g0, g1], &[q0, q1]);
+        }
+        self.last_recorded = recorded;
         let Some(previous) = previous else {
+            self.first_time = Some(sample.time);
             return Ok(());
         };
         let entry = [
@@ -543,17 +568,33 @@ impl StreamCheck {
             }
         }
         self.refused = None;
-        if self.recent.len() < STREAM_CHECK_SAMPLES {
-            return Ok(());
-        }
-        let Some(column) = self
-            .medians
-            .iter()
-            .position(|m| m.median_low() || m.median_high())
-        else {
-            return Ok(());
+        let since = self.first_time.map_or(0.0, |t| sample.time - t);
+        let against = (since >= STREAM_GYRO_CHECK_S)
+            .then(|| self.gyro_fit.agreement())
+            .flatten()
+            .filter(|&a| a < ridi_data::MIN_GYRO_AGREEMENT);
+        let why = if let Some(agreement) = against {
+            let e = ridi_data::SequenceError::GyroDirection {
+                agreement,
+                min: ridi_data::MIN_GYRO_AGREEMENT,
+            };
+            format!(
+                "the stream since its start ({} s): {e}",
+                ridi_data::short(since)
+            )
+        } else {
+            if self.recent.len() < STREAM_CHECK_SAMPLES {
+                return Ok(());
+            }
+            let Some(column) = self
+                .medians
+                .iter()
+                .position(|m| m.median_low() || m.median_high())
+            else {
+                return Ok(());
+            };
+            self.verdict(column, limits)
         };
-        let why = self.verdict(column, limits);
         self.refused = Some(why.clone());
         Err(PipelineError::Live(why))
     }

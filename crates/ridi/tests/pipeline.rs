@@ -719,6 +719,32 @@ fn a_live_stream_at_a_wrong_rate_or_unit_is_refused_by_its_first_window() {
         }
     }
 
+    // A gyro with its sign flipped turns against the recorded orientation pushed with it:
+    // refused once the stream is STREAM_GYRO_CHECK_S long, and from then on; the stream as
+    // recorded is not.
+    let mut live = LiveTracker::new(&model, &opts).unwrap();
+    let (i, err) = first_refused(&mut live, &|_, s| s.gyro = s.gyro * -1.0);
+    assert!(
+        (seq.time()[i] - t0 - ridi::STREAM_GYRO_CHECK_S).abs() < 0.01,
+        "{i}: {err}"
+    );
+    assert!(
+        err.contains("the stream since its start (10") && err.contains("sign flipped"),
+        "{err}"
+    );
+    let mut updates = Vec::new();
+    let flipped = |i| {
+        let mut s = SensorReading::of_frame(&seq, i);
+        s.gyro = s.gyro * -1.0;
+        s
+    };
+    assert!(live.push(&flipped(i + 1), &mut updates).is_err());
+    let mut live = LiveTracker::new(&model, &opts).unwrap();
+    for i in 0..seq.len() {
+        live.push(&SensorReading::of_frame(&seq, i), &mut updates)
+            .unwrap();
+    }
+
     // Two seconds at 100 Hz (frames 0-399 stretched twofold), then 200 Hz again: refused
     // until most of the last second is right (at most 101 samples later), then taken in a new
     // segment; a refused sample given again is refused again.
