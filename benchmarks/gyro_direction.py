@@ -6,13 +6,15 @@ recorded orientation, as `Validation::check_gyro_scale` computes it (the sum ove
 two rate vectors' dot product over the sum of their magnitudes' product, the steps of
 orientation jumps left out), as recorded, with the gyro's sign flipped, and with the
 quaternion's components read in the other orders a user may give (x, y, z, w read as
-w, x, y, z, and the reverse). With `--stream`, instead, the lowest agreement from the start of
-each recording as `ridi::LiveTracker` sums it, once 5 s and once 10 s
-(`ridi::STREAM_GYRO_CHECK_S`) have passed. Needs the Python package (`pip install
+w, x, y, z, and the reverse). With `--stream`, instead, streams started every 2 s into each
+recording as `ridi::LiveTracker` sums them: the lowest agreement once 5 s and once 10 s
+(`ridi::STREAM_GYRO_CHECK_S`) have passed, and how many of the reordered quaternions' streams
+fall under `ridi::STREAM_MIN_GYRO_AGREEMENT` (0) after 10 s. Sequences the reader refuses (the
+whole-recording check included) are counted apart. Needs the Python package (`pip install
 ./crates/ridi-py`).
 
     python benchmarks/gyro_direction.py [--stream] \
-        ../shared/data/raw/tyrex-attitude-smartphones/datasets/*/* \
+        ../shared/data/raw/tyrex-attitude-smartphones/datasets/{android,ios}/* \
         ../shared/data/raw/indoor-location-competition-20/data/*/*/path_data_files/*
 """
 import sys
@@ -56,51 +58,61 @@ def agreement(t, gyro, q):
     return np.sum(dot[keep]) / np.sum(gw[keep])
 
 
-def stream_agreement(t, gyro, q, after_s):
-    """The agreement from the start, as the live tracker sums it, at every step once `after_s`
-    seconds have passed and the orientation turns at 0.1 rad/s RMS."""
+def stream_minimum(t, gyro, q, after_s, every_s=2.0):
+    """The lowest agreement of streams started every `every_s` seconds, as the live tracker
+    sums it from its start, at every step once `after_s` seconds have passed and the
+    orientation turns at 0.1 rad/s RMS: one value per start (NaN where never judged)."""
     dot, gw, ww, kept = step_sums(t, gyro, q)
-    dot, gw, ww, n = (np.cumsum(x * kept) for x in (dot, gw, ww, np.ones_like(dot)))
-    judged = (t[1:] - t[0] >= after_s) & (np.sqrt(ww / np.maximum(n, 1)) >= 0.1) & (gw > 0)
-    return dot[judged] / gw[judged]
-
-
-def extreme(values, pick):
-    return pick(values) if values.size else np.nan
+    sums = [np.concatenate([[0.0], np.cumsum(x * kept)]) for x in (dot, gw, ww, np.ones_like(dot))]
+    out = []
+    for start in np.searchsorted(t, np.arange(t[0], t[-1] - after_s, every_s)):
+        d, g, w, n = (c[start + 1:] - c[start] for c in sums)
+        judged = (t[start + 1:] - t[start] >= after_s) & (np.sqrt(w / np.maximum(n, 1)) >= 0.1)
+        judged &= g > 0
+        out.append(np.min(d[judged] / g[judged]) if judged.any() else np.nan)
+    return np.array(out)
 
 
 def main(paths):
     warnings.simplefilter("ignore")
     stream = "--stream" in paths
     paths = [p for p in paths if p != "--stream"]
-    rows = []
+    rows, refused = [], []
     for path in paths:
         try:
             seqs = ridi.read_any(path)
-        except Exception as e:  # a folder without motion capture, say
-            print(f"skipped {path}: {str(e).splitlines()[0][:100]}", file=sys.stderr)
+        except Exception as e:  # a folder without motion capture, or refused by the checks
+            refused.append(f"{path}: {str(e).splitlines()[0][:200]}")
             continue
         for s in seqs:
             t, g, q = s.time, s.gyro, s.orientation
             if stream:
-                row = (extreme(stream_agreement(t, g, q, 5.0), np.min),
-                       extreme(stream_agreement(t, g, q, 10.0), np.min),
-                       extreme(stream_agreement(t, -g, q, 1.0), np.max))
+                row = (np.nanmin(stream_minimum(t, g, q, 5.0)),
+                       np.nanmin(stream_minimum(t, g, q, 10.0)),
+                       np.concatenate([stream_minimum(t, g, q[:, order], 10.0)
+                                       for order in ([1, 2, 3, 0], [3, 0, 1, 2])]))
             else:
                 row = (agreement(t, g, q), agreement(t, -g, q),
                        agreement(t, g, q[:, [1, 2, 3, 0]]), agreement(t, g, q[:, [3, 0, 1, 2]]))
             rows.append(row)
-            print(f"{s.name:48s} " + " ".join(f"{x:+.2f}" for x in row))
-    a = np.array(rows)
+            print(f"{s.name:48s} " + " ".join(f"{x:+.2f}" for x in row[:2])
+                  + (f" reordered refused {np.mean(row[2][~np.isnan(row[2])] < 0):.0%}"
+                     if stream else " " + " ".join(f"{x:+.2f}" for x in row[2:])))
+    print(f"\n{len(refused)} paths refused by the reader:", *refused, sep="\n  ")
     if stream:
-        print(f"\n{len(rows)} sequences, lowest agreement from the start: after 5 s "
-              f"{np.nanmin(a[:, 0]):+.2f}, after 10 s {np.nanmin(a[:, 1]):+.2f}; sign flipped, "
-              f"after 1 s, at most {np.nanmax(a[:, 2]):+.2f}")
+        low5, low10 = (np.nanmin([r[i] for r in rows]) for i in (0, 1))
+        reordered = np.concatenate([r[2] for r in rows])
+        reordered = reordered[~np.isnan(reordered)]
+        print(f"{len(rows)} sequences, streams started every 2 s, lowest agreement from the "
+              f"start: after 5 s {low5:+.2f}, after 10 s {low10:+.2f} (a flipped gyro: at most "
+              f"{-low10:+.2f}); quaternions reordered: {np.mean(reordered < 0):.0%} of "
+              f"{len(reordered)} streams under 0 after 10 s")
         return
+    a = np.array(rows)
+    refused_share = np.mean(a[:, 2:] < 0.5)
     print(f"\n{len(rows)} sequences: as recorded {a[:, 0].min():+.2f}..{a[:, 0].max():+.2f}; "
           f"sign flipped {a[:, 1].min():+.2f}..{a[:, 1].max():+.2f}; other quaternion orders "
-          f"{a[:, 2:].min():+.2f}..{a[:, 2:].max():+.2f}, "
-          f"{np.mean(np.abs(a[:, 2:]) < 0.5):.0%} of them under 0.5 in size")
+          f"{a[:, 2:].min():+.2f}..{a[:, 2:].max():+.2f}, {refused_share:.0%} of them under 0.5")
 
 
 if __name__ == "__main__":

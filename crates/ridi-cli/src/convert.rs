@@ -57,10 +57,10 @@ impl From<FromFormat> for Format {
     }
 }
 
-/// `--rate`: within [`ridi::CONVERT_RATE_HZ`], the rates whose frames the readers accept
+/// `--rate`: within [`ridi::data::RESAMPLE_RATE_HZ`], the rates whose frames the readers accept
 /// (less than 1 s apart, at least 0.1 ms in the median); phone sensors deliver 5-500 Hz.
 fn rate_hz(text: &str) -> std::result::Result<f64, String> {
-    let (min, max) = ridi::CONVERT_RATE_HZ;
+    let (min, max) = ridi::data::RESAMPLE_RATE_HZ;
     match text.parse::<f64>() {
         Ok(x) if (min..=max).contains(&x) => Ok(x),
         _ => Err(format!(

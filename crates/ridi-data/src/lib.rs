@@ -126,7 +126,7 @@ pub use options::ReadOptions;
 pub use processed::PROCESSED_COLUMNS;
 pub use ridi_frames;
 pub use sequence::{
-    Channel, GroundTruth, OrientationSource, Sequence, SequenceParts, SplitParts,
+    Channel, GroundTruth, OrientationSource, RESAMPLE_RATE_HZ, Sequence, SequenceParts, SplitParts,
     heading_reference, part_name,
 };
 pub use sequence_error::{SequenceError, short};

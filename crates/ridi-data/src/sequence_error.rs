@@ -140,14 +140,15 @@ pub enum SequenceError {
         /// The shortest part asked for.
         min_duration_s: f64,
     },
-    /// A resampling rate outside the 1 Hz to 10 kHz a timeline may step at
-    /// ([`Validation::time_step_range`](crate::Validation::time_step_range)), or a gap limit
-    /// that is not a number above 0 ([`Sequence::resampled`](crate::Sequence::resampled)).
+    /// A resampling rate outside [`RESAMPLE_RATE_HZ`](crate::RESAMPLE_RATE_HZ), or a gap
+    /// limit that is not a number above 0 ([`Sequence::resampled`](crate::Sequence::resampled)).
     #[error(
-        "cannot resample to {} Hz across gaps of up to {} s: the rate must be from 1 Hz to \
-         10 kHz (the steps a sequence may have), the gap limit a number above 0",
+        "cannot resample to {} Hz across gaps of up to {} s: the rate must be from {} to {} Hz \
+         (the steps a sequence may have), the gap limit a number above 0",
         short(*rate_hz),
-        short(*max_gap_s)
+        short(*max_gap_s),
+        crate::RESAMPLE_RATE_HZ.0,
+        crate::RESAMPLE_RATE_HZ.1
     )]
     InvalidRate {
         /// The rate asked for.

@@ -125,6 +125,10 @@ pub struct Validation {
     /// order or inverted turns a phone held upright by 90-180 degrees; a placeholder
     /// (identity) orientation beside a measured gravity disagrees as much.
     pub max_orientation_gravity_deg: f64,
+    /// Least agreement in direction between the gyro and the orientation's rotation rate
+    /// ([`GyroFit::agreement`]): [`MIN_GYRO_AGREEMENT`], 0.5. `-1` (or below) turns the check
+    /// off, for an orientation given for another device frame than the gyro's.
+    pub min_gyro_agreement: f64,
 }
 
 impl Default for Validation {
@@ -145,6 +149,7 @@ impl Default for Validation {
             max_median_speed: 20.0,
             max_speed: 100.0,
             max_orientation_gravity_deg: 45.0,
+            min_gyro_agreement: MIN_GYRO_AGREEMENT,
         }
     }
 }
@@ -327,7 +332,7 @@ impl Validation {
 
     /// Checks the gyro against the rotation rate of `orientation` over `time`: its scale with
     /// [`Self::gyro_scale_range`] (magnitudes), then its direction with
-    /// [`MIN_GYRO_AGREEMENT`]; passes when the orientation hardly turns
+    /// [`Self::min_gyro_agreement`]; passes when the orientation hardly turns
     /// ([`GYRO_SCALE_MIN_RATE`]). The steps where the orientation turns more
     /// than [`ORIENTATION_JUMP_RATE`] faster than the gyro are left out of the fit while they
     /// are at most [`MAX_JUMP_SHARE`] of the steps: a few frames of an OS orientation turning
@@ -365,10 +370,10 @@ impl Validation {
             return Err(SequenceError::GyroScale { scale, min, max });
         }
         match fit.agreement() {
-            Some(agreement) if agreement < MIN_GYRO_AGREEMENT => {
+            Some(agreement) if agreement < self.min_gyro_agreement => {
                 Err(SequenceError::GyroDirection {
                     agreement,
-                    min: MIN_GYRO_AGREEMENT,
+                    min: self.min_gyro_agreement,
                 })
             }
             _ => Ok(()),
@@ -465,14 +470,15 @@ impl GyroFit {
 }
 
 /// The least agreement in direction between the gyro and the orientation's rotation rate that
-/// [`Validation::check_gyro_scale`] accepts: the sum over steps of the two rate vectors' dot
-/// product over the sum of their magnitudes' product (1 when they turn about the same axes, -1
-/// when opposite). Measured on real recordings (`benchmarks/gyro_direction.py`, 127 sequences:
-/// every Tyrex run of both phones and conditions, the 12 Indoor Location Competition walks):
-/// 0.78-1.00 as recorded (the lowest near magnetic disturbance, where the OS orientation drifts
-/// against the gyro); -1.00..-0.78 with the gyro's sign flipped; -0.77..0.76 with the
-/// quaternion's components in another order (x, y, z, w read as w, x, y, z, or the reverse),
-/// 88 % of them under 0.5 in size and so refused.
+/// [`Validation::check_gyro_scale`] accepts by default ([`Validation::min_gyro_agreement`]):
+/// the sum over steps of the two rate vectors' dot product over the sum of their magnitudes'
+/// product (1 when they turn about the same axes, -1 when opposite). Measured on real
+/// recordings (`benchmarks/gyro_direction.py`, 127 sequences: every Tyrex run of both phones
+/// and conditions, the 12 Indoor Location Competition walks): 0.78-1.00 as recorded (the
+/// lowest near magnetic disturbance, where the OS orientation drifts against the gyro);
+/// -1.00..-0.78 with the gyro's sign flipped; -0.77..0.76 with the quaternion's components in
+/// another order (x, y, z, w read as w, x, y, z, or the reverse), 94 % of them under 0.5
+/// and so refused.
 pub const MIN_GYRO_AGREEMENT: f64 = 0.5;
 
 /// How much faster than the gyro the orientation may turn between two frames, rad/s, before
@@ -870,6 +876,13 @@ mod tests {
             "{e}"
         );
         assert!(e.to_string().contains("sign flipped"), "{e}");
+        // An orientation of another device frame, say: the check off.
+        let off = Validation {
+            min_gyro_agreement: -1.0,
+            ..Validation::default()
+        };
+        off.check_gyro_scale(&flipped.0, &flipped.1, &flipped.2)
+            .unwrap();
         // The quaternion given x, y, z, w and read w, x, y, z: its rotation rates keep their
         // magnitudes (the angle between two quaternions is their dot product's) but not their
         // axes.

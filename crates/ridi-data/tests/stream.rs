@@ -174,6 +174,14 @@ fn a_recording_with_one_fault_gets_the_whole_file_readers_error() {
             edit(&[51], &move |cells| cells[c] = t.clone())
         }),
         ("time in microseconds", edit(&all, &scale("time", 1e-3))),
+        ("gyro turning against the orientation", {
+            let flip = [
+                scale("gyro_x", -1.0),
+                scale("gyro_y", -1.0),
+                scale("gyro_z", -1.0),
+            ];
+            edit(&all, &|c| flip.iter().for_each(|f| f(c)))
+        }),
         (
             "ground truth NaN on one row",
             edit(&[200], &set("pos_x", "NaN")),
@@ -193,6 +201,13 @@ fn a_recording_with_one_fault_gets_the_whole_file_readers_error() {
         let stream = streamed(&path, &ReadOptions::default()).map(|_| ());
         assert!(whole.is_err(), "{what}: the whole-file reader accepts it");
         assert_eq!(stream, whole, "{what}");
+        if what.starts_with("gyro turning") {
+            let e = whole.unwrap_err();
+            assert!(
+                e.contains("gyro_x..gyro_z") && e.contains("sign flipped"),
+                "{e}"
+            );
+        }
     }
     // data_plain.txt: fewer rows than announced.
     let plain = dir.path().join("p_plain.txt");

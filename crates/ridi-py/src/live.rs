@@ -112,10 +112,10 @@ impl Update {
 /// previous one) raises ``ValueError`` and leaves the tracking as it was; from the 201st
 /// sample on, the last 200 samples' median rate (200 Hz within 10 %), |gyro| and |acce| are
 /// judged, so a stream in milliseconds, deg/s or g is refused by then (refused samples count
-/// towards the last 200); from 10 s on, a gyro turning against the ``orientation`` pushed
-/// with it (a sign flipped, a quaternion in x, y, z, w order) is refused, and stays so. A gap
-/// longer than 0.1 s starts a new segment
-/// (``Update.restarted``); pushing after ``finish()`` raises.
+/// towards the last 200); once 10 s of samples came with an ``orientation``, a gyro turning
+/// against it (a sign flipped, most quaternions in x, y, z, w order) is refused, and stays so.
+/// A gap longer than 0.1 s starts a new segment (``Update.restarted``); pushing after
+/// ``finish()`` raises.
 ///
 /// >>> live = ridi.LiveTracker(model)                      # doctest: +SKIP
 /// >>> for i in range(len(seq)):                           # doctest: +SKIP

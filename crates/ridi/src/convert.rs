@@ -52,7 +52,7 @@ pub struct ConvertOptions {
     /// How to read (validation limits).
     pub read: ReadOptions,
     /// Resample every sequence to this rate, Hz ([`Sequence::resampled`]), within
-    /// [`CONVERT_RATE_HZ`]; `None` keeps each sequence's timeline.
+    /// [`ridi_data::RESAMPLE_RATE_HZ`]; `None` keeps each sequence's timeline.
     ///
     /// [`Sequence::resampled`]: ridi_data::Sequence::resampled
     pub rate_hz: Option<f64>,
@@ -67,13 +67,6 @@ pub struct ConvertOptions {
 /// Shortest part [`ConvertOptions::split_gaps_s`] keeps, seconds: one feature window of the
 /// paper's models (200 frames at 200 Hz), the least anything can be tracked on.
 pub const SPLIT_MIN_PART_S: f64 = 1.0;
-
-/// The rates a conversion resamples to, Hz, both included: 1.001 to 9,990. The readers (with
-/// the default [`ridi_data::Validation`]) refuse frames 1 s apart or more (`max_gap_s`) and a
-/// median step under 0.1 ms (`time_step_range`); a uniform timeline at exactly 1 Hz or
-/// 10 kHz lands on either side of those bounds once its times are added up in floating point
-/// and written as whole nanoseconds, so the range keeps 0.1 % from each.
-pub const CONVERT_RATE_HZ: (f64, f64) = (1.001, 9990.0);
 
 /// Longest gap `--rate` interpolates across, in frame intervals of the source (its median):
 /// longer ones would be filled with invented frames, so the recording has to be split there

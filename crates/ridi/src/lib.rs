@@ -107,8 +107,8 @@ pub use baselines::{Method, baseline_trajectory, device_heading};
 #[cfg(feature = "bundled-model")]
 pub use bundled::{BUNDLED_MODEL_SUMMARY, bundled_model};
 pub use convert::{
-    CONVERT_RATE_HZ, ConvertOptions, ConvertSummary, Converted, SPLIT_MIN_PART_S, convert,
-    resample_max_gap, split_limit,
+    ConvertOptions, ConvertSummary, Converted, SPLIT_MIN_PART_S, convert, resample_max_gap,
+    split_limit,
 };
 pub use demo::Demo;
 pub use error::{PipelineError, Result};
@@ -123,7 +123,7 @@ pub use inspect::{
 pub use lists::{Purpose, load_listed};
 pub use live::{
     CascadeRegressor, LiveTracker, Recorded, STREAM_ACCE_G, STREAM_CHECK_SAMPLES,
-    STREAM_GYRO_CHECK_S, SensorReading,
+    STREAM_GYRO_CHECK_S, STREAM_MIN_GYRO_AGREEMENT, SensorReading,
 };
 pub use orientation::{apply_orientation, oriented};
 pub use output::{

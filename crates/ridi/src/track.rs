@@ -514,7 +514,7 @@ fn live_for<'m>(
 }
 
 fn track_online(seq: &Sequence, model: &Cascade, opts: &TrackOptions) -> Result<Track> {
-    let mut live = live_for(model, opts, seq.orientation_source())?;
+    let mut live = live_for(model, opts, seq.orientation_source())?.judged_whole();
     let mut updates = Vec::with_capacity(seq.len());
     for i in 0..seq.len() {
         // The recorded orientation whatever its source: `live_for` chose what it is used for.

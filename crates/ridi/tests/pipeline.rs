@@ -729,7 +729,9 @@ fn a_live_stream_at_a_wrong_rate_or_unit_is_refused_by_its_first_window() {
         "{i}: {err}"
     );
     assert!(
-        err.contains("the stream since its start (10") && err.contains("sign flipped"),
+        err.contains("the stream's 10")
+            && err.contains("with a recorded orientation: the gyro")
+            && err.contains("sign flipped"),
         "{err}"
     );
     let mut updates = Vec::new();
