@@ -53,6 +53,14 @@ pub fn counted(n: usize, noun: &str) -> String {
     format!("{n} {noun}{ending}")
 }
 
+/// How often something happened: `once`, `2 times`, ...
+pub(crate) fn times(n: usize) -> String {
+    match n {
+        1 => "once".to_owned(),
+        n => format!("{n} times"),
+    }
+}
+
 /// The first few of `spans`, `a-b s`, and how many more there are: where a warning's findings
 /// are.
 pub fn spans_text(spans: &[(f64, f64)]) -> String {

@@ -164,6 +164,52 @@ pub(crate) fn uniform_timeline(start: f64, end: f64, rate_hz: f64) -> Vec<f64> {
         .collect()
 }
 
+/// Slack on a gap limit, s, so that a gap of exactly the limit (e.g. 15 mocap frames at 60 Hz
+/// against 0.25 s) counts as within it despite rounding.
+pub(crate) const GAP_TOLERANCE_S: f64 = 1e-9;
+
+/// Time spans without long gaps: `[start, end]` of each run of samples whose spacing stays
+/// within `max_gap`; `on_gap` is called with the index of the sample after each gap.
+pub(crate) fn intervals(
+    time: &[f64],
+    max_gap: f64,
+    mut on_gap: impl FnMut(usize),
+) -> Vec<(f64, f64)> {
+    let mut out = Vec::new();
+    let Some(&first) = time.first() else {
+        return out;
+    };
+    let mut start = first;
+    for (i, w) in time.windows(2).enumerate() {
+        if w[1] - w[0] > max_gap + GAP_TOLERANCE_S {
+            out.push((start, w[0]));
+            on_gap(i + 1);
+            start = w[1];
+        }
+    }
+    out.push((start, time[time.len() - 1]));
+    out
+}
+
+/// Intersection of two sorted lists of disjoint closed intervals.
+pub(crate) fn intersect(a: &[(f64, f64)], b: &[(f64, f64)]) -> Vec<(f64, f64)> {
+    let (mut i, mut j) = (0, 0);
+    let mut out = Vec::new();
+    while i < a.len() && j < b.len() {
+        let start = a[i].0.max(b[j].0);
+        let end = a[i].1.min(b[j].1);
+        if start <= end {
+            out.push((start, end));
+        }
+        if a[i].1 < b[j].1 {
+            i += 1;
+        } else {
+            j += 1;
+        }
+    }
+    out
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -300,7 +300,9 @@ pub(crate) fn check_step(
         return Err(DataError::format(
             at(),
             format!(
-                "gap of {:.3} s since line {prev_line} exceeds the limit of {} s",
+                "gap of {:.3} s since line {prev_line} exceeds the limit of {} s: a recording \
+                 paused that long is two; cut it there (the records before this line and those \
+                 from it on, as recordings of their own)",
                 next - prev,
                 short(max_gap_s)
             ),

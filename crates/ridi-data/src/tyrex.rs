@@ -155,10 +155,10 @@ use ridi_frames::nalgebra::Matrix3;
 use ridi_frames::{DeviceVec, QuatError, STANDARD_GRAVITY, WorldFromDevice, WorldVec};
 
 use crate::android;
-use crate::error::{DataError, Location, Result, counted, shown, spans_text};
+use crate::error::{DataError, Location, Result, counted, shown, spans_text, times};
 use crate::mat::{MatFile, MatValue, dims_text};
 use crate::options::ReadOptions;
-use crate::resample::{interpolate_rot, interpolate_vec3, uniform_timeline};
+use crate::resample::{interpolate_rot, interpolate_vec3, intersect, intervals, uniform_timeline};
 use crate::text::{self, Nan};
 use crate::validation::orientation_jump_warning;
 use crate::{
@@ -946,29 +946,6 @@ fn clipping(acce: &Stream<DeviceVec>) -> Option<String> {
     })
 }
 
-/// Slack on a gap limit, s, so that a gap of exactly the limit (e.g. 15 mocap frames at 60 Hz
-/// against 0.25 s) counts as within it despite rounding.
-const GAP_TOLERANCE_S: f64 = 1e-9;
-
-/// Time spans without long gaps: `[start, end]` of each run of samples whose spacing stays
-/// within `max_gap`, with a warning for each split.
-fn intervals(time: &[f64], max_gap: f64, mut on_gap: impl FnMut(usize)) -> Vec<(f64, f64)> {
-    let mut out = Vec::new();
-    let Some(&first) = time.first() else {
-        return out;
-    };
-    let mut start = first;
-    for (i, w) in time.windows(2).enumerate() {
-        if w[1] - w[0] > max_gap + GAP_TOLERANCE_S {
-            out.push((start, w[0]));
-            on_gap(i + 1);
-            start = w[1];
-        }
-    }
-    out.push((start, time[time.len() - 1]));
-    out
-}
-
 /// `seq` with its orientation's `jumps` bridged by the gyro ([`bridge_orientation_jumps`]), and
 /// gravity and linear acceleration derived from the bridged orientation.
 fn bridged(
@@ -1101,25 +1078,6 @@ fn without_lost(mocap: Mocap, lost: impl Fn(usize) -> bool) -> Mocap {
         kept.2.push(q[i]);
     }
     kept
-}
-
-/// Intersection of two sorted lists of disjoint closed intervals.
-fn intersect(a: &[(f64, f64)], b: &[(f64, f64)]) -> Vec<(f64, f64)> {
-    let (mut i, mut j) = (0, 0);
-    let mut out = Vec::new();
-    while i < a.len() && j < b.len() {
-        let start = a[i].0.max(b[j].0);
-        let end = a[i].1.min(b[j].1);
-        if start <= end {
-            out.push((start, end));
-        }
-        if a[i].1 < b[j].1 {
-            i += 1;
-        } else {
-            j += 1;
-        }
-    }
-    out
 }
 
 fn stream_intervals<T>(s: &Stream<T>, max_gap: f64, warnings: &mut Vec<String>) -> Vec<(f64, f64)> {
@@ -1325,10 +1283,7 @@ pub fn read(dir: impl AsRef<Path>, options: &TyrexOptions) -> Result<TyrexRead> 
                 "{}: mocap lost the body {} (up to {longest:.3} s; {}, phone clock): recording \
                  split there",
                 shown(mat),
-                match losses.len() {
-                    1 => "once".to_owned(),
-                    n => format!("{n} times"),
-                },
+                times(losses.len()),
                 spans_text(&losses),
             ));
         }

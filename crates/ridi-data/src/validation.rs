@@ -654,7 +654,7 @@ pub(crate) fn orientation_jump_warning(file: &str, jumps: &[OrientationJump]) ->
             "{file}: the orientation jumps {} ({} turning at up to {} \
              rad/s, more than {ORIENTATION_JUMP_RATE} rad/s faster than the gyro) at {} (phone \
              clock): OS heading corrections or resets, left out of the gyro check",
-            counted(jumps.len(), "time"),
+            crate::error::times(jumps.len()),
             counted(steps, "frame step"),
             short(peak),
             spans_text(&at)

@@ -481,11 +481,19 @@ pub fn convert(
                     source: dir.clone(),
                 });
             }
+            // Named by the source, unless the warning names it (or a file in it) already.
+            let source = dir.display().to_string();
             let warnings = loaded
                 .warnings
                 .into_iter()
                 .chain(warnings)
-                .map(|w| format!("{}: {w}", dir.display()))
+                .map(|w| {
+                    if w.starts_with(&source) {
+                        w
+                    } else {
+                        format!("{source}: {w}")
+                    }
+                })
                 .collect();
             Ok((written, warnings))
         })

@@ -219,23 +219,45 @@ fn evaluate_one(seq: &Sequence, model: &Cascade, opts: &EvalOptions) -> Result<E
     })
 }
 
-/// One warning per sequence whose placement label is not one of the model's classes: the
-/// classifier cannot predict it, so its placement accuracy is 0 (its trajectories are still
-/// worth evaluating). For example: "placement `swing` of Thibaud_Nexus5_NoDist_Swinging is not
-/// one of the model's classes (hand, pocket): its placement accuracy is 0".
+/// One warning per placement label of `seqs` that is not one of the model's classes, naming
+/// its sequences: the classifier cannot predict it, so their placement accuracy is 0 (their
+/// trajectories are still worth evaluating). For example: "placement `swing` of 2 sequences
+/// (Thibaud_Nexus5_NoDist_Swinging, Jakob_Nexus5_NoDist_Swinging) is not one of the model's
+/// classes (hand, pocket): their placement accuracy is 0". A Tyrex motion name under a model of
+/// the Tyrex groups gets the placement map to give.
 pub fn placement_warnings(seqs: &[Sequence], model: &Cascade) -> Vec<String> {
     let classes = model.placement_names();
-    seqs.iter()
-        .filter_map(|s| {
-            let label = s.placement()?;
-            (!classes.iter().any(|c| c == label)).then(|| {
-                format!(
-                    "placement `{label}` of {} is not one of the model's classes ({}): its \
-                     placement accuracy is 0",
-                    s.name(),
-                    classes.join(", ")
-                )
-            })
+    let mut unknown: BTreeMap<&str, Vec<&str>> = BTreeMap::new();
+    for s in seqs {
+        if let Some(label) = s.placement()
+            && !classes.iter().any(|c| c == label)
+        {
+            unknown.entry(label).or_default().push(s.name());
+        }
+    }
+    let tyrex = crate::PlacementMap::tyrex_groups();
+    unknown
+        .into_iter()
+        .map(|(label, names)| {
+            const SHOWN: usize = 3;
+            let mut listed = names[..names.len().min(SHOWN)].join(", ");
+            if names.len() > SHOWN {
+                listed.push_str(&format!(", and {} more", names.len() - SHOWN));
+            }
+            let hint = match tyrex.class_of(label) {
+                Some(class) if classes.iter().any(|c| c == class) => {
+                    " (a Tyrex motion name: give `--placement-map tyrex4`, in Python \
+                     `placement_map=\"tyrex4\"`)"
+                }
+                _ => "",
+            };
+            format!(
+                "placement `{label}` of {} ({listed}) is not one of the model's classes ({}): \
+                 {} placement accuracy is 0{hint}",
+                ridi_data::counted(names.len(), "sequence"),
+                classes.join(", "),
+                if names.len() == 1 { "its" } else { "their" },
+            )
         })
         .collect()
 }

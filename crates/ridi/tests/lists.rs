@@ -253,9 +253,21 @@ fn labels_the_model_does_not_know_are_a_warning_in_the_report() {
         ],
     );
     let test = load(&[&t], Some(&tyrex4), Purpose::Evaluation).unwrap();
-    let want = "placement `swing` of Thibaud_Nexus5_NoDist_Swinging is not one of the model's \
-                classes (hand, pocket): its placement accuracy is 0";
+    let want = "placement `swing` of 1 sequence (Thibaud_Nexus5_NoDist_Swinging) is not one of \
+                the model's classes (hand, pocket): its placement accuracy is 0";
     assert_eq!(ridi::placement_warnings(&test, &model), [want]);
+    // Unmapped Tyrex motion names, one warning per label, with the map that would help.
+    let unmapped = load(&[&t], None, Purpose::Evaluation).unwrap();
+    let warnings = ridi::placement_warnings(&unmapped, &model);
+    assert_eq!(warnings.len(), 2, "{warnings:?}");
+    assert!(
+        warnings[1]
+            .starts_with("placement `Texting` of 1 sequence (Thibaud_Nexus5_NoDist_Texting)")
+            && warnings[1]
+                .ends_with("give `--placement-map tyrex4`, in Python `placement_map=\"tyrex4\"`)"),
+        "{warnings:?}"
+    );
+    assert!(!warnings[0].contains("tyrex4"), "{warnings:?}");
     let opts = EvalOptions {
         methods: vec![Method::Ridi],
         ..EvalOptions::default()

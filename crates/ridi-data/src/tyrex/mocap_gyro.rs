@@ -101,7 +101,7 @@ pub fn mocap_gyro_conflicts(
     let truth = &mocap[from..to];
     let by_gyro = interpolate_rot(gyro_time, &attitude, time);
     // The reader's split tolerance, so that a loss it bridges is judged.
-    let lost = gaps_before(time, max_gap_s + super::GAP_TOLERANCE_S);
+    let lost = gaps_before(time, max_gap_s + crate::resample::GAP_TOLERANCE_S);
 
     // Edges: windows whose two rotations disagree, merged into stretches of frame indices.
     let mut stretches: Vec<(usize, usize)> = Vec::new();
