@@ -52,7 +52,10 @@ pub(crate) fn parse_header(header_line: usize, header: &str, path: &Path) -> Res
                 "expected `N 27` (row and column counts), found `{}`{}",
                 text::snippet(header),
                 // What else a `.txt` of commas or comments may be.
-                if header.starts_with('#') || header.contains(',') {
+                if header.split(',').any(|c| c.trim() == "gyro_x") {
+                    ": this is the header of a RIDI `data.csv`; name the file `.csv` (or \
+                     `.csv.gz`) for it to be read as one"
+                } else if header.starts_with('#') || header.contains(',') {
                     ": if this is a list file (`path,placement` lines), it goes to `--list` of \
                      ridi train and ridi eval (`ridi.read_list` in Python, `Listed::read` in \
                      Rust)"

@@ -284,6 +284,15 @@ fn plain_header_and_row_counts_are_checked() {
         parse_plain(&format!("10 28\n{}", rows.join("\n"))),
         &["data_plain.txt:1: field `columns`"],
     );
+    // A data.csv saved as .txt: named as what it is.
+    let csv = String::from_utf8(valid_csv(10)).unwrap();
+    assert_err(
+        parse_plain(&csv),
+        &[
+            "data_plain.txt:1",
+            "the header of a RIDI `data.csv`; name the file `.csv`",
+        ],
+    );
     assert_err(
         parse_plain(&format!("x 27\n{}", rows.join("\n"))),
         &["data_plain.txt:1: field `rows`"],
