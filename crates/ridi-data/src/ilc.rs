@@ -44,11 +44,12 @@
 //! - Timeline: uniform at [`IlcOptions::rate_hz`] (200 Hz, what the RIDI models expect: the
 //!   50 Hz samples are interpolated linearly, the rotation vector by slerp) over the time every
 //!   IMU stream and the waypoints cover. Nothing is extrapolated: IMU data before the first or
-//!   after the last waypoint (usually under 1.5 s) is dropped, and a dropout of an IMU type
-//!   longer than [`MAX_SENSOR_GAP_S`] stays a gap in the timeline (which tracking refuses and
-//!   [`Sequence::split_at_gaps`] cuts). Times are Unix seconds.
-//! - Ground truth: none with fewer than 2 waypoints (the competition's test paths have none;
-//!   the timeline is then the time every IMU type covers). Otherwise the waypoints, linearly
+//!   after the last waypoint (usually under 1.5 s) is dropped, and a dropout of the
+//!   accelerometer, gyroscope or rotation vector longer than [`MAX_SENSOR_GAP_S`] stays a gap
+//!   in the timeline (which tracking refuses and [`Sequence::split_at_gaps`] cuts). Times are
+//!   Unix seconds.
+//! - Ground truth: none without waypoints (the competition's test paths have none; the
+//!   timeline is then the time every IMU type covers; a single waypoint is refused). Otherwise the waypoints, linearly
 //!   interpolated in time, `z = 0`, in the floor-map frame
 //!   (metres on the floor plan, x right, y up; its heading has nothing to do with the device's
 //!   world frame, so compare trajectories after a 2D alignment). It is a straight line at
@@ -73,7 +74,7 @@
 //! without a line break), a record line that is not `unix_ms<TAB>TYPE_...`, timestamps of one
 //! type that go back or leave a gap longer than the validation's `max_gap_s` (repeated
 //! timestamps keep their first record), a rotation vector longer than 1, a missing accelerometer,
-//! gyroscope or rotation vector, waypoints that do not overlap the IMU
+//! gyroscope or rotation vector, a single waypoint, waypoints that do not overlap the IMU
 //! data, a last record without a line break after it (a file cut off while being written;
 //! complete files end with the `#<TAB>endTime` line), a value beyond its channel's physical
 //! bound (accelerometer, gyroscope, magnetic field, waypoint) and a record type in the wrong unit
@@ -111,9 +112,10 @@ use crate::{
 /// Placement label of every path unless [`IlcOptions::placement`] says otherwise.
 pub const DEFAULT_PLACEMENT: &str = "hand";
 
-/// The longest interval between two records of an IMU type that the timeline is resampled
-/// across, seconds: 0.1, five records at the competition's 50 Hz (its shared walks never
-/// exceed one, 20 ms). Longer dropouts stay gaps in the timeline.
+/// The longest interval between two records of the accelerometer, gyroscope or rotation
+/// vector that the timeline is resampled across, seconds: 0.1, five records at the
+/// competition's 50 Hz (its shared walks never exceed one, 20 ms). Longer dropouts stay gaps
+/// in the timeline.
 pub const MAX_SENSOR_GAP_S: f64 = 0.1;
 
 /// How path files are turned into sequences.
@@ -383,7 +385,15 @@ pub fn parse(bytes: &[u8], path: &Path, options: &IlcOptions) -> Result<IlcPath>
         }
     }
     let wp = &streams[WAYPOINT];
-    // Two waypoints make a ground truth; fewer (a competition test path has none) none.
+    // Two waypoints make a ground truth; a path without any (the competition's test paths) has
+    // none. One alone is a damaged walk rather than a test path: refused, not read without.
+    if wp.time.len() == 1 {
+        return Err(DataError::format(
+            Location::file(path).with_field(KINDS[WAYPOINT].name),
+            "1 TYPE_WAYPOINT record: the ground truth needs at least 2 (a path without any is \
+             read without ground truth)",
+        ));
+    }
     let has_truth = wp.time.len() >= 2;
     let limits = &options.validation;
     for (k, s) in streams.iter().enumerate() {
@@ -422,17 +432,7 @@ pub fn parse(bytes: &[u8], path: &Path, options: &IlcOptions) -> Result<IlcPath>
         .collect::<Result<Vec<WorldFromDevice>>>()?;
 
     let (start, end) = span(&streams, has_truth, path)?;
-    // Not resampled across a dropout of any IMU type: the timeline keeps the hole, which
-    // tracking refuses and `split_at_gaps` cuts, as in any other format.
-    let mut spans = vec![(start, end)];
-    for k in [ACCE, GYRO, RV, MAGNET] {
-        if !streams[k].time.is_empty() {
-            spans = intersect(
-                &spans,
-                &intervals(&streams[k].time, MAX_SENSOR_GAP_S, |_| {}),
-            );
-        }
-    }
+    let spans = imu_spans(&streams, (start, end), limits.max_gap_s, path)?;
     let time: Vec<f64> = spans
         .iter()
         .flat_map(|&(a, b)| uniform_timeline(a, b, options.rate_hz))
@@ -567,6 +567,60 @@ fn parse_records(content: &str, path: &Path) -> Result<([Stream; 5], Header)> {
         " (complete path files end with a `#\tendTime` line)",
     )?;
     Ok((streams, header))
+}
+
+/// The stretches of `span` where the accelerometer, gyroscope and rotation vector all have
+/// records without a dropout longer than [`MAX_SENSOR_GAP_S`]: the timeline is not resampled
+/// across one (it keeps the hole, which tracking refuses and `split_at_gaps` cuts, as in any
+/// other format). Stretches shorter than [`MAX_SENSOR_GAP_S`] (a stray record beside a
+/// dropout) are left out; a file shorter than that is kept whole. The magnetometer, which
+/// tracking does not use, is interpolated across its own dropouts. A hole longer than
+/// `max_gap_s` where dropouts of several types overlap is an error, as a gap that long in one
+/// type is.
+fn imu_spans(
+    streams: &[Stream; 5],
+    span: (f64, f64),
+    max_gap_s: f64,
+    path: &Path,
+) -> Result<Vec<(f64, f64)>> {
+    let mut spans = vec![span];
+    for k in [ACCE, GYRO, RV] {
+        spans = intersect(
+            &spans,
+            &intervals(&streams[k].time, MAX_SENSOR_GAP_S, |_| {}),
+        );
+    }
+    // Beside a dropout, a stray record is no stretch of its own (a short file alone is).
+    if spans.iter().any(|(a, b)| b - a >= MAX_SENSOR_GAP_S) {
+        spans.retain(|(a, b)| b - a >= MAX_SENSOR_GAP_S);
+    }
+    let ms = |t: f64| format!("{:.0}", t * 1000.0);
+    if spans.len() != 1 && spans.iter().all(|(a, b)| b - a < MAX_SENSOR_GAP_S) {
+        return Err(DataError::format(
+            Location::file(path).with_field("unix_ms"),
+            format!(
+                "no stretch of {MAX_SENSOR_GAP_S} s from {} to {} ms where the accelerometer, \
+                 gyroscope and rotation vector all record without a dropout",
+                ms(span.0),
+                ms(span.1)
+            ),
+        ));
+    }
+    if let Some(w) = spans.windows(2).find(|w| w[1].0 - w[0].1 > max_gap_s) {
+        return Err(DataError::format(
+            Location::file(path).with_field("unix_ms"),
+            format!(
+                "the accelerometer, gyroscope and rotation vector together have no data for \
+                 {:.3} s, from {} to {} ms (dropouts of several types overlapping): longer than \
+                 the {} s a recording may pause",
+                w[1].0 - w[0].1,
+                ms(w[0].1),
+                ms(w[1].0),
+                crate::short(max_gap_s)
+            ),
+        ));
+    }
+    Ok(spans)
 }
 
 /// The time every IMU stream and (`with_waypoints`) the waypoints cover.
@@ -882,15 +936,26 @@ mod tests {
     #[test]
     fn waypoint_problems_are_reported() {
         let good = synthetic(3);
-        // One waypoint, or none (a competition test path): no ground truth, the IMU's span.
+        // One waypoint is a damaged walk; none (a competition test path) no ground truth, the
+        // timeline over the IMU's span (here a second longer than the waypoints').
         let only_first = map_lines(&good, |l| {
             (!l.contains("TYPE_WAYPOINT") || l.starts_with("1574559495000")).then(|| l.to_owned())
         });
-        let read = parse_str(&only_first).unwrap();
-        assert!(read.sequence.ground_truth().is_none());
-        assert_eq!(read.waypoints.len(), 1);
-        let with_truth = parse_str(&good).unwrap().sequence;
-        assert!(read.sequence.len() >= with_truth.len());
+        assert_eq!(
+            err(&only_first),
+            "p/abc.txt: field `TYPE_WAYPOINT`: 1 TYPE_WAYPOINT record: the ground truth needs at \
+             least 2 (a path without any is read without ground truth)"
+        );
+        let late = map_lines(&good, |l| {
+            (!l.starts_with("1574559495000\tTYPE_WAYPOINT")).then(|| l.to_owned())
+        });
+        let with_truth = parse_str(&late).unwrap().sequence;
+        let none = map_lines(&good, |l| {
+            (!l.contains("TYPE_WAYPOINT")).then(|| l.to_owned())
+        });
+        let read = parse_str(&none).unwrap();
+        assert!(read.sequence.ground_truth().is_none() && read.waypoints.is_empty());
+        assert!(read.sequence.time()[0] < with_truth.time()[0] - 0.9);
         let same = good.replace(
             "1574559496000\tTYPE_WAYPOINT\t1\t5",
             "1574559495000\tTYPE_WAYPOINT\t1\t5",
@@ -961,6 +1026,42 @@ mod tests {
             (!(hole && l.contains("TYPE_GYROSCOPE\t"))).then(|| l.to_owned())
         });
         let widest = |s: &Sequence| s.time().windows(2).map(|w| w[1] - w[0]).fold(0.0, f64::max);
+        // `good` without the `ty` records from `from` to `to` (unix ms).
+        let drop = |ty: &str, from: i64, to: i64| {
+            let ty = format!("{ty}\t");
+            map_lines(&good, |l| {
+                let t: i64 = l.split('\t').next().unwrap().parse().unwrap_or(0);
+                (!((from..to).contains(&t) && l.contains(&ty))).then(|| l.to_owned())
+            })
+        };
+        // The magnetometer is interpolated across its own dropout.
+        let mag = parse_str(&drop(
+            "TYPE_MAGNETIC_FIELD",
+            1_574_559_496_000,
+            1_574_559_496_500,
+        ));
+        assert!(widest(&mag.unwrap().sequence) < 0.0051);
+        // Overlapping dropouts leaving no data for over 1 s: named as such.
+        let both = map_lines(
+            &drop("TYPE_GYROSCOPE", 1_574_559_496_000, 1_574_559_496_600),
+            |l| {
+                let t: i64 = l.split('\t').next().unwrap().parse().unwrap_or(0);
+                let hole = (1_574_559_496_580..1_574_559_497_200).contains(&t);
+                (!(hole && l.contains("TYPE_ACCELEROMETER\t"))).then(|| l.to_owned())
+            },
+        );
+        let e = err(&both);
+        assert!(
+            e.contains(
+                "field `unix_ms`: the accelerometer, gyroscope and rotation vector \
+                        together have no data for 1.2"
+            ),
+            "{e}"
+        );
+        // A stray record before a dropout at the start is left out, not a frame of its own.
+        let stray = drop("TYPE_GYROSCOPE", 1_574_559_495_010, 1_574_559_495_400);
+        let seq = parse_str(&stray).unwrap().sequence;
+        assert!(widest(&seq) < 0.0051, "{}", widest(&seq));
         let seq = parse_str(&dropout).unwrap().sequence;
         assert!((widest(&seq) - 0.52).abs() < 0.006, "{}", widest(&seq));
         assert_eq!(seq.split_at_gaps(0.1, 0.0).unwrap().parts.len(), 2);

@@ -213,6 +213,30 @@ pub(crate) fn intersect(a: &[(f64, f64)], b: &[(f64, f64)]) -> Vec<(f64, f64)> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn intervals_split_only_at_long_gaps() {
+        let t = [0.0, 0.1, 0.2, 0.7, 0.8, 0.9];
+        let mut gaps = Vec::new();
+        assert_eq!(
+            intervals(&t, 0.25, |i| gaps.push(i)),
+            [(0.0, 0.2), (0.7, 0.9)]
+        );
+        assert_eq!(gaps, [3]);
+        // Exactly the limit is not a split, despite rounding in 15 / 60.
+        let t: Vec<f64> = [0.0, 15.0, 16.0].iter().map(|f| f / 60.0).collect();
+        assert_eq!(intervals(&t, 0.25, |_| panic!("split")).len(), 1);
+        assert!(intervals(&[], 1.0, |_| {}).is_empty());
+    }
+
+    #[test]
+    fn intersection_of_interval_lists() {
+        let a = [(0.0, 10.0), (20.0, 30.0)];
+        let b = [(5.0, 25.0), (28.0, 40.0)];
+        assert_eq!(intersect(&a, &b), [(5.0, 10.0), (20.0, 25.0), (28.0, 30.0)]);
+        assert!(intersect(&a, &[]).is_empty());
+        assert_eq!(intersect(&[(0.0, 1.0)], &[(1.0, 2.0)]), [(1.0, 1.0)]);
+    }
     use ridi_frames::{DeviceVec, WorldFromDevice};
 
     #[test]

@@ -488,7 +488,10 @@ pub fn convert(
                 .into_iter()
                 .chain(warnings)
                 .map(|w| {
-                    if w.starts_with(&source) {
+                    let names_it = w.strip_prefix(&source).is_some_and(|rest| {
+                        rest.starts_with(':') || rest.starts_with(std::path::MAIN_SEPARATOR)
+                    });
+                    if names_it {
                         w
                     } else {
                         format!("{source}: {w}")
