@@ -4,9 +4,10 @@ behind `ridi_data::MIN_GYRO_AGREEMENT`.
 For each sequence the readers give, the agreement of the gyro with the rotation rate of the
 recorded orientation, as `Validation::check_gyro_scale` computes it (the sum over steps of the
 two rate vectors' dot product over the sum of their magnitudes' product, the steps of
-orientation jumps left out), as recorded, with the gyro's sign flipped, and with the
+orientation jumps left out), as recorded, with the gyro's sign flipped, with the
 quaternion's components read in the other orders a user may give (x, y, z, w read as
-w, x, y, z, and the reverse). With `--stream`, instead, streams started every 2 s into each
+w, x, y, z, and the reverse), and with its conjugate (device-from-world given for
+world-from-device). With `--stream`, instead, streams started every 2 s into each
 recording as `ridi::LiveTracker` sums them: the lowest agreement once 5 s and once 10 s
 (`ridi::STREAM_GYRO_CHECK_S`) have passed, and how many of the reordered quaternions' streams
 fall under `ridi::STREAM_MIN_GYRO_AGREEMENT` (0) after 10 s. Sequences the reader refuses (the
@@ -93,7 +94,8 @@ def main(paths):
                                        for order in ([1, 2, 3, 0], [3, 0, 1, 2])]))
             else:
                 row = (agreement(t, g, q), agreement(t, -g, q),
-                       agreement(t, g, q[:, [1, 2, 3, 0]]), agreement(t, g, q[:, [3, 0, 1, 2]]))
+                       agreement(t, g, q[:, [1, 2, 3, 0]]), agreement(t, g, q[:, [3, 0, 1, 2]]),
+                       agreement(t, g, q * np.array([1, -1, -1, -1])))
             rows.append(row)
             print(f"{s.name:48s} " + " ".join(f"{x:+.2f}" for x in row[:2])
                   + (f" reordered refused {np.mean(row[2][~np.isnan(row[2])] < 0):.0%}"
@@ -109,10 +111,12 @@ def main(paths):
               f"{len(reordered)} streams under 0 after 10 s")
         return
     a = np.array(rows)
-    refused_share = np.mean(a[:, 2:] < 0.5)
+    refused_share = np.mean(a[:, 2:4] < 0.5)
     print(f"\n{len(rows)} sequences: as recorded {a[:, 0].min():+.2f}..{a[:, 0].max():+.2f}; "
           f"sign flipped {a[:, 1].min():+.2f}..{a[:, 1].max():+.2f}; other quaternion orders "
-          f"{a[:, 2:].min():+.2f}..{a[:, 2:].max():+.2f}, {refused_share:.0%} of them under 0.5")
+          f"{a[:, 2:4].min():+.2f}..{a[:, 2:4].max():+.2f}, {refused_share:.0%} of them under 0.5; "
+          f"conjugate {a[:, 4].min():+.2f}..{a[:, 4].max():+.2f}, "
+          f"{np.mean(a[:, 4] < 0.5):.0%} under 0.5")
 
 
 if __name__ == "__main__":
