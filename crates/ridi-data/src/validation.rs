@@ -531,16 +531,10 @@ pub(crate) fn step_rates<'a>(
         (dt > 0.0).then(|| {
             // The step's rotation in the device frame (world-from-device q_k = q_{k-1} * step),
             // as a rotation vector: the rate the gyro should read, direction included.
-            let [w0, x, y, z] = (orientation[k - 1].inverse() * orientation[k]).to_wxyz();
-            let v = ridi_frames::nalgebra::Vector3::new(x, y, z) * w0.signum();
-            let angle = 2.0 * v.norm().atan2(w0.abs());
-            let rate = if v.norm() > 0.0 {
-                v * (angle / v.norm() / dt)
-            } else {
-                v
-            };
+            let step = orientation[k - 1].inverse() * orientation[k];
+            let rate = step.quaternion().scaled_axis() / dt;
             let gyro_mean = (*gyro[k - 1].vector() + *gyro[k].vector()) * 0.5;
-            (k, dt, angle / dt, gyro_mean.norm(), gyro_mean.dot(&rate))
+            (k, dt, rate.norm(), gyro_mean.norm(), gyro_mean.dot(&rate))
         })
     })
 }

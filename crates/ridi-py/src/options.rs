@@ -167,8 +167,9 @@ impl Inputs {
             // Errors, warnings and reports name sequences by their names, as lists do by
             // their entries: two of one name (arrays built without `name=`) could not be told
             // apart.
+            let mut first = std::collections::HashMap::new();
             for (j, later) in seqs.iter().enumerate() {
-                if let Some(i) = seqs[..j].iter().position(|s| s.name() == later.name()) {
+                if let Some(i) = first.insert(later.name(), j) {
                     return Err(errors::value(format!(
                         "sequences {i} and {j} are both named `{}`: give each its own name \
                          (`ridi.Sequence(..., name=...)`), by which errors and reports name them",

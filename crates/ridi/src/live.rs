@@ -553,14 +553,16 @@ impl StreamCheck {
             };
         }
         self.last_time = Some(sample.time);
-        let recorded = sample
-            .recorded
-            .map(|r| (sample.time, sample.gyro, r.orientation));
-        if let (Some((t0, g0, q0)), Some((t1, g1, q1))) = (self.last_recorded, recorded) {
-            self.gyro_fit.add_steps(&[t0, t1], &[g0, g1], &[q0, q1]);
-            self.gyro_since.get_or_insert(t0);
+        if !self.gyro_judged_whole {
+            let recorded = sample
+                .recorded
+                .map(|r| (sample.time, sample.gyro, r.orientation));
+            if let (Some((t0, g0, q0)), Some((t1, g1, q1))) = (self.last_recorded, recorded) {
+                self.gyro_fit.add_steps(&[t0, t1], &[g0, g1], &[q0, q1]);
+                self.gyro_since.get_or_insert(t0);
+            }
+            self.last_recorded = recorded;
         }
-        self.last_recorded = recorded;
         let Some(previous) = previous else {
             return Ok(());
         };
@@ -584,13 +586,21 @@ impl StreamCheck {
                 m.pop(low, high);
             }
         }
-        self.refused = None;
-        let since = self.gyro_since.map_or(0.0, |t| sample.time - t);
-        let against = (since >= STREAM_GYRO_CHECK_S && !self.gyro_judged_whole)
-            .then(|| self.gyro_fit.agreement())
-            .flatten()
-            .filter(|&a| a < STREAM_MIN_GYRO_AGREEMENT);
-        let why = if let Some(agreement) = against {
+        self.refused = self
+            .gyro_refusal(sample.time)
+            .or_else(|| self.median_refusal(limits));
+        match &self.refused {
+            Some(why) => Err(PipelineError::Live(why.clone())),
+            None => Ok(()),
+        }
+    }
+
+    /// Why the gyro is refused at `time`: it turns against the recorded orientation, judged
+    /// from [`STREAM_GYRO_CHECK_S`] of samples with one on.
+    fn gyro_refusal(&self, time: f64) -> Option<String> {
+        let since = time - self.gyro_since?;
+        let agreement = self.gyro_fit.agreement()?;
+        (since >= STREAM_GYRO_CHECK_S && agreement < STREAM_MIN_GYRO_AGREEMENT).then(|| {
             let e = ridi_data::SequenceError::GyroDirection {
                 agreement,
                 min: STREAM_MIN_GYRO_AGREEMENT,
@@ -599,21 +609,20 @@ impl StreamCheck {
                 "the stream's {} s with a recorded orientation: {e}",
                 ridi_data::short(since)
             )
-        } else {
-            if self.recent.len() < STREAM_CHECK_SAMPLES {
-                return Ok(());
-            }
-            let Some(column) = self
-                .medians
-                .iter()
-                .position(|m| m.median_low() || m.median_high())
-            else {
-                return Ok(());
-            };
-            self.verdict(column, limits)
-        };
-        self.refused = Some(why.clone());
-        Err(PipelineError::Live(why))
+        })
+    }
+
+    /// Why the last [`STREAM_CHECK_SAMPLES`] are refused, once there are that many: a median
+    /// beyond its bounds.
+    fn median_refusal(&self, limits: &Validation) -> Option<String> {
+        if self.recent.len() < STREAM_CHECK_SAMPLES {
+            return None;
+        }
+        let column = self
+            .medians
+            .iter()
+            .position(|m| m.median_low() || m.median_high())?;
+        Some(self.verdict(column, limits))
     }
 
     /// Why the last second's median of quantity `column` ([`Self::properties`]' order) lies

@@ -51,9 +51,8 @@ pub(crate) fn sample_sequence(name: &str, n: usize, ground_truth: bool, magnet: 
         gyro: (0..n)
             .map(|i| {
                 let (a, b) = if i + 1 < n { (i, i + 1) } else { (i - 1, i) };
-                let [w, x, y, z] = (orientation[a].inverse() * orientation[b]).to_wxyz();
-                let v = Vector3::new(x, y, z) * w.signum();
-                let rate = v * (2.0 * v.norm().atan2(w.abs()) / v.norm().max(1e-300) * 200.0);
+                let step = orientation[a].inverse() * orientation[b];
+                let rate = step.quaternion().scaled_axis() * 200.0;
                 DeviceVec::new(rate.x, rate.y, rate.z) + wave(i, 0.37) * 0.2
             })
             .collect(),
