@@ -4,6 +4,7 @@
 pub mod archive;
 pub mod checksum;
 pub mod download;
+pub mod features;
 pub mod fetch;
 pub mod manifest;
 pub mod ronin_lists;

@@ -56,6 +56,10 @@ enum Task {
     /// Check that the workspace's rust-version is at least that of every package in Cargo.lock
     /// (`cargo metadata`) and that the README names it.
     RustVersion,
+    /// Check that CI's three builds (the workspace's tests, ridi without default features, the
+    /// Python package) turn on the same features of every dependency they share, so that they
+    /// share its artifacts in target/ (`cargo tree`, no build).
+    Features,
     /// Print the sha256sum list of every file under a folder (sorted), e.g. to regenerate
     /// datasets/<name>.sha256.
     Checksums { folder: PathBuf },
@@ -297,6 +301,7 @@ fn run(cli: Cli) -> Result<()> {
         }
         Task::Tidy => xtask::tidy::run(&xtask::workspace_root())?,
         Task::RustVersion => xtask::rust_version::run(&xtask::workspace_root())?,
+        Task::Features => xtask::features::run(&xtask::workspace_root())?,
         Task::Checksums { folder } => {
             let list = checksum::list_tree(&folder)?;
             print!("{}", checksum::format_list(&list));
