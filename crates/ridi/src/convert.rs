@@ -31,6 +31,8 @@ pub struct Converted {
     pub device: Option<DeviceInfo>,
     /// The source it was read from (a file or a folder).
     pub source: PathBuf,
+    /// Whether it has ground truth; the list files name only those that do.
+    pub ground_truth: bool,
 }
 
 /// What [`convert`] wrote.
@@ -372,11 +374,11 @@ fn tyrex_subject(name: &str) -> Option<&str> {
 /// device whose key is one of those (ignoring case, as some file systems do) gets no list, with a
 /// warning; models with the same key (`Nexus 5`, `NEXUS-5`) share one.
 fn device_lists<'a>(
-    sequences: &'a [Converted],
+    sequences: &[&'a Converted],
     taken: &BTreeMap<String, Vec<&'a Converted>>,
 ) -> (BTreeMap<String, Vec<&'a Converted>>, Vec<String>) {
     let mut lists: BTreeMap<String, Vec<&Converted>> = BTreeMap::new();
-    for c in sequences {
+    for &c in sequences {
         if let Some(d) = &c.device {
             lists.entry(d.key()).or_default().push(c);
         }
@@ -400,7 +402,9 @@ fn device_lists<'a>(
 /// Converts every sequence under `source` into `<out>/<name>/processed/data.csv` (with the
 /// sidecar `data.csv.meta` when the sequence names its device, see
 /// [`ridi_data::sidecar_path`]) and writes list files (`name,placement` per line, relative to
-/// `out`): `list_all.txt`, for Tyrex sources one `list_<person>.txt` per person, and one
+/// `out`) of the sequences with ground truth, which training and evaluation need (the others,
+/// such as the Indoor Location Competition's test paths, are in none, with a warning):
+/// `list_all.txt`, for Tyrex sources one `list_<person>.txt` per person, and one
 /// `list_<device>.txt` per device the sequences name ([`DeviceInfo::key`]: `list_nexus5.txt`,
 /// `list_iphone4s.txt`). The placement of a Tyrex run is its motion name, that of an Indoor
 /// Location Competition path `hand`, that of a RIDI sequence the label list files directly in
@@ -479,6 +483,7 @@ pub fn convert(
                     frames: seq.len(),
                     device: seq.device().cloned(),
                     source: dir.clone(),
+                    ground_truth: seq.ground_truth().is_some(),
                 });
             }
             // Named by the source, unless the warning names it (or a file in it) already.
@@ -545,14 +550,34 @@ pub fn convert(
         staging.remove(&sidecar_path(&rel));
     }
 
+    // Lists are what training and evaluation read, and both need ground truth.
+    let (listable, unlisted): (Vec<&Converted>, Vec<&Converted>) =
+        summary.sequences.iter().partition(|c| c.ground_truth);
     let mut lists: BTreeMap<String, Vec<&Converted>> = BTreeMap::new();
-    for c in &summary.sequences {
+    for &c in &listable {
         lists.entry("all".into()).or_default().push(c);
         if let Some(subject) = tyrex_subject(&c.name) {
             lists.entry(subject.to_string()).or_default().push(c);
         }
     }
-    let (by_device, warnings) = device_lists(&summary.sequences, &lists);
+    if !unlisted.is_empty() {
+        let names: Vec<&str> = unlisted.iter().map(|c| c.name.as_str()).collect();
+        let shown = match names.len() {
+            1..=3 => names.join(", "),
+            n => format!("{}, ... ({} more)", names[..2].join(", "), n - 2),
+        };
+        let no_lists = if listable.is_empty() {
+            "no list file written"
+        } else {
+            "left out of the list files"
+        };
+        summary.warnings.push(format!(
+            "{} without ground truth ({shown}): {no_lists}, as training and evaluation need it; \
+             `ridi track` takes each one's data.csv",
+            counted(unlisted.len(), "sequence"),
+        ));
+    }
+    let (by_device, warnings) = device_lists(&listable, &lists);
     summary.warnings.extend(warnings);
     lists.extend(by_device);
     let mut written_lists = Vec::new();

@@ -609,7 +609,48 @@ fn tyrex_runs_without_motion_capture_are_skipped_or_converted_with_a_warning() {
             "{from:?}: {:?}",
             summary.warnings
         );
+        // Lists are for training and evaluation, which need ground truth.
+        assert!(summary.lists.is_empty(), "{:?}", summary.lists);
+        assert!(
+            summary.warnings.iter().any(|w| w.contains(
+                "2 sequences without ground truth (Ann_Nexus5_NoDist_AR, \
+                 Ann_Nexus5_NoDist_Texting): no list file written"
+            )),
+            "{from:?}: {:?}",
+            summary.warnings
+        );
+        assert!(!file_names(&out).iter().any(|f| f.starts_with("list_")));
     }
+}
+
+/// A sequence without ground truth (the competition's test paths) is converted for tracking
+/// and left out of the lists, which training and evaluation read; one warning names it.
+#[test]
+fn sequences_without_ground_truth_are_in_no_list() {
+    let dir = tempfile::tempdir().unwrap();
+    let src = sources_named(dir.path(), &["walk"]);
+    let mut parts = read_sequence(src.join("walk"), &ReadOptions::default())
+        .unwrap()
+        .into_parts();
+    parts.ground_truth = None;
+    parts.name = "test_path".into();
+    let folder = src.join("test_path").join("processed");
+    std::fs::create_dir_all(&folder).unwrap();
+    write_ridi_csv(&Sequence::new(parts).unwrap(), folder.join("data.csv")).unwrap();
+    let out = dir.path().join("out");
+    let summary = convert(&src, &out, &ConvertOptions::default()).unwrap();
+    assert_eq!(summary.sequences.len(), 2);
+    assert!(out.join("test_path/processed/data.csv").is_file());
+    let list = std::fs::read_to_string(out.join("list_all.txt")).unwrap();
+    let listed: Vec<&str> = list.lines().filter(|l| !l.starts_with('#')).collect();
+    assert_eq!(listed, ["walk,"], "{list}");
+    assert!(
+        summary.warnings.iter().any(|w| w
+            == "1 sequence without ground truth (test_path): left out of the list files, as \
+                training and evaluation need it; `ridi track` takes each one's data.csv"),
+        "{:?}",
+        summary.warnings
+    );
 }
 
 /// A sequence whose name a list file cannot hold (read back as a comment, as two fields or two
