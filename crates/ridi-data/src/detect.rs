@@ -218,7 +218,9 @@ pub fn detect(path: impl AsRef<Path>) -> Result<Format> {
 /// Tyrex one warns, in [`TyrexRead::warnings`](crate::tyrex::TyrexRead::warnings): splits at
 /// mocap or sensor gaps, parts shorter than
 /// [`TyrexOptions::min_part_s`](crate::tyrex::TyrexOptions::min_part_s) that were dropped, a
-/// clipped accelerometer, an unknown motion (so no placement). A run read here can come back as
+/// clipped accelerometer, an unknown motion (so no placement); so does the Indoor Location
+/// Competition one, in [`IlcPath::warnings`](crate::ilc::IlcPath::warnings): sensor dropouts
+/// kept as gaps, stray records beside them left out, magnetometer dropouts interpolated. A run read here can come back as
 /// one clean-looking sequence while its reader warned a dozen times
 /// (`Guillaume_Nexus5_NoDist_AR`: 12 warnings, 4 dropped parts). To get them, call
 /// [`tyrex::read`](crate::tyrex::read) with `TyrexOptions::from(opts)` (the options this

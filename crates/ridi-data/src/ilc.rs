@@ -46,8 +46,9 @@
 //!   IMU stream and the waypoints cover. Nothing is extrapolated: IMU data before the first or
 //!   after the last waypoint (usually under 1.5 s) is dropped, and a dropout of the
 //!   accelerometer, gyroscope or rotation vector longer than [`MAX_SENSOR_GAP_S`] stays a gap
-//!   in the timeline (which tracking refuses and [`Sequence::split_at_gaps`] cuts). Times are
-//!   Unix seconds.
+//!   in the timeline (which tracking refuses and [`Sequence::split_at_gaps`] cuts), named in
+//!   [`IlcPath::warnings`] with the stray records beside one that were left out and the
+//!   magnetometer's own dropouts (interpolated across). Times are Unix seconds.
 //! - Ground truth: none without waypoints (the competition's test paths have none; the
 //!   timeline is then the time every IMU type covers; a single waypoint is refused). Otherwise the waypoints, linearly
 //!   interpolated in time, `z = 0`, in the floor-map frame
@@ -179,6 +180,10 @@ pub struct IlcPath {
     pub site: Option<String>,
     /// `FloorName` from the header, when given.
     pub floor: Option<String>,
+    /// What the reader did that the sequence does not show, one line each, naming the file:
+    /// dropouts kept as gaps, stray records beside them left out (times in the file's
+    /// `unix_ms`), magnetometer dropouts interpolated across.
+    pub warnings: Vec<String>,
 }
 
 /// A record type that is read: its name, the names of its values (for errors), how many
@@ -432,7 +437,15 @@ pub fn parse(bytes: &[u8], path: &Path, options: &IlcOptions) -> Result<IlcPath>
         .collect::<Result<Vec<WorldFromDevice>>>()?;
 
     let (start, end) = span(&streams, has_truth, path)?;
-    let spans = imu_spans(&streams, (start, end), limits.max_gap_s, path)?;
+    let mut warnings = Vec::new();
+    let spans = imu_spans(
+        &streams,
+        (start, end),
+        limits.max_gap_s,
+        path,
+        &mut warnings,
+    )?;
+    warnings.extend(magnet_dropouts(&streams[MAGNET], &spans, path));
     let time: Vec<f64> = spans
         .iter()
         .flat_map(|&(a, b)| uniform_timeline(a, b, options.rate_hz))
@@ -475,6 +488,7 @@ pub fn parse(bytes: &[u8], path: &Path, options: &IlcOptions) -> Result<IlcPath>
         device: header.device(),
         site: header.site,
         floor: header.floor,
+        warnings,
     })
 }
 
@@ -582,6 +596,7 @@ fn imu_spans(
     span: (f64, f64),
     max_gap_s: f64,
     path: &Path,
+    warnings: &mut Vec<String>,
 ) -> Result<Vec<(f64, f64)>> {
     let mut spans = vec![span];
     for k in [ACCE, GYRO, RV] {
@@ -591,8 +606,11 @@ fn imu_spans(
         );
     }
     // Beside a dropout, a stray record is no stretch of its own (a short file alone is).
+    let mut strays = Vec::new();
     if spans.iter().any(|(a, b)| b - a >= MAX_SENSOR_GAP_S) {
-        spans.retain(|(a, b)| b - a >= MAX_SENSOR_GAP_S);
+        (spans, strays) = spans
+            .into_iter()
+            .partition(|(a, b)| b - a >= MAX_SENSOR_GAP_S);
     }
     let ms = |t: f64| format!("{:.0}", t * 1000.0);
     if spans.len() != 1 && spans.iter().all(|(a, b)| b - a < MAX_SENSOR_GAP_S) {
@@ -620,7 +638,60 @@ fn imu_spans(
             ),
         ));
     }
+    let file = crate::shown(path);
+    if let Some(w) = spans
+        .windows(2)
+        .max_by(|a, b| (a[1].0 - a[0].1).total_cmp(&(b[1].0 - b[0].1)))
+    {
+        warnings.push(format!(
+            "{file}: dropouts of the accelerometer, gyroscope or rotation vector over \
+             {MAX_SENSOR_GAP_S} s leave {} in the timeline (the longest {:.3} s, from {} to {} \
+             ms), which `ridi track` refuses and `ridi convert --split-at-gaps \
+             {MAX_SENSOR_GAP_S}` cuts",
+            crate::counted(spans.len() - 1, "gap"),
+            w[1].0 - w[0].1,
+            ms(w[0].1),
+            ms(w[1].0)
+        ));
+    }
+    if let Some(first) = strays.first() {
+        warnings.push(format!(
+            "{file}: {} of records shorter than {MAX_SENSOR_GAP_S} s beside a dropout left \
+             out (the first from {} to {} ms)",
+            crate::counted(strays.len(), "stretch"),
+            ms(first.0),
+            ms(first.1)
+        ));
+    }
     Ok(spans)
+}
+
+/// A warning when the magnetometer, which is interpolated across its dropouts (tracking does
+/// not use it; the RIDI-MAG baseline does), has a hole longer than [`MAX_SENSOR_GAP_S`] inside
+/// the kept `spans` (a hole where every sensor stops is a gap of the timeline, not filled).
+fn magnet_dropouts(magnet: &Stream, spans: &[(f64, f64)], path: &Path) -> Option<String> {
+    let (mut holes, mut longest) = (0, 0.0f64);
+    for hole in intervals(&magnet.time, MAX_SENSOR_GAP_S, |_| {})
+        .windows(2)
+        .map(|w| (w[0].1, w[1].0))
+    {
+        let filled = spans
+            .iter()
+            .map(|&(a, b)| hole.1.min(b) - hole.0.max(a))
+            .fold(0.0, f64::max);
+        if filled > MAX_SENSOR_GAP_S {
+            holes += 1;
+            longest = longest.max(filled);
+        }
+    }
+    (holes > 0).then(|| {
+        format!(
+            "{}: the magnetometer drops out {} for over {MAX_SENSOR_GAP_S} s (the longest \
+             {longest:.3} s): interpolated across (only the RIDI-MAG baseline uses it)",
+            crate::shown(path),
+            crate::error::times(holes)
+        )
+    })
 }
 
 /// The time every IMU stream and (`with_waypoints`) the waypoints cover.
@@ -1040,7 +1111,15 @@ mod tests {
             1_574_559_496_000,
             1_574_559_496_500,
         ));
-        assert!(widest(&mag.unwrap().sequence) < 0.0051);
+        let mag = mag.unwrap();
+        assert!(widest(&mag.sequence) < 0.0051);
+        assert_eq!(
+            mag.warnings,
+            [
+                "p/abc.txt: the magnetometer drops out once for over 0.1 s (the longest 0.520 s): \
+              interpolated across (only the RIDI-MAG baseline uses it)"
+            ]
+        );
         // Overlapping dropouts leaving no data for over 1 s: named as such.
         let both = map_lines(
             &drop("TYPE_GYROSCOPE", 1_574_559_496_000, 1_574_559_496_600),
@@ -1060,13 +1139,55 @@ mod tests {
         );
         // A stray record before a dropout at the start is left out, not a frame of its own.
         let stray = drop("TYPE_GYROSCOPE", 1_574_559_495_010, 1_574_559_495_400);
-        let seq = parse_str(&stray).unwrap().sequence;
-        assert!(widest(&seq) < 0.0051, "{}", widest(&seq));
-        let seq = parse_str(&dropout).unwrap().sequence;
-        assert!((widest(&seq) - 0.52).abs() < 0.006, "{}", widest(&seq));
-        assert_eq!(seq.split_at_gaps(0.1, 0.0).unwrap().parts.len(), 2);
-        let whole = parse_str(&good).unwrap().sequence;
-        assert!(widest(&whole) < 0.0051, "{}", widest(&whole));
+        let read = parse_str(&stray).unwrap();
+        assert!(
+            widest(&read.sequence) < 0.0051,
+            "{}",
+            widest(&read.sequence)
+        );
+        assert_eq!(
+            read.warnings,
+            [
+                "p/abc.txt: 1 stretch of records shorter than 0.1 s beside a dropout left out \
+              (the first from 1574559495000 to 1574559495000 ms)"
+            ]
+        );
+        let read = parse_str(&dropout).unwrap();
+        let seq = &read.sequence;
+        assert!((widest(seq) - 0.52).abs() < 0.006, "{}", widest(seq));
+        assert_eq!(seq.clone().split_at_gaps(0.1, 0.0).unwrap().parts.len(), 2);
+        assert_eq!(read.warnings.len(), 1, "{:?}", read.warnings);
+        assert!(
+            read.warnings[0].starts_with(
+                "p/abc.txt: dropouts of the accelerometer, gyroscope or rotation vector over 0.1 \
+                 s leave 1 gap in the timeline (the longest 0.5"
+            ) && read.warnings[0].ends_with(
+                "which `ridi track` refuses and `ridi convert --split-at-gaps 0.1` cuts"
+            ),
+            "{}",
+            read.warnings[0]
+        );
+        // Every sensor stopping at once (a stalled logger) leaves a gap; the magnetometer is
+        // not interpolated there, so no warning of its own.
+        let stall = map_lines(&good, |l| {
+            let t: i64 = l.split('\t').next().unwrap().parse().unwrap_or(0);
+            let hole = (1_574_559_496_000..1_574_559_496_500).contains(&t);
+            (!hole || l.contains("TYPE_WAYPOINT")).then(|| l.to_owned())
+        });
+        let read = parse_str(&stall).unwrap();
+        assert_eq!(read.warnings.len(), 1, "{:?}", read.warnings);
+        assert!(
+            read.warnings[0].contains("leave 1 gap"),
+            "{:?}",
+            read.warnings
+        );
+        let whole = parse_str(&good).unwrap();
+        assert!(
+            widest(&whole.sequence) < 0.0051,
+            "{}",
+            widest(&whole.sequence)
+        );
+        assert!(whole.warnings.is_empty(), "{:?}", whole.warnings);
         // Cut off inside an accelerometer record.
         let cut_at = good.find("1574559496500\tTYPE_ACCELEROMETER").unwrap() + 44;
         assert!(good[..cut_at].ends_with("\t0.1\t0.2\t9.8"));

@@ -29,7 +29,7 @@
 //!
 //! [`detect`] tells the format of a file or folder and [`read_sequence`] reads any of them
 //! (a Tyrex run only when it is not split into parts; it drops the reader's warnings, which
-//! [`tyrex::read`] returns). [`ReadOptions`] holds the validation limits and the
+//! [`tyrex::read`] and [`ilc::read`] return). [`ReadOptions`] holds the validation limits and the
 //! raw synchronization settings.
 //!
 //! [`RowReader`] reads a RIDI `data.csv`, `data_plain.txt` or raw folder row by row, in memory

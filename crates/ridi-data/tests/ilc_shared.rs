@@ -51,6 +51,8 @@ fn every_path_reads_onto_a_200_hz_timeline_with_waypoint_ground_truth() {
         assert!(seq.magnet().is_some());
         assert!((seq.rate_hz() - 200.0).abs() < 1e-3, "{}", seq.rate_hz());
         assert!(seq.max_gap() < 0.0051);
+        // No sensor dropouts: nothing to warn of.
+        assert!(p.warnings.is_empty(), "{name}: {:?}", p.warnings);
         // 20-40 s walks, 4-8 waypoints; the sequence spans the waypoints (the first is marked
         // up to 0.2 s before the IMU starts).
         assert!((18.0..42.0).contains(&seq.duration()), "{}", seq.duration());

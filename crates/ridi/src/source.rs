@@ -2,6 +2,7 @@
 
 use std::path::{Path, PathBuf};
 
+use ridi_data::ilc::{self, IlcOptions};
 use ridi_data::tyrex::{self, TyrexOptions};
 use ridi_data::{
     DataError, FileId, Format, Location, ReadOptions, Sequence, detect, read_sequence,
@@ -14,7 +15,7 @@ pub struct Loaded {
     pub format: Format,
     /// The sequences (a Tyrex recording split at a long mocap loss gives several).
     pub sequences: Vec<Sequence>,
-    /// Things a user should know (splits, dropped parts).
+    /// Things a user should know (splits, dropped parts, sensor dropouts kept as gaps).
     pub warnings: Vec<String>,
 }
 
@@ -78,6 +79,15 @@ pub fn read_any(
             Ok(Loaded {
                 format,
                 sequences: read.sequences,
+                warnings: read.warnings,
+            })
+        }
+        Format::Ilc => {
+            // A path file is read by itself (detect takes no folder for it).
+            let read = ilc::read(path, &IlcOptions::from(opts))?;
+            Ok(Loaded {
+                format,
+                sequences: vec![read.sequence],
                 warnings: read.warnings,
             })
         }
