@@ -109,9 +109,12 @@ pub fn compare(
     let mut problems = Vec::new();
     for ((package, version), features) in other {
         match workspace.get(&(package.clone(), version.clone())) {
-            Some(ours) if ours != features => problems.push(format!(
-                "{package} {version}: {name} turns on {}, the workspace's tests {}: give it the \
-                 workspace's features in {aligned_in}",
+            // A build that needs only one of the ways the workspace compiles a crate (for the
+            // proc-macro side and for the target, say) reuses that one.
+            Some(ours) if !features.is_subset(ours) => problems.push(format!(
+                "{package} {version}: {name} turns on {}, where the workspace's tests build {}: \
+                 give it the workspace's features in {aligned_in} (as a build-dependency when \
+                 a proc-macro or build script needs it)",
                 shown(features),
                 shown(ours)
             )),
@@ -126,7 +129,7 @@ pub fn compare(
                 if !ours.is_empty() {
                     problems.push(format!(
                         "{package}: {name} resolves {version}, the workspace {}: `cargo update \
-                         -p {package} --precise {}` for the manifest beside {aligned_in}",
+                         --manifest-path {aligned_in} -p {package}@{version} --precise {}`",
                         ours.join(", "),
                         ours[0]
                     ));
@@ -233,11 +236,19 @@ faer v0.24.4|
         assert!(
             problems[1]
                 .contains("serde: the Python package resolves 1.0.228, the workspace 1.0.229")
-                && problems[1].contains("--precise 1.0.229"),
+                && problems[1].contains(
+                    "--manifest-path crates/ridi-py/Cargo.toml -p serde@1.0.228 --precise 1.0.229"
+                ),
             "{}",
             problems[1]
         );
         assert!(compare(&ws, &ws, "x", "y").is_empty());
+        // One of the two ways the workspace builds a crate is no problem; a third is.
+        let ws = parse("libc v0.2.1|std\nlibc v0.2.1|default,std\n").unwrap();
+        let one = parse("libc v0.2.1|default,std\n").unwrap();
+        assert!(compare(&ws, &one, "x", "y").is_empty());
+        let other = parse("libc v0.2.1|extra_traits,std\n").unwrap();
+        assert_eq!(compare(&ws, &other, "x", "y").len(), 1);
     }
 
     #[test]

@@ -351,6 +351,81 @@ fn check_overwrites(
     Ok(())
 }
 
+/// The list files an earlier conversion wrote into `out` (their first line says so) that this
+/// one does not rewrite and that name one of the `unlisted` sequences, now rewritten without
+/// ground truth: left in place they would still offer them to training and evaluation.
+fn stale_lists(
+    out: &Path,
+    lists: &BTreeMap<String, Vec<&Converted>>,
+    unlisted: &[&Converted],
+) -> Vec<String> {
+    let Ok(entries) = std::fs::read_dir(out) else {
+        return Vec::new();
+    };
+    let mut stale: Vec<String> = entries
+        .filter_map(|e| e.ok()?.file_name().into_string().ok())
+        .filter(|name| {
+            name.strip_prefix("list_")
+                .and_then(|n| n.strip_suffix(".txt"))
+                .is_some_and(|key| !lists.contains_key(key))
+        })
+        .filter(|name| {
+            let Ok(text) = std::fs::read_to_string(out.join(name)) else {
+                return false;
+            };
+            text.starts_with("# written by `ridi convert ")
+                && text.lines().filter(|l| !l.starts_with('#')).any(|l| {
+                    let listed = l.split(',').next().unwrap_or("");
+                    unlisted.iter().any(|c| c.name == listed)
+                })
+        })
+        .collect();
+    stale.sort();
+    stale
+}
+
+/// The warning naming the sequences without ground truth, which no list names.
+fn unlisted_warning(
+    out: &Path,
+    unlisted: &[&Converted],
+    no_lists: bool,
+    stale: &[String],
+) -> String {
+    const SHOWN: usize = 3;
+    let mut names: Vec<&str> = unlisted
+        .iter()
+        .take(SHOWN)
+        .map(|c| c.name.as_str())
+        .collect();
+    let more = format!("and {} more", unlisted.len().saturating_sub(SHOWN));
+    if unlisted.len() > SHOWN {
+        names.push(&more);
+    }
+    let lists = if no_lists {
+        "no list file written"
+    } else {
+        "left out of the list files"
+    };
+    let (its, it) = match unlisted.len() {
+        1 => ("its", "it"),
+        _ => ("each one's", "them"),
+    };
+    let removed = match stale {
+        [] => String::new(),
+        _ => format!(
+            " (removed the earlier {}, which named {it})",
+            stale.join(", ")
+        ),
+    };
+    format!(
+        "{}: {} without ground truth ({}): {lists}, as training and evaluation need ground \
+         truth{removed}; `ridi track` takes {its} data.csv",
+        ridi_data::shown(out),
+        counted(unlisted.len(), "sequence"),
+        names.join(", ")
+    )
+}
+
 /// The person of a Tyrex run name `<Person>_<Phone>_<Dist>_<Motion>`, also for the parts
 /// of a split run (`..._<Motion>_part2`).
 fn tyrex_subject(name: &str) -> Option<&str> {
@@ -560,26 +635,18 @@ pub fn convert(
             lists.entry(subject.to_string()).or_default().push(c);
         }
     }
-    if !unlisted.is_empty() {
-        let names: Vec<&str> = unlisted.iter().map(|c| c.name.as_str()).collect();
-        let shown = match names.len() {
-            1..=3 => names.join(", "),
-            n => format!("{}, ... ({} more)", names[..2].join(", "), n - 2),
-        };
-        let no_lists = if listable.is_empty() {
-            "no list file written"
-        } else {
-            "left out of the list files"
-        };
-        summary.warnings.push(format!(
-            "{} without ground truth ({shown}): {no_lists}, as training and evaluation need it; \
-             `ridi track` takes each one's data.csv",
-            counted(unlisted.len(), "sequence"),
-        ));
-    }
     let (by_device, warnings) = device_lists(&listable, &lists);
     summary.warnings.extend(warnings);
     lists.extend(by_device);
+    if !unlisted.is_empty() {
+        let stale = stale_lists(out, &lists, &unlisted);
+        for name in &stale {
+            staging.remove(Path::new(name));
+        }
+        summary
+            .warnings
+            .push(unlisted_warning(out, &unlisted, lists.is_empty(), &stale));
+    }
     let mut written_lists = Vec::new();
     for (key, entries) in &lists {
         let name = format!("list_{key}.txt");

@@ -613,8 +613,9 @@ fn tyrex_runs_without_motion_capture_are_skipped_or_converted_with_a_warning() {
         assert!(summary.lists.is_empty(), "{:?}", summary.lists);
         assert!(
             summary.warnings.iter().any(|w| w.contains(
-                "2 sequences without ground truth (Ann_Nexus5_NoDist_AR, \
-                 Ann_Nexus5_NoDist_Texting): no list file written"
+                ": 2 sequences without ground truth (Ann_Nexus5_NoDist_AR, \
+                 Ann_Nexus5_NoDist_Texting): no list file written, as training and evaluation \
+                 need ground truth; `ridi track` takes each one's data.csv"
             )),
             "{from:?}: {:?}",
             summary.warnings
@@ -644,10 +645,50 @@ fn sequences_without_ground_truth_are_in_no_list() {
     let list = std::fs::read_to_string(out.join("list_all.txt")).unwrap();
     let listed: Vec<&str> = list.lines().filter(|l| !l.starts_with('#')).collect();
     assert_eq!(listed, ["walk,"], "{list}");
+    let warning = format!(
+        "{}: 1 sequence without ground truth (test_path): left out of the list files, as \
+         training and evaluation need ground truth; `ridi track` takes its data.csv",
+        out.display()
+    );
     assert!(
-        summary.warnings.iter().any(|w| w
-            == "1 sequence without ground truth (test_path): left out of the list files, as \
-                training and evaluation need it; `ridi track` takes each one's data.csv"),
+        summary.warnings.contains(&warning),
+        "{:?}",
+        summary.warnings
+    );
+
+    // A sequence an earlier conversion listed, converted again without ground truth, leaves
+    // no list of that conversion naming it; a list of one's own stays.
+    let earlier = dir.path().join("earlier");
+    convert(
+        &sources_named(&earlier, &["walk", "test_path"]),
+        &out,
+        &ConvertOptions::default(),
+    )
+    .unwrap();
+    assert_eq!(
+        std::fs::read_to_string(out.join("list_all.txt"))
+            .unwrap()
+            .lines()
+            .count(),
+        3
+    );
+    std::fs::write(out.join("list_mine.txt"), "test_path,\n").unwrap();
+    let alone = dir.path().join("alone");
+    std::fs::create_dir_all(&alone).unwrap();
+    std::fs::rename(src.join("test_path"), alone.join("test_path")).unwrap();
+    let summary = convert(&alone, &out, &ConvertOptions::default()).unwrap();
+    assert!(summary.lists.is_empty());
+    assert!(!out.join("list_all.txt").exists() && !out.join("list_nexus5.txt").exists());
+    assert!(
+        out.join("list_mine.txt").is_file(),
+        "not written by convert"
+    );
+    assert!(
+        summary.warnings.iter().any(|w| w.contains(
+            "1 sequence without ground truth (test_path): no list file written, as training \
+             and evaluation need ground truth (removed the earlier list_all.txt, list_nexus5.txt, \
+             which named it)"
+        )),
         "{:?}",
         summary.warnings
     );
