@@ -51,7 +51,8 @@ enum Task {
         trust_unpinned: bool,
     },
     /// Fast convention checks (no build): each crate's dependencies match the layer table of
-    /// docs/ARCHITECTURE.md, no error enum uses a retired spelling, no new public module.
+    /// docs/ARCHITECTURE.md, no error enum uses a retired spelling, no new public module, the
+    /// dev profile names every crate and crates/ridi-py repeats the workspace's profiles.
     Tidy,
     /// Check that the workspace's rust-version is at least that of every package in Cargo.lock
     /// (`cargo metadata`) and that the README names it.

@@ -10,6 +10,12 @@
 //!   that is not public: new items are re-exported at the crate root from private modules, as
 //!   ripgrep's crates do.
 //!
+//! - The dev profile compiles every workspace crate as the root Cargo.toml names it (a
+//!   `[profile.dev.package.<crate>]` section each, no `package."*"`, which would take
+//!   precedence over build-override and optimize build scripts and proc macros), and
+//!   crates/ridi-py, a workspace of its own, repeats the root's dev and release profiles for
+//!   itself and the crates it builds, so that both share artifacts in one `target/`.
+//!
 //! It reads files only (no build), so it takes well under a second.
 
 use std::collections::{BTreeMap, BTreeSet};
@@ -56,6 +62,7 @@ pub fn run(root: &Path) -> Result<()> {
     let crates = workspace_crates(root)?;
     let table = layer_table(&root.join("docs/ARCHITECTURE.md"))?;
     check_layers(&crates, &table, &mut problems);
+    check_profiles(root, &crates, &mut problems)?;
     for krate in crates.values() {
         // This file names the retired spellings.
         for file in rust_files(&krate.dir.join("src"))?
@@ -78,7 +85,7 @@ pub fn run(root: &Path) -> Result<()> {
     }
     if problems.is_empty() {
         println!(
-            "tidy: {} crates: layers, error spellings and public modules as documented",
+            "tidy: {} crates: layers, error spellings, public modules and profiles as documented",
             crates.len()
         );
         return Ok(());
@@ -244,6 +251,96 @@ pub fn check_layers(
     }
 }
 
+/// The profile sections of a manifest: `profile.<name>` tables.
+fn profiles(path: &Path) -> Result<toml::Table> {
+    let text =
+        std::fs::read_to_string(path).with_context(|| format!("reading {}", path.display()))?;
+    let doc: toml::Table =
+        toml::from_str(&text).with_context(|| format!("parsing {}", path.display()))?;
+    Ok(doc
+        .get("profile")
+        .and_then(|p| p.as_table())
+        .cloned()
+        .unwrap_or_default())
+}
+
+/// The dev profile's per-crate sections against the workspace crates, and ridi-py's profiles
+/// against the root's (see the module documentation).
+pub fn check_profiles(
+    root: &Path,
+    crates: &BTreeMap<String, Crate>,
+    problems: &mut Vec<String>,
+) -> Result<()> {
+    const PY: &str = "ridi-py";
+    let ours = profiles(&root.join("Cargo.toml"))?;
+    let package = |p: &toml::Table, profile: &str| -> toml::Table {
+        p.get(profile)
+            .and_then(|d| d.get("package"))
+            .and_then(|d| d.as_table())
+            .cloned()
+            .unwrap_or_default()
+    };
+    let named = package(&ours, "dev");
+    if named.contains_key("*") {
+        problems.push(
+            "Cargo.toml: `[profile.dev.package.\"*\"]` takes precedence over build-override: \
+             set the dependencies' options in `[profile.dev]` and name the workspace's crates"
+                .into(),
+        );
+    }
+    for name in crates.keys().filter(|n| n.as_str() != PY) {
+        if !named.contains_key(name) {
+            problems.push(format!(
+                "Cargo.toml: no `[profile.dev.package.{name}]`: a workspace crate is compiled \
+                 as the others are (opt-level 1, line tables), not as a dependency"
+            ));
+        }
+    }
+    let Some(py) = crates.get(PY) else {
+        return Ok(());
+    };
+    let theirs = profiles(&py.dir.join("Cargo.toml"))?;
+    let shown = format!("crates/{PY}/Cargo.toml");
+    let without_packages = |p: &toml::Table, profile: &str| -> Option<toml::Table> {
+        let mut t = p.get(profile)?.as_table()?.clone();
+        t.remove("package");
+        Some(t)
+    };
+    for profile in ["dev", "release"] {
+        if without_packages(&ours, profile) != without_packages(&theirs, profile) {
+            problems.push(format!(
+                "{shown}: `[profile.{profile}]` is not the root Cargo.toml's: its builds would \
+                 not share the workspace's artifacts"
+            ));
+        }
+    }
+    // ridi-py itself and every workspace crate it builds, as the workspace names them.
+    let mut built: BTreeSet<&str> = BTreeSet::new();
+    let mut todo: Vec<&str> = py.deps.iter().map(String::as_str).collect();
+    while let Some(name) = todo.pop() {
+        if built.insert(name) {
+            todo.extend(
+                crates
+                    .get(name)
+                    .into_iter()
+                    .flat_map(|c| c.deps.iter().map(String::as_str)),
+            );
+        }
+    }
+    let member = named.values().next().cloned();
+    let py_named = package(&theirs, "dev");
+    for name in built.iter().copied().chain([PY]) {
+        let want = named.get(name).cloned().or_else(|| member.clone());
+        if py_named.get(name) != want.as_ref() {
+            problems.push(format!(
+                "{shown}: `[profile.dev.package.{name}]` should be the root Cargo.toml's (that of \
+                 the workspace's crates)"
+            ));
+        }
+    }
+    Ok(())
+}
+
 /// Retired spellings in the error enums of one source file.
 pub fn check_error_spellings(file: &str, text: &str, problems: &mut Vec<String>) {
     let lines: Vec<&str> = text.lines().collect();
@@ -387,6 +484,58 @@ fn rust_files(dir: &Path) -> Result<Vec<PathBuf>> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn profiles_name_every_crate_and_ridi_py_repeats_them() {
+        let dir = tempfile::tempdir().unwrap();
+        let member = "opt-level = 1\ndebug = \"line-tables-only\"\n";
+        let root = format!(
+            "[profile.release]\ndebug = 1\n[profile.dev]\nopt-level = 2\n\
+             [profile.dev.package.a]\n{member}[profile.dev.package.ridi-py]\n{member}"
+        );
+        std::fs::write(dir.path().join("Cargo.toml"), &root).unwrap();
+        let py = dir.path().join("py");
+        std::fs::create_dir(&py).unwrap();
+        let krate = |dir: &Path, deps: &[&str]| Crate {
+            dir: dir.to_path_buf(),
+            deps: deps.iter().map(|d| d.to_string()).collect(),
+            dev_deps: BTreeSet::new(),
+        };
+        let mut crates = BTreeMap::new();
+        crates.insert("a".to_string(), krate(dir.path(), &[]));
+        crates.insert("b".to_string(), krate(dir.path(), &["a"]));
+        crates.insert("ridi-py".to_string(), krate(&py, &["b"]));
+        std::fs::write(py.join("Cargo.toml"), &root).unwrap();
+        let mut problems = Vec::new();
+        check_profiles(dir.path(), &crates, &mut problems).unwrap();
+        assert_eq!(
+            problems,
+            [
+                "Cargo.toml: no `[profile.dev.package.b]`: a workspace crate is compiled as the \
+                 others are (opt-level 1, line tables), not as a dependency",
+                "crates/ridi-py/Cargo.toml: `[profile.dev.package.b]` should be the root \
+                 Cargo.toml's (that of the workspace's crates)",
+            ]
+        );
+        let fixed = format!("{root}[profile.dev.package.b]\n{member}");
+        std::fs::write(dir.path().join("Cargo.toml"), &fixed).unwrap();
+        std::fs::write(py.join("Cargo.toml"), &fixed).unwrap();
+        problems.clear();
+        check_profiles(dir.path(), &crates, &mut problems).unwrap();
+        assert!(problems.is_empty(), "{problems:?}");
+        // Another dev profile in ridi-py, and `package."*"` in the root.
+        std::fs::write(
+            py.join("Cargo.toml"),
+            fixed.replace("opt-level = 2", "opt-level = 3"),
+        )
+        .unwrap();
+        let star = format!("{fixed}[profile.dev.package.\"*\"]\nopt-level = 2\n");
+        std::fs::write(dir.path().join("Cargo.toml"), star).unwrap();
+        check_profiles(dir.path(), &crates, &mut problems).unwrap();
+        assert_eq!(problems.len(), 2, "{problems:?}");
+        assert!(problems[0].contains("takes precedence over build-override"));
+        assert!(problems[1].contains("`[profile.dev]` is not the root Cargo.toml's"));
+    }
 
     #[test]
     fn retired_error_spellings_are_named_with_file_and_line() {
