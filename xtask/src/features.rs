@@ -110,7 +110,10 @@ pub fn compare(
     for ((package, version), features) in other {
         match workspace.get(&(package.clone(), version.clone())) {
             // A build that needs only one of the ways the workspace compiles a crate (for the
-            // proc-macro side and for the target, say) reuses that one.
+            // proc-macro side and for the target, say) reuses that one. `cargo tree` does not
+            // say which side a feature set is for: one the workspace builds for the host only
+            // (opt-level 0) and another build needs on the target passes here, and is compiled
+            // again.
             Some(ours) if !features.is_subset(ours) => problems.push(format!(
                 "{package} {version}: {name} turns on {}, where the workspace's tests build {}: \
                  give it the workspace's features in {aligned_in} (as a build-dependency when \

@@ -288,6 +288,17 @@ pub fn check_profiles(
                 .into(),
         );
     }
+    let kinds: BTreeSet<String> = crates
+        .keys()
+        .filter_map(|n| named.get(n))
+        .map(|t| t.to_string())
+        .collect();
+    if kinds.len() > 1 {
+        problems.push(format!(
+            "Cargo.toml: the workspace's crates have {} different dev profiles: one for all",
+            kinds.len()
+        ));
+    }
     for name in crates.keys().filter(|n| n.as_str() != PY) {
         if !named.contains_key(name) {
             problems.push(format!(
@@ -327,14 +338,26 @@ pub fn check_profiles(
             );
         }
     }
-    let member = named.values().next().cloned();
+    // ridi-py itself is compiled as the workspace's crates are (as `ridi`, say).
+    let mut expected: toml::Table = named
+        .iter()
+        .filter(|(name, _)| !crates.contains_key(*name) || built.contains(name.as_str()))
+        .map(|(name, table)| (name.clone(), table.clone()))
+        .collect();
+    if let Some(table) = named.get("ridi") {
+        expected.insert(PY.into(), table.clone());
+    }
     let py_named = package(&theirs, "dev");
-    for name in built.iter().copied().chain([PY]) {
-        let want = named.get(name).cloned().or_else(|| member.clone());
-        if py_named.get(name) != want.as_ref() {
+    let keys: BTreeSet<&String> = expected.keys().chain(py_named.keys()).collect();
+    for name in keys {
+        if py_named.get(name) != expected.get(name) {
             problems.push(format!(
-                "{shown}: `[profile.dev.package.{name}]` should be the root Cargo.toml's (that of \
-                 the workspace's crates)"
+                "{shown}: `[profile.dev.package.{name}]` should be {} (the root Cargo.toml's, \
+                 for the crates it builds)",
+                match expected.get(name) {
+                    Some(t) => t.to_string(),
+                    None => "absent".into(),
+                }
             ));
         }
     }
@@ -491,11 +514,15 @@ mod tests {
         let member = "opt-level = 1\ndebug = \"line-tables-only\"\n";
         let root = format!(
             "[profile.release]\ndebug = 1\n[profile.dev]\nopt-level = 2\n\
-             [profile.dev.package.a]\n{member}[profile.dev.package.ridi-py]\n{member}"
+             [profile.dev.package.a]\n{member}"
         );
-        std::fs::write(dir.path().join("Cargo.toml"), &root).unwrap();
+        let own = format!("[profile.dev.package.ridi-py]\n{member}");
         let py = dir.path().join("py");
         std::fs::create_dir(&py).unwrap();
+        let write = |root: &str, ridi_py: &str| {
+            std::fs::write(dir.path().join("Cargo.toml"), root).unwrap();
+            std::fs::write(py.join("Cargo.toml"), ridi_py).unwrap();
+        };
         let krate = |dir: &Path, deps: &[&str]| Crate {
             dir: dir.to_path_buf(),
             deps: deps.iter().map(|d| d.to_string()).collect(),
@@ -503,38 +530,59 @@ mod tests {
         };
         let mut crates = BTreeMap::new();
         crates.insert("a".to_string(), krate(dir.path(), &[]));
-        crates.insert("b".to_string(), krate(dir.path(), &["a"]));
-        crates.insert("ridi-py".to_string(), krate(&py, &["b"]));
-        std::fs::write(py.join("Cargo.toml"), &root).unwrap();
-        let mut problems = Vec::new();
-        check_profiles(dir.path(), &crates, &mut problems).unwrap();
+        crates.insert("ridi".to_string(), krate(dir.path(), &["a"]));
+        crates.insert("ridi-py".to_string(), krate(&py, &["ridi"]));
+        let check = || {
+            let mut problems = Vec::new();
+            check_profiles(dir.path(), &crates, &mut problems).unwrap();
+            problems
+        };
+        write(&root, &format!("{root}{own}"));
         assert_eq!(
-            problems,
+            check(),
             [
-                "Cargo.toml: no `[profile.dev.package.b]`: a workspace crate is compiled as the \
-                 others are (opt-level 1, line tables), not as a dependency",
-                "crates/ridi-py/Cargo.toml: `[profile.dev.package.b]` should be the root \
-                 Cargo.toml's (that of the workspace's crates)",
+                "Cargo.toml: no `[profile.dev.package.ridi]`: a workspace crate is compiled as \
+                 the others are (opt-level 1, line tables), not as a dependency",
+                "crates/ridi-py/Cargo.toml: `[profile.dev.package.ridi-py]` should be absent \
+                 (the root Cargo.toml's, for the crates it builds)",
             ]
         );
-        let fixed = format!("{root}[profile.dev.package.b]\n{member}");
-        std::fs::write(dir.path().join("Cargo.toml"), &fixed).unwrap();
-        std::fs::write(py.join("Cargo.toml"), &fixed).unwrap();
-        problems.clear();
-        check_profiles(dir.path(), &crates, &mut problems).unwrap();
-        assert!(problems.is_empty(), "{problems:?}");
-        // Another dev profile in ridi-py, and `package."*"` in the root.
-        std::fs::write(
-            py.join("Cargo.toml"),
-            fixed.replace("opt-level = 2", "opt-level = 3"),
-        )
-        .unwrap();
+        let fixed = format!("{root}[profile.dev.package.ridi]\n{member}");
+        write(&fixed, &format!("{fixed}{own}"));
+        assert!(check().is_empty(), "{:?}", check());
+        // ridi-py without its own section, or with another dev profile; `package."*"` or a
+        // crate of its own kind in the root.
+        write(&fixed, &fixed);
+        assert_eq!(check().len(), 1, "{:?}", check());
+        assert!(
+            check()[0].contains("`[profile.dev.package.ridi-py]` should be { "),
+            "{:?}",
+            check()
+        );
+        write(
+            &fixed,
+            &format!("{fixed}{own}").replace("opt-level = 2", "opt-level = 3"),
+        );
+        assert_eq!(check().len(), 1, "{:?}", check());
+        assert!(check()[0].contains("`[profile.dev]` is not the root Cargo.toml's"));
         let star = format!("{fixed}[profile.dev.package.\"*\"]\nopt-level = 2\n");
-        std::fs::write(dir.path().join("Cargo.toml"), star).unwrap();
-        check_profiles(dir.path(), &crates, &mut problems).unwrap();
+        write(&star, &format!("{fixed}{own}"));
+        let problems = check();
         assert_eq!(problems.len(), 2, "{problems:?}");
         assert!(problems[0].contains("takes precedence over build-override"));
-        assert!(problems[1].contains("`[profile.dev]` is not the root Cargo.toml's"));
+        assert!(
+            problems[1].contains("`[profile.dev.package.*]` should be { "),
+            "{problems:?}"
+        );
+        write(
+            &fixed.replacen("opt-level = 1", "opt-level = 3", 1),
+            &format!("{fixed}{own}"),
+        );
+        assert!(
+            check()
+                .iter()
+                .any(|p| p.contains("2 different dev profiles"))
+        );
     }
 
     #[test]

@@ -351,36 +351,61 @@ fn check_overwrites(
     Ok(())
 }
 
-/// The list files an earlier conversion wrote into `out` (their first line says so) that this
-/// one does not rewrite and that name one of the `unlisted` sequences, now rewritten without
-/// ground truth: left in place they would still offer them to training and evaluation.
+/// A list file an earlier conversion wrote into `out` that this one does not rewrite and that
+/// names one of the `unlisted` sequences, now rewritten without ground truth: left as it was,
+/// it would still offer them to training and evaluation.
+struct StaleList {
+    /// Its file name in `out`.
+    name: String,
+    /// Its text without those sequences' lines; `None` when no sequence is left.
+    kept: Option<String>,
+}
+
+/// The [`StaleList`]s of `out`: lists whose first line says `ridi convert` wrote them (a list
+/// of one's own is never touched), other than those this conversion writes (`lists`, compared
+/// ignoring case, as some file systems do) and those it read (`read`, the source's lists).
 fn stale_lists(
     out: &Path,
     lists: &BTreeMap<String, Vec<&Converted>>,
     unlisted: &[&Converted],
-) -> Vec<String> {
+    read: &[PathBuf],
+) -> Vec<StaleList> {
     let Ok(entries) = std::fs::read_dir(out) else {
         return Vec::new();
     };
-    let mut stale: Vec<String> = entries
+    let read: Vec<PathBuf> = read.iter().filter_map(|p| p.canonicalize().ok()).collect();
+    let mut stale: Vec<StaleList> = entries
         .filter_map(|e| e.ok()?.file_name().into_string().ok())
         .filter(|name| {
             name.strip_prefix("list_")
                 .and_then(|n| n.strip_suffix(".txt"))
-                .is_some_and(|key| !lists.contains_key(key))
+                .is_some_and(|key| !lists.keys().any(|k| k.eq_ignore_ascii_case(key)))
         })
         .filter(|name| {
-            let Ok(text) = std::fs::read_to_string(out.join(name)) else {
-                return false;
+            let path = out.join(name);
+            path.is_file() && !path.canonicalize().is_ok_and(|p| read.contains(&p))
+        })
+        .filter_map(|name| {
+            let text = std::fs::read_to_string(out.join(&name)).ok()?;
+            if !text.starts_with("# written by `ridi convert ") {
+                return None;
+            }
+            let names_one = |l: &str| {
+                let listed = l.split(',').next().unwrap_or("");
+                !l.starts_with('#') && unlisted.iter().any(|c| c.name == listed)
             };
-            text.starts_with("# written by `ridi convert ")
-                && text.lines().filter(|l| !l.starts_with('#')).any(|l| {
-                    let listed = l.split(',').next().unwrap_or("");
-                    unlisted.iter().any(|c| c.name == listed)
-                })
+            if !text.lines().any(names_one) {
+                return None;
+            }
+            let lines: Vec<&str> = text.lines().filter(|l| !names_one(l)).collect();
+            let kept = lines
+                .iter()
+                .any(|l| !l.starts_with('#') && !l.trim().is_empty())
+                .then(|| lines.join("\n") + "\n");
+            Some(StaleList { name, kept })
         })
         .collect();
-    stale.sort();
+    stale.sort_by(|a, b| a.name.cmp(&b.name));
     stale
 }
 
@@ -389,7 +414,7 @@ fn unlisted_warning(
     out: &Path,
     unlisted: &[&Converted],
     no_lists: bool,
-    stale: &[String],
+    stale: &[StaleList],
 ) -> String {
     const SHOWN: usize = 3;
     let mut names: Vec<&str> = unlisted
@@ -410,12 +435,21 @@ fn unlisted_warning(
         1 => ("its", "it"),
         _ => ("each one's", "them"),
     };
-    let removed = match stale {
+    // Each earlier list either lost the lines of those sequences or, left empty, went.
+    let edits: Vec<String> = [(true, "removed"), (false, "left out of")]
+        .into_iter()
+        .filter_map(|(gone, verb)| {
+            let names: Vec<&str> = stale
+                .iter()
+                .filter(|l| l.kept.is_none() == gone)
+                .map(|l| l.name.as_str())
+                .collect();
+            (!names.is_empty()).then(|| format!("{verb} the earlier {}", names.join(", ")))
+        })
+        .collect();
+    let removed = match edits.as_slice() {
         [] => String::new(),
-        _ => format!(
-            " (removed the earlier {}, which named {it})",
-            stale.join(", ")
-        ),
+        _ => format!(" ({}, which named {it})", edits.join("; ")),
     };
     format!(
         "{}: {} without ground truth ({}): {lists}, as training and evaluation need ground \
@@ -639,9 +673,13 @@ pub fn convert(
     summary.warnings.extend(warnings);
     lists.extend(by_device);
     if !unlisted.is_empty() {
-        let stale = stale_lists(out, &lists, &unlisted);
-        for name in &stale {
-            staging.remove(Path::new(name));
+        let stale = stale_lists(out, &lists, &unlisted, &listed.lists);
+        for list in &stale {
+            let rel = Path::new(&list.name);
+            match &list.kept {
+                Some(text) => write_atomically(&staging.file(rel)?, |w| write!(w, "{text}"))?,
+                None => staging.remove(rel),
+            }
         }
         summary
             .warnings

@@ -656,8 +656,8 @@ fn sequences_without_ground_truth_are_in_no_list() {
         summary.warnings
     );
 
-    // A sequence an earlier conversion listed, converted again without ground truth, leaves
-    // no list of that conversion naming it; a list of one's own stays.
+    // A sequence an earlier conversion listed, converted again without ground truth, is left
+    // out of that conversion's lists (a list left empty goes); a list of one's own stays.
     let earlier = dir.path().join("earlier");
     convert(
         &sources_named(&earlier, &["walk", "test_path"]),
@@ -678,7 +678,11 @@ fn sequences_without_ground_truth_are_in_no_list() {
     std::fs::rename(src.join("test_path"), alone.join("test_path")).unwrap();
     let summary = convert(&alone, &out, &ConvertOptions::default()).unwrap();
     assert!(summary.lists.is_empty());
-    assert!(!out.join("list_all.txt").exists() && !out.join("list_nexus5.txt").exists());
+    for list in ["list_all.txt", "list_nexus5.txt"] {
+        let text = std::fs::read_to_string(out.join(list)).unwrap();
+        let listed: Vec<&str> = text.lines().filter(|l| !l.starts_with('#')).collect();
+        assert_eq!(listed, ["walk,"], "{list}: {text}");
+    }
     assert!(
         out.join("list_mine.txt").is_file(),
         "not written by convert"
@@ -686,9 +690,27 @@ fn sequences_without_ground_truth_are_in_no_list() {
     assert!(
         summary.warnings.iter().any(|w| w.contains(
             "1 sequence without ground truth (test_path): no list file written, as training \
-             and evaluation need ground truth (removed the earlier list_all.txt, list_nexus5.txt, \
-             which named it)"
+             and evaluation need ground truth (left out of the earlier list_all.txt, \
+             list_nexus5.txt, which named it)"
         )),
+        "{:?}",
+        summary.warnings
+    );
+    let only = dir.path().join("only");
+    convert(
+        &sources_named(&dir.path().join("e2"), &["test_path"]),
+        &only,
+        &ConvertOptions::default(),
+    )
+    .unwrap();
+    let summary = convert(&alone, &only, &ConvertOptions::default()).unwrap();
+    assert!(!only.join("list_all.txt").exists() && !only.join("list_nexus5.txt").exists());
+    assert!(
+        summary
+            .warnings
+            .iter()
+            .any(|w| w
+                .contains("(removed the earlier list_all.txt, list_nexus5.txt, which named it)")),
         "{:?}",
         summary.warnings
     );
