@@ -347,19 +347,8 @@ fn target_dir(root: &Path) -> PathBuf {
 
 /// Runs cargo in the workspace; returns its stdout (stderr goes to the terminal).
 fn cargo(root: &Path, args: &[&str]) -> Result<String> {
-    let cargo = std::env::var_os("CARGO").unwrap_or_else(|| "cargo".into());
     let target = target_dir(root);
-    let out = Command::new(cargo)
-        .args(args)
-        .current_dir(root)
-        .env("CARGO_TARGET_DIR", &target)
-        .stderr(std::process::Stdio::inherit())
-        .output()
-        .with_context(|| format!("running cargo {}", args.join(" ")))?;
-    if !out.status.success() {
-        bail!("cargo {} failed: {}", args.join(" "), out.status);
-    }
-    let stdout = String::from_utf8_lossy(&out.stdout).into_owned();
+    let stdout = xtask::cargo_stdout(root, args, &[("CARGO_TARGET_DIR", &target)])?;
     print!("{stdout}");
     Ok(stdout)
 }

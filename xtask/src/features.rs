@@ -14,7 +14,6 @@
 
 use std::collections::{BTreeMap, BTreeSet};
 use std::path::Path;
-use std::process::Command;
 
 use anyhow::{Context, Result, bail};
 
@@ -144,24 +143,10 @@ pub fn compare(
 }
 
 fn tree(root: &Path, args: &[&str]) -> Result<Resolved> {
-    let cargo = std::env::var_os("CARGO").unwrap_or_else(|| "cargo".into());
-    let out = Command::new(cargo)
-        .arg("tree")
-        .arg("--locked")
-        .args(args)
-        .args(["--prefix", "none", "--format", "{p}|{f}"])
-        .current_dir(root)
-        .stderr(std::process::Stdio::inherit())
-        .output()
-        .context("running cargo tree")?;
-    if !out.status.success() {
-        bail!(
-            "cargo tree --locked {} failed: {}",
-            args.join(" "),
-            out.status
-        );
-    }
-    parse(&String::from_utf8_lossy(&out.stdout))
+    let mut all = vec!["tree", "--locked"];
+    all.extend(args);
+    all.extend(["--prefix", "none", "--format", "{p}|{f}"]);
+    parse(&crate::cargo_stdout(root, &all, &[])?)
 }
 
 /// Runs the check in the workspace at `root`; prints what it compared on success.

@@ -11,7 +11,9 @@ pub mod ronin_lists;
 pub mod rust_version;
 pub mod tidy;
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
+
+use anyhow::{Context, Result, bail};
 
 /// Where the Tyrex data are by default, relative to the workspace root: the shared data folder
 /// beside the checkout.
@@ -47,4 +49,22 @@ pub fn tyrex_root(data: Option<PathBuf>) -> anyhow::Result<PathBuf> {
         data.display()
     );
     Ok(data)
+}
+
+/// Runs cargo (the one `cargo xtask` runs under, `$CARGO`) with `args` and the environment
+/// `env` in `root`, its stderr on the terminal; returns its stdout, or an error naming the
+/// command when it fails.
+pub fn cargo_stdout(root: &Path, args: &[&str], env: &[(&str, &Path)]) -> Result<String> {
+    let cargo = std::env::var_os("CARGO").unwrap_or_else(|| "cargo".into());
+    let out = std::process::Command::new(cargo)
+        .args(args)
+        .envs(env.iter().copied())
+        .current_dir(root)
+        .stderr(std::process::Stdio::inherit())
+        .output()
+        .with_context(|| format!("running cargo {}", args.join(" ")))?;
+    if !out.status.success() {
+        bail!("cargo {} failed: {}", args.join(" "), out.status);
+    }
+    Ok(String::from_utf8_lossy(&out.stdout).into_owned())
 }

@@ -7,7 +7,6 @@
 
 use std::collections::BTreeMap;
 use std::path::Path;
-use std::process::Command;
 
 use anyhow::{Context, Result, bail};
 
@@ -131,18 +130,13 @@ pub fn readme_version(readme: &str) -> Option<RustVersion> {
 
 /// Runs the check in the workspace at `root`; prints the versions on success.
 pub fn run(root: &Path) -> Result<()> {
-    let cargo = std::env::var_os("CARGO").unwrap_or_else(|| "cargo".into());
-    let out = Command::new(cargo)
-        .args(["metadata", "--format-version", "1", "--locked"])
-        .current_dir(root)
-        .stderr(std::process::Stdio::inherit())
-        .output()
-        .context("running cargo metadata")?;
-    if !out.status.success() {
-        bail!("cargo metadata --locked failed: {}", out.status);
-    }
+    let out = crate::cargo_stdout(
+        root,
+        &["metadata", "--format-version", "1", "--locked"],
+        &[],
+    )?;
     let metadata: serde_json::Value =
-        serde_json::from_slice(&out.stdout).context("parsing the output of cargo metadata")?;
+        serde_json::from_str(&out).context("parsing the output of cargo metadata")?;
     let packages = packages(&metadata)?;
     let mut problems = check(&packages);
     let declared = packages

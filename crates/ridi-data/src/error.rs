@@ -61,19 +61,24 @@ pub(crate) fn times(n: usize) -> String {
     }
 }
 
+/// The first `shown` of `items` and how many more there are, for a message: `a, b, c, and 2
+/// more`.
+pub fn first_few(
+    items: impl ExactSizeIterator<Item = impl std::fmt::Display>,
+    shown: usize,
+) -> String {
+    let total = items.len();
+    let mut text: Vec<String> = items.take(shown).map(|i| i.to_string()).collect();
+    if total > shown {
+        text.push(format!("and {} more", total - shown));
+    }
+    text.join(", ")
+}
+
 /// The first few of `spans`, `a-b s`, and how many more there are: where a warning's findings
 /// are.
 pub fn spans_text(spans: &[(f64, f64)]) -> String {
-    const SHOWN: usize = 5;
-    let mut text: Vec<String> = spans
-        .iter()
-        .take(SHOWN)
-        .map(|(a, b)| format!("{a:.2}-{b:.2} s"))
-        .collect();
-    if spans.len() > SHOWN {
-        text.push(format!("and {} more", spans.len() - SHOWN));
-    }
-    text.join(", ")
+    first_few(spans.iter().map(|(a, b)| format!("{a:.2}-{b:.2} s")), 5)
 }
 
 /// An error and its causes on one line, as the `ridi` command and the Python package print

@@ -583,6 +583,11 @@ fn parse_records(content: &str, path: &Path) -> Result<([Stream; 5], Header)> {
     Ok((streams, header))
 }
 
+/// A time in the file's own unit, Unix milliseconds, for a message.
+fn ms(t: f64) -> String {
+    format!("{:.0}", t * 1000.0)
+}
+
 /// The stretches of `span` where the accelerometer, gyroscope and rotation vector all have
 /// records without a dropout longer than [`MAX_SENSOR_GAP_S`]: the timeline is not resampled
 /// across one (it keeps the hole, which tracking refuses and `split_at_gaps` cuts, as in any
@@ -612,7 +617,6 @@ fn imu_spans(
             .into_iter()
             .partition(|(a, b)| b - a >= MAX_SENSOR_GAP_S);
     }
-    let ms = |t: f64| format!("{:.0}", t * 1000.0);
     if spans.len() != 1 && spans.iter().all(|(a, b)| b - a < MAX_SENSOR_GAP_S) {
         return Err(DataError::format(
             Location::file(path).with_field("unix_ms"),
@@ -703,7 +707,6 @@ fn span(streams: &[Stream; 5], with_waypoints: bool, path: &Path) -> Result<(f64
         .collect();
     let imu_start = imu.iter().map(|s| s.span().0).fold(f64::MIN, f64::max);
     let imu_end = imu.iter().map(|s| s.span().1).fold(f64::MAX, f64::min);
-    let ms = |t: f64| format!("{:.0}", t * 1000.0);
     if imu_start >= imu_end {
         return Err(DataError::format(
             Location::file(path),
@@ -1081,22 +1084,6 @@ mod tests {
             (!l.contains("TYPE_MAGNETIC_FIELD\t")).then(|| l.to_owned())
         });
         assert!(parse_str(&no_mag).unwrap().sequence.magnet().is_none());
-        // A 1.5 s hole in the accelerometer.
-        let holed = map_lines(&good, |l| {
-            let t: i64 = l.split('\t').next().unwrap().parse().unwrap_or(0);
-            let hole = (1_574_559_496_000..1_574_559_497_500).contains(&t);
-            (!(hole && l.contains("TYPE_ACCELEROMETER\t"))).then(|| l.to_owned())
-        });
-        let e = err(&holed);
-        assert!(e.contains("field `unix_ms`: gap of 1.520 s"), "{e}");
-        // A 0.5 s dropout of the gyroscope stays a gap in the timeline, not interpolated
-        // across: tracking refuses it and `split_at_gaps` cuts there.
-        let dropout = map_lines(&good, |l| {
-            let t: i64 = l.split('\t').next().unwrap().parse().unwrap_or(0);
-            let hole = (1_574_559_496_000..1_574_559_496_500).contains(&t);
-            (!(hole && l.contains("TYPE_GYROSCOPE\t"))).then(|| l.to_owned())
-        });
-        let widest = |s: &Sequence| s.time().windows(2).map(|w| w[1] - w[0]).fold(0.0, f64::max);
         // `good` without the `ty` records from `from` to `to` (unix ms).
         let drop = |ty: &str, from: i64, to: i64| {
             let ty = format!("{ty}\t");
@@ -1105,6 +1092,14 @@ mod tests {
                 (!((from..to).contains(&t) && l.contains(&ty))).then(|| l.to_owned())
             })
         };
+        // A 1.5 s hole in the accelerometer.
+        let holed = drop("TYPE_ACCELEROMETER", 1_574_559_496_000, 1_574_559_497_500);
+        let e = err(&holed);
+        assert!(e.contains("field `unix_ms`: gap of 1.520 s"), "{e}");
+        // A 0.5 s dropout of the gyroscope stays a gap in the timeline, not interpolated
+        // across: tracking refuses it and `split_at_gaps` cuts there.
+        let dropout = drop("TYPE_GYROSCOPE", 1_574_559_496_000, 1_574_559_496_500);
+        let widest = |s: &Sequence| s.time().windows(2).map(|w| w[1] - w[0]).fold(0.0, f64::max);
         // The magnetometer is interpolated across its own dropout.
         let mag = parse_str(&drop(
             "TYPE_MAGNETIC_FIELD",

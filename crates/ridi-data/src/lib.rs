@@ -113,7 +113,7 @@ mod write;
 
 pub use detect::{Format, detect, read_sequence, source_files};
 pub use device::{DeviceError, DeviceInfo};
-pub use error::{DataError, Location, Result, counted, one_line, shown, spans_text};
+pub use error::{DataError, Location, Result, counted, first_few, one_line, shown, spans_text};
 pub use file_id::FileId;
 #[cfg(feature = "internals")]
 #[doc(hidden)]

@@ -416,16 +416,6 @@ fn unlisted_warning(
     no_lists: bool,
     stale: &[StaleList],
 ) -> String {
-    const SHOWN: usize = 3;
-    let mut names: Vec<&str> = unlisted
-        .iter()
-        .take(SHOWN)
-        .map(|c| c.name.as_str())
-        .collect();
-    let more = format!("and {} more", unlisted.len().saturating_sub(SHOWN));
-    if unlisted.len() > SHOWN {
-        names.push(&more);
-    }
     let lists = if no_lists {
         "no list file written"
     } else {
@@ -456,7 +446,7 @@ fn unlisted_warning(
          truth{removed}; `ridi track` takes {its} data.csv",
         ridi_data::shown(out),
         counted(unlisted.len(), "sequence"),
-        names.join(", ")
+        ridi_data::first_few(unlisted.iter().map(|c| &c.name), 3)
     )
 }
 

@@ -239,11 +239,7 @@ pub fn placement_warnings(seqs: &[Sequence], model: &Cascade) -> Vec<String> {
     unknown
         .into_iter()
         .map(|(label, names)| {
-            const SHOWN: usize = 3;
-            let mut listed = names[..names.len().min(SHOWN)].join(", ");
-            if names.len() > SHOWN {
-                listed.push_str(&format!(", and {} more", names.len() - SHOWN));
-            }
+            let listed = ridi_data::first_few(names.iter(), 3);
             let hint = match tyrex.class_of(label) {
                 Some(class) if classes.iter().any(|c| c == class) => {
                     " (a Tyrex motion name: give `--placement-map tyrex4`, in Python \
