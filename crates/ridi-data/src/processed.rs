@@ -4,7 +4,7 @@
 use std::path::Path;
 
 use ridi_frames::nalgebra::{Quaternion, UnitQuaternion};
-use ridi_frames::{DeviceVec, QuatError, WorldFromDevice};
+use ridi_frames::{DeviceVec, FilterConfig, QuatError, WorldFromDevice};
 
 use crate::error::{DataError, Location, Result};
 use crate::options::ReadOptions;
@@ -93,6 +93,9 @@ pub(crate) struct Table {
     pub has_magnet: bool,
     /// `pos_*` and `ori_*` columns exist (they may still be all NaN, meaning "none").
     pub has_ground_truth: bool,
+    /// `linacce_*`, `grav_*` and `rv_*` columns exist; without them the orientation is
+    /// estimated ([`SequenceParts::estimate_orientation`]).
+    pub has_orientation: bool,
 }
 
 /// Parses one data line of the processed layout: `cells()` yields its cells, `column_of(c)`
@@ -265,23 +268,72 @@ pub(crate) fn assemble(table: Table, path: &Path, opts: &ReadOptions) -> Result<
         .has_magnet
         .then(|| vec3::<ridi_frames::Device>(rows, MAGNET))
         .filter(|m| m.iter().any(|v| *v != DeviceVec::ZERO));
-    let parts = SequenceParts {
+    let at = |e| text::sequence_error(path, Some(&table.lines), &ProcessedFields, e);
+    let mut parts = SequenceParts {
         name: name_from_path(path),
         placement: None,
         time,
         gyro: vec3(rows, GYRO),
         acce: vec3(rows, ACCE),
-        linacce: vec3(rows, LINACCE),
-        gravity: vec3(rows, GRAV),
+        linacce: Vec::new(),
+        gravity: Vec::new(),
         magnet,
-        orientation: rotations(&table, RV, path)?,
+        orientation: Vec::new(),
         orientation_source: Some(OrientationSource::GameRotationVector),
         ground_truth: ground_truth(&table, path)?,
         steps: None,
         device: None,
     };
-    Sequence::with_validation(parts, &opts.validation)
-        .map_err(|e| text::sequence_error(path, Some(&table.lines), &ProcessedFields, e))
+    if table.has_orientation {
+        parts.linacce = vec3(rows, LINACCE);
+        parts.gravity = vec3(rows, GRAV);
+        parts.orientation = rotations(&table, RV, path)?;
+    } else {
+        if let Some(i) = zero_acce_until(&parts.time, &parts.acce) {
+            return Err(zero_acce(path, table.lines[i]));
+        }
+        parts
+            .estimate_orientation(&FilterConfig::default())
+            .map_err(at)?;
+    }
+    Sequence::with_validation(parts, &opts.validation).map_err(at)
+}
+
+/// How long a file without orientation columns may read a zero accelerometer from its start
+/// (seconds): the estimate starts from the first nonzero readings, and a stream holds its rows
+/// until they come, so a limit bounds what it holds. Real recorders log a reading in the first
+/// sample; a minute of exact zeros is a broken recording.
+pub(crate) const MAX_ZERO_ACCE_S: f64 = 60.0;
+
+/// The first frame more than [`MAX_ZERO_ACCE_S`] from the start reached before the
+/// accelerometer has read nonzero [`FilterConfig::init_samples`] times, which the estimate of
+/// the orientation waits for; `None` when there is none.
+pub(crate) fn zero_acce_until(time: &[f64], acce: &[DeviceVec]) -> Option<usize> {
+    let needed = FilterConfig::default().init_samples;
+    let mut nonzero = 0;
+    for (i, (&t, a)) in time.iter().zip(acce).enumerate() {
+        if t - time[0] > MAX_ZERO_ACCE_S {
+            return Some(i);
+        }
+        nonzero += usize::from(*a != DeviceVec::ZERO);
+        if nonzero >= needed {
+            return None;
+        }
+    }
+    None
+}
+
+/// The error for `line` of `path` (a file without orientation columns), reached with the
+/// accelerometer still zero ([`zero_acce_until`]).
+pub(crate) fn zero_acce(path: &Path, line: usize) -> DataError {
+    use text::Fields;
+    DataError::format(
+        Location::line(path, line).with_field(ProcessedFields.field(Channel::Acce, None)),
+        format!(
+            "the accelerometer reads zero for more than {MAX_ZERO_ACCE_S} s from the start: no \
+             gravity to estimate the orientation from (the file has no orientation columns)"
+        ),
+    )
 }
 
 #[cfg(test)]

@@ -2,29 +2,39 @@
 //!
 //! Columns are selected by header name, so the leading unnamed pandas index column, extra
 //! columns of later versions and any column order are all accepted. Required: `time`, `gyro_*`,
-//! `acce_*`, `linacce_*`, `grav_*`, `rv_*`. Optional: `magnet_*` (all zeros also means "not
-//! recorded"), and `pos_*` with `ori_*` together (NaN on every row also means "no ground
+//! `acce_*`. Optional: `linacce_*`, `grav_*` and `rv_*` together, the phone's own orientation
+//! (without them, as a recorder that logs only the gyro and the accelerometer writes the file,
+//! the orientation is estimated from those two:
+//! [`SequenceParts::estimate_orientation`](crate::SequenceParts::estimate_orientation), the
+//! source [`Estimated`](crate::OrientationSource::Estimated)); `magnet_*` (all zeros also means
+//! "not recorded"); and `pos_*` with `ori_*` together (NaN on every row also means "no ground
 //! truth"). Time is in nanoseconds and becomes absolute seconds. A last row without a line break
 //! after it is refused: the file was cut off while being written, maybe inside a value. The
 //! device and the orientation source, which the layout has no column for, come from the
 //! optional sidecar ridi-rs writes beside the file ([`sidecar_path`](crate::sidecar_path)).
 
+use std::ops::Range;
 use std::path::Path;
 
-use crate::Sequence;
 use crate::error::{DataError, Location, Result};
 use crate::options::ReadOptions;
-use crate::processed::{self, MAGNET, POS, PROCESSED_COLUMNS, RV, Table};
+use crate::processed::{self, LINACCE, MAGNET, POS, PROCESSED_COLUMNS, RV, Table};
+use crate::{OrientationSource, Sequence};
 use crate::{sidecar, text};
 
 /// Reads a RIDI processed `data.csv`. The sequence is named after its capture folder (see
 /// [`read_sequence`](crate::read_sequence)); its device and orientation source are those the
 /// optional sidecar beside the file names ([`sidecar_path`](crate::sidecar_path)), else none and
-/// RIDI's game rotation vector.
+/// RIDI's game rotation vector (or, without orientation columns, the estimate: the sidecar may
+/// then name no other source).
 pub fn read(path: impl AsRef<Path>, opts: &ReadOptions) -> Result<Sequence> {
     let path = path.as_ref();
     let mut seq = parse(&text::read_file(path)?, path, opts)?;
-    sidecar::read(path)?.apply(&mut seq);
+    let side = sidecar::read(path)?;
+    if seq.orientation_source() == Some(OrientationSource::Estimated) {
+        side.check_estimated()?;
+    }
+    side.apply(&mut seq);
     Ok(seq)
 }
 
@@ -51,6 +61,8 @@ pub(crate) struct Header {
     slots: Vec<Option<usize>>,
     pub(crate) has_magnet: bool,
     pub(crate) has_ground_truth: bool,
+    /// `linacce_*`, `grav_*` and `rv_*` are in the file (else the orientation is estimated).
+    pub(crate) has_orientation: bool,
 }
 
 pub(crate) fn parse_header(line: usize, content: &str, path: &Path) -> Result<Header> {
@@ -69,11 +81,14 @@ pub(crate) fn parse_header(line: usize, content: &str, path: &Path) -> Result<He
         slots.push(slot);
     }
     // A group is present when any of its columns is; then all of them must be.
-    let group = |range: std::ops::Range<usize>, required: bool, what: &str| -> Result<bool> {
-        if !required && !found[range.clone()].iter().any(|&f| f) {
+    let group = |mut all: std::iter::Chain<Range<usize>, Range<usize>>,
+                 required: bool,
+                 what: &str|
+     -> Result<bool> {
+        if !required && !all.clone().any(|k| found[k]) {
             return Ok(false);
         }
-        match range.clone().find(|&k| !found[k]) {
+        match all.find(|&k| !found[k]) {
             Some(k) => Err(DataError::format(
                 at(PROCESSED_COLUMNS[k]),
                 format!("missing column `{}` ({what})", PROCESSED_COLUMNS[k]),
@@ -81,15 +96,27 @@ pub(crate) fn parse_header(line: usize, content: &str, path: &Path) -> Result<He
             None => Ok(true),
         }
     };
-    group(0..MAGNET, true, "required")?;
-    group(RV..27, true, "required")?;
-    let has_magnet = group(MAGNET..POS, false, "the magnet columns come as a set")?;
-    let has_ground_truth = group(POS..RV, false, "ground truth needs all of pos_* and ori_*")?;
+    // One range, or two chained.
+    let one = |r: Range<usize>| r.chain(0..0);
+    group(one(0..LINACCE), true, "required")?;
+    let has_orientation = group(
+        (LINACCE..MAGNET).chain(RV..27),
+        false,
+        "linacce_*, grav_* and rv_* come together: give all of them, or none to have the \
+         orientation estimated from gyro_* and acce_*",
+    )?;
+    let has_magnet = group(one(MAGNET..POS), false, "the magnet columns come as a set")?;
+    let has_ground_truth = group(
+        one(POS..RV),
+        false,
+        "ground truth needs all of pos_* and ori_*",
+    )?;
     Ok(Header {
         line,
         slots,
         has_magnet,
         has_ground_truth,
+        has_orientation,
     })
 }
 
@@ -162,6 +189,7 @@ fn parse_table(text: &str, path: &Path) -> Result<Table> {
         lines: row_lines,
         has_magnet: header.has_magnet,
         has_ground_truth: header.has_ground_truth,
+        has_orientation: header.has_orientation,
     })
 }
 
@@ -183,7 +211,18 @@ mod tests {
             .copied()
             .collect();
         let h = parse_header(1, &no_gt.join(","), p).unwrap();
-        assert!(h.has_magnet && !h.has_ground_truth);
+        assert!(h.has_magnet && !h.has_ground_truth && h.has_orientation);
+        let bare = "time,gyro_x,gyro_y,gyro_z,acce_x,acce_y,acce_z";
+        let h = parse_header(1, bare, p).unwrap();
+        assert!(!h.has_magnet && !h.has_ground_truth && !h.has_orientation);
+        let e = parse_header(1, &format!("{bare},rv_w,rv_x,rv_y,rv_z"), p)
+            .err()
+            .unwrap();
+        assert!(
+            e.to_string()
+                .starts_with("h.csv:1: field `linacce_x`: missing column"),
+            "{e}"
+        );
         let partial: Vec<_> = PROCESSED_COLUMNS
             .iter()
             .filter(|&&c| c != "ori_z")

@@ -167,5 +167,6 @@ fn parse_table(text: &str, path: &Path) -> Result<Table> {
         lines: row_lines,
         has_magnet: true,
         has_ground_truth: true,
+        has_orientation: true,
     })
 }

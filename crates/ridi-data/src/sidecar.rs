@@ -47,9 +47,31 @@ const SOURCE: &str = "orientation_source";
 pub(crate) struct Sidecar {
     pub(crate) device: Option<DeviceInfo>,
     pub(crate) orientation_source: Option<OrientationSource>,
+    /// The sidecar and the line naming the orientation source, for [`Self::check_estimated`].
+    source_at: Option<(PathBuf, usize)>,
 }
 
 impl Sidecar {
+    /// Refuses a sidecar naming another source than [`OrientationSource::Estimated`] beside a
+    /// data file without orientation columns, whose orientation the reader estimates.
+    pub(crate) fn check_estimated(&self) -> Result<()> {
+        match (self.orientation_source, &self.source_at) {
+            (Some(s), Some((path, line))) if s != OrientationSource::Estimated => {
+                Err(DataError::format(
+                    Location::line(path, *line).with_field(SOURCE),
+                    format!(
+                        "names `{}`, but the data file has no orientation columns \
+                         (linacce_*, grav_*, rv_*): its orientation is estimated (`{}`, or no \
+                         such line)",
+                        s.key(),
+                        OrientationSource::Estimated.key()
+                    ),
+                ))
+            }
+            _ => Ok(()),
+        }
+    }
+
     /// Gives `seq` the sidecar's device and, when it names one, its orientation source.
     pub(crate) fn apply(self, seq: &mut Sequence) {
         seq.set_device(self.device);
@@ -133,6 +155,7 @@ fn parse(content: &str, path: &Path) -> Result<Sidecar> {
         }
     }
     let orientation_source = source.map(|(_, s)| s);
+    let source_at = source.map(|(line, _)| (path.to_path_buf(), line));
     let device = match (device, rate) {
         (None, None) => None,
         (None, Some((line, _))) => {
@@ -149,6 +172,7 @@ fn parse(content: &str, path: &Path) -> Result<Sidecar> {
     Ok(Sidecar {
         device,
         orientation_source,
+        source_at,
     })
 }
 

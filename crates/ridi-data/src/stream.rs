@@ -2,7 +2,9 @@
 //!
 //! [`RowReader`] reads a `data.csv` or `data_plain.txt` (either gzip-compressed) line by line
 //! with the parsers of [`ridi_csv`](crate::ridi_csv) and [`ridi_plain`](crate::ridi_plain),
-//! checks each row as it comes (numbers, time order and gaps, rotations, ground truth) and
+//! checks each row as it comes (numbers, time order and gaps, rotations, ground truth; a
+//! `data.csv` without orientation columns gets the whole-file reader's estimate, its rows held
+//! for the estimate's first 2 s) and
 //! keeps running sums for what needs the whole recording (the median interval, the units of
 //! every channel, gravity, the ground truth's speed). [`RowReader::finish`] then refuses what
 //! [`Sequence::new`](crate::Sequence::new) would refuse, with the error the whole-file reader
@@ -19,10 +21,13 @@
 //! a Tyrex run splits at gaps), RoNIN and MAT files are read by random access, so their
 //! readers take the whole recording ([`Format::streams`]).
 
+use std::collections::VecDeque;
 use std::io::{BufRead, BufReader, Read};
 use std::path::{Path, PathBuf};
 
-use ridi_frames::{DeviceVec, WorldFromDevice, WorldVec};
+use ridi_frames::{
+    DeviceVec, EstimateError, FilterConfig, OrientationFilter, WorldFromDevice, WorldVec,
+};
 
 use crate::error::{DataError, Location, Result};
 use crate::options::ReadOptions;
@@ -345,8 +350,27 @@ struct Processed {
     lines: Lines,
     header: Header,
     ground_truth: GroundTruthState,
-    /// Line of the previous row.
-    last_line: Option<usize>,
+    /// Time and line of the previous row parsed.
+    last: Option<(f64, usize)>,
+    /// The orientation being estimated, for a `data.csv` without orientation columns.
+    estimating: Option<Box<Estimating>>,
+}
+
+/// The orientation of a file without orientation columns, estimated as its rows come: the
+/// whole-file reader's estimate ([`SequenceParts::estimate_orientation`](crate::SequenceParts::estimate_orientation)), which
+/// [`OrientationFilter`] gives one sample at a time once it has the first seconds' tilt. Rows
+/// wait here until their orientation is known (2 s with the default filter;
+/// [`processed::MAX_ZERO_ACCE_S`] at most).
+struct Estimating {
+    filter: OrientationFilter,
+    /// Rows parsed, with their lines, waiting for the orientations in `known` (the first
+    /// `known.len()` of them have one).
+    held: VecDeque<(Row, usize)>,
+    known: VecDeque<WorldFromDevice>,
+    /// The filter's output, reused.
+    out: Vec<WorldFromDevice>,
+    /// The file's rows are all parsed and the filter finished.
+    finished: bool,
 }
 
 /// Where the rows come from (each boxed: a raw folder's readers take a few kilobytes).
@@ -530,9 +554,12 @@ impl RowReader {
             (name, None, source, Source::Raw(Box::new(raw)))
         } else {
             let (processed, side) = Self::open_processed(format, &file)?;
-            let source = side
-                .orientation_source
-                .or(Some(OrientationSource::GameRotationVector));
+            let source = match processed.estimating {
+                Some(_) => Some(OrientationSource::Estimated),
+                None => side
+                    .orientation_source
+                    .or(Some(OrientationSource::GameRotationVector)),
+            };
             let name = processed::name_from_path(&file);
             (
                 name,
@@ -569,11 +596,26 @@ impl RowReader {
             (_, None) => return Err(ridi_csv::empty_file(file)),
         };
         let side = sidecar::read(file)?;
+        let estimating = match &header {
+            Header::Csv(h) if !h.has_orientation => {
+                side.check_estimated()?;
+                Some(Box::new(Estimating {
+                    filter: OrientationFilter::new(FilterConfig::default())
+                        .expect("the default filter is valid"),
+                    held: VecDeque::new(),
+                    known: VecDeque::new(),
+                    out: Vec::new(),
+                    finished: false,
+                }))
+            }
+            _ => None,
+        };
         let processed = Processed {
             lines,
             header,
             ground_truth: GroundTruthState::default(),
-            last_line: None,
+            last: None,
+            estimating,
         };
         Ok((processed, side))
     }
@@ -818,7 +860,7 @@ impl RowReader {
             Source::Processed(p) => {
                 let max_gap_s = self.opts.validation.max_gap_s;
                 let rows = self.sums.rows;
-                p.read_row(&self.path, max_gap_s, rows, self.previous.as_ref())?
+                p.read_row(&self.path, max_gap_s, rows)?
                     .map(|(row, line)| (row, Some(line)))
             }
             Source::Raw(raw) => raw.next_row(self.sums.rows, self.previous.as_ref())?,
@@ -927,14 +969,61 @@ impl RowReader {
 }
 
 impl Processed {
-    /// Parses and checks the next row of the file at `path`, the `rows`-th, after `previous`;
-    /// with its line.
+    /// The next row of the file at `path`, the `rows`-th, with its line: parsed and checked,
+    /// with its orientation estimated when the file has none.
     fn read_row(
         &mut self,
         path: &Path,
         max_gap_s: f64,
         rows: usize,
-        previous: Option<&Row>,
+    ) -> Result<Option<(Row, usize)>> {
+        let Some(mut e) = self.estimating.take() else {
+            return self.parse_row(path, max_gap_s, rows);
+        };
+        let next = loop {
+            if let Some(q) = e.known.pop_front() {
+                let (mut row, line) = e.held.pop_front().expect("a held row per orientation");
+                (row.gravity, row.linacce) = ridi_frames::gravity_and_linacce(q, row.acce);
+                row.orientation = q;
+                break Some((row, line));
+            }
+            if e.finished {
+                break None;
+            }
+            let rows = rows + e.held.len();
+            let e = &mut *e;
+            match self.parse_row(path, max_gap_s, rows)? {
+                Some((row, line)) => {
+                    let first = e.held.front().map_or(row.time, |(r, _)| r.time);
+                    if e.known.is_empty() && row.time - first > processed::MAX_ZERO_ACCE_S {
+                        return Err(processed::zero_acce(path, line));
+                    }
+                    e.filter
+                        .push(row.time, row.gyro, row.acce, &mut e.out)
+                        .map_err(|error| estimate_error(path, error))?;
+                    e.held.push_back((row, line));
+                }
+                None => {
+                    e.filter
+                        .finish(&mut e.out)
+                        .map_err(|error| estimate_error(path, error))?;
+                    e.finished = true;
+                }
+            }
+            e.known.extend(e.out.drain(..));
+        };
+        self.estimating = Some(e);
+        Ok(next)
+    }
+
+    /// Parses and checks the next line of the file at `path`, the `rows`-th row; with its
+    /// line. Without orientation columns, the row's orientation, gravity and linear
+    /// acceleration are placeholders ([`Self::read_row`] estimates them).
+    fn parse_row(
+        &mut self,
+        path: &Path,
+        max_gap_s: f64,
+        rows: usize,
     ) -> Result<Option<(Row, usize)>> {
         let Some((line, content)) = self.lines.next()? else {
             return Ok(None);
@@ -949,16 +1038,23 @@ impl Processed {
             }
         };
         let time = r[TIME] / 1e9;
-        if let (Some(p), Some(p_line)) = (previous, self.last_line) {
+        if let Some(previous) = self.last {
             text::check_step(
-                (p.time, p_line),
+                previous,
                 (time, line),
                 path,
                 PROCESSED_COLUMNS[TIME],
                 max_gap_s,
             )?;
         }
-        let orientation = processed::rotation_at(&r, RV, path, line)?;
+        let has_orientation = match &self.header {
+            Header::Csv(h) => h.has_orientation,
+            Header::Plain(_) => true,
+        };
+        let orientation = match has_orientation {
+            true => processed::rotation_at(&r, RV, path, line)?,
+            false => WorldFromDevice::identity(),
+        };
         let has_ground_truth = match &self.header {
             Header::Csv(h) => h.has_ground_truth,
             Header::Plain(_) => true,
@@ -999,7 +1095,7 @@ impl Processed {
             ground_truth,
             steps: None,
         };
-        self.last_line = Some(line);
+        self.last = Some((time, line));
         Ok(Some((row, line)))
     }
 
@@ -1009,20 +1105,30 @@ impl Processed {
         match &self.header {
             Header::Csv(h) if rows == 0 => return Err(ridi_csv::no_rows(path, h.line)),
             Header::Plain(h) => {
-                let last = self.last_line.unwrap_or(h.line);
+                let last = self.last.map_or(h.line, |(_, line)| line);
                 if let Some(e) = h.too_few(path, rows, last) {
                     return Err(e);
                 }
             }
             Header::Csv(_) => {}
         }
-        match self.last_line {
-            Some(line) if !self.lines.ends_in_break => {
+        match self.last {
+            Some((_, line)) if !self.lines.ends_in_break => {
                 Err(text::cut_off(Location::line(path, line), ""))
             }
             _ => Ok(()),
         }
     }
+}
+
+/// The error the whole-file reader gives when the estimate of the orientation of the file at
+/// `path` fails.
+fn estimate_error(path: &Path, error: EstimateError) -> DataError {
+    let e = SequenceError::Estimate {
+        what: "orientation estimate",
+        error,
+    };
+    text::sequence_error_at(path, |_| None, &ProcessedFields, e)
 }
 
 impl Iterator for RowReader {

@@ -613,3 +613,155 @@ fn a_pose_file_that_grows_after_open_is_refused_as_changed() {
     let grow = |dir: &Path| append(dir, "pose.txt", 2, "0 0.5 1.5 0 0 0 1");
     refused_as_changed(|_| {}, grow, "pose.txt:6002");
 }
+
+/// `csv` (a `data.csv`'s text) without the columns whose names start with one of `dropped`.
+fn without_columns(csv: &str, dropped: &[&str]) -> String {
+    let mut lines = csv.lines();
+    let header: Vec<&str> = lines.next().unwrap().split(',').collect();
+    let keep: Vec<usize> = (0..header.len())
+        .filter(|&c| !dropped.iter().any(|d| header[c].starts_with(d)))
+        .collect();
+    let pick = |l: &str| -> String {
+        let cells: Vec<&str> = l.split(',').collect();
+        let kept: Vec<&str> = keep.iter().map(|&c| cells[c]).collect();
+        kept.join(",") + "\n"
+    };
+    std::iter::once(header.join(","))
+        .chain(lines.map(String::from))
+        .map(|l| pick(&l))
+        .collect()
+}
+
+/// Asserts that `path` streams as `whole` reads it: the same rows bit for bit, or the same
+/// error.
+fn assert_processed_streams_as_read(path: &Path, whole: &ridi_data::Result<Sequence>) {
+    let stream = streamed(path, &ReadOptions::default());
+    let read = match whole {
+        Err(e) => return assert_eq!(stream.map(|_| ()), Err(e.to_string())),
+        Ok(read) => read,
+    };
+    let rows = stream.unwrap();
+    assert_eq!(rows.len(), read.len());
+    for (i, r) in rows.iter().enumerate() {
+        assert_eq!(r.time, read.time()[i]);
+        assert_eq!(r.gyro, read.gyro()[i]);
+        assert_eq!(r.acce, read.acce()[i]);
+        assert_eq!(r.linacce, read.linacce()[i], "frame {i}");
+        assert_eq!(r.gravity, read.gravity()[i], "frame {i}");
+        assert_eq!(r.orientation, read.orientation()[i], "frame {i}");
+        assert_eq!(r.magnet, read.magnet().map(|m| m[i]));
+        let gt = read
+            .ground_truth()
+            .map(|g| (g.position[i], g.orientation[i]));
+        assert_eq!(r.ground_truth, gt);
+    }
+    let reader = RowReader::open(path, &ReadOptions::default()).unwrap();
+    assert_eq!(reader.orientation_source(), read.orientation_source());
+}
+
+/// The columns of the phone's own orientation, which a recorder of gyro and accelerometer alone
+/// does not write.
+const ORIENTATION_COLUMNS: [&str; 3] = ["linacce_", "grav_", "rv_"];
+
+#[test]
+fn a_data_csv_without_orientation_columns_reads_and_streams_with_the_estimate() {
+    let dir = tempfile::tempdir().unwrap();
+    // 6 s: the estimate settles over the first 2 s before it gives an orientation.
+    let seq = walk(1200);
+    let full = dir.path().join("full.csv");
+    write_ridi_csv(&seq, &full).unwrap();
+    let text = without_columns(
+        &std::fs::read_to_string(&full).unwrap(),
+        &ORIENTATION_COLUMNS,
+    );
+    let path = file(dir.path(), "walk.csv", &text);
+    let opts = ReadOptions::default();
+    let read = read_sequence(&path, &opts);
+    assert_processed_streams_as_read(&path, &read);
+    let read = read.unwrap();
+    assert_eq!(
+        read.orientation_source(),
+        Some(OrientationSource::Estimated)
+    );
+    // What the whole recording's estimate gives, bit for bit.
+    let mut parts = seq.clone().into_parts();
+    parts.estimate_orientation(&Default::default()).unwrap();
+    assert_eq!(read.orientation(), &parts.orientation[..]);
+    assert_eq!(read.gravity(), &parts.gravity[..]);
+    assert_eq!(read.linacce(), &parts.linacce[..]);
+    // A flat phone: the estimate's gravity is along device z.
+    let g = read.gravity()[600];
+    assert!(
+        g.z() > 9.7 && g.x().abs() < 0.3 && g.y().abs() < 0.3,
+        "{g:?}"
+    );
+    assert!(read.ground_truth().is_some() && read.magnet().is_some());
+    // The same, gzip-compressed, and with a sidecar that says so.
+    let gz = dir.path().join("walk.csv.gz");
+    std::fs::write(&gz, gzip(text.as_bytes())).unwrap();
+    file(
+        dir.path(),
+        "walk.csv.gz.meta",
+        "orientation_source = estimated\n",
+    );
+    let read = read_sequence(&gz, &opts);
+    assert_processed_streams_as_read(&gz, &read);
+    assert_eq!(read.unwrap().orientation(), &parts.orientation[..]);
+}
+
+#[test]
+fn a_data_csv_with_part_of_its_orientation_or_no_gravity_is_refused_by_name() {
+    let dir = tempfile::tempdir().unwrap();
+    let seq = walk(1200);
+    let full = dir.path().join("full.csv");
+    write_ridi_csv(&seq, &full).unwrap();
+    let full = std::fs::read_to_string(&full).unwrap();
+    let opts = ReadOptions::default();
+    let refused = |path: &Path, expected: &str| {
+        let whole = read_sequence(path, &opts);
+        assert_processed_streams_as_read(path, &whole);
+        let Err(e) = whole else {
+            panic!("{}: accepted", path.display())
+        };
+        let e = e.to_string();
+        assert!(e.contains(expected), "{e}");
+    };
+    // A rotation without the gravity it goes with, or the other way round.
+    let path = file(dir.path(), "a.csv", &without_columns(&full, &["grav_"]));
+    refused(
+        &path,
+        "a.csv:1: field `grav_x`: missing column `grav_x` (linacce_*, grav_* and rv_*",
+    );
+    let path = file(dir.path(), "b.csv", &without_columns(&full, &["rv_w"]));
+    refused(&path, "b.csv:1: field `rv_w`: missing column");
+    // A sidecar naming the phone's orientation beside a file that has none.
+    let text = without_columns(&full, &ORIENTATION_COLUMNS);
+    let path = file(dir.path(), "c.csv", &text);
+    file(
+        dir.path(),
+        "c.csv.meta",
+        "device = Pixel 7\norientation_source = rotation-vector\n",
+    );
+    refused(
+        &path,
+        "c.csv.meta:2: field `orientation_source`: names `rotation-vector`, but the data file \
+         has no orientation columns",
+    );
+    // An accelerometer of exact zeros: short, and for longer than the estimate may wait.
+    let zeros = |rows: usize| -> String {
+        let mut out = String::from("time,gyro_x,gyro_y,gyro_z,acce_x,acce_y,acce_z\n");
+        for i in 0..rows {
+            out += &format!("{},0.01,0.02,0.03,0,0,0\n", 1_000_000_000 + 20_000_000 * i);
+        }
+        out
+    };
+    refused(
+        &file(dir.path(), "short.csv", &zeros(100)),
+        "no nonzero accelerometer sample",
+    );
+    // 50 Hz: frame 3001 (line 3003) is the first more than 60 s after the first.
+    refused(
+        &file(dir.path(), "zeros.csv", &zeros(3100)),
+        "zeros.csv:3003: field `acce_x..acce_z`: the accelerometer reads zero for more than 60 s",
+    );
+}

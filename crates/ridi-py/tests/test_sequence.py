@@ -322,6 +322,23 @@ def test_gravity_and_orientation_left_out_are_derived_or_estimated(seq, model):
         ridi.Sequence(seq.time * 1000, seq.gyro, seq.acce)
 
 
+def test_a_data_csv_of_gyro_and_accelerometer_alone_reads_with_the_estimate(seq, tmp_path):
+    # A recorder that logs only the two sensors: the orientation estimated as from arrays.
+    ns = np.round(seq.time * 1e9).astype(np.int64)
+    lines = ["time,gyro_x,gyro_y,gyro_z,acce_x,acce_y,acce_z"] + [
+        ",".join([str(t), *map(repr, g), *map(repr, a)])
+        for t, g, a in zip(ns.tolist(), seq.gyro.tolist(), seq.acce.tolist())
+    ]
+    (tmp_path / "data.csv").write_text("\n".join(lines) + "\n")
+    read = ridi.read(tmp_path / "data.csv")
+    bare = ridi.Sequence(read.time, seq.gyro, seq.acce)
+    assert read.orientation_source == "estimated"
+    for key in ("orientation", "gravity", "linacce"):
+        np.testing.assert_array_equal(getattr(read, key), getattr(bare, key), err_msg=key)
+    (tmp_path / "data.csv.meta").write_text("orientation_source = game-rotation-vector\n")
+    with pytest.raises(ValueError, match=r"data.csv.meta:1: field `orientation_source`: names"):
+        ridi.read(tmp_path / "data.csv")
+
 def same_sequence(a, b):
     """Every constructor argument of `a` and `b` agrees (so a new argument the pickling misses
     fails here)."""
