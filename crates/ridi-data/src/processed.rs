@@ -4,12 +4,14 @@
 use std::path::Path;
 
 use ridi_frames::nalgebra::{Quaternion, UnitQuaternion};
-use ridi_frames::{DeviceVec, FilterConfig, QuatError, WorldFromDevice};
+use ridi_frames::{
+    DeviceVec, EstimateError, FilterConfig, OrientationFilter, QuatError, WorldFromDevice,
+};
 
 use crate::error::{DataError, Location, Result};
 use crate::options::ReadOptions;
 use crate::text;
-use crate::{Channel, GroundTruth, OrientationSource, Sequence, SequenceParts};
+use crate::{Channel, GroundTruth, OrientationSource, Sequence, SequenceError, SequenceParts};
 
 /// The 27 columns of the RIDI processed layout, in the order the original writes them. `time`
 /// is in nanoseconds; `ori_*` is the Tango ground-truth orientation and `rv_*` the game
@@ -289,51 +291,102 @@ pub(crate) fn assemble(table: Table, path: &Path, opts: &ReadOptions) -> Result<
         parts.gravity = vec3(rows, GRAV);
         parts.orientation = rotations(&table, RV, path)?;
     } else {
-        if let Some(i) = zero_acce_until(&parts.time, &parts.acce) {
-            return Err(zero_acce(path, table.lines[i]));
-        }
+        check_estimate_starts(&parts, &table.lines, path)?;
         parts
             .estimate_orientation(&FilterConfig::default())
-            .map_err(at)?;
+            .map_err(|e| match e {
+                SequenceError::Estimate { error, .. } => estimate_error(path, error),
+                e => at(e),
+            })?;
     }
     Sequence::with_validation(parts, &opts.validation).map_err(at)
 }
 
-/// How long a file without orientation columns may read a zero accelerometer from its start
-/// (seconds): the estimate starts from the first nonzero readings, and a stream holds its rows
-/// until they come, so a limit bounds what it holds. Real recorders log a reading in the first
-/// sample; a minute of exact zeros is a broken recording.
-pub(crate) const MAX_ZERO_ACCE_S: f64 = 60.0;
+/// How long the orientation estimate of a file without orientation columns may wait to start,
+/// in seconds and in rows from the file's first row: [`OrientationFilter`] holds its samples
+/// until it has [`FilterConfig::init_samples`] nonzero accelerometer readings and
+/// [`FilterConfig::settle_time`] of samples (2 s), and a stream holds its rows meanwhile, so
+/// the limits bound what it holds (100 000 rows: 10 s at 10 kHz, the fastest rate the readers
+/// accept). Real recorders log a reading in their first sample.
+pub(crate) const MAX_ESTIMATE_WAIT: (f64, usize) = (60.0, 100_000);
 
-/// The first frame more than [`MAX_ZERO_ACCE_S`] from the start reached before the
-/// accelerometer has read nonzero [`FilterConfig::init_samples`] times, which the estimate of
-/// the orientation waits for; `None` when there is none.
-pub(crate) fn zero_acce_until(time: &[f64], acce: &[DeviceVec]) -> Option<usize> {
-    let needed = FilterConfig::default().init_samples;
-    let mut nonzero = 0;
-    for (i, (&t, a)) in time.iter().zip(acce).enumerate() {
-        if t - time[0] > MAX_ZERO_ACCE_S {
-            return Some(i);
-        }
-        nonzero += usize::from(*a != DeviceVec::ZERO);
-        if nonzero >= needed {
-            return None;
-        }
-    }
-    None
+/// The filter a file without orientation columns is estimated with, row by row or whole
+/// ([`SequenceParts::estimate_orientation`]).
+pub(crate) fn estimate_filter() -> OrientationFilter {
+    OrientationFilter::new(FilterConfig::default()).expect("the default filter is valid")
 }
 
-/// The error for `line` of `path` (a file without orientation columns), reached with the
-/// accelerometer still zero ([`zero_acce_until`]).
-pub(crate) fn zero_acce(path: &Path, line: usize) -> DataError {
-    use text::Fields;
+/// Whether `filter`, fed `rows` rows since the file's first row at `first_time`, has waited
+/// too long ([`MAX_ESTIMATE_WAIT`]) when a row at `time` comes and it has not started.
+pub(crate) fn estimate_waited_too_long(
+    filter: &OrientationFilter,
+    rows: usize,
+    first_time: f64,
+    time: f64,
+) -> bool {
+    filter.orientation().is_none()
+        && (time - first_time > MAX_ESTIMATE_WAIT.0 || rows >= MAX_ESTIMATE_WAIT.1)
+}
+
+/// The error for `line` of `path`, where the estimate has waited too long.
+pub(crate) fn estimate_wait_error(path: &Path, line: usize) -> DataError {
+    let config = FilterConfig::default();
+    let (seconds, rows) = MAX_ESTIMATE_WAIT;
     DataError::format(
-        Location::line(path, line).with_field(ProcessedFields.field(Channel::Acce, None)),
+        Location::line(path, line).with_field(acce_field()),
         format!(
-            "the accelerometer reads zero for more than {MAX_ZERO_ACCE_S} s from the start: no \
-             gravity to estimate the orientation from (the file has no orientation columns)"
+            "the orientation estimate has not started {seconds} s or {rows} rows into the \
+             file (the file has no orientation columns; the estimate needs {} nonzero \
+             accelerometer readings and {} s of rows): an accelerometer reading zero, or time \
+             in another unit than nanoseconds?",
+            config.init_samples, config.settle_time
         ),
     )
+}
+
+/// The error of the estimate of the orientation of `path`, a file without orientation columns.
+pub(crate) fn estimate_error(path: &Path, error: EstimateError) -> DataError {
+    match error {
+        EstimateError::NoGravity => DataError::format(
+            Location::file(path).with_field(acce_field()),
+            "no nonzero accelerometer reading to estimate the orientation from (the file has no \
+             orientation columns)",
+        ),
+        error => text::sequence_error_at(
+            path,
+            |_| None,
+            &ProcessedFields,
+            SequenceError::Estimate {
+                what: "orientation estimate",
+                error,
+            },
+        ),
+    }
+}
+
+fn acce_field() -> String {
+    use text::Fields;
+    ProcessedFields.field(Channel::Acce, None)
+}
+
+/// Refuses a file without orientation columns whose estimate waits too long to start, at the
+/// line where it has: the check the stream makes as the rows come.
+fn check_estimate_starts(parts: &SequenceParts, lines: &[usize], path: &Path) -> Result<()> {
+    let mut filter = estimate_filter();
+    let mut out = Vec::new();
+    let time = &parts.time;
+    for (i, (&t, &line)) in time.iter().zip(lines).enumerate() {
+        if filter.orientation().is_some() {
+            break;
+        }
+        if estimate_waited_too_long(&filter, i, time[0], t) {
+            return Err(estimate_wait_error(path, line));
+        }
+        filter
+            .push(t, parts.gyro[i], parts.acce[i], &mut out)
+            .map_err(|e| estimate_error(path, e))?;
+    }
+    Ok(())
 }
 
 #[cfg(test)]

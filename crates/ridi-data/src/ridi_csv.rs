@@ -13,7 +13,6 @@
 //! device and the orientation source, which the layout has no column for, come from the
 //! optional sidecar ridi-rs writes beside the file ([`sidecar_path`](crate::sidecar_path)).
 
-use std::ops::Range;
 use std::path::Path;
 
 use crate::error::{DataError, Location, Result};
@@ -32,7 +31,7 @@ pub fn read(path: impl AsRef<Path>, opts: &ReadOptions) -> Result<Sequence> {
     let mut seq = parse(&text::read_file(path)?, path, opts)?;
     let side = sidecar::read(path)?;
     if seq.orientation_source() == Some(OrientationSource::Estimated) {
-        side.check_estimated()?;
+        side.check_estimated(path)?;
     }
     side.apply(&mut seq);
     Ok(seq)
@@ -80,36 +79,29 @@ pub(crate) fn parse_header(line: usize, content: &str, path: &Path) -> Result<He
         }
         slots.push(slot);
     }
-    // A group is present when any of its columns is; then all of them must be.
-    let group = |mut all: std::iter::Chain<Range<usize>, Range<usize>>,
-                 required: bool,
-                 what: &str|
-     -> Result<bool> {
-        if !required && !all.clone().any(|k| found[k]) {
-            return Ok(false);
-        }
-        match all.find(|&k| !found[k]) {
-            Some(k) => Err(DataError::format(
-                at(PROCESSED_COLUMNS[k]),
-                format!("missing column `{}` ({what})", PROCESSED_COLUMNS[k]),
-            )),
-            None => Ok(true),
-        }
-    };
-    // One range, or two chained.
-    let one = |r: Range<usize>| r.chain(0..0);
-    group(one(0..LINACCE), true, "required")?;
+    let at = |k: usize| at(PROCESSED_COLUMNS[k]);
+    group(&found, 0..LINACCE, true, "required", at)?;
     let has_orientation = group(
+        &found,
         (LINACCE..MAGNET).chain(RV..27),
         false,
         "linacce_*, grav_* and rv_* come together: give all of them, or none to have the \
          orientation estimated from gyro_* and acce_*",
+        at,
     )?;
-    let has_magnet = group(one(MAGNET..POS), false, "the magnet columns come as a set")?;
+    let has_magnet = group(
+        &found,
+        MAGNET..POS,
+        false,
+        "the magnet columns come as a set",
+        at,
+    )?;
     let has_ground_truth = group(
-        one(POS..RV),
+        &found,
+        POS..RV,
         false,
         "ground truth needs all of pos_* and ori_*",
+        at,
     )?;
     Ok(Header {
         line,
@@ -118,6 +110,27 @@ pub(crate) fn parse_header(line: usize, content: &str, path: &Path) -> Result<He
         has_ground_truth,
         has_orientation,
     })
+}
+
+/// Whether the group of `columns` is in the file (`found`): when any of its columns is, all of
+/// them must be (else an error at `at` of the first missing one); `required`, always.
+fn group(
+    found: &[bool; 27],
+    mut columns: impl Iterator<Item = usize> + Clone,
+    required: bool,
+    what: &str,
+    at: impl Fn(usize) -> Location,
+) -> Result<bool> {
+    if !required && !columns.clone().any(|k| found[k]) {
+        return Ok(false);
+    }
+    match columns.find(|&k| !found[k]) {
+        Some(k) => Err(DataError::format(
+            at(k),
+            format!("missing column `{}` ({what})", PROCESSED_COLUMNS[k]),
+        )),
+        None => Ok(true),
+    }
 }
 
 /// The error for a file without a header line.

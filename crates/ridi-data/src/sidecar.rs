@@ -13,9 +13,11 @@
 //! `#` comments and blank lines are skipped; every other line is `key = value`. Keys:
 //! `device` (the model, [`DeviceInfo::new`]), `device_imu_rate_hz` (only with `device`,
 //! [`DeviceInfo::with_imu_rate`]) and `orientation_source` ([`OrientationSource::key`]; without
-//! it, the layout's own: RIDI's game rotation vector). Other keys are skipped, so that files of a later version with
-//! more keys still read. A malformed line, a key given twice or a value that is not valid is an
-//! error naming the sidecar, the line and the key.
+//! it, the layout's own: RIDI's game rotation vector, or the estimate for a `data.csv` without
+//! orientation columns, beside which a sidecar may name no other source). Other keys are
+//! skipped, so that files of a later version with more keys still read. A malformed line, a key
+//! given twice or a value that is not valid is an error naming the sidecar, the line and the
+//! key.
 //!
 //! The sidecar is optional: a data file without one (RIDI's own, one written by another tool)
 //! reads with no device. The writers replace it together with the data file: the old sidecar is
@@ -47,27 +49,26 @@ const SOURCE: &str = "orientation_source";
 pub(crate) struct Sidecar {
     pub(crate) device: Option<DeviceInfo>,
     pub(crate) orientation_source: Option<OrientationSource>,
-    /// The sidecar and the line naming the orientation source, for [`Self::check_estimated`].
-    source_at: Option<(PathBuf, usize)>,
+    /// The line naming the orientation source, for [`Self::check_estimated`].
+    source_line: Option<usize>,
 }
 
 impl Sidecar {
     /// Refuses a sidecar naming another source than [`OrientationSource::Estimated`] beside a
     /// data file without orientation columns, whose orientation the reader estimates.
-    pub(crate) fn check_estimated(&self) -> Result<()> {
-        match (self.orientation_source, &self.source_at) {
-            (Some(s), Some((path, line))) if s != OrientationSource::Estimated => {
-                Err(DataError::format(
-                    Location::line(path, *line).with_field(SOURCE),
-                    format!(
-                        "names `{}`, but the data file has no orientation columns \
+    /// `data` is the data file's path.
+    pub(crate) fn check_estimated(&self, data: &Path) -> Result<()> {
+        match (self.orientation_source, self.source_line) {
+            (Some(s), Some(line)) if s != OrientationSource::Estimated => Err(DataError::format(
+                Location::line(sidecar_path(data), line).with_field(SOURCE),
+                format!(
+                    "names `{}`, but the data file has no orientation columns \
                          (linacce_*, grav_*, rv_*): its orientation is estimated (`{}`, or no \
                          such line)",
-                        s.key(),
-                        OrientationSource::Estimated.key()
-                    ),
-                ))
-            }
+                    s.key(),
+                    OrientationSource::Estimated.key()
+                ),
+            )),
             _ => Ok(()),
         }
     }
@@ -155,7 +156,7 @@ fn parse(content: &str, path: &Path) -> Result<Sidecar> {
         }
     }
     let orientation_source = source.map(|(_, s)| s);
-    let source_at = source.map(|(line, _)| (path.to_path_buf(), line));
+    let source_line = source.map(|(line, _)| line);
     let device = match (device, rate) {
         (None, None) => None,
         (None, Some((line, _))) => {
@@ -172,7 +173,7 @@ fn parse(content: &str, path: &Path) -> Result<Sidecar> {
     Ok(Sidecar {
         device,
         orientation_source,
-        source_at,
+        source_line,
     })
 }
 

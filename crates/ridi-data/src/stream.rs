@@ -25,9 +25,7 @@ use std::collections::VecDeque;
 use std::io::{BufRead, BufReader, Read};
 use std::path::{Path, PathBuf};
 
-use ridi_frames::{
-    DeviceVec, EstimateError, FilterConfig, OrientationFilter, WorldFromDevice, WorldVec,
-};
+use ridi_frames::{DeviceVec, OrientationFilter, WorldFromDevice, WorldVec};
 
 use crate::error::{DataError, Location, Result};
 use crate::options::ReadOptions;
@@ -336,6 +334,17 @@ enum Header {
     Plain(ridi_plain::Header),
 }
 
+impl Header {
+    /// A `data.csv`'s header, which says which column groups the file has (a
+    /// `data_plain.txt` has every column).
+    fn csv(&self) -> Option<&ridi_csv::Header> {
+        match self {
+            Header::Csv(h) => Some(h),
+            Header::Plain(_) => None,
+        }
+    }
+}
+
 /// The ground truth's state while streaming: all NaN means none, and then on every row.
 #[derive(Debug, Clone, Copy, Default)]
 struct GroundTruthState {
@@ -360,7 +369,7 @@ struct Processed {
 /// whole-file reader's estimate ([`SequenceParts::estimate_orientation`](crate::SequenceParts::estimate_orientation)), which
 /// [`OrientationFilter`] gives one sample at a time once it has the first seconds' tilt. Rows
 /// wait here until their orientation is known (2 s with the default filter;
-/// [`processed::MAX_ZERO_ACCE_S`] at most).
+/// [`processed::MAX_ESTIMATE_WAIT`] at most).
 struct Estimating {
     filter: OrientationFilter,
     /// Rows parsed, with their lines, waiting for the orientations in `known` (the first
@@ -596,12 +605,11 @@ impl RowReader {
             (_, None) => return Err(ridi_csv::empty_file(file)),
         };
         let side = sidecar::read(file)?;
-        let estimating = match &header {
-            Header::Csv(h) if !h.has_orientation => {
-                side.check_estimated()?;
+        let estimating = match header.csv() {
+            Some(h) if !h.has_orientation => {
+                side.check_estimated(file)?;
                 Some(Box::new(Estimating {
-                    filter: OrientationFilter::new(FilterConfig::default())
-                        .expect("the default filter is valid"),
+                    filter: processed::estimate_filter(),
                     held: VecDeque::new(),
                     known: VecDeque::new(),
                     out: Vec::new(),
@@ -645,7 +653,8 @@ impl RowReader {
         self.device.as_ref()
     }
 
-    /// Where the orientation comes from: the sidecar's, else RIDI's game rotation vector.
+    /// Where the orientation comes from: the sidecar's, else RIDI's game rotation vector; the
+    /// estimate for a `data.csv` without orientation columns.
     pub fn orientation_source(&self) -> Option<OrientationSource> {
         self.orientation_source
     }
@@ -980,40 +989,53 @@ impl Processed {
         let Some(mut e) = self.estimating.take() else {
             return self.parse_row(path, max_gap_s, rows);
         };
-        let next = loop {
+        // Put back also after an error, so that the reader's state stays whole.
+        let next = self.next_estimated(&mut e, path, max_gap_s, rows);
+        self.estimating = Some(e);
+        next
+    }
+
+    /// [`Self::read_row`] of a file without orientation columns: rows parsed and pushed
+    /// through the filter until the next one's orientation is known.
+    fn next_estimated(
+        &mut self,
+        e: &mut Estimating,
+        path: &Path,
+        max_gap_s: f64,
+        rows: usize,
+    ) -> Result<Option<(Row, usize)>> {
+        loop {
             if let Some(q) = e.known.pop_front() {
                 let (mut row, line) = e.held.pop_front().expect("a held row per orientation");
                 (row.gravity, row.linacce) = ridi_frames::gravity_and_linacce(q, row.acce);
                 row.orientation = q;
-                break Some((row, line));
+                return Ok(Some((row, line)));
             }
             if e.finished {
-                break None;
+                return Ok(None);
             }
-            let rows = rows + e.held.len();
-            let e = &mut *e;
-            match self.parse_row(path, max_gap_s, rows)? {
+            match self.parse_row(path, max_gap_s, rows + e.held.len())? {
                 Some((row, line)) => {
+                    // Nothing has left `held` before the filter starts.
                     let first = e.held.front().map_or(row.time, |(r, _)| r.time);
-                    if e.known.is_empty() && row.time - first > processed::MAX_ZERO_ACCE_S {
-                        return Err(processed::zero_acce(path, line));
+                    if processed::estimate_waited_too_long(&e.filter, e.held.len(), first, row.time)
+                    {
+                        return Err(processed::estimate_wait_error(path, line));
                     }
                     e.filter
                         .push(row.time, row.gyro, row.acce, &mut e.out)
-                        .map_err(|error| estimate_error(path, error))?;
+                        .map_err(|error| processed::estimate_error(path, error))?;
                     e.held.push_back((row, line));
                 }
                 None => {
                     e.filter
                         .finish(&mut e.out)
-                        .map_err(|error| estimate_error(path, error))?;
+                        .map_err(|error| processed::estimate_error(path, error))?;
                     e.finished = true;
                 }
             }
             e.known.extend(e.out.drain(..));
-        };
-        self.estimating = Some(e);
-        Ok(next)
+        }
     }
 
     /// Parses and checks the next line of the file at `path`, the `rows`-th row; with its
@@ -1047,18 +1069,12 @@ impl Processed {
                 max_gap_s,
             )?;
         }
-        let has_orientation = match &self.header {
-            Header::Csv(h) => h.has_orientation,
-            Header::Plain(_) => true,
-        };
+        let has_orientation = self.header.csv().is_none_or(|h| h.has_orientation);
         let orientation = match has_orientation {
             true => processed::rotation_at(&r, RV, path, line)?,
             false => WorldFromDevice::identity(),
         };
-        let has_ground_truth = match &self.header {
-            Header::Csv(h) => h.has_ground_truth,
-            Header::Plain(_) => true,
-        };
+        let has_ground_truth = self.header.csv().is_none_or(|h| h.has_ground_truth);
         let mut ground_truth = None;
         if has_ground_truth {
             let gt = processed::gt(&r);
@@ -1079,10 +1095,7 @@ impl Processed {
                 ground_truth = Some((position, processed::rotation_at(&r, ORI, path, line)?));
             }
         }
-        let has_magnet = match &self.header {
-            Header::Csv(h) => h.has_magnet,
-            Header::Plain(_) => true,
-        };
+        let has_magnet = self.header.csv().is_none_or(|h| h.has_magnet);
         let v = |at: usize| DeviceVec::new(r[at], r[at + 1], r[at + 2]);
         let row = Row {
             time,
@@ -1119,16 +1132,6 @@ impl Processed {
             _ => Ok(()),
         }
     }
-}
-
-/// The error the whole-file reader gives when the estimate of the orientation of the file at
-/// `path` fails.
-fn estimate_error(path: &Path, error: EstimateError) -> DataError {
-    let e = SequenceError::Estimate {
-        what: "orientation estimate",
-        error,
-    };
-    text::sequence_error_at(path, |_| None, &ProcessedFields, e)
 }
 
 impl Iterator for RowReader {

@@ -757,11 +757,35 @@ fn a_data_csv_with_part_of_its_orientation_or_no_gravity_is_refused_by_name() {
     };
     refused(
         &file(dir.path(), "short.csv", &zeros(100)),
-        "no nonzero accelerometer sample",
+        "short.csv: field `acce_x..acce_z`: no nonzero accelerometer reading",
     );
     // 50 Hz: frame 3001 (line 3003) is the first more than 60 s after the first.
     refused(
         &file(dir.path(), "zeros.csv", &zeros(3100)),
-        "zeros.csv:3003: field `acce_x..acce_z`: the accelerometer reads zero for more than 60 s",
+        "zeros.csv:3003: field `acce_x..acce_z`: the orientation estimate has not started 60 s \
+         or 100000 rows into the file",
+    );
+    // Time in microseconds read as nanoseconds: 2 s never pass, and the rows are bounded.
+    let mut fast = String::from("time,gyro_x,gyro_y,gyro_z,acce_x,acce_y,acce_z\n");
+    for i in 0..100_010 {
+        fast += &format!("{},0.01,0.02,0.03,0.1,0.2,9.8\n", 1_000_000_000 + 5 * i);
+    }
+    refused(
+        &file(dir.path(), "fast.csv", &fast),
+        "fast.csv:100002: field `acce_x..acce_z`: the orientation estimate has not started",
+    );
+    // Readings too small to have a direction count as zero in both readers.
+    let mut tiny = String::from("time,gyro_x,gyro_y,gyro_z,acce_x,acce_y,acce_z\n");
+    for i in 0..4000 {
+        let a = if i < 3500 {
+            "1e-200,0,0"
+        } else {
+            "0.1,0.2,9.8"
+        };
+        tiny += &format!("{},0.01,0.02,0.03,{a}\n", 1_000_000_000 + 20_000_000 * i as u64);
+    }
+    refused(
+        &file(dir.path(), "tiny.csv", &tiny),
+        "tiny.csv:3003: field `acce_x..acce_z`: the orientation estimate has not started",
     );
 }
