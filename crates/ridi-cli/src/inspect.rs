@@ -34,7 +34,7 @@ pub(crate) fn run(Args { sequence, json }: Args) -> Result<()> {
     // A recording that streams is summed up as it is read, in memory that does not grow with
     // its length.
     if ridi::data::detect(&sequence).is_ok_and(|f| f.streams()) {
-        let rows = ridi::data::RowReader::open(&sequence, &ReadOptions::default())?;
+        let rows = ridi::data::RowReader::open(&sequence, &inspect_options(&sequence))?;
         let report = ridi::inspect_stream(rows)?;
         if json {
             outln!("{}", escaped(serde_json::to_string_pretty(&report)?));
@@ -43,7 +43,7 @@ pub(crate) fn run(Args { sequence, json }: Args) -> Result<()> {
         }
         return Ok(());
     }
-    let loaded = ridi::read_any(&sequence, None, &ReadOptions::default())?;
+    let loaded = ridi::read_any(&sequence, None, &inspect_options(&sequence))?;
     let mut reports = Vec::new();
     for seq in &loaded.sequences {
         let mut report = ridi::inspect(seq, loaded.format);
@@ -123,6 +123,17 @@ fn escaped(json: String) -> String {
         }
     }
     out
+}
+
+/// How `ridi inspect` reads `sequence`: a recording paused for longer than the readers' limit
+/// is described (its longest gap among the warnings) where the format keeps the pause as a gap
+/// ([`ridi::data::Format::keeps_gaps`]); a RIDI raw folder keeps the limit.
+fn inspect_options(sequence: &Path) -> ReadOptions {
+    let mut opts = ReadOptions::default();
+    if ridi::source_format(sequence, None).is_ok_and(|f| f.keeps_gaps()) {
+        opts.validation.max_gap_s = f64::INFINITY;
+    }
+    opts
 }
 
 #[cfg(test)]

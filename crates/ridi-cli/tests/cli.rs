@@ -1228,3 +1228,101 @@ fn the_heading_is_the_corrected_gyros_unless_asked_for_the_gyros_alone() {
     assert!(stderr(&out).contains("--heading"), "{}", stderr(&out));
     assert!(!dir.path().join("bad.csv").exists());
 }
+
+/// A recording paused for 3 s: `ridi inspect` describes a data.csv and `convert
+/// --split-at-gaps` cuts it; a RIDI raw folder, whose sensors are interpolated onto the pose's
+/// times, keeps the readers' limit of 1 s for both.
+#[test]
+fn a_recording_paused_for_seconds_is_inspected_and_split_where_its_format_allows() {
+    let dir = tempfile::tempdir().unwrap();
+    // The sample is gzip-compressed: a plain copy by convert's own writer.
+    let plain = dir.path().join("plain");
+    let out = ridi(&[
+        "convert",
+        s(&sample_dataset().join("Jakob_Nexus5_NoDist_Texting")),
+        "--out",
+        s(&plain),
+    ]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let csv = plain.join("Jakob_Nexus5_NoDist_Texting/processed/data.csv");
+    let lines: Vec<String> = std::fs::read_to_string(&csv)
+        .unwrap()
+        .lines()
+        .map(String::from)
+        .collect();
+    let time = lines[0].split(',').position(|c| c == "time").unwrap();
+    let mut paused = String::new();
+    for (i, l) in lines.iter().enumerate() {
+        let mut cells: Vec<String> = l.split(',').map(String::from).collect();
+        if i > 2000 {
+            let t: i64 = cells[time].parse().unwrap();
+            cells[time] = (t + 3_000_000_000).to_string();
+        }
+        paused += &(cells.join(",") + "\n");
+    }
+    let walk = dir.path().join("src/walk");
+    std::fs::create_dir_all(&walk).unwrap();
+    std::fs::write(walk.join("data.csv"), paused).unwrap();
+    let out = ridi(&["inspect", s(&walk)]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        text.contains("longest gap 3.005 s") && text.contains("--split-at-gaps 0.1` cuts"),
+        "{text}"
+    );
+    let out = ridi(&["track", s(&walk), "--out", s(&dir.path().join("t.csv"))]);
+    let err = stderr(&out);
+    assert!(
+        !out.status.success() && err.contains("data.csv:2002: field `time`: gap of 3.005 s"),
+        "{err}"
+    );
+    let conv = dir.path().join("conv");
+    let out = ridi(&[
+        "convert",
+        s(&dir.path().join("src")),
+        "--out",
+        s(&conv),
+        "--split-at-gaps",
+        "0.1",
+    ]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert!(conv.join("walk_part1").is_dir() && conv.join("walk_part2").is_dir());
+
+    let raw = dir.path().join("raw");
+    raw_folder(&raw, 9.81, &[]);
+    for entry in std::fs::read_dir(&raw).unwrap() {
+        let path = entry.unwrap().path();
+        let text = std::fs::read_to_string(&path).unwrap();
+        let shifted: String = text
+            .lines()
+            .enumerate()
+            .map(|(i, l)| match l.split_once(' ') {
+                Some((t, rest)) if i > 1000 => {
+                    format!("{} {rest}\n", t.parse::<i64>().unwrap() + 3_000_000_000)
+                }
+                _ => format!("{l}\n"),
+            })
+            .collect();
+        std::fs::write(&path, shifted).unwrap();
+    }
+    let conv = dir.path().join("conv_raw");
+    for args in [
+        vec!["inspect", s(&raw)],
+        vec![
+            "convert",
+            s(&raw),
+            "--out",
+            s(&conv),
+            "--split-at-gaps",
+            "0.1",
+        ],
+    ] {
+        let err = error(&ridi(&args));
+        // The first file checked: gyro.txt.
+        assert!(
+            err.contains("gyro.txt:1002: field `t`: gap of 3.005 s"),
+            "{err}"
+        );
+    }
+    assert!(!conv.exists());
+}

@@ -39,6 +39,17 @@ impl fmt::Display for Format {
 }
 
 impl Format {
+    /// Whether a reader of this format given an unbounded
+    /// [`Validation::max_gap_s`](crate::Validation::max_gap_s) keeps every pause of the recording
+    /// as a gap between frames, where [`Sequence::split_at_gaps`](crate::Sequence::split_at_gaps)
+    /// can cut it, and invents no value inside it: the frames are the file's rows (RIDI's
+    /// processed files, RoNIN), or the reader cuts its timeline at each dropout of a sensor
+    /// stream (Tyrex, Indoor Location Competition). Not a RIDI raw folder, whose sensors are
+    /// interpolated onto the pose's times: there the limit also bounds a hole in one sensor.
+    pub fn keeps_gaps(self) -> bool {
+        self != Format::RidiRaw
+    }
+
     /// What a source of this format looks like, for errors about a source that is not one.
     pub fn layout(self) -> &'static str {
         match self {

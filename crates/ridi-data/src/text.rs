@@ -302,7 +302,8 @@ pub(crate) fn check_step(
             format!(
                 "gap of {:.3} s since line {prev_line} exceeds the limit of {} s: a recording \
                  paused that long is two; cut it there (the records before this line and those \
-                 from it on, as recordings of their own)",
+                 from it on, as recordings of their own: `ridi convert --split-at-gaps 0.1` \
+                 does, in every format but a RIDI raw folder)",
                 next - prev,
                 short(max_gap_s)
             ),

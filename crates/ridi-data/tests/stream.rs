@@ -782,7 +782,10 @@ fn a_data_csv_with_part_of_its_orientation_or_no_gravity_is_refused_by_name() {
         } else {
             "0.1,0.2,9.8"
         };
-        tiny += &format!("{},0.01,0.02,0.03,{a}\n", 1_000_000_000 + 20_000_000 * i as u64);
+        tiny += &format!(
+            "{},0.01,0.02,0.03,{a}\n",
+            1_000_000_000 + 20_000_000 * i as u64
+        );
     }
     refused(
         &file(dir.path(), "tiny.csv", &tiny),

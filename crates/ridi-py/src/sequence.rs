@@ -497,10 +497,15 @@ fn read_sequences(
     py: Python<'_>,
     path: &std::path::Path,
     format: Option<&str>,
+    split_at_gaps: Option<f64>,
 ) -> PyResult<Vec<Sequence>> {
     let from = format.map(|f| choice("format", f, &FORMATS)).transpose()?;
-    let loaded = options::detached(py, || ridi::read_any(path, from, &options::read_options()))?
-        .map_err(errors::data)?;
+    let read = options::read_options();
+    let loaded = options::detached(py, || match split_at_gaps {
+        Some(max_gap) => ridi::read_split(path, from, &read, max_gap),
+        None => ridi::read_any(path, from, &read),
+    })?
+    .map_err(errors::data)?;
     warn(py, &loaded.warnings)?;
     let format = loaded.format;
     Ok(loaded
@@ -515,6 +520,11 @@ fn read_sequences(
 /// sequence folder, as ``ridi track`` reads it. ``format`` forces one (``ridi-csv``, ``ridi-plain``, ``ridi-raw``,
 /// ``tyrex``, ``ilc``, ``ronin``) instead of detecting it. The readers' warnings are ``UserWarning``\ s.
 ///
+/// ``split_at_gaps`` (seconds, above 0) cuts the recording at every gap longer than that, as
+/// ``ridi convert --split-at-gaps`` does: a pause longer than the 1 s the readers accept is
+/// read and cut too (in every format but a RIDI raw folder), parts shorter than 1 s are
+/// dropped with a warning; read the parts with ``ridi.read_any``.
+///
 /// Raises ``OSError`` when the file cannot be read, ``ValueError`` naming the file, line and
 /// field when its content is wrong, and ``ValueError`` when the source holds several
 /// sequences (read those with ``ridi.read_any``).
@@ -523,9 +533,14 @@ fn read_sequences(
 /// >>> seq.gyro.shape                                                    # doctest: +SKIP
 /// (4800, 3)
 #[pyfunction]
-#[pyo3(signature = (path, format=None))]
-pub(crate) fn read(py: Python<'_>, path: PathBuf, format: Option<&str>) -> PyResult<Sequence> {
-    let mut seqs = read_sequences(py, &path, format)?;
+#[pyo3(signature = (path, format=None, *, split_at_gaps=None))]
+pub(crate) fn read(
+    py: Python<'_>,
+    path: PathBuf,
+    format: Option<&str>,
+    split_at_gaps: Option<f64>,
+) -> PyResult<Sequence> {
+    let mut seqs = read_sequences(py, &path, format, split_at_gaps)?;
     if seqs.len() != 1 {
         return Err(errors::value(format!(
             "{} holds {} sequences; read them with `ridi.read_any`, or convert it with `ridi \
@@ -538,15 +553,19 @@ pub(crate) fn read(py: Python<'_>, path: PathBuf, format: Option<&str>) -> PyRes
 }
 
 /// Reads every sequence at `path` (``ridi.read`` for sources that hold several, such as a
-/// Tyrex run split at a long motion-capture loss), in order.
+/// Tyrex run split at a long motion-capture loss, or a recording cut by ``split_at_gaps``),
+/// in order.
+///
+/// >>> parts = ridi.read_any("walk/data.csv", split_at_gaps=0.1)  # doctest: +SKIP
 #[pyfunction]
-#[pyo3(signature = (path, format=None))]
+#[pyo3(signature = (path, format=None, *, split_at_gaps=None))]
 pub(crate) fn read_any(
     py: Python<'_>,
     path: PathBuf,
     format: Option<&str>,
+    split_at_gaps: Option<f64>,
 ) -> PyResult<Vec<Sequence>> {
-    read_sequences(py, &path, format)
+    read_sequences(py, &path, format, split_at_gaps)
 }
 
 /// Reads the sequences of list files (``path,placement`` per line, ``#`` comments, paths

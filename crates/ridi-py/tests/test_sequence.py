@@ -339,6 +339,26 @@ def test_a_data_csv_of_gyro_and_accelerometer_alone_reads_with_the_estimate(seq,
     with pytest.raises(ValueError, match=r"data.csv.meta:1: field `orientation_source`: names"):
         ridi.read(tmp_path / "data.csv")
 
+def test_a_recording_paused_for_seconds_is_read_split_at_its_gaps(seq, tmp_path):
+    ns = np.round(seq.time * 1e9).astype(np.int64)
+    ns[2000:] += 3_000_000_000
+    lines = ["time,gyro_x,gyro_y,gyro_z,acce_x,acce_y,acce_z"] + [
+        ",".join([str(t), *map(repr, g), *map(repr, a)])
+        for t, g, a in zip(ns.tolist(), seq.gyro.tolist(), seq.acce.tolist())
+    ]
+    path = tmp_path / "data.csv"
+    path.write_text("\n".join(lines) + "\n")
+    with pytest.raises(ValueError, match=r"data.csv:2002: field `time`: gap of 3.005 s"):
+        ridi.read(path)
+    with pytest.warns(UserWarning, match=r"split at 1 gap longer than 0.1 s; 2 parts kept"):
+        first, second = ridi.read_any(path, split_at_gaps=0.1)
+    assert (len(first), len(second)) == (2000, len(seq) - 2000)
+    np.testing.assert_array_equal(second.gyro, seq.gyro[2000:])
+    with pytest.raises(ValueError, match="holds 2 sequences"), pytest.warns(UserWarning):
+        ridi.read(path, split_at_gaps=0.1)
+    with pytest.raises(ValueError, match="cannot split at gaps longer than -1 s"):
+        ridi.read_any(path, split_at_gaps=-1.0)
+
 def same_sequence(a, b):
     """Every constructor argument of `a` and `b` agrees (so a new argument the pickling misses
     fails here)."""

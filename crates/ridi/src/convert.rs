@@ -12,7 +12,7 @@ use ridi_data::{
 };
 use ridi_data::{ilc, tyrex};
 
-use crate::source::{ReadFiles, is_a, not_a, read_any, with_article};
+use crate::source::{Loaded, ReadFiles, is_a, not_a, read_any, source_format, with_article};
 use crate::staging::Staging;
 
 /// One sequence written by [`convert`].
@@ -62,7 +62,8 @@ pub struct ConvertOptions {
     /// ([`Sequence::split_at_gaps`]): parts `<name>_part1`, `_part2`, ... (the plain name when
     /// one is left); a part shorter than [`SPLIT_MIN_PART_S`] is dropped with a warning, and a
     /// conversion left without any sequence is an error. `None` keeps sequences whole. What
-    /// `ridi track` (a gap over 0.1 s) and `rate_hz` (over 5 frame intervals) refuse.
+    /// `ridi track` (a gap over 0.1 s) and `rate_hz` (over 5 frame intervals) refuse. Each
+    /// source is read by [`read_split`], which also cuts pauses longer than the readers' limit.
     pub split_gaps_s: Option<f64>,
 }
 
@@ -131,6 +132,37 @@ fn split(
         kept.extend(parts);
     }
     Ok(kept)
+}
+
+/// [`read_any`] of `path`, its sequences cut at every gap longer than `max_gap_s`
+/// ([`Sequence::split_at_gaps`]), parts under [`SPLIT_MIN_PART_S`] dropped, one warning per
+/// sequence cut after the reader's: what `ridi convert --split-at-gaps` reads. Below `opts`'
+/// [`max_gap_s`](ridi_data::Validation::max_gap_s), the pauses longer than that limit are read
+/// and cut too, in every format whose reader keeps them as gaps ([`Format::keeps_gaps`]: all
+/// but a RIDI raw folder, where the limit stands). A source left without any part has no
+/// sequence (its warning says so).
+///
+/// # Errors
+/// As [`read_any`]; [`SequenceError::InvalidGap`] (named by `path`) for a `max_gap_s` that is
+/// not a finite number above 0.
+pub fn read_split(
+    path: &Path,
+    from: Option<Format>,
+    opts: &ReadOptions,
+    max_gap_s: f64,
+) -> Result<Loaded, DataError> {
+    let format = source_format(path, from)?;
+    let mut loaded = if format.keeps_gaps() && max_gap_s < opts.validation.max_gap_s {
+        let mut pausing = opts.clone();
+        pausing.validation.max_gap_s = f64::INFINITY;
+        read_any(path, Some(format), &pausing)?
+    } else {
+        read_any(path, Some(format), opts)?
+    };
+    let sequences = std::mem::take(&mut loaded.sequences);
+    loaded.sequences = split(sequences, max_gap_s, &mut loaded.warnings)
+        .map_err(|e| DataError::sequence(path, e))?;
+    Ok(loaded)
 }
 
 /// What converting one source produced: the sequences written and the warnings.
@@ -530,16 +562,13 @@ pub fn convert(
     let results: Vec<Result<Written, DataError>> = dirs
         .par_iter()
         .map(|dir| {
-            let loaded = read_any(dir, from, &opts.read)?;
+            let loaded = match opts.split_gaps_s {
+                Some(max_gap) => read_split(dir, from, &opts.read, max_gap)?,
+                None => read_any(dir, from, &opts.read)?,
+            };
             let mut written = Vec::new();
             let listed = dir.canonicalize().ok().and_then(|d| labels.get(&d));
-            let mut warnings = Vec::new();
-            let sequences = match opts.split_gaps_s {
-                None => loaded.sequences,
-                Some(max_gap) => split(loaded.sequences, max_gap, &mut warnings)
-                    .map_err(|e| DataError::sequence(dir, e))?,
-            };
-            for seq in &sequences {
+            for seq in &loaded.sequences {
                 let resampled = match opts.rate_hz {
                     Some(rate) => {
                         let max_gap = resample_max_gap(seq);
@@ -590,7 +619,6 @@ pub fn convert(
             let warnings = loaded
                 .warnings
                 .into_iter()
-                .chain(warnings)
                 .map(|w| {
                     let names_it = w.strip_prefix(&source).is_some_and(|rest| {
                         rest.starts_with(':') || rest.starts_with(std::path::MAIN_SEPARATOR)

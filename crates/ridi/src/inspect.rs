@@ -270,11 +270,20 @@ fn report(s: Summary) -> Inspection {
         ));
     }
     if rate_hz > 0.0 && max_gap_s > 5.0 / rate_hz {
-        warnings.push(format!(
+        let mut w = format!(
             "longest gap {:.3} s is {:.0} frame intervals",
             max_gap_s,
             max_gap_s * rate_hz
-        ));
+        );
+        // `ridi inspect` reads pauses the other commands refuse (`inspect_options`).
+        let limit = ridi_data::Validation::default().max_gap_s;
+        if max_gap_s > limit {
+            w += &format!(
+                ", longer than the {limit} s the other commands read across: `ridi convert \
+                 --split-at-gaps 0.1` cuts the recording at its gaps"
+            );
+        }
+        warnings.push(w);
     }
     if (gravity_norm.mean - ridi_frames::STANDARD_GRAVITY).abs() > 0.3 {
         warnings.push(format!(

@@ -107,8 +107,8 @@ pub use baselines::{Method, baseline_trajectory, device_heading};
 #[cfg(feature = "bundled-model")]
 pub use bundled::{BUNDLED_MODEL_SUMMARY, bundled_model};
 pub use convert::{
-    ConvertOptions, ConvertSummary, Converted, SPLIT_MIN_PART_S, convert, resample_max_gap,
-    split_limit,
+    ConvertOptions, ConvertSummary, Converted, SPLIT_MIN_PART_S, convert, read_split,
+    resample_max_gap, split_limit,
 };
 pub use demo::Demo;
 pub use error::{PipelineError, Result};
@@ -131,7 +131,7 @@ pub use output::{
     check_output_file, check_output_folder, save_model,
 };
 pub use placement::PlacementMap;
-pub use source::{Loaded, ReadFiles, read_any};
+pub use source::{Loaded, ReadFiles, read_any, source_format};
 pub use staging::Staging;
 pub use track::{
     StreamedTrack, TRACK_RATE_HZ, TRACK_RATE_TOLERANCE, Track, regress_sequence, track,

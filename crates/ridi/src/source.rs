@@ -56,6 +56,23 @@ pub(crate) fn with_article(name: &str) -> String {
     format!("{} {name}", if vowel { "an" } else { "a" })
 }
 
+/// The format [`read_any`] reads `path` as: `from` when `path` is one (a folder of nothing
+/// known counts as a RIDI raw folder, whose reader names the files it lacks), else what
+/// [`detect`] finds.
+///
+/// # Errors
+/// A `path` that is not `from` (saying what it is and what `from` looks like), or of no known
+/// format.
+pub fn source_format(path: &Path, from: Option<Format>) -> Result<Format, DataError> {
+    Ok(match from {
+        None => detect(path)?,
+        Some(Format::RidiCsv | Format::RidiPlain) if is_a(path, Format::RidiCsv) => detect(path)?,
+        Some(want) if is_a(path, want) => want,
+        Some(Format::RidiRaw) if path.is_dir() && detect(path).is_err() => Format::RidiRaw,
+        Some(want) => return Err(not_a(path, want)),
+    })
+}
+
 /// Reads the sequence(s) at `path`: a RIDI `data.csv`, `data_plain.txt`, RIDI raw folder,
 /// Tyrex sequence folder, Indoor Location Competition path file or RoNIN sequence folder. `from` forces a format
 /// instead of detecting it: a source that is not one is an error saying what it is and what
@@ -65,14 +82,7 @@ pub fn read_any(
     from: Option<Format>,
     opts: &ReadOptions,
 ) -> Result<Loaded, DataError> {
-    let format = match from {
-        None => detect(path)?,
-        Some(Format::RidiCsv | Format::RidiPlain) if is_a(path, Format::RidiCsv) => detect(path)?,
-        Some(want) if is_a(path, want) => want,
-        // A folder of nothing known, read as a raw folder: the reader names the files it lacks.
-        Some(Format::RidiRaw) if path.is_dir() && detect(path).is_err() => Format::RidiRaw,
-        Some(want) => return Err(not_a(path, want)),
-    };
+    let format = source_format(path, from)?;
     match format {
         Format::Tyrex => {
             let read = tyrex::read(path, &TyrexOptions::from(opts))?;

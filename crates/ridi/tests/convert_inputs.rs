@@ -791,3 +791,75 @@ fn two_sequences_of_one_name_are_refused() {
         .to_string();
     assert!(e.contains("whatever its case"), "{e}");
 }
+
+/// A recording paused for longer than the readers accept (3 s) is refused whole, inspected,
+/// and converted in two parts when split at its gaps.
+#[test]
+fn a_recording_paused_for_seconds_converts_split_at_its_gaps() {
+    use ridi::data::Validation;
+    let dir = tempfile::tempdir().unwrap();
+    let opts = ReadOptions::default();
+    let walk = read_sequence(seq("Thibaud_Nexus5_NoDist_Texting"), &opts).unwrap();
+    let mut parts = walk.into_parts();
+    for t in &mut parts.time[2000..] {
+        *t += 3.0;
+    }
+    let pausing = Validation {
+        max_gap_s: f64::INFINITY,
+        ..Validation::default()
+    };
+    let paused = Sequence::with_validation(parts, &pausing).unwrap();
+    let folder = dir.path().join("src/walk/processed");
+    std::fs::create_dir_all(&folder).unwrap();
+    write_ridi_csv(&paused, folder.join("data.csv")).unwrap();
+    let src = dir.path().join("src");
+
+    let e = convert(&src, &dir.path().join("out1"), &ConvertOptions::default())
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("data.csv:2002: field `time`: gap of 3.005 s since line 2001")
+            && e.contains("`ridi convert --split-at-gaps 0.1` does"),
+        "{e}"
+    );
+    let inspected = ridi::inspect(
+        &ridi::read_any(
+            &folder.join("data.csv"),
+            ridi::source_format(&src.join("walk"), None).ok(),
+            &ReadOptions {
+                validation: pausing,
+                ..ReadOptions::default()
+            },
+        )
+        .unwrap()
+        .sequences[0],
+        Format::RidiCsv,
+    );
+    assert!(Format::RidiCsv.keeps_gaps() && !Format::RidiRaw.keeps_gaps());
+    assert!(
+        inspected
+            .warnings
+            .iter()
+            .any(|w| w.starts_with("longest gap 3.005 s")
+                && w.ends_with(
+                    "`ridi convert --split-at-gaps 0.1` cuts the recording at its gaps"
+                )),
+        "{:?}",
+        inspected.warnings
+    );
+
+    let split = ConvertOptions {
+        split_gaps_s: Some(0.5),
+        ..ConvertOptions::default()
+    };
+    let out = dir.path().join("out2");
+    let summary = convert(&src, &out, &split).unwrap();
+    let names: Vec<&str> = summary.sequences.iter().map(|c| c.name.as_str()).collect();
+    assert_eq!(names, ["walk_part1", "walk_part2"]);
+    let (a, b) = (
+        read_sequence(out.join("walk_part1"), &opts).unwrap(),
+        read_sequence(out.join("walk_part2"), &opts).unwrap(),
+    );
+    assert_eq!((a.len(), b.len()), (2000, paused.len() - 2000));
+    assert!((b.time()[0] - paused.time()[2000]).abs() < 1e-9);
+}

@@ -196,11 +196,16 @@ class LiveTracker:
     @property
     def regressions(self) -> Regressions: ...
 
-def read(path: StrPath, format: Optional[Format] = None) -> Sequence:
+def read(
+    path: StrPath, format: Optional[Format] = None, *, split_at_gaps: Optional[float] = None
+) -> Sequence:
     """The one recording at ``path``, in any format ridi-rs reads."""
 
-def read_any(path: StrPath, format: Optional[Format] = None) -> List[Sequence]:
-    """Every sequence at ``path`` (a Tyrex run split at a motion-capture loss gives several)."""
+def read_any(
+    path: StrPath, format: Optional[Format] = None, *, split_at_gaps: Optional[float] = None
+) -> List[Sequence]:
+    """Every sequence at ``path`` (a Tyrex run split at a motion-capture loss, or a recording
+    cut by ``split_at_gaps``, gives several)."""
 
 def read_list(
     lists: Union[StrPath, Seq[StrPath]],
