@@ -73,7 +73,8 @@ def aligned(estimate, truth, t, seconds=10.0):
 
 
 def main():
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    # The docstring's first paragraph (it spans two lines).
+    parser = argparse.ArgumentParser(description=" ".join(__doc__.split("\n\n")[0].split()))
     parser.add_argument("--plot", default="trajectory.png", help="image to draw (matplotlib)")
     args = parser.parse_args()
 

@@ -65,6 +65,9 @@ impl ListEntry {
         let mut entries = Vec::new();
         for list in lists {
             let path = list.as_ref();
+            if path.is_dir() {
+                return Err(folder_for_list(path));
+            }
             entries.extend(parse_list(
                 &text::read_file_bounded(path, MAX_LIST_BYTES)?,
                 path,
@@ -72,6 +75,30 @@ impl ListEntry {
         }
         Ok(entries)
     }
+}
+
+/// The error for a folder given as a list file, naming the lists in it (`ridi convert` writes
+/// `list_all.txt` and one per person and device).
+fn folder_for_list(path: &Path) -> DataError {
+    let mut lists: Vec<String> = std::fs::read_dir(path)
+        .into_iter()
+        .flatten()
+        .flatten()
+        .map(|e| e.file_name().to_string_lossy().into_owned())
+        .filter(|n| n.starts_with("list") && n.ends_with(".txt"))
+        .collect();
+    lists.sort();
+    let hint = match lists.len() {
+        0 => String::new(),
+        _ => format!(
+            "; it holds {}",
+            crate::first_few(lists.iter().map(crate::shown), 5)
+        ),
+    };
+    DataError::format(
+        Location::file(path),
+        format!("is a folder, not a list file (one `path,placement` line per sequence){hint}"),
+    )
 }
 
 /// Parses the content of a list file; `path` is the list file itself (relative entries are
@@ -292,5 +319,23 @@ mod tests {
         for name in ["walk_1", "a b", "Jakob_iPhone4S_NoDist_AR_part2", "ünïcode"] {
             assert_eq!(unlistable_name(name), None, "{name:?}");
         }
+    }
+
+    #[test]
+    fn a_folder_given_as_a_list_names_the_lists_in_it() {
+        let dir = tempfile::tempdir().unwrap();
+        let e = ListEntry::read(&[dir.path()]).unwrap_err().to_string();
+        assert!(
+            e.ends_with("is a folder, not a list file (one `path,placement` line per sequence)"),
+            "{e}"
+        );
+        for name in ["list_all.txt", "list_Jakob.txt", "notes.txt"] {
+            std::fs::write(dir.path().join(name), "").unwrap();
+        }
+        let e = ListEntry::read(&[dir.path()]).unwrap_err().to_string();
+        assert!(
+            e.ends_with("; it holds list_Jakob.txt, list_all.txt"),
+            "{e}"
+        );
     }
 }

@@ -68,6 +68,8 @@ pub(crate) fn parse_header(line: usize, content: &str, path: &Path) -> Result<He
     let at = |field: &str| Location::line(path, line).with_field(field);
     let mut slots = Vec::new();
     let mut found = [false; 27];
+    // Names of no column of the layout, for the error about a missing one (a typo, `gyroy`).
+    let mut unknown = Vec::new();
     for cell in text::cells(content, b',') {
         let name = header_name(cell);
         let slot = PROCESSED_COLUMNS.iter().position(|&c| c == name);
@@ -76,11 +78,28 @@ pub(crate) fn parse_header(line: usize, content: &str, path: &Path) -> Result<He
                 return Err(DataError::format(at(name), "column appears twice"));
             }
             found[k] = true;
+        } else if !name.is_empty() {
+            unknown.push(format!("`{}`", text::snippet(name)));
         }
         slots.push(slot);
     }
+    if slots.len() == 1
+        && let Some(sep) = [';', '\t', ' '].into_iter().find(|&c| content.contains(c))
+    {
+        return Err(DataError::format(
+            Location::line(path, line),
+            format!("the header is one column holding {sep:?}: a data.csv is separated by commas"),
+        ));
+    }
+    let unknown = match unknown.len() {
+        0 => String::new(),
+        _ => format!(
+            "; unknown columns in the header: {}",
+            crate::first_few(unknown.into_iter(), 5)
+        ),
+    };
     let at = |k: usize| at(PROCESSED_COLUMNS[k]);
-    group(&found, 0..LINACCE, true, "required", at)?;
+    group(&found, 0..LINACCE, true, "required", at, &unknown)?;
     let has_orientation = group(
         &found,
         (LINACCE..MAGNET).chain(RV..27),
@@ -88,6 +107,7 @@ pub(crate) fn parse_header(line: usize, content: &str, path: &Path) -> Result<He
         "linacce_*, grav_* and rv_* come together: give all of them, or none to have the \
          orientation estimated from gyro_* and acce_*",
         at,
+        &unknown,
     )?;
     let has_magnet = group(
         &found,
@@ -95,6 +115,7 @@ pub(crate) fn parse_header(line: usize, content: &str, path: &Path) -> Result<He
         false,
         "the magnet columns come as a set",
         at,
+        &unknown,
     )?;
     let has_ground_truth = group(
         &found,
@@ -102,6 +123,7 @@ pub(crate) fn parse_header(line: usize, content: &str, path: &Path) -> Result<He
         false,
         "ground truth needs all of pos_* and ori_*",
         at,
+        &unknown,
     )?;
     Ok(Header {
         line,
@@ -113,13 +135,15 @@ pub(crate) fn parse_header(line: usize, content: &str, path: &Path) -> Result<He
 }
 
 /// Whether the group of `columns` is in the file (`found`): when any of its columns is, all of
-/// them must be (else an error at `at` of the first missing one); `required`, always.
+/// them must be (else an error at `at` of the first missing one, ending in `unknown`, the
+/// header's names of no column); `required`, always.
 fn group(
     found: &[bool; 27],
     mut columns: impl Iterator<Item = usize> + Clone,
     required: bool,
     what: &str,
     at: impl Fn(usize) -> Location,
+    unknown: &str,
 ) -> Result<bool> {
     if !required && !columns.clone().any(|k| found[k]) {
         return Ok(false);
@@ -127,7 +151,10 @@ fn group(
     match columns.find(|&k| !found[k]) {
         Some(k) => Err(DataError::format(
             at(k),
-            format!("missing column `{}` ({what})", PROCESSED_COLUMNS[k]),
+            format!(
+                "missing column `{}` ({what}){unknown}",
+                PROCESSED_COLUMNS[k]
+            ),
         )),
         None => Ok(true),
     }
@@ -225,6 +252,22 @@ mod tests {
             .collect();
         let h = parse_header(1, &no_gt.join(","), p).unwrap();
         assert!(h.has_magnet && !h.has_ground_truth && h.has_orientation);
+        // A typo is named beside the column it misses; another separator is named alone.
+        let e = parse_header(1, "time,gyro_x,gyroy,gyro_z,acce_x,acce_y,acce_z", p)
+            .err()
+            .unwrap();
+        assert_eq!(
+            e.to_string(),
+            "h.csv:1: field `gyro_y`: missing column `gyro_y` (required); unknown columns in \
+             the header: `gyroy`"
+        );
+        let e = parse_header(1, "time;gyro_x;gyro_y;gyro_z;acce_x;acce_y;acce_z", p)
+            .err()
+            .unwrap();
+        assert_eq!(
+            e.to_string(),
+            "h.csv:1: the header is one column holding ';': a data.csv is separated by commas"
+        );
         let bare = "time,gyro_x,gyro_y,gyro_z,acce_x,acce_y,acce_z";
         let h = parse_header(1, bare, p).unwrap();
         assert!(!h.has_magnet && !h.has_ground_truth && !h.has_orientation);

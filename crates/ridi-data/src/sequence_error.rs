@@ -19,24 +19,55 @@ pub fn short(v: f64) -> String {
     }
 }
 
-/// Which unit a timeline stepping by `median` "seconds" is in, where one divisor takes the
-/// step to a phone's 10 Hz..1 kHz: a time in milliseconds, say, steps by 5 at 200 Hz.
-fn time_unit_guess(median: f64) -> String {
-    [
-        (1e3, "milliseconds"),
-        (1e6, "microseconds"),
-        (1e9, "nanoseconds"),
-    ]
-    .into_iter()
-    .find(|(divisor, _)| (1e-3..=0.1).contains(&(median / divisor)))
-    .map_or_else(
-        || "time in the wrong unit?".to_owned(),
-        |(divisor, unit)| {
-            format!(
-                "time in {unit} instead of seconds (divide by {})?",
-                short(divisor)
-            )
-        },
+/// A timestamp for a message, to `decimals` places, trailing zeros dropped (`0.495`, not
+/// `0.49500000000000005`); unlike [`short`], never in scientific notation (a unix time). To
+/// the nanosecond the files store (9), two timestamps that differ print differently.
+fn time_text(t: f64, decimals: usize) -> String {
+    let s = format!("{t:.decimals$}");
+    if s.contains('.') {
+        s.trim_end_matches('0').trim_end_matches('.').to_owned()
+    } else {
+        s
+    }
+}
+
+/// Time units a file may hold its timestamps in, with their length in seconds.
+const TIME_UNITS: [(&str, f64); 4] = [
+    ("seconds", 1.0),
+    ("milliseconds", 1e-3),
+    ("microseconds", 1e-6),
+    ("nanoseconds", 1e-9),
+];
+
+/// The message of [`SequenceError::TimeStep`] for timestamps read as `expected` units (one of
+/// [`TIME_UNITS`]): the other unit in which the file's numbers would step by 1-100 ms, the
+/// intervals of phone sensors, if one does.
+pub(crate) fn time_step_message(median: f64, (min, max): (f64, f64), expected: &str) -> String {
+    let scale = TIME_UNITS
+        .iter()
+        .find(|u| u.0 == expected)
+        .map_or(1.0, |u| u.1);
+    let guess = TIME_UNITS
+        .iter()
+        .filter(|u| u.0 != expected)
+        .find(|(_, s)| (1e-3..=0.1).contains(&(median / scale * s)))
+        .map_or_else(
+            || "time in the wrong unit?".to_owned(),
+            |&(unit, s)| {
+                let factor = s / scale;
+                let fix = if factor < 1.0 {
+                    format!("divide by {}", short((1.0 / factor).round()))
+                } else {
+                    format!("multiply by {}", short(factor.round()))
+                };
+                format!("time in {unit} instead of {expected} ({fix})?")
+            },
+        );
+    format!(
+        "timestamps step by {} s (median), outside {}..{} s: {guess}",
+        short(median),
+        short(min),
+        short(max)
     )
 }
 
@@ -101,7 +132,11 @@ pub enum SequenceError {
         index: usize,
     },
     /// Time does not strictly increase.
-    #[error("time does not increase at frame {index}: {previous} s then {next} s")]
+    #[error(
+        "time does not increase at frame {index}: {} s then {} s",
+        time_text(*previous, 9),
+        time_text(*next, 9)
+    )]
     TimeNotIncreasing {
         /// 0-based index of the later frame.
         index: usize,
@@ -112,7 +147,8 @@ pub enum SequenceError {
     },
     /// Two frames are too far apart.
     #[error(
-        "gap of {gap_s:.3} s before frame {index} (at {time} s) exceeds {} s",
+        "gap of {gap_s:.3} s before frame {index} (at {} s) exceeds {} s",
+        time_text(*time, 3),
         short(*max_gap_s)
     )]
     Gap {
@@ -283,13 +319,7 @@ pub enum SequenceError {
         max: f64,
     },
     /// The median interval between timestamps is outside [`Validation::time_step_range`](crate::Validation::time_step_range).
-    #[error(
-        "timestamps step by {} s (median), outside {}..{} s: {}",
-        short(*median),
-        short(*min),
-        short(*max),
-        time_unit_guess(*median)
-    )]
+    #[error("{}", time_step_message(*median, (*min, *max), "seconds"))]
     TimeStep {
         /// Median interval, seconds.
         median: f64,

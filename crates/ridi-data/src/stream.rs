@@ -265,7 +265,9 @@ impl Lines {
                 } else {
                     DataError::format(
                         Location::file(&self.path),
-                        format!("corrupt or truncated gzip data: {e}"),
+                        format!(
+                            "corrupt or truncated gzip data, or other bytes after its end: {e}"
+                        ),
                     )
                 }
             }

@@ -82,7 +82,7 @@ pub(crate) fn gunzip_if_gzip(bytes: Vec<u8>, path: &Path) -> Result<Vec<u8>> {
         |e| {
             DataError::format(
                 Location::file(path),
-                format!("corrupt or truncated gzip data: {e}"),
+                format!("corrupt or truncated gzip data, or other bytes after its end: {e}"),
             )
         },
     )?;
@@ -395,9 +395,13 @@ pub(crate) fn sequence_error_at(
         SequenceError::AcceScale { .. } => return whole(Channel::Acce, e.to_string()),
         SequenceError::LinacceScale { .. } => return whole(Channel::Linacce, e.to_string()),
         SequenceError::GroundTruthSpeed { .. } => return whole(Channel::Position, e.to_string()),
-        SequenceError::TimeStep { .. } => {
+        &SequenceError::TimeStep { median, min, max } => {
             let unit = fields.time_unit();
-            return whole(Channel::Time, format!("{e} (this format expects {unit})"));
+            let message = crate::sequence_error::time_step_message(median, (min, max), unit);
+            return whole(
+                Channel::Time,
+                format!("{message} (this format expects {unit})"),
+            );
         }
         _ => return DataError::sequence(path, e),
     };

@@ -316,7 +316,18 @@ fn csv_positions_in_millimetres_are_refused() {
 
 #[test]
 fn csv_time_in_seconds_or_milliseconds_is_refused() {
-    for (divisor, step) in [(1e9, "e-12 s (median)"), (1e6, "by 5e-9 s (median)")] {
+    for (divisor, step, unit) in [
+        (
+            1e9,
+            "e-12 s (median)",
+            "seconds instead of nanoseconds (multiply by 1e9)",
+        ),
+        (
+            1e6,
+            "by 5e-9 s (median)",
+            "milliseconds instead of nanoseconds (multiply by 1e6)",
+        ),
+    ] {
         let text = csv_scaled(1..2, |ns| {
             let t = ns / divisor;
             // Milliseconds as integers, like a recorder would write them.
@@ -327,7 +338,9 @@ fn csv_time_in_seconds_or_milliseconds_is_refused() {
             &[
                 "walk/data.csv: field `time`: timestamps step by ",
                 step,
-                "outside 1e-4..1 s: time in the wrong unit? (this format expects nanoseconds)",
+                "outside 1e-4..1 s: time in ",
+                unit,
+                "? (this format expects nanoseconds)",
             ],
         );
     }

@@ -39,6 +39,7 @@ fn file_kind(e: &PipelineError) -> Option<ErrorKind> {
         PipelineError::Output(o) => Some(match o {
             OutputError::Io { error, .. } => error.kind(),
             OutputError::NoFolder { .. } => ErrorKind::NotFound,
+            OutputError::FolderIsFile { .. } => ErrorKind::NotADirectory,
             OutputError::IsFolder { .. } | OutputError::FolderName { .. } => {
                 ErrorKind::IsADirectory
             }

@@ -421,12 +421,16 @@ impl Sequence {
     fn __repr__(&self) -> String {
         format!(
             "Sequence('{}', {} frames, {:.2} s, placement={}, ground truth: {})",
-            self.inner.name(),
+            // Escaped as every message is: a name may hold a line break or a terminal escape.
+            ridi::data::shown(self.inner.name()),
             self.inner.len(),
             self.inner.duration(),
             self.inner
                 .placement()
-                .map_or("None".to_string(), |p| format!("'{p}'")),
+                .map_or("None".to_string(), |p| format!(
+                    "'{}'",
+                    ridi::data::shown(p)
+                )),
             if self.inner.ground_truth().is_some() {
                 "yes"
             } else {

@@ -88,6 +88,8 @@ def test_control_characters_in_names_are_escaped_as_the_cli_escapes_them(tmp_pat
     args["name"] = "walk\x1b]0;x\x07"
     with pytest.raises(ValueError, match=r"sequence `walk\\u\{1b\}\]0;x\\u\{7\}`: `gyro`"):
         ridi.Sequence(**args)
+    named = ridi.Sequence(seq.time, seq.gyro, seq.acce, name="walk\n\x1b[31m", placement="hand\x07")
+    assert "walk\\n\\u{1b}[31m" in repr(named) and "'hand\\u{7}'" in repr(named), repr(named)
 
 
 def test_reader_warnings_are_escaped_as_the_cli_prints_them(tmp_path):

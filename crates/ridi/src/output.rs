@@ -46,6 +46,18 @@ pub enum OutputError {
         /// Its folder.
         folder: PathBuf,
     },
+    /// The folder of an output file, or one on the way to it, is a file.
+    #[error(
+        "cannot write {}: {} is a file, not a folder",
+        ridi_data::shown(path),
+        ridi_data::shown(file)
+    )]
+    FolderIsFile {
+        /// The output file.
+        path: PathBuf,
+        /// The file on its folder's path.
+        file: PathBuf,
+    },
     /// An output file's path ends in `/` (or `.`, `..`): it names a folder, even one that does
     /// not exist, which no file can be written as.
     #[error(
@@ -194,6 +206,12 @@ pub fn check_output_file(path: &Path) -> Result<(), OutputError> {
         });
     }
     let folder = folder_of(path);
+    if let Some(file) = folder.ancestors().find(|d| d.exists() && !d.is_dir()) {
+        return Err(OutputError::FolderIsFile {
+            path: path.to_path_buf(),
+            file: file.to_path_buf(),
+        });
+    }
     if !folder.is_dir() {
         return Err(OutputError::NoFolder {
             path: path.to_path_buf(),
@@ -753,6 +771,10 @@ mod tests {
         assert!(e.ends_with("no does not exist"), "{e}");
         let e = message(check_output_file(dir.path()).unwrap_err());
         assert!(e.ends_with("it is a folder"), "{e}");
+        for inside in ["t.csv", "a/t.csv"] {
+            let e = message(check_output_file(&file.join(inside)).unwrap_err());
+            assert!(e.ends_with("file.txt is a file, not a folder"), "{e}");
+        }
         // A folder that does not exist yet, named as one: refused before any work, not when
         // the file is renamed into place.
         for name in ["new/", "new/.", "new/..", "."] {
