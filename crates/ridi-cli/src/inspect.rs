@@ -127,7 +127,7 @@ fn escaped(json: String) -> String {
 
 /// How `ridi inspect` reads `sequence`: a recording paused for longer than the readers' limit
 /// is described (its longest gap among the warnings) where the format keeps the pause as a gap
-/// ([`ridi::data::Format::keeps_gaps`]); a RIDI raw folder keeps the limit.
+/// ([`ridi::data::Format::keeps_gaps`]); a RIDI raw or RoNIN folder keeps the limit.
 fn inspect_options(sequence: &Path) -> ReadOptions {
     let mut opts = ReadOptions::default();
     if ridi::source_format(sequence, None).is_ok_and(|f| f.keeps_gaps()) {

@@ -43,11 +43,14 @@ impl Format {
     /// [`Validation::max_gap_s`](crate::Validation::max_gap_s) keeps every pause of the recording
     /// as a gap between frames, where [`Sequence::split_at_gaps`](crate::Sequence::split_at_gaps)
     /// can cut it, and invents no value inside it: the frames are the file's rows (RIDI's
-    /// processed files, RoNIN), or the reader cuts its timeline at each dropout of a sensor
-    /// stream (Tyrex, Indoor Location Competition). Not a RIDI raw folder, whose sensors are
-    /// interpolated onto the pose's times: there the limit also bounds a hole in one sensor.
+    /// processed files), or the reader cuts its timeline at each dropout of a sensor stream
+    /// (Tyrex; the Indoor Location Competition's, which leaves out a magnetometer that drops
+    /// out for longer than [`ilc::MAX_MAGNET_FILL_S`](crate::ilc::MAX_MAGNET_FILL_S)). Not a
+    /// RIDI raw folder, whose sensors are interpolated onto the pose's times (there the limit
+    /// also bounds a hole in one sensor), nor RoNIN, whose gyro-integrated orientation would
+    /// take a pause in one step.
     pub fn keeps_gaps(self) -> bool {
-        self != Format::RidiRaw
+        !matches!(self, Format::RidiRaw | Format::Ronin)
     }
 
     /// What a source of this format looks like, for errors about a source that is not one.

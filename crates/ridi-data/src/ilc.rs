@@ -74,7 +74,9 @@
 //! non-finite value, too few values (a truncated line), too many (two records run together
 //! without a line break), a record line that is not `unix_ms<TAB>TYPE_...`, timestamps of one
 //! type that go back or leave a gap longer than the validation's `max_gap_s` (repeated
-//! timestamps keep their first record), a rotation vector longer than 1, a missing accelerometer,
+//! timestamps keep their first record; with that limit raised, as `ridi convert
+//! --split-at-gaps` reads, a pause stays a gap of the timeline and a magnetometer dropout over
+//! [`MAX_MAGNET_FILL_S`] leaves the magnetometer out), a rotation vector longer than 1, a missing accelerometer,
 //! gyroscope or rotation vector, a single waypoint, waypoints that do not overlap the IMU
 //! data, a last record without a line break after it (a file cut off while being written;
 //! complete files end with the `#<TAB>endTime` line), a value beyond its channel's physical
@@ -118,6 +120,12 @@ pub const DEFAULT_PLACEMENT: &str = "hand";
 /// competition's 50 Hz (its shared walks never exceed one, 20 ms). Longer dropouts stay gaps
 /// in the timeline.
 pub const MAX_SENSOR_GAP_S: f64 = 0.1;
+
+/// Longest magnetometer dropout inside the timeline that is interpolated across, seconds: the
+/// readers' default longest gap ([`Validation::max_gap_s`](crate::Validation::max_gap_s)), which
+/// every record type is held to unless the limit is raised (`ridi inspect`, `ridi convert
+/// --split-at-gaps`: pauses then stay gaps, and a longer magnetometer dropout leaves it out).
+pub const MAX_MAGNET_FILL_S: f64 = 1.0;
 
 /// How path files are turned into sequences.
 #[derive(Debug, Clone, PartialEq)]
@@ -408,7 +416,8 @@ pub fn parse(bytes: &[u8], path: &Path, options: &IlcOptions) -> Result<IlcPath>
         } else {
             (limits.max_gap_s, &s.time[..])
         };
-        text::check_time(&s.time, &s.lines, path, "unix_ms", gap)?;
+        // The median step first: a time in another unit shows as gaps too, and its error
+        // names the unit.
         let values = s.values.iter().copied();
         text::check_stream(
             limits,
@@ -419,6 +428,7 @@ pub fn parse(bytes: &[u8], path: &Path, options: &IlcOptions) -> Result<IlcPath>
             KINDS[k].channel,
             values,
         )?;
+        text::check_time(&s.time, &s.lines, path, "unix_ms", gap)?;
     }
 
     let rv = &streams[RV];
@@ -445,7 +455,8 @@ pub fn parse(bytes: &[u8], path: &Path, options: &IlcOptions) -> Result<IlcPath>
         path,
         &mut warnings,
     )?;
-    warnings.extend(magnet_dropouts(&streams[MAGNET], &spans, path));
+    let (magnet_warning, keep_magnet) = magnet_dropouts(&streams[MAGNET], &spans, path);
+    warnings.extend(magnet_warning);
     let time: Vec<f64> = spans
         .iter()
         .flat_map(|&(a, b)| uniform_timeline(a, b, options.rate_hz))
@@ -472,7 +483,8 @@ pub fn parse(bytes: &[u8], path: &Path, options: &IlcOptions) -> Result<IlcPath>
         acce,
         linacce,
         gravity,
-        magnet: (!streams[MAGNET].time.is_empty()).then(|| streams[MAGNET].resample(&time)),
+        magnet: (keep_magnet && !streams[MAGNET].time.is_empty())
+            .then(|| streams[MAGNET].resample(&time)),
         orientation,
         orientation_source: Some(OrientationSource::RotationVector),
         ground_truth,
@@ -670,10 +682,11 @@ fn imu_spans(
     Ok(spans)
 }
 
-/// A warning when the magnetometer, which is interpolated across its dropouts (tracking does
-/// not use it; the RIDI-MAG baseline does), has a hole longer than [`MAX_SENSOR_GAP_S`] inside
-/// the kept `spans` (a hole where every sensor stops is a gap of the timeline, not filled).
-fn magnet_dropouts(magnet: &Stream, spans: &[(f64, f64)], path: &Path) -> Option<String> {
+/// The warning about the magnetometer's dropouts over [`MAX_SENSOR_GAP_S`] inside the kept
+/// `spans`, which the sequence interpolates across, and whether it keeps the magnetometer: not
+/// when a dropout there is longer than [`MAX_MAGNET_FILL_S`] (which only a `max_gap_s` above
+/// that lets through, as `ridi convert --split-at-gaps` reads), whose filling would be made up.
+fn magnet_dropouts(magnet: &Stream, spans: &[(f64, f64)], path: &Path) -> (Option<String>, bool) {
     let (mut holes, mut longest) = (0, 0.0f64);
     for hole in intervals(&magnet.time, MAX_SENSOR_GAP_S, |_| {})
         .windows(2)
@@ -688,14 +701,23 @@ fn magnet_dropouts(magnet: &Stream, spans: &[(f64, f64)], path: &Path) -> Option
             longest = longest.max(filled);
         }
     }
-    (holes > 0).then(|| {
+    let file = crate::shown(path);
+    if longest > MAX_MAGNET_FILL_S {
+        let warning = format!(
+            "{file}: the magnetometer drops out for {longest:.3} s while the other sensors \
+             record, longer than the {MAX_MAGNET_FILL_S} s it is interpolated across: left out \
+             (only the RIDI-MAG baseline uses it)"
+        );
+        return (Some(warning), false);
+    }
+    let warning = (holes > 0).then(|| {
         format!(
-            "{}: the magnetometer drops out {} for over {MAX_SENSOR_GAP_S} s (the longest \
+            "{file}: the magnetometer drops out {} for over {MAX_SENSOR_GAP_S} s (the longest \
              {longest:.3} s): interpolated across (only the RIDI-MAG baseline uses it)",
-            crate::shown(path),
             crate::error::times(holes)
         )
-    })
+    });
+    (warning, true)
 }
 
 /// The time every IMU stream and (`with_waypoints`) the waypoints cover.
@@ -1113,6 +1135,22 @@ mod tests {
             [
                 "p/abc.txt: the magnetometer drops out once for over 0.1 s (the longest 0.520 s): \
               interpolated across (only the RIDI-MAG baseline uses it)"
+            ]
+        );
+        // A 1.5-s magnetometer dropout is refused as a gap; with pauses read (`ridi convert
+        // --split-at-gaps`), the magnetometer is left out rather than filled across it.
+        let long = drop("TYPE_MAGNETIC_FIELD", 1_574_559_496_000, 1_574_559_497_500);
+        assert!(err(&long).contains("field `unix_ms`: gap of 1.520 s"));
+        let mut pausing = IlcOptions::default();
+        pausing.validation.max_gap_s = f64::INFINITY;
+        let read = parse(long.as_bytes(), Path::new("p/abc.txt"), &pausing).unwrap();
+        assert!(read.sequence.magnet().is_none());
+        assert_eq!(
+            read.warnings,
+            [
+                "p/abc.txt: the magnetometer drops out for 1.520 s while the other sensors \
+                 record, longer than the 1 s it is interpolated across: left out (only the \
+                 RIDI-MAG baseline uses it)"
             ]
         );
         // Overlapping dropouts leaving no data for over 1 s: named as such.

@@ -84,7 +84,9 @@ pub(crate) fn parse_header(line: usize, content: &str, path: &Path) -> Result<He
         slots.push(slot);
     }
     if slots.len() == 1
-        && let Some(sep) = [';', '\t', ' '].into_iter().find(|&c| content.contains(c))
+        && let Some(sep) = [';', '\t', ' ']
+            .into_iter()
+            .find(|&c| content.trim().contains(c))
     {
         return Err(DataError::format(
             Location::line(path, line),

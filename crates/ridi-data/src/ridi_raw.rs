@@ -436,7 +436,7 @@ impl<S: LineSource> RecordReader<S> {
                 }
                 if self.step.is_none() {
                     let (path, gap) = (&self.path, self.max_gap_s);
-                    self.step = text::check_step(previous, next, path, "t", gap).err();
+                    self.step = text::check_step(previous, next, path, "t", (gap, false)).err();
                 }
             }
             self.previous = Some(next);

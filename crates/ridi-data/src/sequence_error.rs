@@ -43,10 +43,9 @@ const TIME_UNITS: [(&str, f64); 4] = [
 /// [`TIME_UNITS`]): the other unit in which the file's numbers would step by 1-100 ms, the
 /// intervals of phone sensors, if one does.
 pub(crate) fn time_step_message(median: f64, (min, max): (f64, f64), expected: &str) -> String {
-    let scale = TIME_UNITS
-        .iter()
-        .find(|u| u.0 == expected)
-        .map_or(1.0, |u| u.1);
+    let unit = TIME_UNITS.iter().find(|u| u.0 == expected);
+    debug_assert!(unit.is_some(), "`{expected}` is no unit of TIME_UNITS");
+    let scale = unit.map_or(1.0, |u| u.1);
     let guess = TIME_UNITS
         .iter()
         .filter(|u| u.0 != expected)

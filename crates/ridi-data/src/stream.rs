@@ -1068,7 +1068,7 @@ impl Processed {
                 (time, line),
                 path,
                 PROCESSED_COLUMNS[TIME],
-                max_gap_s,
+                (max_gap_s, true),
             )?;
         }
         let has_orientation = self.header.csv().is_none_or(|h| h.has_orientation);

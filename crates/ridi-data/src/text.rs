@@ -256,7 +256,9 @@ pub(crate) fn count(cell: &str, path: &Path, line: usize, field: &str) -> Result
 }
 
 /// Checks that `time` (seconds, one entry per line of `lines`) strictly increases without
-/// gaps longer than `max_gap_s`, naming the offending line.
+/// gaps longer than `max_gap_s`, naming the offending line. The file is of a
+/// [`Format::keeps_gaps`](crate::Format::keeps_gaps) format: a gap's error says that `ridi
+/// convert --split-at-gaps` cuts it.
 pub(crate) fn check_time(
     time: &[f64],
     lines: &[usize],
@@ -267,18 +269,26 @@ pub(crate) fn check_time(
     for (i, w) in time.windows(2).enumerate() {
         let line = lines.get(i + 1).copied().unwrap_or(0);
         let prev_line = lines.get(i).copied().unwrap_or(0);
-        check_step((w[0], prev_line), (w[1], line), path, field, max_gap_s)?;
+        check_step(
+            (w[0], prev_line),
+            (w[1], line),
+            path,
+            field,
+            (max_gap_s, true),
+        )?;
     }
     Ok(())
 }
 
-/// [`check_time`] of one step: from `prev` to `next` (each a time in seconds and its line).
+/// [`check_time`] of one step: from `prev` to `next` (each a time in seconds and its line),
+/// the gap's error naming `ridi convert --split-at-gaps` if `splittable` (not for a RIDI raw
+/// folder, whose pauses it cannot cut).
 pub(crate) fn check_step(
     (prev, prev_line): (f64, usize),
     (next, line): (f64, usize),
     path: &Path,
     field: &str,
-    max_gap_s: f64,
+    (max_gap_s, splittable): (f64, bool),
 ) -> Result<()> {
     let at = || Location::line(path, line).with_field(field);
     if next == prev {
@@ -302,10 +312,14 @@ pub(crate) fn check_step(
             format!(
                 "gap of {:.3} s since line {prev_line} exceeds the limit of {} s: a recording \
                  paused that long is two; cut it there (the records before this line and those \
-                 from it on, as recordings of their own: `ridi convert --split-at-gaps 0.1` \
-                 does, in every format but a RIDI raw folder)",
+                 from it on, as recordings of their own{})",
                 next - prev,
-                short(max_gap_s)
+                short(max_gap_s),
+                if splittable {
+                    ": `ridi convert --split-at-gaps 0.1` does"
+                } else {
+                    ""
+                }
             ),
         ));
     }

@@ -267,6 +267,14 @@ impl LiveTracker {
         let (velocities, placements) = live.regressions();
         Regressions::of(velocities, placements, self.model.placement_names())
     }
+
+    fn __repr__(&self) -> String {
+        format!(
+            "LiveTracker(placements={:?}, {} regressions so far)",
+            self.model.placement_names(),
+            self.lock().regressions().0.len()
+        )
+    }
 }
 
 /// `N` numbers of one sample for argument `name`, or a `TypeError` that says so (pyo3's own

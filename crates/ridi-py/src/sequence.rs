@@ -524,9 +524,9 @@ fn read_sequences(
 /// sequence folder, as ``ridi track`` reads it. ``format`` forces one (``ridi-csv``, ``ridi-plain``, ``ridi-raw``,
 /// ``tyrex``, ``ilc``, ``ronin``) instead of detecting it. The readers' warnings are ``UserWarning``\ s.
 ///
-/// ``split_at_gaps`` (seconds, above 0) cuts the recording at every gap longer than that, as
+/// ``split_at_gaps`` (seconds, above 0 and below 1) cuts the recording at every gap longer than that, as
 /// ``ridi convert --split-at-gaps`` does: a pause longer than the 1 s the readers accept is
-/// read and cut too (in every format but a RIDI raw folder), parts shorter than 1 s are
+/// read and cut too (in every format but a RIDI raw or RoNIN folder), parts shorter than 1 s are
 /// dropped with a warning; read the parts with ``ridi.read_any``.
 ///
 /// Raises ``OSError`` when the file cannot be read, ``ValueError`` naming the file, line and

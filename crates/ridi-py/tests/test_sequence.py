@@ -360,6 +360,8 @@ def test_a_recording_paused_for_seconds_is_read_split_at_its_gaps(seq, tmp_path)
         ridi.read(path, split_at_gaps=0.1)
     with pytest.raises(ValueError, match="cannot split at gaps longer than -1 s"):
         ridi.read_any(path, split_at_gaps=-1.0)
+    with pytest.raises(ValueError, match="the readers accept gaps of up to 1 s, so a split must"):
+        ridi.read_any(path, split_at_gaps=1.0)
 
 def same_sequence(a, b):
     """Every constructor argument of `a` and `b` agrees (so a new argument the pickling misses

@@ -70,6 +70,8 @@ def test_heading_gyro_is_the_cli_flag_and_what_a_live_tracker_without_orientatio
         updates += live.push(seq.time[i], seq.gyro[i], seq.acce[i])
     updates += live.finish()
     np.testing.assert_array_equal(np.array([u.position for u in updates]), online.position)
+    assert repr(live).startswith("LiveTracker(placements=[") and repr(live).endswith(
+        f"], {len(online.regressions.frame)} regressions so far)")
     # The orientation alone corrects the heading as the whole recorded triple does.
     corrected = ridi.track(seq, model, online=True)
     live = ridi.LiveTracker(model)

@@ -136,23 +136,42 @@ fn split(
 
 /// [`read_any`] of `path`, its sequences cut at every gap longer than `max_gap_s`
 /// ([`Sequence::split_at_gaps`]), parts under [`SPLIT_MIN_PART_S`] dropped, one warning per
-/// sequence cut after the reader's: what `ridi convert --split-at-gaps` reads. Below `opts`'
-/// [`max_gap_s`](ridi_data::Validation::max_gap_s), the pauses longer than that limit are read
-/// and cut too, in every format whose reader keeps them as gaps ([`Format::keeps_gaps`]: all
-/// but a RIDI raw folder, where the limit stands). A source left without any part has no
-/// sequence (its warning says so).
+/// sequence cut after the reader's: what `ridi convert --split-at-gaps` reads. `max_gap_s` is
+/// below `opts`' [`max_gap_s`](ridi_data::Validation::max_gap_s); pauses longer than that limit
+/// are read and cut too, in every format whose reader keeps them as gaps
+/// ([`Format::keeps_gaps`]; elsewhere the limit stands), so no part keeps a gap the readers
+/// refuse. A source left without any part has no sequence (its warning says so).
 ///
 /// # Errors
 /// As [`read_any`]; [`SequenceError::InvalidGap`] (named by `path`) for a `max_gap_s` that is
-/// not a finite number above 0.
+/// not a finite number above 0, and an error for one not below the readers' limit.
 pub fn read_split(
     path: &Path,
     from: Option<Format>,
     opts: &ReadOptions,
     max_gap_s: f64,
 ) -> Result<Loaded, DataError> {
+    let limit = opts.validation.max_gap_s;
+    if !(max_gap_s.is_finite() && max_gap_s > 0.0) {
+        let e = SequenceError::InvalidGap {
+            max_gap_s,
+            min_duration_s: SPLIT_MIN_PART_S,
+        };
+        return Err(DataError::sequence(path, e));
+    }
+    if max_gap_s >= limit {
+        return Err(DataError::format(
+            Location::file(path),
+            format!(
+                "cannot split at gaps longer than {} s: the readers accept gaps of up to {} s, \
+                 so a split must be below that to cut every pause",
+                short(max_gap_s),
+                short(limit)
+            ),
+        ));
+    }
     let format = source_format(path, from)?;
-    let mut loaded = if format.keeps_gaps() && max_gap_s < opts.validation.max_gap_s {
+    let mut loaded = if format.keeps_gaps() {
         let mut pausing = opts.clone();
         pausing.validation.max_gap_s = f64::INFINITY;
         read_any(path, Some(format), &pausing)?
@@ -375,8 +394,7 @@ fn check_overwrites(
         if inputs.overwritten_by(out).is_some() {
             return Err(DataError::format(
                 Location::file(out),
-                "the conversion reads this file and would replace it: choose an --out outside \
-                 the source",
+                "cannot write it: the command reads it; choose an --out outside the source",
             ));
         }
     }

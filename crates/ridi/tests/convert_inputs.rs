@@ -249,7 +249,7 @@ fn list_labels_in_the_source_carry_over_and_a_folder_of_another_format_is_named(
         .unwrap_err()
         .to_string();
     assert!(
-        e.contains("the conversion reads this file and would replace it"),
+        e.contains(": cannot write it: the command reads it; choose an --out outside the source"),
         "{e}"
     );
     assert_eq!(
