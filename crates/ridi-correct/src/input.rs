@@ -98,7 +98,11 @@ pub(crate) fn validate_time(time: &[f64], max_dt: f64) -> Result<(), CorrectErro
 
 /// A velocity at a frame: the horizontal velocity in the stabilized frame S that the
 /// correction makes the integrated velocity follow there (a regressed one, or a ground-truth
-/// one for an oracle). Not a training target (ridi-features' targets are those).
+/// one for an oracle). Not a training target (ridi-features' targets are those). S is the
+/// correction's [`CorrectionConfig::up_axis`](crate::CorrectionConfig::up_axis): set it to
+/// the S the velocities were regressed in (a trained model's), which a bare velocity cannot
+/// say (the [`Tracker`](crate::Tracker) checks it against its regressor's
+/// [`up_axis`](crate::VelocityRegressor::up_axis)).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct FrameVelocity {
     /// Frame index (into the slices of the correction).

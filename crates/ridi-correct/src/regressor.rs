@@ -50,7 +50,54 @@ pub struct RegressorOutput {
 pub type RegressorError = Box<dyn std::error::Error + Send + Sync>;
 
 /// A source of regressed velocities for the [`Tracker`](crate::Tracker): the SVR cascade in
-/// production, test doubles in tests.
+/// production (the `ridi` crate's `CascadeRegressor` turns a trained model's windows into
+/// features), test doubles in tests, or a model of one's own.
+///
+/// ```
+/// use ridi_correct::{
+///     FrameWindow, RegressorError, RegressorOutput, Tracker, TrackerConfig, VelocityRegressor,
+/// };
+/// use ridi_frames::nalgebra::Vector3;
+/// use ridi_frames::{DeviceVec, ImuSample, StabHorizontal, WorldFromDevice};
+///
+/// /// Says the walker goes forward (S's -z) at 1 m/s, whatever the frames: a stand-in for a
+/// /// trained model, which would regress from `frames.imu`.
+/// struct Forward;
+///
+/// impl VelocityRegressor for Forward {
+///     fn window_len(&self) -> usize {
+///         1
+///     }
+///     fn regress(
+///         &mut self,
+///         _frames: &FrameWindow<'_>,
+///     ) -> Result<Option<RegressorOutput>, RegressorError> {
+///         let velocity = StabHorizontal::new(0.0, -1.0);
+///         Ok(Some(RegressorOutput { velocity, placement: None }))
+///     }
+/// }
+///
+/// let mut tracker = Tracker::new(TrackerConfig::default(), Forward)?;
+/// // Ten seconds at 200 Hz of a phone held upright (device +y up, S's up axis) that measures
+/// // no motion: the correction makes the trajectory follow the regressed velocities.
+/// let quarter_turn_about_x = Vector3::new(std::f64::consts::FRAC_PI_2, 0.0, 0.0);
+/// let upright = WorldFromDevice::from_scaled_axis(quarter_turn_about_x);
+/// let mut last = None;
+/// for i in 0..2000 {
+///     let sample = ImuSample {
+///         time: i as f64 * 0.005,
+///         gyro: DeviceVec::ZERO,
+///         linacce: DeviceVec::ZERO,
+///         gravity: DeviceVec::new(0.0, 9.81, 0.0),
+///         orientation: upright,
+///     };
+///     last = Some(tracker.push(&sample)?);
+/// }
+/// let end = last.unwrap().pose.position;
+/// let walked = end.x().hypot(end.y());
+/// assert!((8.0..10.5).contains(&walked), "{walked} m");
+/// # Ok::<(), Box<dyn std::error::Error>>(())
+/// ```
 pub trait VelocityRegressor {
     /// How many of the most recent frames [`regress`](Self::regress) needs, at least 1 (the
     /// tracker refuses 0). The tracker only asks for a regression once a segment holds that

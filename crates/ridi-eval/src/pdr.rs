@@ -242,7 +242,9 @@ fn filtfilt(x: &[f64], f: &Biquad) -> Vec<f64> {
 /// Builds a PDR trajectory: one horizontal position per frame.
 ///
 /// `heading[f]` is the walking direction at frame `f`, radians, counter-clockwise from the world
-/// +x axis about world up (so a step moves by `L · (cos h, sin h)`). The position is piecewise
+/// +x axis about world up (so a step moves by `L · (cos h, sin h)`); for a phone carried facing
+/// forward, its S frame's forward direction (`ridi_frames::UpAxis::forward_heading`, which the
+/// `ridi` crate's PDR baseline takes). The position is piecewise
 /// constant, jumping at each step frame:
 ///
 /// ```text

@@ -5,7 +5,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::frame::{Device, Stabilized};
 use crate::rotation::{Rot, StabFromDevice, StabFromWorld, WorldFromDevice};
-use crate::vector::{DeviceVec, Vec3, WorldVec};
+use crate::vector::{DeviceVec, StabVec, Vec3, WorldVec};
 
 /// Up axis of the stabilized frame S (+y, as in the original RIDI code).
 pub const UP_S: Vec3<Stabilized> = Vec3::new(0.0, 1.0, 0.0);
@@ -117,6 +117,24 @@ impl UpAxis {
         gravity: DeviceVec,
     ) -> StabFromWorld {
         self.align(gravity) * orientation.inverse()
+    }
+
+    /// Heading of S's forward direction (-z) in the world: radians counter-clockwise from W +x
+    /// about W up, the walking direction of a phone carried facing forward. What a step-based
+    /// baseline walks along (ridi-eval's `pdr_trajectory` takes one per frame).
+    ///
+    /// ```
+    /// use ridi_frames::{DeviceVec, UpAxis, WorldFromDevice};
+    ///
+    /// // A phone lying flat, screen up, top towards W +y: it faces W +y (90 degrees).
+    /// let up = DeviceVec::new(0.0, 0.0, 9.81);
+    /// let h = UpAxis::PlusY.forward_heading(WorldFromDevice::identity(), up);
+    /// assert!((h - std::f64::consts::FRAC_PI_2).abs() < 1e-9);
+    /// ```
+    pub fn forward_heading(self, orientation: WorldFromDevice, gravity: DeviceVec) -> f64 {
+        let forward = StabVec::new(0.0, 0.0, -1.0);
+        let f: WorldVec = self.stab_from_world(orientation, gravity).inverse() * forward;
+        f.y().atan2(f.x())
     }
 }
 

@@ -19,7 +19,7 @@ use std::str::FromStr;
 use ridi_correct::{CorrectionConfig, FrameVelocity, correct, integrate, world_acceleration};
 use ridi_data::Sequence;
 use ridi_eval::{StepDetectorConfig, detect_steps, pdr_trajectory};
-use ridi_frames::{StabHorizontal, StabVec, UpAxis, WorldVec};
+use ridi_frames::{StabHorizontal, UpAxis, WorldVec};
 use serde::{Deserialize, Serialize};
 
 use crate::error::{PipelineError, Result};
@@ -102,14 +102,10 @@ impl FromStr for Method {
 /// S -z, at every frame. S is built on device -y while the phone is upside down
 /// ([`UpAxis::PlusOrMinusY`]), where the paper's S, and so its yaw, turns erratically.
 pub fn device_heading(seq: &Sequence) -> Vec<f64> {
-    let forward = StabVec::new(0.0, 0.0, -1.0);
     seq.orientation()
         .iter()
         .zip(seq.gravity())
-        .map(|(&q, &g)| {
-            let f: WorldVec = UpAxis::PlusOrMinusY.stab_from_world(q, g).inverse() * forward;
-            f.y().atan2(f.x())
-        })
+        .map(|(&q, &g)| UpAxis::PlusOrMinusY.forward_heading(q, g))
         .collect()
 }
 
