@@ -74,7 +74,7 @@ pub const SPLIT_MIN_PART_S: f64 = 1.0;
 /// Longest gap `--rate` interpolates across, in frame intervals of the source (its median):
 /// longer ones would be filled with invented frames, so the recording has to be split there
 /// first.
-const RESAMPLE_MAX_GAP_FRAMES: f64 = 5.0;
+pub(crate) const RESAMPLE_MAX_GAP_FRAMES: f64 = 5.0;
 
 /// The longest gap in `seq` that `ridi convert --rate` (and Python's `Sequence.resampled`)
 /// interpolates across, seconds: 5 of its median frame intervals.

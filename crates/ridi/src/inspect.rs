@@ -6,6 +6,7 @@ use ridi_frames::UpAxis;
 use ridi_regress::{Cascade, GridRow, Solver, StoredAs};
 use serde::Serialize;
 
+use crate::convert::RESAMPLE_MAX_GAP_FRAMES;
 use crate::track::{TRACK_RATE_HZ, TRACK_RATE_TOLERANCE};
 use ridi_features::Orientation;
 
@@ -91,6 +92,9 @@ struct Summary {
     max_gap: f64,
     /// The median rate, when it is off [`TRACK_RATE_HZ`] by more than [`TRACK_RATE_TOLERANCE`].
     rate_off: Option<f64>,
+    /// The median rate (one over the median frame interval), which gaps do not lower: what a
+    /// gap is counted in frame intervals of. `None`: not known (a stream without a long gap).
+    median_rate: Option<f64>,
     orientation_source: Option<ridi_data::OrientationSource>,
     gravity_norm: SeriesStats,
     upside_down: usize,
@@ -150,6 +154,7 @@ pub fn inspect_stream(mut rows: ridi_data::RowReader) -> crate::Result<Inspectio
         duration: last.zip(first).map_or(0.0, |(l, f)| l - f),
         max_gap,
         rate_off: None,
+        median_rate: None,
         orientation_source: rows.orientation_source(),
         gravity_norm: gravity.stats(),
         upside_down,
@@ -161,8 +166,18 @@ pub fn inspect_stream(mut rows: ridi_data::RowReader) -> crate::Result<Inspectio
     };
     rows.finish()?;
     let rate_off = crate::track::rate_off(&rate, &file, &opts)?;
+    // The exact median takes another pass over the file: only for a gap the report counts.
+    let fastest = TRACK_RATE_HZ * (1.0 + TRACK_RATE_TOLERANCE);
+    let median_rate = match rate_off {
+        Some(rate) => Some(rate),
+        None if summary.max_gap > RESAMPLE_MAX_GAP_FRAMES / fastest => {
+            Some(1.0 / ridi_data::median_interval(&file, &opts)?)
+        }
+        None => None,
+    };
     Ok(report(Summary {
         rate_off: rate_off.filter(|_| summary.frames >= 2),
+        median_rate: median_rate.filter(|_| summary.frames >= 2),
         ..summary
     }))
 }
@@ -224,6 +239,7 @@ pub fn inspect(seq: &Sequence, format: Format) -> Inspection {
         duration: seq.duration(),
         max_gap: seq.max_gap(),
         rate_off: (seq.len() >= 2 && off).then_some(median_rate),
+        median_rate: (seq.len() >= 2).then_some(median_rate),
         orientation_source: seq.orientation_source(),
         gravity_norm: SeriesStats::of(seq.gravity().iter().map(|g| g.norm())),
         upside_down: seq
@@ -269,11 +285,13 @@ fn report(s: Summary) -> Inspection {
             s.frames
         ));
     }
-    if rate_hz > 0.0 && max_gap_s > 5.0 / rate_hz {
+    // Warned of beyond what `ridi convert --rate` interpolates across.
+    let median_rate = s.median_rate.unwrap_or(rate_hz);
+    if median_rate > 0.0 && max_gap_s > RESAMPLE_MAX_GAP_FRAMES / median_rate {
         let mut w = format!(
             "longest gap {:.3} s is {:.0} frame intervals",
             max_gap_s,
-            max_gap_s * rate_hz
+            max_gap_s * median_rate
         );
         // `ridi inspect` reads pauses the other commands refuse (`inspect_options`).
         let limit = ridi_data::Validation::default().max_gap_s;
