@@ -149,19 +149,6 @@ fn print_summary(report: &Report) {
     for w in &report.warnings {
         eprintln!("warning: {}", shown(w));
     }
-    let weak = report
-        .sequences
-        .iter()
-        .filter(|s| s.alignment_extent_m < ridi::eval::WEAK_ALIGNMENT_EXTENT_M)
-        .count();
-    if weak > 0 {
-        eprintln!(
-            "warning: in {weak} of {} the ground truth moves less than {} m within the \
-             alignment window, so their fitted heading is weakly determined (listed in report.md)",
-            counted(report.sequences.len(), "sequence"),
-            ridi::eval::WEAK_ALIGNMENT_EXTENT_M
-        );
-    }
     outln!(
         "\n{}; velocity MSE S-x {:.3} S-z {:.3} (m/s)^2; placement accuracy {}",
         counted(report.sequences.len(), "sequence"),

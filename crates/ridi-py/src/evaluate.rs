@@ -109,6 +109,7 @@ pub(crate) fn evaluate<'py>(
                     }
                     Inputs::Sequences(mut seqs) => {
                         if let Some(map) = &map {
+                            map.check(&seqs)?;
                             map.apply(&mut seqs);
                         }
                         ridi::evaluate(&seqs, model, &opts).map(|(report, _)| report)

@@ -361,6 +361,7 @@ pub(crate) fn train(
                 }
                 Inputs::Sequences(mut seqs) => {
                     if let Some(map) = &map {
+                        map.check(&seqs)?;
                         map.apply(&mut seqs);
                     }
                     ridi::train(&seqs, &opts, &mut report)

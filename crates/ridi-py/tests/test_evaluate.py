@@ -4,6 +4,7 @@ options and refusals."""
 import json
 import math
 
+import numpy as np
 import pytest
 
 import ridi
@@ -99,3 +100,14 @@ def test_one_method_by_name_and_warnings_as_python_warnings(model, test_list):
     assert one["methods"] == ["ridi"] and one["warnings"]
     with pytest.warns(UserWarning):
         assert same(one, ridi.evaluate(test_list, model, methods=["ridi"]))
+
+
+def test_a_weakly_determined_alignment_is_a_warning_in_the_report_and_in_python(seq, model):
+    # Ground truth that never moves: the alignment's heading rests on no motion at all.
+    still = ridi.Sequence(seq.time, seq.gyro, seq.acce, seq.gravity, seq.orientation,
+                          name="still", placement="hand",
+                          ground_truth_position=np.zeros((len(seq), 3)),
+                          ground_truth_orientation=seq.orientation)
+    with pytest.warns(UserWarning, match=r"weakly determined alignment in 1 of 1 sequence: .*still \(0.00 m\)"):
+        report = ridi.evaluate([still], model, methods="ridi", placement_map="tyrex4")
+    assert any(w.startswith("weakly determined alignment") for w in report["warnings"])

@@ -115,6 +115,13 @@ def test_training_lists_are_checked_at_their_line(tmp_path):
         ridi.train(listed, grid="none")
     with pytest.raises(ValueError, match=r"no placement label"):
         ridi.train([ridi.read(run)], grid="none")
+    # A label the map lacks is refused in sequences as in lists, not made a class of its own.
+    typo = [ridi.read(run).with_placement("Swingin")]
+    message = r"sequence `Guillaume_Nexus5_NoDist_AR`: placement `Swingin` is not in the placement map"
+    with pytest.raises(ValueError, match=message):
+        ridi.train(typo, grid="none", placement_map="tyrex4")
+    with pytest.raises(ValueError, match=message):
+        ridi.evaluate(typo, ridi.bundled_model(), placement_map="tyrex4")
     with pytest.raises(TypeError, match="list file"):
         ridi.train(3.5)
     with pytest.raises(ValueError, match="no list file and no sequence"):

@@ -349,7 +349,15 @@ pub fn evaluate(
         let cm = ConfusionMatrix::from_names(&truth, &predicted, &classes)?;
         (cm.accuracy(), Some(cm))
     };
-    let (results, traces) = done.into_iter().map(|e| (e.result, e.traces)).unzip();
+    let (results, traces): (Vec<SequenceResult>, _) =
+        done.into_iter().map(|e| (e.result, e.traces)).unzip();
+    // Without regressions there is no placement accuracy to warn about.
+    let mut warnings = if opts.methods.iter().any(|m| m.needs_model()) {
+        placement_warnings(seqs, model)
+    } else {
+        Vec::new()
+    };
+    warnings.extend(weak_alignment(&results, opts.metrics.align));
     Ok((
         Report {
             sequences: results,
@@ -360,15 +368,43 @@ pub fn evaluate(
             config: opts.metrics,
             recorded_heading: opts.track.recorded_heading,
             methods: opts.methods.iter().map(|m| m.key().to_string()).collect(),
-            // Without regressions there is no placement accuracy to warn about.
-            warnings: if opts.methods.iter().any(|m| m.needs_model()) {
-                placement_warnings(seqs, model)
-            } else {
-                Vec::new()
-            },
+            warnings,
         },
         traces,
     ))
+}
+
+/// The warning about the sequences whose ground truth moves less than
+/// [`ridi_eval::WEAK_ALIGNMENT_EXTENT_M`] within the alignment window `align`, naming the first
+/// few with their travel: their fitted heading rests on little motion.
+fn weak_alignment(sequences: &[SequenceResult], align: ridi_eval::AlignWindow) -> Option<String> {
+    let weak: Vec<String> = sequences
+        .iter()
+        .filter(|s| s.alignment_extent_m < ridi_eval::WEAK_ALIGNMENT_EXTENT_M)
+        .map(|s| {
+            format!(
+                "{} ({:.2} m)",
+                ridi_data::shown(&s.name),
+                s.alignment_extent_m
+            )
+        })
+        .collect();
+    (!weak.is_empty()).then(|| {
+        format!(
+            "weakly determined alignment in {} of {}: the ground truth moves less than {} m \
+             within the alignment window, so the fitted heading rests on little motion and \
+             every metric inherits its error: {}{}",
+            weak.len(),
+            ridi_data::counted(sequences.len(), "sequence"),
+            ridi_eval::WEAK_ALIGNMENT_EXTENT_M,
+            ridi_data::first_few(weak.into_iter(), 5),
+            // Aligned on the whole trajectory already, there is no larger window to offer.
+            match align {
+                ridi_eval::AlignWindow::All => "",
+                _ => " (`ridi eval --align all` shows them without it)",
+            }
+        )
+    })
 }
 
 fn sequence_reports<'a>(results: impl Iterator<Item = &'a SequenceResult>) -> Vec<SequenceReport> {
@@ -481,29 +517,6 @@ impl Report {
         );
         for w in &self.warnings {
             let _ = writeln!(out, "**Warning**: {w}.\n");
-        }
-        let weak: Vec<String> = self
-            .sequences
-            .iter()
-            .filter(|s| s.alignment_extent_m < ridi_eval::WEAK_ALIGNMENT_EXTENT_M)
-            .map(|s| format!("{} ({:.2} m)", s.name, s.alignment_extent_m))
-            .collect();
-        if !weak.is_empty() {
-            let _ = writeln!(
-                out,
-                "**Weakly determined alignment** in {} of {}: the ground truth moves \
-                 less than {} m within the alignment window, so the fitted heading rests on \
-                 little motion and every metric inherits its error: {}.{}\n",
-                weak.len(),
-                ridi_data::counted(self.sequences.len(), "sequence"),
-                ridi_eval::WEAK_ALIGNMENT_EXTENT_M,
-                weak.join(", "),
-                // Aligned on the whole trajectory already, there is no larger window to offer.
-                match self.config.align {
-                    ridi_eval::AlignWindow::All => "",
-                    _ => " `ridi eval --align all` shows them without it.",
-                }
-            );
         }
         let _ = writeln!(out, "## Overall (mean over sequences)\n");
         let mut head = "| method |".to_string();
@@ -785,18 +798,24 @@ mod tests {
     fn a_weak_alignment_is_flagged_and_the_whole_run_offered_unless_already_used() {
         let mut weak = result("still", None, 1.0);
         weak.alignment_extent_m = 0.4;
-        let mut r = report(vec![weak, result("walk", None, 1.0)]);
-        let md = r.to_markdown();
+        let sequences = vec![weak, result("walk", None, 1.0)];
+        let w = weak_alignment(&sequences, ridi_eval::AlignWindow::default()).unwrap();
         assert!(
-            md.contains("**Weakly determined alignment** in 1 of 2 sequences")
-                && md.contains("still (0.40 m). `ridi eval --align all` shows them"),
-            "{md}"
+            w.starts_with("weakly determined alignment in 1 of 2 sequences")
+                && w.ends_with("still (0.40 m) (`ridi eval --align all` shows them without it)"),
+            "{w}"
         );
-        r.config.align = ridi_eval::AlignWindow::All;
-        let md = r.to_markdown();
+        let w = weak_alignment(&sequences, ridi_eval::AlignWindow::All).unwrap();
+        assert!(w.ends_with("still (0.40 m)"), "{w}");
+        assert_eq!(
+            weak_alignment(&sequences[1..], ridi_eval::AlignWindow::All),
+            None
+        );
+        let mut r = report(sequences);
+        r.warnings.push(w);
         assert!(
-            md.contains("still (0.40 m).\n") && !md.contains("--align all"),
-            "{md}"
+            r.to_markdown()
+                .contains("**Warning**: weakly determined alignment in 1 of 2")
         );
     }
 

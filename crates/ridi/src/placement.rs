@@ -127,23 +127,41 @@ impl PlacementMap {
     /// not have is an error naming `at`, the label and the labels and classes the map has.
     pub fn class_at<'a>(&'a self, label: &'a str, at: Location) -> Result<&'a str> {
         self.class_of(label).ok_or_else(|| {
-            let labels: Vec<&str> = self.map.keys().map(String::as_str).collect();
-            let classes: Vec<&str> = self.classes().into_iter().collect();
-            DataError::format(
-                at.with_field("placement"),
-                format!(
-                    "placement `{label}` is not in the placement map {} (labels {}; classes {})",
-                    self.name,
-                    labels.join(", "),
-                    classes.join(", ")
-                ),
-            )
-            .into()
+            DataError::format(at.with_field("placement"), self.unknown(label)).into()
         })
     }
 
+    /// Refuses a sequence whose placement label the map does not have, naming the sequence:
+    /// what [`crate::load_listed`] refuses of a listed one, for sequences built otherwise
+    /// (Python's `Sequence`s). Call it before [`Self::apply`].
+    pub fn check(&self, seqs: &[Sequence]) -> Result<()> {
+        for s in seqs {
+            if let Some(label) = s.placement().filter(|l| self.class_of(l).is_none()) {
+                return Err(crate::PipelineError::sequence(
+                    s.name(),
+                    self.unknown(label),
+                ));
+            }
+        }
+        Ok(())
+    }
+
+    /// The message for `label`, which the map does not have.
+    fn unknown(&self, label: &str) -> String {
+        let labels: Vec<&str> = self.map.keys().map(String::as_str).collect();
+        let classes: Vec<&str> = self.classes().into_iter().collect();
+        format!(
+            "placement `{}` is not in the placement map {} (labels {}; classes {})",
+            ridi_data::shown(label),
+            self.name,
+            labels.join(", "),
+            classes.join(", ")
+        )
+    }
+
     /// Relabels every sequence whose label the map has; others keep theirs (load list files
-    /// with [`crate::load_listed`], which refuses labels the map does not have).
+    /// with [`crate::load_listed`], which refuses labels the map does not have, or
+    /// [`Self::check`] the sequences first).
     pub fn apply(&self, seqs: &mut [Sequence]) {
         for s in seqs {
             if let Some(class) = s.placement().and_then(|p| self.class_of(p)) {

@@ -153,7 +153,7 @@ fn train_track_and_evaluate_on_the_sample_dataset() {
     // their travel, in the warning and only there.
     let warning = md
         .lines()
-        .find(|l| l.starts_with("**Weakly determined alignment**"))
+        .find(|l| l.starts_with("**Warning**: weakly determined alignment"))
         .unwrap_or("");
     for s in &report.sequences {
         let seq = test.iter().find(|q| q.name() == s.name).unwrap();
