@@ -158,27 +158,42 @@ fn print_summary(report: &Report) {
             .placement_accuracy
             .map_or("-".into(), |a| format!("{a:.3}"))
     );
+    let c = &report.config;
     outln!(
-        "{:<10} {:>9} {:>9} {:>9} {:>9} {:>11}",
+        "{:<10} {:>26} {:>9} {:>9} {:>9} {:>11}",
         "method",
-        "RTE 5s m",
+        format!("RTE {}s m [95 %]", c.short_rte_window_s),
         "ATE m",
-        "RTE m",
+        format!("RTE {}s m", c.rte_window_s),
         "MPE m",
         "path ratio"
     );
     let opt = |v: Option<f64>| v.map_or("-".to_string(), |v| format!("{v:.3}"));
     for key in &report.methods {
         if let Some(m) = report.summary.get(key) {
+            let interval = report.intervals.get(key).and_then(|i| i.get("rte_5s_m"));
+            let rte_5s = match interval {
+                Some(i) => format!("{:.3} [{:.3}, {:.3}]", m.rte_5s_m, i.low, i.high),
+                None => format!("{:.3}", m.rte_5s_m),
+            };
             outln!(
-                "{key:<10} {:>9.3} {:>9.3} {:>9.3} {:>9.3} {:>11}",
-                m.rte_5s_m,
+                "{key:<10} {rte_5s:>26} {:>9.3} {:>9.3} {:>9.3} {:>11}",
                 m.ate_m,
                 m.rte_m,
                 m.mpe_m,
                 opt(m.path_length_ratio)
             );
         }
+    }
+    if let Some(d) = report.ridi_minus.get("pdr").and_then(|d| d.get("rte_5s_m")) {
+        outln!(
+            "ridi - pdr, RTE {}s: {:+.3} m [{:+.3}, {:+.3}] (paired over sequences; every \
+             interval and difference in report.md)",
+            c.short_rte_window_s,
+            d.mean,
+            d.low,
+            d.high
+        );
     }
     // A test set that spans phones says how each fared: the question a new phone asks.
     let devices = report.per_device();

@@ -15,6 +15,8 @@
 //!   per-sequence results (`report.json`), per-method means, markdown tables
 //!   (`report.md`).
 //! - PDR ([`pdr_trajectory`], [`detect_steps`]): the step-counting baseline: step detection and step-and-heading integration.
+//! - Intervals ([`mean_interval`], [`runs_interval`], [`ratio_interval`]): how far a mean over
+//!   runs can be trusted, by a bootstrap over whole runs (a run's parts drawn together).
 //!
 //! Inputs are validated: empty, mismatched or non-finite inputs give an [`EvalError`], never a
 //! panic.
@@ -59,6 +61,7 @@
 //! ```
 
 mod align;
+mod bootstrap;
 mod error;
 mod metrics;
 mod pdr;
@@ -68,6 +71,7 @@ pub use align::{
     AlignWindow, AlignmentFit, Rigid2, WEAK_ALIGNMENT_EXTENT_M, align_trajectory, fit_alignment,
     fit_rigid_2d, target_extent,
 };
+pub use bootstrap::{DRAWS, Interval, mean_interval, ratio_interval, runs_interval};
 pub use error::{EvalError, Result};
 pub use metrics::{
     ConfusionMatrix, EvalConfig, RATE_TOLERANCE, TrajectoryEval, TrajectoryMetrics, accuracy, ate,
@@ -78,5 +82,6 @@ pub use metrics::{
 pub use pdr::{StepDetectorConfig, detect_steps, detect_steps_in_magnitude, pdr_trajectory};
 pub use report::{
     MethodMetrics, MethodSummary, Metric, SequenceReport, markdown_confusion,
-    markdown_metric_table, markdown_table, summarize,
+    markdown_metric_table, markdown_table, paired_differences, run_of, summarize,
+    summary_intervals,
 };

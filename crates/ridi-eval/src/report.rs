@@ -3,10 +3,12 @@
 //! into `report.json` and `report.md`. Method and sequence order is kept as given, so tables
 //! read in the order the pipeline ran things.
 
+use std::collections::BTreeMap;
 use std::fmt::Write as _;
 
 use serde::{Deserialize, Serialize};
 
+use crate::bootstrap::Interval;
 use crate::metrics::{ConfusionMatrix, TrajectoryMetrics};
 
 /// One field of [`TrajectoryMetrics`], to pick a column.
@@ -175,6 +177,83 @@ pub fn summarize(sequences: &[SequenceReport]) -> Vec<MethodSummary> {
             }
         })
         .collect()
+}
+
+/// The run a sequence belongs to: its name without the `_partN` suffix of a recording split at
+/// its gaps. A bootstrap draws a run's parts together.
+pub fn run_of(sequence: &str) -> &str {
+    match sequence.rsplit_once("_part") {
+        Some((run, n)) if !n.is_empty() && n.bytes().all(|b| b.is_ascii_digit()) => run,
+        _ => sequence,
+    }
+}
+
+/// Per method and metric key, the 95 % interval of the method's mean over `sequences`
+/// ([`mean_interval`](crate::mean_interval), the parts of a run drawn together), over the
+/// sequences where the metric is defined; none for a metric defined nowhere.
+pub fn summary_intervals(
+    sequences: &[SequenceReport],
+) -> BTreeMap<String, BTreeMap<String, Interval>> {
+    per_method(sequences, |s, method| {
+        s.methods
+            .iter()
+            .find(|m| m.method == method)
+            .map(|m| &m.metrics)
+            .map(|m| Metric::ALL.map(|metric| metric.value(m)))
+    })
+}
+
+/// Per method other than `reference` and per metric key, the paired difference `reference -
+/// method`: its mean over the sequences where both have the metric and its 95 % interval
+/// ([`mean_interval`](crate::mean_interval), the parts of a run drawn together). An interval
+/// that leaves out 0 tells the two apart on these runs.
+pub fn paired_differences(
+    sequences: &[SequenceReport],
+    reference: &str,
+) -> BTreeMap<String, BTreeMap<String, Interval>> {
+    let mut out = per_method(sequences, |s, method| {
+        let of = |name: &str| {
+            s.methods
+                .iter()
+                .find(|m| m.method == name)
+                .map(|m| &m.metrics)
+        };
+        let (r, m) = (of(reference)?, of(method)?);
+        Some(Metric::ALL.map(|metric| Some(metric.value(r)? - metric.value(m)?)))
+    });
+    out.remove(reference);
+    out
+}
+
+/// For each method of `sequences`, the interval of each metric's mean over the values `values`
+/// gives per sequence (`None`: the sequence has no value for that method).
+fn per_method(
+    sequences: &[SequenceReport],
+    values: impl Fn(&SequenceReport, &str) -> Option<[Option<f64>; 8]>,
+) -> BTreeMap<String, BTreeMap<String, Interval>> {
+    let methods: std::collections::BTreeSet<&str> = sequences
+        .iter()
+        .flat_map(|s| s.methods.iter().map(|m| m.method.as_str()))
+        .collect();
+    let mut out = BTreeMap::new();
+    for method in methods {
+        let rows: Vec<(&str, [Option<f64>; 8])> = sequences
+            .iter()
+            .filter_map(|s| Some((run_of(&s.sequence), values(s, method)?)))
+            .collect();
+        let mut metrics = BTreeMap::new();
+        for (k, metric) in Metric::ALL.iter().enumerate() {
+            let (v, runs): (Vec<f64>, Vec<&str>) = rows
+                .iter()
+                .filter_map(|(run, row)| Some((row[k]?, *run)))
+                .unzip();
+            if let Some(i) = crate::mean_interval(&v, &runs) {
+                metrics.insert(metric.key().to_owned(), i);
+            }
+        }
+        out.insert(method.to_owned(), metrics);
+    }
+    out
 }
 
 fn mean(values: impl Iterator<Item = f64>) -> Option<f64> {
@@ -346,6 +425,37 @@ mod tests {
                 serde_json::to_value(m).unwrap(),
                 serde_json::Value::String(m.key().into())
             );
+        }
+    }
+
+    #[test]
+    fn intervals_hold_the_means_and_differences_pair_the_sequences() {
+        let i = summary_intervals(&sample());
+        // ridi: MPE 1 and 3 over two runs; the mean between the bounds, which are values.
+        let mpe = i["ridi"]["mpe_m"];
+        assert_eq!(mpe.mean, 2.0);
+        assert!(
+            mpe.low >= 1.0 && mpe.high <= 3.0 && mpe.contains(2.0),
+            "{mpe:?}"
+        );
+        // Defined on one sequence only: its value, without spread.
+        let pct = i["ridi"]["mpe_pct"];
+        assert_eq!((pct.mean, pct.low, pct.high), (2.0, 2.0, 2.0));
+        assert!(i["pdr"].contains_key("rte_5s_m"));
+        // pdr ran on the first sequence alone: the difference is over that one.
+        let d = paired_differences(&sample(), "ridi");
+        assert!(!d.contains_key("ridi"));
+        let rte = d["pdr"]["rte_5s_m"];
+        assert_eq!((rte.mean, rte.low, rte.high), (-9.0, -9.0, -9.0));
+        assert!(paired_differences(&sample(), "nothing")["ridi"].is_empty());
+    }
+
+    #[test]
+    fn parts_of_a_split_recording_are_one_run() {
+        assert_eq!(run_of("walk_part2"), "walk");
+        assert_eq!(run_of("walk_part12"), "walk");
+        for whole in ["walk", "walk_part", "walk_partial", "walk_part2b", "part3"] {
+            assert_eq!(run_of(whole), whole);
         }
     }
 

@@ -105,6 +105,16 @@ pub struct Report {
     pub sequences: Vec<SequenceResult>,
     /// Mean of each metric over sequences, per method key.
     pub summary: BTreeMap<String, TrajectoryMetrics>,
+    /// The 95 % interval of each mean of `summary`, per method and metric key: a bootstrap
+    /// over the sequences, the parts of a run drawn together
+    /// ([`ridi_eval::summary_intervals`]). Empty in reports written before it existed.
+    #[serde(default)]
+    pub intervals: BTreeMap<String, BTreeMap<String, ridi_eval::Interval>>,
+    /// `ridi`'s paired difference from each other method, `ridi - method`, per metric key: its
+    /// mean over the sequences and 95 % interval ([`ridi_eval::paired_differences`]); an
+    /// interval that leaves out 0 tells the two apart on these runs. Empty without `ridi`.
+    #[serde(default)]
+    pub ridi_minus: BTreeMap<String, BTreeMap<String, ridi_eval::Interval>>,
     /// Velocity MSE over all regressions of all sequences, (m/s)^2 (`NaN` without
     /// regressions, `null` in JSON).
     #[serde(deserialize_with = "nan_if_null")]
@@ -125,6 +135,31 @@ pub struct Report {
     /// Things to know before reading the numbers, one sentence each ([`placement_warnings`]);
     /// also in `report.md`.
     pub warnings: Vec<String>,
+}
+
+/// A mean as report tables print it ([`Metric::format`]) with its interval when known, `1.033
+/// [0.90, 1.19]`; a difference (`signed`) with its sign, bold when the interval leaves out 0.
+fn with_interval(
+    metric: Metric,
+    mean: Option<f64>,
+    interval: Option<&ridi_eval::Interval>,
+    signed: bool,
+) -> String {
+    let Some(i) = interval.filter(|_| mean.is_some()) else {
+        return metric.format(mean);
+    };
+    let value = metric.format(mean);
+    let value = if signed && !value.starts_with('-') {
+        format!("+{value}")
+    } else {
+        value
+    };
+    let text = format!("{value} [{:.2}, {:.2}]", i.low, i.high);
+    if signed && (i.low > 0.0 || i.high < 0.0) {
+        format!("**{text}**")
+    } else {
+        text
+    }
 }
 
 /// Reads a pair of floats that JSON holds as `null` where they are `NaN` (serde_json writes
@@ -314,6 +349,8 @@ pub fn evaluate(
         .into_iter()
         .map(|s| (s.method, s.mean))
         .collect();
+    let intervals = ridi_eval::summary_intervals(&reports);
+    let ridi_minus = ridi_eval::paired_differences(&reports, Method::Ridi.key());
     let squared: Vec<[f64; 2]> = done
         .iter()
         .flat_map(|e| e.squared_errors.iter().copied())
@@ -362,6 +399,8 @@ pub fn evaluate(
         Report {
             sequences: results,
             summary,
+            intervals,
+            ridi_minus,
             velocity_mse,
             placement_accuracy,
             placement_confusion,
@@ -518,7 +557,14 @@ impl Report {
         for w in &self.warnings {
             let _ = writeln!(out, "**Warning**: {w}.\n");
         }
-        let _ = writeln!(out, "## Overall (mean over sequences)\n");
+        let _ = writeln!(
+            out,
+            "## Overall (mean over sequences [95 % interval])\n\nIntervals: a bootstrap over \
+             the sequences ({} resamples, the parts of a run drawn together); they say how \
+             well these runs pin a mean down, not how far it carries to other people or \
+             phones.\n",
+            ridi_eval::DRAWS
+        );
         let mut head = "| method |".to_string();
         let mut rule = "| --- |".to_string();
         for m in Metric::ALL {
@@ -530,7 +576,32 @@ impl Report {
             if let Some(mean) = self.summary.get(key) {
                 let _ = write!(out, "| {key} |");
                 for m in Metric::ALL {
-                    let _ = write!(out, " {} |", m.format(m.value(mean)));
+                    let interval = self.intervals.get(key).and_then(|i| i.get(m.key()));
+                    let _ = write!(
+                        out,
+                        " {} |",
+                        with_interval(m, m.value(mean), interval, false)
+                    );
+                }
+                let _ = writeln!(out);
+            }
+        }
+        let others: Vec<&String> = self
+            .methods
+            .iter()
+            .filter(|k| self.ridi_minus.contains_key(*k))
+            .collect();
+        if !others.is_empty() {
+            let _ = writeln!(
+                out,
+                "\n## ridi minus each method (paired over sequences [95 % interval]; bold: the \
+                 interval leaves out 0)\n\n{head}\n{rule}"
+            );
+            for key in others {
+                let _ = write!(out, "| {key} |");
+                for m in Metric::ALL {
+                    let d = self.ridi_minus[key].get(m.key());
+                    let _ = write!(out, " {} |", with_interval(m, d.map(|d| d.mean), d, true));
                 }
                 let _ = writeln!(out);
             }
@@ -733,6 +804,8 @@ mod tests {
         Report {
             sequences,
             summary: BTreeMap::new(),
+            intervals: BTreeMap::new(),
+            ridi_minus: BTreeMap::new(),
             velocity_mse: [0.1, 0.1],
             placement_accuracy: Some(1.0),
             placement_confusion: None,

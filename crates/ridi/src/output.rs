@@ -700,6 +700,8 @@ mod tests {
                 })
                 .collect(),
             summary: BTreeMap::new(),
+            intervals: BTreeMap::new(),
+            ridi_minus: BTreeMap::new(),
             velocity_mse: [f64::NAN; 2],
             placement_accuracy: None,
             placement_confusion: None,

@@ -145,6 +145,14 @@ fn train_track_and_evaluate_on_the_sample_dataset() {
             assert!(metrics.get(key).is_some(), "{} lacks {key}", m.key());
         }
         assert!(json["summary"][m.key()]["rte_5s_m"].is_number());
+        // Every mean has its 95 % interval, and ridi its paired difference from the others.
+        let i = &json["intervals"][m.key()]["rte_5s_m"];
+        let (mean, low, high) = (i["mean"].as_f64(), i["low"].as_f64(), i["high"].as_f64());
+        assert_eq!(mean, json["summary"][m.key()]["rte_5s_m"].as_f64());
+        assert!(low <= mean && mean <= high, "{i}");
+        if m.key() != "ridi" {
+            assert!(json["ridi_minus"][m.key()]["rte_5s_m"]["mean"].is_number());
+        }
     }
     let md = std::fs::read_to_string(dir.path().join("report.md")).unwrap();
     assert!(md.contains("## Per placement") && md.contains("| ridi |"));
