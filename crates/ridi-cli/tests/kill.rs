@@ -348,10 +348,20 @@ fn an_interrupted_run_removes_its_temporaries() {
             "Jakob_Nexus5_NoDist_Texting",
         ],
     );
-    for (signal, code) in [("-INT", 130), ("-TERM", 143)] {
-        let out = dir.path().join(format!("out{signal}"));
-        std::fs::create_dir_all(&out).unwrap();
-        std::fs::write(out.join("mine.txt"), "the user's").unwrap();
+    // The last: an --out folder the run creates (and its parent), which it removes too.
+    for (signal, code, existing) in [
+        ("-INT", 130, true),
+        ("-TERM", 143, true),
+        ("-INT", 130, false),
+    ] {
+        let out = match existing {
+            true => dir.path().join(format!("out{signal}")),
+            false => dir.path().join("new/out"),
+        };
+        if existing {
+            std::fs::create_dir_all(&out).unwrap();
+            std::fs::write(out.join("mine.txt"), "the user's").unwrap();
+        }
         let mut child = Command::new(env!("CARGO_BIN_EXE_ridi"))
             .args(["convert", s(&src), "--out", s(&out)])
             .stdout(Stdio::null())
@@ -366,7 +376,11 @@ fn an_interrupted_run_removes_its_temporaries() {
         }
         assert_eq!(done.status.code(), Some(code), "{}", stderr(&done));
         assert!(stderr(&done).contains("interrupted"), "{}", stderr(&done));
-        assert_eq!(litter(&out), Vec::<PathBuf>::new());
-        assert_eq!(file_names(&out), ["mine.txt"]);
+        if existing {
+            assert_eq!(litter(&out), Vec::<PathBuf>::new());
+            assert_eq!(file_names(&out), ["mine.txt"]);
+        } else {
+            assert!(!dir.path().join("new").exists(), "{:?}", tree(dir.path()));
+        }
     }
 }

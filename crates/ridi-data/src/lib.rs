@@ -134,8 +134,8 @@ pub use sidecar::{SIDECAR_SUFFIX, sidecar_path};
 pub use stream::{MedianTest, Row, RowReader, median_interval};
 pub use temporaries::{
     STAGING_LOCK, STAGING_PREFIX, StaleTemporary, TEMPORARY_FILE_PREFIX, TemporariesHold,
-    Temporary, hold_temporaries, register_temporary, remove_temporaries_for_exit, remove_temporary,
-    stale_temporaries, temporary_prefix,
+    Temporary, hold_temporaries, register_created_folder, register_temporary,
+    remove_temporaries_for_exit, remove_temporary, stale_temporaries, temporary_prefix,
 };
 pub use text::read_text;
 pub use validation::{

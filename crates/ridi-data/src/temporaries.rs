@@ -30,7 +30,9 @@ pub const STAGING_LOCK: &str = "lock";
 /// The temporaries of this process, and whether it is on its way out.
 struct Registry {
     next: u64,
-    entries: Vec<(u64, PathBuf)>,
+    /// Each path, and whether it is a folder made for an output, removed only when empty
+    /// ([`register_created_folder`]), rather than a temporary, removed with all it holds.
+    entries: Vec<(u64, PathBuf, bool)>,
     exiting: bool,
 }
 
@@ -52,7 +54,7 @@ pub struct Temporary(u64);
 
 impl Drop for Temporary {
     fn drop(&mut self) {
-        registry().entries.retain(|(id, _)| *id != self.0);
+        registry().entries.retain(|(id, _, _)| *id != self.0);
     }
 }
 
@@ -81,8 +83,20 @@ pub fn register_temporary<T>(
     let (made, path) = create()?;
     let id = reg.next;
     reg.next += 1;
-    reg.entries.push((id, path));
+    reg.entries.push((id, path, false));
     Ok((made, Temporary(id)))
+}
+
+/// Registers `folder`, made for an output (an `--out` folder that did not exist), so that
+/// [`remove_temporaries_for_exit`] removes it if it is still empty once the temporaries inside
+/// are gone: an interrupted run leaves no empty folder behind. Its owner removes it, if empty,
+/// when the output fails otherwise.
+pub fn register_created_folder(folder: PathBuf) -> Temporary {
+    let mut reg = registry();
+    let id = reg.next;
+    reg.next += 1;
+    reg.entries.push((id, folder, true));
+    Temporary(id)
 }
 
 /// Holds off [`remove_temporaries_for_exit`] while alive: for a commit that must not be cut in half
@@ -110,8 +124,16 @@ pub fn hold_temporaries() -> TemporariesHold {
 pub fn remove_temporaries_for_exit() {
     let mut reg = registry();
     reg.exiting = true;
-    for (_, path) in std::mem::take(&mut reg.entries) {
+    let (mut folders, temporaries): (Vec<_>, Vec<_>) = std::mem::take(&mut reg.entries)
+        .into_iter()
+        .partition(|(_, _, created)| *created);
+    for (_, path, _) in temporaries {
         remove_temporary(&path);
+    }
+    // The deepest first; only when empty: never what someone else put there meanwhile.
+    folders.sort_by_key(|(_, path, _)| std::cmp::Reverse(path.components().count()));
+    for (_, path, _) in folders {
+        let _ = std::fs::remove_dir(&path);
     }
     // Held until the process ends.
     std::mem::forget(reg);
@@ -255,7 +277,11 @@ mod tests {
         drop(forgotten);
         // Not called for real: it would stop every other test's writes. What it does to
         // each entry:
-        let entries: Vec<PathBuf> = registry().entries.iter().map(|(_, p)| p.clone()).collect();
+        let entries: Vec<PathBuf> = registry()
+            .entries
+            .iter()
+            .map(|(_, p, _)| p.clone())
+            .collect();
         assert!(entries.contains(&a) && !entries.contains(&b));
         remove_temporary(&a);
         assert!(!a.exists() && b.exists());

@@ -326,7 +326,8 @@ struct ListLabels {
 }
 
 /// Placement labels that list files directly in a `source` folder (`list*.txt`) give its
-/// sequences: the RIDI layout keeps them there, not in the data. A file that does not parse
+/// sequences: the RIDI layout keeps them there, not in the data ([`convert`] also reads the
+/// parent folder's for a sequence given alone). A file that does not parse
 /// as a list is skipped; an entry may name the sequence folder or its `processed/` file; a
 /// sequence two lists label differently keeps the first label (lists by name), with a warning.
 fn labels_from_lists(source: &Path) -> ListLabels {
@@ -574,7 +575,20 @@ pub fn convert(
         paths: dirs,
         skipped,
     } = sources(source, from)?;
-    let listed = labels_from_lists(source);
+    let mut listed = labels_from_lists(source);
+    // One sequence given alone: the RIDI layout keeps its lists beside it, in its folder's
+    // parent (`datasets/sample/list_test.txt` labels `datasets/sample/<run>`).
+    if let [only] = &dirs[..]
+        && let Ok(folder) = only.canonicalize()
+        && !listed.labels.contains_key(&folder)
+        && let Some(parent) = folder.parent()
+    {
+        let beside = labels_from_lists(parent);
+        if let Some(label) = beside.labels.get(&folder) {
+            listed.labels.insert(folder.clone(), label.clone());
+            listed.lists.extend(beside.lists);
+        }
+    }
     let labels = &listed.labels;
     let mut staging = Staging::new(out)?;
     let results: Vec<Result<Written, DataError>> = dirs

@@ -50,20 +50,27 @@ pub struct Staging {
     removals: Vec<PathBuf>,
 }
 
-/// Folders created for the output, removed when dropped if they are empty.
+/// Folders created for the output, removed when dropped if they are empty; those made before
+/// the commit are registered so that an interrupted run's cleanup does the same
+/// ([`ridi_data::register_created_folder`]; the cleanup waits for a commit under way).
 #[derive(Debug, Default)]
-struct CreatedDirs(Vec<PathBuf>);
+struct CreatedDirs(Vec<(PathBuf, Option<Temporary>)>);
 
 impl CreatedDirs {
-    /// Creates `dir` and its missing ancestors, remembering those it created.
-    fn create(&mut self, dir: &Path) -> Result<(), DataError> {
+    /// Creates `dir` and its missing ancestors, remembering those it created, registered when
+    /// `register` (not during a commit, which holds the registry:
+    /// [`ridi_data::hold_temporaries`]).
+    fn create(&mut self, dir: &Path, register: bool) -> Result<(), DataError> {
         let missing: Vec<PathBuf> = dir
             .ancestors()
             .take_while(|d| !d.as_os_str().is_empty() && !d.exists())
             .map(Path::to_path_buf)
             .collect();
         std::fs::create_dir_all(dir).map_err(|e| DataError::io(dir, e))?;
-        self.0.extend(missing);
+        self.0.extend(missing.into_iter().map(|d| {
+            let registered = register.then(|| ridi_data::register_created_folder(d.clone()));
+            (d, registered)
+        }));
         Ok(())
     }
 }
@@ -71,8 +78,8 @@ impl CreatedDirs {
 impl Drop for CreatedDirs {
     fn drop(&mut self) {
         self.0
-            .sort_by_key(|d| std::cmp::Reverse(d.components().count()));
-        for dir in &self.0 {
+            .sort_by_key(|(d, _)| std::cmp::Reverse(d.components().count()));
+        for (dir, _) in &self.0 {
             // Only when empty: never what someone else put there meanwhile.
             let _ = std::fs::remove_dir(dir);
         }
@@ -106,7 +113,7 @@ impl Staging {
     /// if an interrupted commit cannot be finished.
     pub fn new(out: &Path) -> Result<Self, DataError> {
         let mut created = CreatedDirs::default();
-        created.create(out)?;
+        created.create(out, true)?;
         recover(out)?;
         let prefix = temporary_prefix(STAGING_PREFIX);
         let ((root, lock), registered) = register_temporary(|| {
@@ -219,7 +226,7 @@ impl Staging {
                 files
                     .iter()
                     .filter_map(|rel| self.out.join(rel).parent().map(Path::to_path_buf))
-                    .try_for_each(|dir| self.created.create(&dir))
+                    .try_for_each(|dir| self.created.create(&dir, false))
             })
             .and_then(|()| move_into_place(&self.root, &self.out, &mut moved));
         if kill_point::killed() {
@@ -228,9 +235,11 @@ impl Staging {
             std::mem::forget(self);
             return result;
         }
+        // Forgotten (their registrations dropped) once the hold is released.
+        let mut kept = Vec::new();
         if result.is_ok() {
             remove_temporary(&self.root);
-            self.created.0.clear();
+            kept = std::mem::take(&mut self.created.0);
         } else {
             for m in moved.iter().rev() {
                 let dest = self.out.join(&m.rel);
@@ -245,6 +254,7 @@ impl Staging {
             let _ = std::fs::remove_file(&point);
         }
         drop(hold);
+        drop(kept);
         result
     }
 }

@@ -863,3 +863,17 @@ fn a_recording_paused_for_seconds_converts_split_at_its_gaps() {
     assert_eq!((a.len(), b.len()), (2000, paused.len() - 2000));
     assert!((b.time()[0] - paused.time()[2000]).abs() < 1e-9);
 }
+
+/// A sequence converted alone takes its placement from the lists beside it, in its parent
+/// folder, as a whole folder's sequences take theirs from the lists in it.
+#[test]
+fn a_sequence_converted_alone_keeps_the_label_the_lists_beside_it_give() {
+    let dir = tempfile::tempdir().unwrap();
+    let src = sources_named(dir.path(), &["walk"]);
+    std::fs::write(src.join("list_train.txt"), "walk,Texting\n").unwrap();
+    let out = dir.path().join("out");
+    let summary = convert(&src.join("walk"), &out, &ConvertOptions::default()).unwrap();
+    assert_eq!(summary.sequences[0].placement.as_deref(), Some("Texting"));
+    let list = std::fs::read_to_string(out.join("list_all.txt")).unwrap();
+    assert!(list.ends_with("\nwalk,Texting\n"), "{list}");
+}
