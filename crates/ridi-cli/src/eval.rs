@@ -149,11 +149,13 @@ fn print_summary(report: &Report) {
     for w in &report.warnings {
         eprintln!("warning: {}", shown(w));
     }
+    let mse = match report.velocity_mse {
+        [x, z] if x.is_finite() && z.is_finite() => format!("S-x {x:.3} S-z {z:.3} (m/s)^2"),
+        _ => "- (no regressions)".to_owned(),
+    };
     outln!(
-        "\n{}; velocity MSE S-x {:.3} S-z {:.3} (m/s)^2; placement accuracy {}",
+        "\n{}; velocity MSE {mse}; placement accuracy {}",
         counted(report.sequences.len(), "sequence"),
-        report.velocity_mse[0],
-        report.velocity_mse[1],
         report
             .placement_accuracy
             .map_or("-".into(), |a| format!("{a:.3}"))

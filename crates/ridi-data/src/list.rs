@@ -63,18 +63,51 @@ impl ListEntry {
     /// the list file and line); [`Listed::load`] reads the sequences.
     pub fn read(lists: &[impl AsRef<Path>]) -> Result<Vec<ListEntry>> {
         let mut entries = Vec::new();
+        let mut read: Vec<(FileId, &Path)> = Vec::new();
         for list in lists {
             let path = list.as_ref();
             if path.is_dir() {
                 return Err(folder_for_list(path));
             }
-            entries.extend(parse_list(
-                &text::read_file_bounded(path, MAX_LIST_BYTES)?,
-                path,
-            )?);
+            // The same list twice would list each of its recordings twice.
+            if let Ok(id) = FileId::of(path) {
+                if let Some((_, first)) = read.iter().find(|(i, _)| *i == id) {
+                    let also = match *first == path {
+                        true => String::new(),
+                        false => format!(" (as {})", shown(first)),
+                    };
+                    return Err(DataError::format(
+                        Location::file(path),
+                        format!("list file given twice{also}"),
+                    ));
+                }
+                read.push((id, path));
+            }
+            let bytes = text::read_file_bounded(path, MAX_LIST_BYTES)?;
+            entries.extend(parse_list(&bytes, path).map_err(|e| match recording(path) {
+                Some(format) => DataError::format(
+                    Location::file(path),
+                    format!(
+                        "is a recording ({format}), not a list file (one `path,placement` \
+                         line per sequence)"
+                    ),
+                ),
+                None => e,
+            })?);
         }
         Ok(entries)
     }
+}
+
+/// The format of a list file that does not parse, when it is a recording: a `.csv` (`.csv.gz`)
+/// or a competition path file (a `.txt` of a list cannot be told from a `data_plain.txt` by its
+/// name).
+fn recording(path: &Path) -> Option<crate::Format> {
+    let name = path.file_name()?.to_string_lossy().to_lowercase();
+    if name.ends_with(".csv") || name.ends_with(".csv.gz") {
+        return Some(crate::Format::RidiCsv);
+    }
+    crate::ilc::is_path_file(path).then_some(crate::Format::Ilc)
 }
 
 /// The error for a folder given as a list file, naming the lists in it (`ridi convert` writes
@@ -335,6 +368,30 @@ mod tests {
         let e = ListEntry::read(&[dir.path()]).unwrap_err().to_string();
         assert!(
             e.ends_with("; it holds list_Jakob.txt, list_all.txt"),
+            "{e}"
+        );
+    }
+
+    #[test]
+    fn a_list_given_twice_or_a_recording_given_as_a_list_is_named() {
+        let dir = tempfile::tempdir().unwrap();
+        let list = dir.path().join("list.txt");
+        std::fs::write(&list, "walk,Texting\n").unwrap();
+        let e = ListEntry::read(&[&list, &list]).unwrap_err().to_string();
+        assert!(e.ends_with("list.txt: list file given twice"), "{e}");
+        std::fs::create_dir(dir.path().join("sub")).unwrap();
+        let other = dir.path().join("sub/../list.txt");
+        let e = ListEntry::read(&[&list, &other]).unwrap_err().to_string();
+        assert!(e.contains("list file given twice (as "), "{e}");
+        let csv = dir.path().join("data.csv");
+        let recording = "time,gyro_x,gyro_y,gyro_z,acce_x,acce_y,acce_z\n1,2,3,4,5,6,7\n";
+        std::fs::write(&csv, recording).unwrap();
+        let e = ListEntry::read(&[&csv]).unwrap_err().to_string();
+        assert!(
+            e.ends_with(
+                "data.csv: is a recording (RIDI processed csv), not a list file (one \
+                 `path,placement` line per sequence)"
+            ),
             "{e}"
         );
     }

@@ -547,11 +547,14 @@ impl Report {
                 None => "the gyro's alone".to_string(),
             }
         );
+        let mse = match self.velocity_mse {
+            [x, z] if x.is_finite() && z.is_finite() => format!("S-x {x:.4}, S-z {z:.4} (m/s)^2"),
+            // Methods without a model regress nothing.
+            _ => "- (no regressions)".to_owned(),
+        };
         let _ = writeln!(
             out,
-            "Velocity MSE (all regressions): S-x {:.4}, S-z {:.4} (m/s)^2; placement accuracy {}.\n",
-            self.velocity_mse[0],
-            self.velocity_mse[1],
+            "Velocity MSE (all regressions): {mse}; placement accuracy {}.\n",
             fmt_opt(self.placement_accuracy)
         );
         for w in &self.warnings {
