@@ -302,5 +302,17 @@ pub fn train(
         groups: &data.groups,
         feature_config: &config,
     };
-    Ok(Cascade::train(&set, &opts.cascade, progress)?)
+    Cascade::train(&set, &opts.cascade, progress).map_err(|e| match e {
+        // One window every `step` frames: a coarse step leaves a placement few samples.
+        ridi_regress::RegressError::NotEnoughData(why) => {
+            ridi_regress::RegressError::NotEnoughData(format!(
+                "{why} (training takes a window every {} frames of {}: a smaller sample \
+                 step, `--step`, or more recordings of that placement give more)",
+                config.step,
+                ridi_data::counted(seqs.len(), "sequence")
+            ))
+            .into()
+        }
+        e => e.into(),
+    })
 }
