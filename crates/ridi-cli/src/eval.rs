@@ -146,6 +146,7 @@ pub(crate) fn print_written(report: &Report, written: &EvalWritten, folder: &Eva
 }
 
 fn print_summary(report: &Report) {
+    const RTE_5S: &str = ridi::eval::Metric::Rte5sM.key();
     for w in &report.warnings {
         eprintln!("warning: {}", shown(w));
     }
@@ -173,7 +174,7 @@ fn print_summary(report: &Report) {
     let opt = |v: Option<f64>| v.map_or("-".to_string(), |v| format!("{v:.3}"));
     for key in &report.methods {
         if let Some(m) = report.summary.get(key) {
-            let interval = report.intervals.get(key).and_then(|i| i.get("rte_5s_m"));
+            let interval = report.intervals.get(key).and_then(|i| i.get(RTE_5S));
             let rte_5s = match interval {
                 Some(i) => format!("{:.3} [{:.3}, {:.3}]", m.rte_5s_m, i.low, i.high),
                 None => format!("{:.3}", m.rte_5s_m),
@@ -187,7 +188,11 @@ fn print_summary(report: &Report) {
             );
         }
     }
-    if let Some(d) = report.ridi_minus.get("pdr").and_then(|d| d.get("rte_5s_m")) {
+    if let Some(d) = report
+        .ridi_minus
+        .get(ridi::Method::Pdr.key())
+        .and_then(|d| d.get(RTE_5S))
+    {
         outln!(
             "ridi - pdr, RTE {}s: {:+.3} m [{:+.3}, {:+.3}] (paired over sequences; every \
              interval and difference in report.md)",

@@ -33,8 +33,15 @@ pub(crate) fn run(Args { sequence, json }: Args) -> Result<()> {
     }
     // A recording that streams is summed up as it is read, in memory that does not grow with
     // its length.
-    if ridi::data::detect(&sequence).is_ok_and(|f| f.streams()) {
-        let rows = ridi::data::RowReader::open(&sequence, &inspect_options(&sequence))?;
+    // A recording paused for longer than the readers' limit is described (its longest gap
+    // among the warnings) where its format keeps the pause as a gap.
+    let format = ridi::source_format(&sequence, None);
+    let opts = match &format {
+        Ok(format) => ReadOptions::default().reading_pauses(*format),
+        Err(_) => ReadOptions::default(),
+    };
+    if format.as_ref().is_ok_and(|f| f.streams()) {
+        let rows = ridi::data::RowReader::open(&sequence, &opts)?;
         let report = ridi::inspect_stream(rows)?;
         if json {
             outln!("{}", escaped(serde_json::to_string_pretty(&report)?));
@@ -43,7 +50,7 @@ pub(crate) fn run(Args { sequence, json }: Args) -> Result<()> {
         }
         return Ok(());
     }
-    let loaded = ridi::read_any(&sequence, None, &inspect_options(&sequence))?;
+    let loaded = ridi::read_any(&sequence, None, &opts)?;
     let mut reports = Vec::new();
     for seq in &loaded.sequences {
         let mut report = ridi::inspect(seq, loaded.format);
@@ -123,17 +130,6 @@ fn escaped(json: String) -> String {
         }
     }
     out
-}
-
-/// How `ridi inspect` reads `sequence`: a recording paused for longer than the readers' limit
-/// is described (its longest gap among the warnings) where the format keeps the pause as a gap
-/// ([`ridi::data::Format::keeps_gaps`]); a RIDI raw or RoNIN folder keeps the limit.
-fn inspect_options(sequence: &Path) -> ReadOptions {
-    let mut opts = ReadOptions::default();
-    if ridi::source_format(sequence, None).is_ok_and(|f| f.keeps_gaps()) {
-        opts.validation.max_gap_s = f64::INFINITY;
-    }
-    opts
 }
 
 #[cfg(test)]

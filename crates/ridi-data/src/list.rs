@@ -103,11 +103,9 @@ impl ListEntry {
 /// or a competition path file (a `.txt` of a list cannot be told from a `data_plain.txt` by its
 /// name).
 fn recording(path: &Path) -> Option<crate::Format> {
-    let name = path.file_name()?.to_string_lossy().to_lowercase();
-    if name.ends_with(".csv") || name.ends_with(".csv.gz") {
-        return Some(crate::Format::RidiCsv);
-    }
-    crate::ilc::is_path_file(path).then_some(crate::Format::Ilc)
+    crate::detect(path)
+        .ok()
+        .filter(|f| matches!(f, crate::Format::RidiCsv | crate::Format::Ilc))
 }
 
 /// The error for a folder given as a list file, naming the lists in it (`ridi convert` writes

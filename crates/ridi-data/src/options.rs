@@ -1,6 +1,6 @@
 //! Options shared by every reader.
 
-use crate::Validation;
+use crate::{Format, Validation};
 
 /// How readers build and check sequences. [`ReadOptions::default`] follows the original RIDI
 /// processing.
@@ -24,5 +24,19 @@ impl Default for ReadOptions {
             pose_trim: 800,
             rate_without_pose_hz: 200.0,
         }
+    }
+}
+
+impl ReadOptions {
+    /// These options with an unbounded `max_gap_s` where `format` keeps a pause as a gap of the
+    /// timeline ([`Format::keeps_gaps`]), unchanged for other formats: how a recording paused
+    /// for longer than the limit is read to be described or cut there (`ridi inspect`, `ridi
+    /// convert --split-at-gaps`).
+    pub fn reading_pauses(&self, format: Format) -> ReadOptions {
+        let mut opts = self.clone();
+        if format.keeps_gaps() {
+            opts.validation.max_gap_s = f64::INFINITY;
+        }
+        opts
     }
 }

@@ -48,7 +48,7 @@ impl Metric {
     ];
 
     /// The JSON key of this metric in [`TrajectoryMetrics`].
-    pub fn key(self) -> &'static str {
+    pub const fn key(self) -> &'static str {
         match self {
             Self::MpeM => "mpe_m",
             Self::MpePct => "mpe_pct",

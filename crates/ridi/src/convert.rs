@@ -171,13 +171,7 @@ pub fn read_split(
         ));
     }
     let format = source_format(path, from)?;
-    let mut loaded = if format.keeps_gaps() {
-        let mut pausing = opts.clone();
-        pausing.validation.max_gap_s = f64::INFINITY;
-        read_any(path, Some(format), &pausing)?
-    } else {
-        read_any(path, Some(format), opts)?
-    };
+    let mut loaded = read_any(path, Some(format), &opts.reading_pauses(format))?;
     let sequences = std::mem::take(&mut loaded.sequences);
     loaded.sequences = split(sequences, max_gap_s, &mut loaded.warnings)
         .map_err(|e| DataError::sequence(path, e))?;
