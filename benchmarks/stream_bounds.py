@@ -2,9 +2,12 @@
 """The real-data figures behind two validation bounds (docs/benchmarks.md, "Bounds of the
 live stream check"): over every second (200 frames, every 20th window) of every recording, the
 median |acce| in g, the median |gyro| and the median rate, which `ridi::STREAM_ACCE_G`, the
-median gyro bound and the rate tolerance of `LiveTracker` must hold; and per recording the
-median angle between gravity and the orientation's up axis, which
-`Validation::max_orientation_gravity_deg` (45 degrees) must hold.
+median gyro bound and the rate tolerance of `LiveTracker` must hold; the median angle between
+gravity and the orientation's up axis (per recording and per second), which
+`Validation::max_orientation_gravity_deg` (45 degrees) must hold; and per second the median
+|gravity| and the linear acceleration's scale against accelerometer minus gravity (where its
+RMS is at least 0.5 m/s^2), which `Validation::gravity_range` (8.5..11 m/s^2) and
+`linacce_scale_range` (0.5..2) must hold for a stream's last second as for a recording.
 
 Usage: benchmarks/stream_bounds.py [SHARED]  (SHARED defaults to ../shared; needs the `ridi`
 Python package: `pip install ./crates/ridi-py`). Reads the shared Tyrex runs (both phones),
@@ -44,6 +47,7 @@ sources = (sorted(glob.glob(os.path.join(RAW, "tyrex-attitude-smartphones", "dat
                               recursive=True))
            + sorted(glob.glob(os.path.join(ROOT, "datasets", "sample", "*_*"))))
 acce, gyro, rate, angle, n = [], [], [], [], 0
+up_second, gravity, scale = [], [], []
 warnings.simplefilter("ignore")
 for path in sources:
     try:
@@ -57,11 +61,25 @@ for path in sources:
         acce.append(seconds(np.linalg.norm(s.acce, axis=1)) / G)
         gyro.append(seconds(np.linalg.norm(s.gyro, axis=1)))
         rate.append(1.0 / seconds(np.diff(s.time)))
-        angle.append(np.median(up_angles(s)))
-acce, gyro, rate = (np.concatenate(v) for v in (acce, gyro, rate))
+        up = up_angles(s)
+        angle.append(np.median(up))
+        up_second.append(seconds(up))
+        gravity.append(seconds(np.linalg.norm(s.gravity, axis=1)))
+        d = s.acce - s.gravity
+        for i in range(0, len(s) - WINDOW + 1, STEP):
+            dw, lw = d[i:i + WINDOW], s.linacce[i:i + WINDOW]
+            if np.sqrt(np.mean(np.sum(dw * dw, axis=1))) >= 0.5:
+                scale.append(np.sum(dw * lw) / np.sum(lw * lw))
+acce, gyro, rate, up_second, gravity = (
+    np.concatenate(v) for v in (acce, gyro, rate, up_second, gravity))
 print(f"{n} sequences, {len(acce)} one-second windows")
 print(f"median |acce| per second: {acce.min():.2f}..{acce.max():.2f} g")
 print(f"median |gyro| per second: at most {gyro.max():.2f} rad/s")
 print(f"median rate per second: {rate.min():.2f}..{rate.max():.2f} Hz")
 print(f"median angle of gravity from the orientation's up axis per sequence: "
       f"at most {max(angle):.3f} degrees")
+print(f"median angle of gravity from the orientation's up axis per second: "
+      f"at most {up_second.max():.3f} degrees")
+print(f"median |gravity| per second: {gravity.min():.3f}..{gravity.max():.3f} m/s^2")
+print(f"linear acceleration's scale per second ({len(scale)} seconds with an RMS of at least "
+      f"0.5 m/s^2): {min(scale):.3f}..{max(scale):.3f}")

@@ -141,7 +141,7 @@ pub use text::read_text;
 pub use validation::{
     GYRO_SCALE_MIN_RATE, GyroFit, LINACCE_SCALE_MIN_RMS, MAX_JUMP_SHARE, MIN_GYRO_AGREEMENT,
     ORIENTATION_JUMP_RATE, OrientationJump, Validation, bridge_orientation_jumps,
-    orientation_jumps,
+    orientation_jumps, up_angle_deg,
 };
 pub use write::{
     PendingFile, Precision, RoundTrip, write_atomically, write_pending, write_ridi_csv,

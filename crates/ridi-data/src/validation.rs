@@ -22,7 +22,7 @@ fn median(v: &mut [f64]) -> f64 {
 
 /// The angle between `gravity` and the up axis of `orientation` in the device frame, degrees;
 /// `None` for a zero gravity, which has no direction.
-pub(crate) fn up_angle_deg(orientation: WorldFromDevice, gravity: DeviceVec) -> Option<f64> {
+pub fn up_angle_deg(orientation: WorldFromDevice, gravity: DeviceVec) -> Option<f64> {
     let g = gravity.norm();
     (g > 0.0).then(|| {
         let up = ridi_frames::gravity_in_device(orientation, 1.0);
@@ -43,7 +43,7 @@ pub(crate) fn up_angle_deg(orientation: WorldFromDevice, gravity: DeviceVec) -> 
 /// | --- | --- | --- |
 /// | largest gyro component | 21.7 rad/s | 100 rad/s |
 /// | median \|gyro\| per recording | 0.24..4.25 rad/s | 10 rad/s |
-/// | largest accelerometer / linear acceleration component | 39.6 / 31.1 m/s^2 | 2000 m/s^2 |
+/// | largest accelerometer / linear acceleration component | 39.6 / 31.1 m/s^2 | 2000 / 2020 m/s^2 |
 /// | largest gravity component | 9.81 m/s^2 | 20 m/s^2 |
 /// | mean \|acce\| / mean \|gravity\| | 0.99..1.87 | 0.5..3 |
 /// | largest magnetometer component | 67 uT | 10 000 uT |
@@ -67,9 +67,10 @@ pub struct Validation {
     /// Largest accepted |component| of the gyro, rad/s: 100. Phone gyroscopes saturate at
     /// about 35 rad/s (2000 deg/s); a larger value is corrupt, or degrees per second.
     pub max_gyro: f64,
-    /// Largest accepted |component| of the accelerometer and the linear acceleration, m/s^2:
-    /// 2000 (about 200 g, far above the 16-32 g range of phone accelerometers): a larger value
-    /// is corrupt, or in mm/s^2.
+    /// Largest accepted |component| of the accelerometer, m/s^2: 2000 (about 200 g, far above
+    /// the 16-32 g range of phone accelerometers): a larger value is corrupt, or in mm/s^2.
+    /// The linear acceleration's is this plus [`Self::max_gravity`], so that an accelerometer
+    /// within its limit never gives a linear acceleration (`acce - gravity`) beyond its own.
     pub max_acce: f64,
     /// Largest accepted |component| of gravity, m/s^2: 20, twice its magnitude.
     pub max_gravity: f64,
@@ -160,7 +161,8 @@ impl Validation {
         match channel {
             Channel::Time => f64::INFINITY,
             Channel::Gyro => self.max_gyro,
-            Channel::Acce | Channel::Linacce => self.max_acce,
+            Channel::Acce => self.max_acce,
+            Channel::Linacce => self.max_acce + self.max_gravity,
             Channel::Gravity => self.max_gravity,
             Channel::Magnet => self.max_magnet,
             Channel::Position => self.max_position,
@@ -401,8 +403,9 @@ impl Validation {
     }
 
     /// [`Self::check_linacce_scale`] of its sums over `n` frames: of (acce - gravity) times
-    /// linacce (`dl`), linacce squared (`ll`) and (acce - gravity) squared (`dd`).
-    pub(crate) fn linacce_scale_verdict(
+    /// linacce (`dl`), linacce squared (`ll`) and (acce - gravity) squared (`dd`). A stream's
+    /// check keeps those sums over its last frames (`ridi::LiveTracker`).
+    pub fn linacce_scale_verdict(
         &self,
         dl: f64,
         ll: f64,

@@ -188,9 +188,13 @@ impl SensorReading {
 /// tracking as it was. So does one refused because the stream's last second (its last
 /// [`STREAM_CHECK_SAMPLES`]) has a median rate off [`TRACK_RATE_HZ`](crate::TRACK_RATE_HZ) by
 /// more than [`TRACK_RATE_TOLERANCE`](crate::TRACK_RATE_TOLERANCE) (a 50 Hz stream, or time
-/// in milliseconds), a median |gyro| of a gyro in deg/s, or a median |acce| of an
-/// accelerometer in g ([`STREAM_ACCE_G`]): such a stream is refused before its first velocity
-/// is regressed. The samples with a new time count towards that second whether they are
+/// in milliseconds), a median |gyro| of a gyro in deg/s, a median |acce| of an
+/// accelerometer in g ([`STREAM_ACCE_G`]), or a recorded gravity and linear acceleration that
+/// disagree with the samples' orientation and accelerometer as a recording's checks judge them
+/// ([`Validation`]: gravity a median of over 45 degrees off the orientation's up axis, negated
+/// say; a median |gravity| outside 8.5..11 m/s², in g say; a linear acceleration whose scale
+/// against accelerometer minus gravity is outside 0.5..2, the accelerometer itself say): such
+/// a stream is refused before its first velocity is regressed. The samples with a new time count towards that second whether they are
 /// tracked or refused, so that samples are taken again once most of the last
 /// [`STREAM_CHECK_SAMPLES`] are right (a sample given again is refused again). A stream whose
 /// gyro turns against the recorded orientation pushed with it (a sign flipped, most
@@ -301,7 +305,7 @@ impl<'m> LiveTracker<'m> {
     /// whose whole recording passed that check ([`ridi_data::Validation::check_gyro_scale`]),
     /// whose stretches need not each agree as much.
     pub(crate) fn judged_whole(mut self) -> Self {
-        self.stream.gyro_judged_whole = true;
+        self.stream.judged_whole = true;
         self
     }
 
@@ -505,9 +509,45 @@ pub const STREAM_MIN_GYRO_AGREEMENT: f64 = 0.0;
 /// bounds ([`Validation::acce_gravity_ratio`]): a second varies more than a recording.
 pub const STREAM_ACCE_G: (f64, f64) = (0.35, 10.0);
 
+/// One sample as [`StreamCheck`] judges it: the interval from the one before (seconds), |gyro|,
+/// |acce| and, when it came with a recorded orientation, gravity and linear acceleration, how
+/// those agree.
+#[derive(Debug, Clone, Copy)]
+struct Judged {
+    interval: f64,
+    gyro: f64,
+    acce: f64,
+    recorded: Option<JudgedRecorded>,
+}
+
+/// How a sample's recorded orientation, gravity and linear acceleration agree: gravity's angle
+/// from the orientation's up axis (degrees), |gravity|, and the linear acceleration's terms of
+/// [`Validation::linacce_scale_verdict`] (with `d = acce - gravity`: `d.l`, `l.l`, `d.d`).
+#[derive(Debug, Clone, Copy)]
+struct JudgedRecorded {
+    up_deg: f64,
+    gravity: f64,
+    linacce_terms: [f64; 3],
+}
+
+impl Judged {
+    /// Quantity `column` of [`StreamCheck::properties`]' order; `None` for a recorded
+    /// quantity of a sample without one.
+    fn value(&self, column: usize) -> Option<f64> {
+        match column {
+            0 => Some(self.interval),
+            1 => Some(self.gyro),
+            2 => Some(self.acce),
+            3 => self.recorded.map(|r| r.up_deg),
+            _ => self.recorded.map(|r| r.gravity),
+        }
+    }
+}
+
 /// The last [`STREAM_CHECK_SAMPLES`] of a stream, and whether the median of each quantity
 /// lies beyond its bounds, from counts ([`MedianTest`], as the readers judge a recording), so
-/// that a median is judged in constant time per sample.
+/// that a median is judged in constant time per sample; the linear acceleration's scale from
+/// sums kept over the same samples.
 #[derive(Debug, Default)]
 struct StreamCheck {
     last_time: Option<f64>,
@@ -517,28 +557,65 @@ struct StreamCheck {
     /// with one (its first sample's time) on.
     gyro_fit: ridi_data::GyroFit,
     gyro_since: Option<f64>,
-    /// The gyro is not judged: a recording validated whole streamed ([`crate::track`]).
-    gyro_judged_whole: bool,
-    /// Per sample: the interval from the one before (seconds), |gyro|, |acce|.
-    recent: VecDeque<[f64; 3]>,
+    /// Why the gyro was refused, once it was: it stays so.
+    gyro_refused: Option<String>,
+    /// The recorded orientation is not judged: a recording validated whole streamed
+    /// ([`crate::track`]).
+    judged_whole: bool,
+    recent: VecDeque<Judged>,
     /// Each quantity's properties: low, a rate too fast, a gyro (none), an accelerometer too
-    /// weak; high, a rate too slow, a gyro too fast, an accelerometer too strong.
-    medians: [MedianTest; 3],
+    /// weak, (none), a gravity too weak; high, a rate too slow, a gyro too fast, an
+    /// accelerometer too strong, a gravity far from the orientation's up axis, a gravity too
+    /// strong.
+    medians: [MedianTest; 5],
+    /// Sums of the recent samples' [`JudgedRecorded::linacce_terms`], and how many.
+    linacce_sums: [f64; 3],
+    linacce_count: usize,
+    /// Samples dropped from `recent` since the sums were last added up afresh (they are, once
+    /// every window, so that rounding does not build up over a long stream).
+    dropped: usize,
     /// Why the last sample judged was refused, while the stream stays refused: a sample given
     /// again (its time not after the last one) gets the same answer.
     refused: Option<String>,
 }
 
 impl StreamCheck {
-    /// The (low, high) properties of each of `sample`'s quantities (interval, |gyro|, |acce|).
-    fn properties(sample: &[f64; 3], limits: &Validation) -> [(bool, bool); 3] {
-        let [interval, gyro, acce] = *sample;
+    /// The (low, high) properties of each of `sample`'s quantities (interval, |gyro|, |acce|,
+    /// gravity's angle from up, |gravity|).
+    fn properties(sample: &Judged, limits: &Validation) -> [(bool, bool); 5] {
         let g = ridi_frames::STANDARD_GRAVITY;
+        let (up, gravity) = match sample.recorded {
+            Some(r) => (
+                (false, r.up_deg > limits.max_orientation_gravity_deg),
+                (
+                    r.gravity < limits.gravity_range.0,
+                    r.gravity > limits.gravity_range.1,
+                ),
+            ),
+            None => ((false, false), (false, false)),
+        };
         [
-            crate::track::rate_beyond(interval),
-            (false, gyro > limits.max_median_gyro),
-            (acce < STREAM_ACCE_G.0 * g, acce > STREAM_ACCE_G.1 * g),
+            crate::track::rate_beyond(sample.interval),
+            (false, sample.gyro > limits.max_median_gyro),
+            (
+                sample.acce < STREAM_ACCE_G.0 * g,
+                sample.acce > STREAM_ACCE_G.1 * g,
+            ),
+            up,
+            gravity,
         ]
+    }
+
+    /// `sample`'s recorded orientation, gravity and linear acceleration as judged.
+    fn judge_recorded(sample: &SensorReading) -> Option<JudgedRecorded> {
+        let r = sample.recorded?;
+        let d = sample.acce - r.gravity;
+        Some(JudgedRecorded {
+            // A zero gravity has no direction: never beyond the angle.
+            up_deg: ridi_data::up_angle_deg(r.orientation, r.gravity).unwrap_or(0.0),
+            gravity: r.gravity.norm(),
+            linacce_terms: [d.dot(r.linacce), r.linacce.dot(r.linacce), d.dot(d)],
+        })
     }
 
     /// Counts `sample` and judges the last second. A sample whose time is not after the last
@@ -553,7 +630,7 @@ impl StreamCheck {
             };
         }
         self.last_time = Some(sample.time);
-        if !self.gyro_judged_whole {
+        if !self.judged_whole {
             let recorded = sample
                 .recorded
                 .map(|r| (sample.time, sample.gyro, r.orientation));
@@ -566,33 +643,84 @@ impl StreamCheck {
         let Some(previous) = previous else {
             return Ok(());
         };
-        let entry = [
-            sample.time - previous,
-            sample.gyro.norm(),
-            sample.acce.norm(),
-        ];
-        for (m, (low, high)) in self
-            .medians
-            .iter_mut()
-            .zip(Self::properties(&entry, limits))
-        {
-            m.push(low, high);
-        }
+        let entry = Judged {
+            interval: sample.time - previous,
+            gyro: sample.gyro.norm(),
+            acce: sample.acce.norm(),
+            recorded: if self.judged_whole {
+                None
+            } else {
+                Self::judge_recorded(sample)
+            },
+        };
+        self.count(&entry, limits, true);
         self.recent.push_back(entry);
         if self.recent.len() > STREAM_CHECK_SAMPLES
             && let Some(old) = self.recent.pop_front()
         {
-            for (m, (low, high)) in self.medians.iter_mut().zip(Self::properties(&old, limits)) {
-                m.pop(low, high);
+            self.count(&old, limits, false);
+            self.dropped += 1;
+            if self.dropped >= STREAM_CHECK_SAMPLES {
+                self.dropped = 0;
+                self.linacce_sums = [0.0; 3];
+                for r in self.recent.iter().filter_map(|e| e.recorded) {
+                    for (sum, term) in self.linacce_sums.iter_mut().zip(r.linacce_terms) {
+                        *sum += term;
+                    }
+                }
             }
         }
+        if self.gyro_refused.is_none() {
+            self.gyro_refused = self.gyro_refusal(sample.time);
+        }
         self.refused = self
-            .gyro_refusal(sample.time)
-            .or_else(|| self.median_refusal(limits));
+            .gyro_refused
+            .clone()
+            .or_else(|| self.median_refusal(limits))
+            .or_else(|| self.linacce_refusal(limits));
         match &self.refused {
             Some(why) => Err(PipelineError::Live(why.clone())),
             None => Ok(()),
         }
+    }
+
+    /// Counts `entry` into the medians and sums (`add`), or out of them.
+    fn count(&mut self, entry: &Judged, limits: &Validation, add: bool) {
+        for (m, (low, high)) in self.medians.iter_mut().zip(Self::properties(entry, limits)) {
+            if add {
+                m.push(low, high);
+            } else {
+                m.pop(low, high);
+            }
+        }
+        if let Some(r) = entry.recorded {
+            let sign = if add { 1.0 } else { -1.0 };
+            for (sum, term) in self.linacce_sums.iter_mut().zip(r.linacce_terms) {
+                *sum += sign * term;
+            }
+            if add {
+                self.linacce_count += 1;
+            } else {
+                self.linacce_count -= 1;
+            }
+        }
+    }
+
+    /// Why the last [`STREAM_CHECK_SAMPLES`] are refused, once there are that many and most
+    /// came with a recorded linear acceleration: its scale against accelerometer minus gravity
+    /// ([`Validation::linacce_scale_verdict`]).
+    fn linacce_refusal(&self, limits: &Validation) -> Option<String> {
+        if self.recent.len() < STREAM_CHECK_SAMPLES || self.linacce_count * 2 < self.recent.len() {
+            return None;
+        }
+        let [dl, ll, dd] = self.linacce_sums;
+        let e = limits
+            .linacce_scale_verdict(dl, ll, dd, self.linacce_count)
+            .err()?;
+        Some(format!(
+            "the stream's last {} samples: {e}",
+            self.recent.len()
+        ))
     }
 
     /// Why the gyro is refused at `time`: it turns against the recorded orientation, judged
@@ -628,7 +756,7 @@ impl StreamCheck {
     /// Why the last second's median of quantity `column` ([`Self::properties`]' order) lies
     /// beyond its bounds.
     fn verdict(&self, column: usize, limits: &Validation) -> String {
-        let mut values: Vec<f64> = self.recent.iter().map(|e| e[column]).collect();
+        let mut values: Vec<f64> = self.recent.iter().filter_map(|e| e.value(column)).collect();
         values.sort_by(f64::total_cmp);
         let median = values[values.len() / 2];
         let n = self.recent.len();
@@ -650,6 +778,23 @@ impl StreamCheck {
                 max: limits.max_median_gyro,
             }
             .to_string(),
+            3 => ridi_data::SequenceError::OrientationGravity {
+                median_deg: median,
+                max_deg: limits.max_orientation_gravity_deg,
+            }
+            .to_string(),
+            4 => {
+                let (min, max) = limits.gravity_range;
+                format!(
+                    "median |gravity| {} m/s^2 is outside {min}..{max} m/s^2: gravity in {}?",
+                    ridi_data::short(median),
+                    if median < min {
+                        "g instead of m/s^2"
+                    } else {
+                        "another unit than m/s^2, or another column"
+                    }
+                )
+            }
             _ => format!(
                 "median |acce| {} m/s^2 is {} g, outside {}..{} g: accelerometer in {}?",
                 ridi_data::short(median),

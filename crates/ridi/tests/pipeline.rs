@@ -697,7 +697,10 @@ fn a_live_stream_at_a_wrong_rate_or_unit_is_refused_by_its_first_window() {
     };
     let t0 = seq.time()[0];
     type Edit<'a> = &'a dyn Fn(usize, &mut SensorReading);
-    let cases: [(Edit, &[&str]); 4] = [
+    fn recorded(s: &mut SensorReading) -> &mut ridi::Recorded {
+        s.recorded.as_mut().unwrap()
+    }
+    let cases: [(Edit, &[&str]); 7] = [
         // 100 Hz: the frames' times stretched twofold.
         (
             &|i, s| s.time = t0 + 2.0 * (seq.time()[i] - t0),
@@ -714,6 +717,24 @@ fn a_live_stream_at_a_wrong_rate_or_unit_is_refused_by_its_first_window() {
         (
             &|_, s| s.acce = s.acce / ridi::frames::STANDARD_GRAVITY,
             &["g instead of m/s^2"],
+        ),
+        // The recorded orientation, gravity and linear acceleration disagreeing as the
+        // sequence's own checks would find: gravity negated, in g, not taken out of the
+        // linear acceleration.
+        (
+            &|_, s| recorded(s).gravity = recorded(s).gravity * -1.0,
+            &["gravity is 180 degrees from the up axis"],
+        ),
+        (
+            &|_, s| recorded(s).gravity = recorded(s).gravity / ridi::frames::STANDARD_GRAVITY,
+            &["median |gravity| 1", "gravity in g instead of m/s^2"],
+        ),
+        (
+            &|_, s| recorded(s).linacce = s.acce,
+            &[
+                "accelerometer minus gravity is -0.0",
+                "times the linear acceleration",
+            ],
         ),
     ];
     for (edit, words) in cases {
@@ -749,6 +770,10 @@ fn a_live_stream_at_a_wrong_rate_or_unit_is_refused_by_its_first_window() {
         s
     };
     assert!(live.push(&flipped(i + 1), &mut updates).is_err());
+    // Stays so, also for samples that agree again (an agreement over the whole stream near 0
+    // would otherwise be refused and taken by turns).
+    let again = live.push(&SensorReading::of_frame(&seq, i + 2), &mut updates);
+    assert_eq!(again.unwrap_err().to_string(), err);
     let mut live = LiveTracker::new(&model, &opts).unwrap();
     for i in 0..seq.len() {
         live.push(&SensorReading::of_frame(&seq, i), &mut updates)
