@@ -8,7 +8,6 @@ matplotlib is optional: without it the table is printed and the plot skipped.
 """
 
 import argparse
-import sys
 import time
 from pathlib import Path
 
@@ -21,17 +20,8 @@ SAMPLE = Path(__file__).resolve().parent.parent / "datasets" / "sample"
 
 def print_table(report):
     """The summary `ridi demo` and `ridi eval` print."""
-    for w in report["warnings"]:
-        print(f"warning: {w}", file=sys.stderr)
-    # ridi_eval::WEAK_ALIGNMENT_EXTENT_M: below 1 m the fitted heading rests on little motion.
-    weak = sum(s["alignment_extent_m"] < 1.0 for s in report["sequences"])
-    if weak:
-        print(
-            f"warning: in {weak} of {len(report['sequences'])} sequences the ground truth moves"
-            " less than 1 m within the alignment window, so their fitted heading is weakly"
-            " determined",
-            file=sys.stderr,
-        )
+    # The report's warnings (a weakly determined alignment, say) came as Python warnings when
+    # ridi.evaluate returned it; they are in report["warnings"] too.
     accuracy = report["placement_accuracy"]
     mse = report["velocity_mse"]
     print(

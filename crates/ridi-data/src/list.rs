@@ -237,7 +237,7 @@ impl Listed {
             })
             .collect::<Result<_>>()?;
         for (i, (seq, e)) in sequences.iter().zip(&entries).enumerate() {
-            if let Some(j) = sequences[..i].iter().position(|s| same_data(s, seq)) {
+            if let Some(j) = sequences[..i].iter().position(|s| s.is_same_recording(seq)) {
                 return Err(copy_error(e, &entries[j]));
             }
         }
@@ -280,7 +280,7 @@ impl Listed {
             }
         }
         for (seq, e) in later.sequences.iter().zip(&later.entries) {
-            if let Some(i) = self.sequences.iter().position(|s| same_data(s, seq)) {
+            if let Some(i) = self.sequences.iter().position(|s| s.is_same_recording(seq)) {
                 return Err(copy_error(e, &self.entries[i]));
             }
         }
@@ -329,13 +329,6 @@ fn copy_error(e: &ListEntry, first: &ListEntry) -> DataError {
             first.line
         ),
     )
-}
-
-/// Whether two sequences are one recording: the same timestamps, gyro and accelerometer
-/// samples, every one of them. Slice comparison stops at the first difference, so two
-/// recordings cost a length and a timestamp compare (phone clocks count nanoseconds from boot).
-fn same_data(a: &Sequence, b: &Sequence) -> bool {
-    a.time() == b.time() && a.gyro() == b.gyro() && a.acce() == b.acce()
 }
 
 #[cfg(test)]

@@ -506,6 +506,15 @@ impl Sequence {
     pub fn is_empty(&self) -> bool {
         false
     }
+    /// Whether `other` is the same recording, whatever its name, format or labels: the same
+    /// timestamps, gyro and accelerometer samples, every one of them (a recording given twice
+    /// would count twice in a mean, or be tested on after training on it). Slice comparison
+    /// stops at the first difference, so two recordings cost a length and a timestamp compare
+    /// (phone clocks count nanoseconds from boot).
+    pub fn is_same_recording(&self, other: &Sequence) -> bool {
+        self.time() == other.time() && self.gyro() == other.gyro() && self.acce() == other.acce()
+    }
+
     /// Timestamps, seconds.
     pub fn time(&self) -> &[f64] {
         &self.parts.time

@@ -2,8 +2,9 @@
 //!
 //! In: float64 arrays of any layout (C or Fortran order, strided slices, negative strides) are
 //! read in place through an ndarray view, without a contiguous copy first; the one copy made is
-//! into the `Sequence`'s own storage. Another dtype is a `TypeError`, another shape a
-//! `ValueError`, both naming the argument; values (NaN, units) are checked by the facade's own
+//! into the `Sequence`'s own storage. Arrays of other real dtypes and array-likes (lists,
+//! pandas) are converted to float64 by numpy first. A dtype that is not a real number is a
+//! `TypeError`, another shape a `ValueError`, both naming the argument; values (NaN, units) are checked by the facade's own
 //! validation, which names the array and the frame.
 //!
 //! Out: each array is built once in Rust and handed to numpy without a further copy.
@@ -15,6 +16,7 @@ use numpy::{
 };
 use pyo3::exceptions::PyTypeError;
 use pyo3::prelude::*;
+use pyo3::types::{PyList, PyTuple};
 use ridi::frames::nalgebra::{Quaternion, UnitQuaternion};
 use ridi::frames::{Frame, QuatError, Vec3, WorldFromDevice};
 
@@ -32,26 +34,79 @@ fn shape_text(shape: &[usize]) -> String {
 }
 
 /// `obj` as a numpy array of float64, or a `TypeError` naming the argument `name`.
+///
+/// A float64 array is taken as it is (read in place). Another array of real numbers (float32,
+/// integers) and what numpy reads as one (a list, a pandas column or frame) are converted, as
+/// `np.asarray(obj, dtype=np.float64)` would: a copy, exact for every float32 and for integers
+/// up to 2^53. `time` alone refuses float16 and float32: their 11 or 24 bits have rounded
+/// the timestamps already (to 0.24 ms an hour into a recording, to minutes at Unix times).
 fn float64<'py>(obj: &Bound<'py, PyAny>, name: &str) -> PyResult<Bound<'py, PyUntypedArray>> {
-    let Ok(array) = obj.cast::<PyUntypedArray>() else {
-        return Err(PyTypeError::new_err(format!(
-            "`{name}` must be a numpy array of float64, not {}",
-            obj.get_type().name()?
-        )));
+    let py = obj.py();
+    let array = match obj.cast::<PyUntypedArray>() {
+        Ok(array) => array.clone(),
+        Err(_) => {
+            let readable = obj.is_instance_of::<PyList>()
+                || obj.is_instance_of::<PyTuple>()
+                || obj.hasattr("__array__")?;
+            let converted = readable
+                .then(|| {
+                    py.import("numpy")
+                        .and_then(|np| np.call_method1("asarray", (obj,)))
+                        .ok()
+                        .and_then(|a| a.cast_into::<PyUntypedArray>().ok())
+                })
+                .flatten();
+            match converted {
+                Some(array) => array,
+                None => {
+                    return Err(PyTypeError::new_err(format!(
+                        "`{name}` must be an array of numbers (a numpy array, a list of \
+                         numbers or a pandas column), not {}",
+                        described(obj)
+                    )));
+                }
+            }
+        }
     };
     let found = array.dtype();
-    if !found.is_equiv_to(&dtype::<f64>(obj.py())) {
-        // Timestamps as numpy dates: a cast to float64 would give nanoseconds, not seconds.
-        let convert = if found.kind() == b'M' {
-            format!("seconds as float64: ({name} - {name}[0]) / np.timedelta64(1, 's')")
-        } else {
-            format!("np.asarray({name}, dtype=np.float64)")
-        };
-        return Err(PyTypeError::new_err(format!(
-            "`{name}` has dtype {found}; ridi takes float64 ({convert})"
-        )));
+    if found.is_equiv_to(&dtype::<f64>(py)) {
+        return Ok(array);
     }
-    Ok(array.clone())
+    let kind = found.kind();
+    let coarse_time = name == "time" && kind == b'f' && found.itemsize() < 8;
+    if matches!(kind, b'f' | b'i' | b'u') && !coarse_time {
+        return array
+            .call_method1("astype", ("float64",))?
+            .cast_into::<PyUntypedArray>()
+            .map_err(PyErr::from);
+    }
+    let convert = match kind {
+        // Numpy dates and durations: a cast to float64 would give nanoseconds, not seconds.
+        b'M' => format!("seconds as float64: ({name} - {name}[0]) / np.timedelta64(1, 's')"),
+        b'm' => format!("seconds as float64: {name} / np.timedelta64(1, 's')"),
+        _ if coarse_time => "its bits have rounded the timestamps already (to 0.24 ms an hour \
+             into a recording, to minutes at Unix times): compute them in float64"
+            .to_string(),
+        _ => "an array of real numbers".to_string(),
+    };
+    Err(PyTypeError::new_err(format!(
+        "`{name}` has dtype {found}; ridi takes float64 ({convert})"
+    )))
+}
+
+/// What `obj` is, for a message: its type, and its shape when it has one.
+pub(crate) fn described(obj: &Bound<'_, PyAny>) -> String {
+    let kind = obj
+        .get_type()
+        .name()
+        .map_or_else(|_| "?".to_owned(), |n| n.to_string());
+    match obj.getattr("shape") {
+        Ok(shape) => format!("{kind} of shape {shape}"),
+        Err(_) => match obj.len() {
+            Ok(n) => format!("{kind} of length {n}"),
+            Err(_) => kind,
+        },
+    }
 }
 
 /// The `(frames, cols)` float64 array `obj`, argument `name`; `frames` is the length of `time`
@@ -66,12 +121,12 @@ pub(crate) fn matrix<'py>(
     let shape = array.shape();
     let fits = shape.len() == 2 && shape[1] == cols && frames.is_none_or(|n| shape[0] == n);
     if !fits {
-        let rows = match frames {
-            Some(n) => format!("{n}, one row per frame of `time`"),
-            None => "N".to_string(),
+        let (rows, per_frame) = match frames {
+            Some(n) => (n.to_string(), ", one row per frame of `time`"),
+            None => ("N".to_string(), ""),
         };
         return Err(errors::value(format!(
-            "`{name}` must have shape ({rows}, {cols}); it has shape {}",
+            "`{name}` must have shape ({rows}, {cols}){per_frame}; it has shape {}",
             shape_text(shape)
         )));
     }

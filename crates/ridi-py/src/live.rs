@@ -10,7 +10,7 @@ use ridi::frames::DeviceVec;
 use ridi::regress::Cascade;
 use ridi::{Recorded, SensorReading};
 
-use crate::arrays::rotation;
+use crate::arrays::{described, rotation};
 use crate::errors;
 use crate::model::Model;
 use crate::options;
@@ -31,7 +31,8 @@ pub(crate) struct Update {
     /// Velocity ``(x, y, z)``, m/s, world frame.
     #[pyo3(get)]
     velocity: (f64, f64, f64),
-    /// The accelerometer bias applied from this frame on ``(x, y, z)``, m/s², device frame.
+    /// The bias correction added to the linear acceleration from this frame on ``(x, y, z)``
+    /// (minus the accelerometer's estimated bias), m/s², device frame.
     #[pyo3(get)]
     bias: (f64, f64, f64),
     /// True when this sample started a new segment after a gap longer than 0.1 s.
@@ -287,19 +288,4 @@ fn values<const N: usize>(obj: &Bound<'_, PyAny>, name: &str) -> PyResult<[f64; 
             described(obj)
         ))
     })
-}
-
-/// What `obj` is, for a message: its type, and its shape when it has one.
-fn described(obj: &Bound<'_, PyAny>) -> String {
-    let kind = obj
-        .get_type()
-        .name()
-        .map_or_else(|_| "?".to_owned(), |n| n.to_string());
-    match obj.getattr("shape") {
-        Ok(shape) => format!("{kind} of shape {shape}"),
-        Err(_) => match obj.len() {
-            Ok(n) => format!("{kind} of length {n}"),
-            Err(_) => kind,
-        },
-    }
 }

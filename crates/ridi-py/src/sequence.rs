@@ -162,6 +162,12 @@ impl Sequence {
             ));
         }
         let device = match device {
+            None if device_imu_rate_hz.is_some() => {
+                return Err(errors::value(
+                    "`device_imu_rate_hz` without `device`: name the phone whose IMU sampled at \
+                     that rate (`device=\"Pixel 7\"`, say)",
+                ));
+            }
             None => None,
             Some(model) => {
                 let d = DeviceInfo::new(model).map_err(|e| errors::value(e.to_string()))?;
@@ -316,7 +322,7 @@ impl Sequence {
         self.inner.duration()
     }
 
-    /// Mean rate, Hz (frames over duration).
+    /// Mean rate, Hz: frame intervals over duration, `(N - 1) / duration`.
     #[getter]
     fn rate_hz(&self) -> f64 {
         self.inner.rate_hz()
@@ -367,6 +373,17 @@ impl Sequence {
     #[pyo3(signature = (rate_hz, max_gap_s=None))]
     fn resampled(&self, rate_hz: f64, max_gap_s: Option<f64>) -> PyResult<Self> {
         let max_gap = max_gap_s.unwrap_or_else(|| ridi::resample_max_gap(&self.inner));
+        let median_step = 1.0 / self.inner.median_rate_hz();
+        // Not a gap limit of no sequence (0, NaN): the resampler names those.
+        if max_gap_s.is_some() && max_gap > 0.0 && max_gap < median_step {
+            return Err(errors::value(format!(
+                "`max_gap_s` is {max_gap} s, below the median frame interval of sequence `{}` \
+                 ({} s): every frame would be a gap; give at least that (the default is 5 \
+                 intervals)",
+                self.inner.name(),
+                ridi::data::short(median_step)
+            )));
+        }
         let resampled = self
             .inner
             .resampled(rate_hz, max_gap)

@@ -3,12 +3,14 @@ options and refusals."""
 
 import json
 import math
+import subprocess
+import sys
 
 import numpy as np
 import pytest
 
 import ridi
-from conftest import SAMPLE
+from conftest import ROOT, SAMPLE
 
 RUNS = ["Thibaud_Nexus5_NoDist_Texting", "Thibaud_Nexus5_NoDist_FrontPocket"]
 
@@ -91,6 +93,17 @@ def test_bad_evaluations_are_refused(model, test_list, tmp_path):
         ridi.evaluate(unnamed, model)
     with pytest.raises(ValueError, match=r"sequences 0 and 1 are both named `sequence`"):
         ridi.train(unnamed, grid="none")
+    # A renamed copy of a recording is the recording: the CLI's lists refuse it by content.
+    copy = ridi.Sequence(seqs[0].time, seqs[0].gyro, seqs[0].acce, seqs[0].gravity,
+                         seqs[0].orientation, name="renamed", placement=seqs[0].placement,
+                         ground_truth_position=seqs[0].ground_truth_position,
+                         ground_truth_orientation=seqs[0].ground_truth_orientation)
+    given = [*seqs[:3], copy]
+    for call in (lambda d: ridi.evaluate(d, model), lambda d: ridi.train(d, grid="none")):
+        with pytest.raises(ValueError, match=rf"sequences 0 \(`{seqs[0].name}`\) and "
+                                             rf"{len(given) - 1} \(`renamed`\) are the same "
+                                             r"recording"):
+            call(given)
 
 
 def test_one_method_by_name_and_warnings_as_python_warnings(model, test_list):
@@ -111,3 +124,16 @@ def test_a_weakly_determined_alignment_is_a_warning_in_the_report_and_in_python(
     with pytest.warns(UserWarning, match=r"weakly determined alignment in 1 of 1 sequence: .*still \(0.00 m\)"):
         report = ridi.evaluate([still], model, methods="ridi", placement_map="tyrex4")
     assert any(w.startswith("weakly determined alignment") for w in report["warnings"])
+
+
+def test_the_python_demo_runs_as_its_docstring_says(tmp_path):
+    # examples/python_demo.py, as a user runs it: the demo's table per device, each warning
+    # once (as a Python warning), exit code 0.
+    done = subprocess.run(
+        [sys.executable, "-W", "always", str(ROOT / "examples" / "python_demo.py"), "--plot",
+         str(tmp_path / "t.png")], capture_output=True, text=True, timeout=600, cwd=tmp_path)
+    assert done.returncode == 0, done.stderr
+    assert "RTE 5 s per device (m):" in done.stdout and "iPhone 4S" in done.stdout
+    for line in set(done.stderr.splitlines()):
+        if "Warning" in line:
+            assert done.stderr.count(line) == 1, done.stderr

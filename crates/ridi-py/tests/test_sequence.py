@@ -168,6 +168,32 @@ def test_any_layout_is_read_in_place(seq):
     np.testing.assert_array_equal(built.time, seq.time)
 
 
+def test_arrays_of_other_real_dtypes_and_array_likes_read_as_float64(seq):
+    # float32 sensors, integer counts, lists, an object with __array__ (a pandas column):
+    # each converted as np.asarray(x, dtype=np.float64) would, so the sequence is the one
+    # built from those float64 arrays.
+    args = arrays_of(seq)
+
+    class Column:
+        def __init__(self, values):
+            self.values = values
+
+        def __array__(self, dtype=None, copy=None):
+            return self.values
+
+    given = dict(args, gyro=args["gyro"].astype(np.float32), acce=args["acce"].tolist(),
+                 gravity=Column(args["gravity"]), linacce=np.asfortranarray(args["linacce"]),
+                 time=tuple(args["time"]))
+    expected = dict(args, gyro=args["gyro"].astype(np.float32).astype(np.float64))
+    built, reference = ridi.Sequence(**given), ridi.Sequence(**expected)
+    for key in ("time", "gyro", "acce", "gravity", "linacce", "orientation"):
+        np.testing.assert_array_equal(getattr(built, key), getattr(reference, key), err_msg=key)
+    # Integers convert exactly.
+    whole = np.round(args["acce"]).astype(np.int32)
+    rounded = ridi.Sequence(**dict(args, acce=whole))
+    np.testing.assert_array_equal(rounded.acce, whole.astype(np.float64))
+
+
 def test_linacce_defaults_to_acce_minus_gravity(seq):
     args = arrays_of(seq)
     del args["linacce"]
@@ -178,16 +204,25 @@ def test_linacce_defaults_to_acce_minus_gravity(seq):
 @pytest.mark.parametrize(
     "change, error, message",
     [
-        (lambda a: a.update(gyro=a["gyro"].astype(np.float32)), TypeError,
-         r"`gyro` has dtype float32; ridi takes float64"),
+        (lambda a: a.update(time=a["time"].astype(np.float32)), TypeError,
+         r"`time` has dtype float32; ridi takes float64 \(its bits have rounded the timestamps"),
+        (lambda a: a.update(gyro=a["gyro"] > 0), TypeError,
+         r"`gyro` has dtype bool; ridi takes float64 \(an array of real numbers\)"),
+        (lambda a: a.update(acce=a["acce"].astype(str)), TypeError, r"`acce` has dtype <U"),
+        (lambda a: a.update(time=(a["time"] * 1e9).astype("timedelta64[ns]")), TypeError,
+         r"`time` has dtype timedelta64\[ns\]; ridi takes float64 \(seconds as float64: "
+         r"time / np.timedelta64\(1, 's'\)\)"),
         (lambda a: a.update(time=np.datetime64("2026-11-27") + (a["time"] * 1e9).astype(
             "timedelta64[ns]")), TypeError,
          r"`time` has dtype datetime64\[ns\]; ridi takes float64 \(seconds as float64: "
          r"\(time - time\[0\]\) / np.timedelta64\(1, 's'\)\)"),
-        (lambda a: a.update(acce=a["acce"].tolist()), TypeError,
-         r"`acce` must be a numpy array of float64, not list"),
+        (lambda a: a.update(acce="acce.csv"), TypeError,
+         r"`acce` must be an array of numbers \(a numpy array, a list of numbers or a pandas "
+         r"column\), not str of length 8"),
+        (lambda a: a.update(acce=[[0.0, 1.0, 2.0], [3.0]]), TypeError,
+         r"`acce` must be an array of numbers"),
         (lambda a: a.update(gyro=a["gyro"][:, :2]), ValueError,
-         r"`gyro` must have shape \(\d+, one row per frame of `time`, 3\); it has shape \(\d+, 2\)"),
+         r"`gyro` must have shape \(\d+, 3\), one row per frame of `time`; it has shape \(\d+, 2\)"),
         (lambda a: a.update(gravity=a["gravity"][:-1]), ValueError,
          r"`gravity` must have shape"),
         (lambda a: a.update(time=a["time"][:, None]), ValueError,
@@ -216,6 +251,8 @@ def test_linacce_defaults_to_acce_minus_gravity(seq):
          r"ground truth needs both"),
         (lambda a: a.update(acce=a["acce"] / 9.81, linacce=None), ValueError,
          r"accelerometer in g"),
+        (lambda a: a.update(device=None), ValueError,
+         r"`device_imu_rate_hz` without `device`: name the phone"),
         (lambda a: a.update(orientation_source="compass"), ValueError,
          r"`orientation_source` is 'compass'"),
         (lambda a: a.update(time=a["time"] * 1000), ValueError,
@@ -252,6 +289,10 @@ def test_resampling_refuses_rates_and_gap_limits_no_sequence_may_have(seq):
         with pytest.raises(ValueError, match=r"the gap limit a number above 0"):
             seq.resampled(100.0, max_gap_s=gap)
     assert len(seq.resampled(100.0, max_gap_s=float("inf"))) == pytest.approx(len(seq) / 2, abs=1)
+    # Below the frame interval every frame is a gap: said so, rather than advising a split.
+    with pytest.raises(ValueError, match=r"`max_gap_s` is 0.000001 s, below the median frame interval "
+                                         r"of sequence `Thibaud_Nexus5_NoDist_Texting` \(0.005"):
+        seq.resampled(200.0, max_gap_s=1e-6)
 
 
 def test_with_placement_and_len(seq):

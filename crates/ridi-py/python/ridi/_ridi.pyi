@@ -10,6 +10,8 @@ __version__: str
 
 StrPath = Union[str, "os.PathLike[str]"]
 Array = npt.NDArray[np.float64]
+ArrayIn = npt.ArrayLike
+"""An input array: float64 is read in place, other real dtypes and array-likes converted."""
 Format = Literal["ridi-csv", "ridi-plain", "ridi-raw", "tyrex", "ilc", "ronin"]
 Inputs = Union[StrPath, Seq[StrPath], Seq["Sequence"]]
 
@@ -30,19 +32,19 @@ class Sequence:
 
     def __init__(
         self,
-        time: Array,
-        gyro: Array,
-        acce: Array,
-        gravity: Optional[Array] = None,
-        orientation: Optional[Array] = None,
+        time: ArrayIn,
+        gyro: ArrayIn,
+        acce: ArrayIn,
+        gravity: Optional[ArrayIn] = None,
+        orientation: Optional[ArrayIn] = None,
         *,
-        linacce: Optional[Array] = None,
+        linacce: Optional[ArrayIn] = None,
         name: str = "sequence",
         placement: Optional[str] = None,
-        magnet: Optional[Array] = None,
-        ground_truth_position: Optional[Array] = None,
-        ground_truth_orientation: Optional[Array] = None,
-        steps: Optional[Array] = None,
+        magnet: Optional[ArrayIn] = None,
+        ground_truth_position: Optional[ArrayIn] = None,
+        ground_truth_orientation: Optional[ArrayIn] = None,
+        steps: Optional[ArrayIn] = None,
         orientation_source: Optional[
             Literal[
                 "game-rotation-vector",
