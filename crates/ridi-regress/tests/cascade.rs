@@ -405,19 +405,26 @@ fn small_or_degenerate_placements_give_clear_errors_or_documented_fallbacks() {
         Cascade::train(&empty.set(), &fixed, &mut NoProgress),
         Err(RegressError::NotEnoughData(m)) if m.contains("leg")
     ));
-    // A placement recorded in a single sequence cannot be cross-validated by sequence.
+    // A placement recorded in a single sequence cannot be cross-validated by sequence: refused
+    // before any stage starts, also when it is the last placement the search would reach.
     let mut one_seq = make(2, 3, 10, 3);
     for (g, p) in one_seq.group.iter_mut().zip(&one_seq.placement) {
-        if *p == 0 {
+        if *p == 1 {
             *g = 0;
         }
     }
-    match Cascade::train(&one_seq.set(), &small_grid(), &mut NoProgress) {
+    let mut stages = 0;
+    let mut count = |_: &ProgressEvent<'_>| {
+        stages += 1;
+        true
+    };
+    match Cascade::train(&one_seq.set(), &small_grid(), &mut count) {
         Err(e @ RegressError::TooFewSequences { found: 1, .. }) => {
-            assert!(e.to_string().starts_with("placement 'placement0': "), "{e}")
+            assert!(e.to_string().starts_with("placement 'placement1': "), "{e}")
         }
         other => panic!("expected TooFewSequences, got {other:?}"),
     }
+    assert_eq!(stages, 0);
     // A single placement: no classifier, every query gets placement 0.
     let single = make(1, 3, 10, 4);
     let model = Cascade::train(&single.set(), &fixed, &mut NoProgress).unwrap();

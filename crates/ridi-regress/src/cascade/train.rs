@@ -152,7 +152,22 @@ fn check_training_set(
         RegressorChoice::Fixed { c, epsilon } => {
             svr::SvrParams::new(*c, *epsilon, 1.0).validate()?;
         }
-        RegressorChoice::Grid(g) => g.validate()?,
+        RegressorChoice::Grid(g) => {
+            g.validate()?;
+            // Checked before any training, not when the search reaches the placement: a
+            // search cross-validates by sequence, so each placement needs two.
+            for (c, m) in members.iter().enumerate() {
+                let mut groups: Vec<u64> = m.iter().map(|&i| data.groups[i]).collect();
+                groups.sort_unstable();
+                groups.dedup();
+                if groups.len() < 2 {
+                    return Err(RegressError::TooFewSequences {
+                        placement: data.placement_names[c].clone(),
+                        found: groups.len(),
+                    });
+                }
+            }
+        }
     }
     if let Solver::Nystrom(n) = params.method {
         // A deserialized config is checked too (the type's constructor checks the others).
