@@ -271,6 +271,8 @@ fn the_nystrom_solver_keeps_its_own_share_of_the_variance() {
             "nystrom",
             "--landmarks",
             "64",
+            "--seed",
+            "7",
             "--storage",
             storage,
             "--out",
@@ -280,6 +282,13 @@ fn the_nystrom_solver_keeps_its_own_share_of_the_variance() {
         let out = ridi(&["inspect", s(&model), "--json"]);
         assert!(out.status.success(), "{}", stderr(&out));
         let json: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+        // Two trainings differing in the draw alone are told apart.
+        assert_eq!(json["landmark_seed"], 7);
+        let text = String::from_utf8(ridi(&["inspect", s(&model)]).stdout).unwrap();
+        assert!(
+            text.contains("landmarks per machine drawn with seed 7"),
+            "{text}"
+        );
         let variance = json["stored_variance"].as_f64().unwrap();
         (json["projected_components"].as_u64(), variance)
     };
@@ -458,7 +467,7 @@ fn convert_train_track_and_eval() {
     let json: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
     assert_eq!(json["window"], 200);
     assert_eq!(json["step"], 20);
-    assert_eq!(json["up_axis"], "plus_or_minus_y");
+    assert_eq!(json["up_axis"], "plus-or-minus-y");
     assert_eq!(json["placements"][0]["name"], "hand");
     assert_eq!(
         json["placements"][0]["speed"],

@@ -55,9 +55,9 @@ pub fn align_gravity(gravity: DeviceVec) -> StabFromDevice {
 ///
 /// Every S rotation of a frame depends only on that frame's gravity, so features, targets,
 /// corrections and baselines that share an `UpAxis` share one S. A model records the one it
-/// was trained with.
+/// was trained with. Its serde names are the command line's (`plus-y`, `plus-or-minus-y`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default, Serialize, Deserialize)]
-#[serde(rename_all = "snake_case")]
+#[serde(rename_all = "kebab-case")]
 pub enum UpAxis {
     /// [`align_gravity`] at every attitude: the smallest rotation onto device +y, as in the
     /// original RIDI code.

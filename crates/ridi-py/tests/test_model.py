@@ -21,6 +21,8 @@ def test_train_gives_the_cli_model_bytes(model, ridi_bin, tmp_path):
     assert same, "the model differs from the one `ridi train` writes"
     assert model.placement_names == ["hand", "pocket", "running", "swing"]
     assert (model.window, model.orientation, model.up_axis) == (200, "estimated", "plus-or-minus-y")
+    # One spelling: the description's, the property's and the argument's.
+    assert model.describe()["up_axis"] == model.up_axis
 
 
 def test_the_nystrom_solver_gives_the_cli_model_bytes(ridi_bin, tmp_path):
@@ -151,6 +153,7 @@ def test_the_bundled_model_is_the_one_ridi_track_uses_without_a_model(ridi_bin, 
     model = ridi.bundled_model()
     assert model.placement_names == ["hand", "pocket", "running", "swing"]
     assert model.describe()["landmarks"] is not None
+    assert model.describe()["landmark_seed"] == 0
     seq = ridi.read(SAMPLE / "Thibaud_Nexus5_NoDist_Texting")
     out = tmp_path / "t.csv"
     ridi_bin("track", SAMPLE / "Thibaud_Nexus5_NoDist_Texting", "--out", out)

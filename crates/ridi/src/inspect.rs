@@ -204,8 +204,9 @@ pub struct Inspection {
     pub rate_hz: f64,
     /// Longest interval between frames, seconds.
     pub max_gap_s: f64,
-    /// Where the device orientation comes from.
-    pub orientation_source: Option<String>,
+    /// Where the device orientation comes from (in JSON by its key, as in files:
+    /// `rotation-vector`).
+    pub orientation_source: Option<ridi_data::OrientationSource>,
     /// Gravity magnitude, m/s^2.
     pub gravity_norm: SeriesStats,
     /// Fraction of frames with the phone upside down ([`UpAxis::is_upside_down`]), where the
@@ -345,7 +346,7 @@ fn report(s: Summary) -> Inspection {
         duration_s: s.duration,
         rate_hz,
         max_gap_s,
-        orientation_source: s.orientation_source.map(|o| o.to_string()),
+        orientation_source: s.orientation_source,
         gravity_norm,
         upside_down_fraction,
         acce_norm,
@@ -391,7 +392,8 @@ impl std::fmt::Display for Inspection {
         writeln!(
             f,
             "orientation:  {}",
-            self.orientation_source.as_deref().unwrap_or("(unknown)")
+            self.orientation_source
+                .map_or("(unknown)".to_owned(), |o| o.to_string())
         )?;
         let g = &self.gravity_norm;
         writeln!(
@@ -441,6 +443,8 @@ pub struct ModelInspection {
     /// [`ridi_regress::Solver`]): the classifier's are drawn from all rows, each placement's
     /// regressors' from its own (its samples).
     pub landmarks: Option<usize>,
+    /// Seed of a Nyström model's landmark draw (`ridi train --seed`; `None`: exact).
+    pub landmark_seed: Option<u64>,
     /// Frames per feature window.
     pub window: usize,
     /// Frames between training windows.
@@ -537,6 +541,10 @@ pub fn inspect_model(model: &Cascade) -> ModelInspection {
             Solver::Exact => None,
             Solver::Nystrom(n) => Some(n.landmarks()),
         },
+        landmark_seed: match model.solver() {
+            Solver::Exact => None,
+            Solver::Nystrom(n) => Some(n.seed()),
+        },
         window: config.window,
         step: config.step,
         feature_sigma: config.feature_sigma,
@@ -584,11 +592,12 @@ impl std::fmt::Display for ModelInspection {
             "orientation: {orientation} (track and eval use the same)"
         )?;
         if let Some(m) = self.landmarks {
+            let seed = self.landmark_seed.unwrap_or_default();
             writeln!(
                 f,
-                "solver: Nyström, up to {m} landmarks per machine (the classifier's from all \
-                 rows; each placement's regressors', by kernel ridge, from its rows: its samples \
-                 below)"
+                "solver: Nyström, up to {m} landmarks per machine drawn with seed {seed} (the \
+                 classifier's from all rows; each placement's regressors', by kernel ridge, from \
+                 its rows: its samples below)"
             )?;
         }
         match self.projected_components {
