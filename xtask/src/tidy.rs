@@ -16,7 +16,10 @@
 //!   crates/ridi-py, a workspace of its own, repeats the root's dev and release profiles for
 //!   itself and the crates it builds, so that both share artifacts in one `target/`.
 //!
-//! It reads files only (no build), so it takes well under a second.
+//! - Each crate README's dependency count ("**Dependencies:** N crates", and ridi's "N with
+//!   `default-features = false`") is what `cargo tree` counts now.
+//!
+//! It reads files and runs `cargo tree` (no build), so it takes a few seconds.
 
 use std::collections::{BTreeMap, BTreeSet};
 use std::fmt::Write as _;
@@ -63,6 +66,7 @@ pub fn run(root: &Path) -> Result<()> {
     let table = layer_table(&root.join("docs/ARCHITECTURE.md"))?;
     check_layers(&crates, &table, &mut problems);
     check_profiles(root, &crates, &mut problems)?;
+    check_dependency_counts(root, &crates, &mut problems)?;
     for krate in crates.values() {
         // This file names the retired spellings.
         for file in rust_files(&krate.dir.join("src"))?
@@ -85,7 +89,8 @@ pub fn run(root: &Path) -> Result<()> {
     }
     if problems.is_empty() {
         println!(
-            "tidy: {} crates: layers, error spellings, public modules and profiles as documented",
+            "tidy: {} crates: layers, error spellings, public modules, profiles and dependency \
+             counts as documented",
             crates.len()
         );
         return Ok(());
@@ -208,6 +213,76 @@ pub fn layer_table(path: &Path) -> Result<BTreeMap<String, BTreeSet<String>>> {
         bail!("{}: the layer table has no rows", path.display());
     }
     Ok(out)
+}
+
+/// Compares the dependency counts each crate's README states (its "**Dependencies:** N
+/// crates", and ridi's "N with `default-features = false`" after it) with `cargo tree`'s,
+/// counted as the READMEs say: `cargo tree -p <crate> -e normal --prefix none --no-dedupe
+/// [--no-default-features] | sort -u | wc -l`.
+fn check_dependency_counts(
+    root: &Path,
+    crates: &BTreeMap<String, Crate>,
+    problems: &mut Vec<String>,
+) -> Result<()> {
+    const STATED: &str = "**Dependencies:** ";
+    const LEAN: &str = " with `default-features = false`";
+    for (name, krate) in crates {
+        let Ok(readme) = std::fs::read_to_string(krate.dir.join("README.md")) else {
+            continue;
+        };
+        let Some(at) = readme.find(STATED) else {
+            continue;
+        };
+        let statement = &readme[at + STATED.len()..];
+        let mut stated = vec![(leading_count(statement), " crates", None)];
+        // "...itself included; 90 with `default-features = false`".
+        if let Some(end) = statement.find(LEAN) {
+            let before = &statement[..end];
+            let start = before
+                .rfind(|c: char| !c.is_ascii_digit())
+                .map_or(0, |i| i + 1);
+            stated.push((
+                leading_count(&before[start..]),
+                LEAN,
+                Some("--no-default-features"),
+            ));
+        }
+        for (count, what, flag) in stated {
+            let mut args = vec![
+                "tree",
+                "--locked",
+                "-p",
+                name,
+                "-e",
+                "normal",
+                "--prefix",
+                "none",
+                "--no-dedupe",
+            ];
+            args.extend(flag);
+            let tree = crate::cargo_stdout(root, &args, &[])?;
+            let found = tree
+                .lines()
+                .filter(|l| !l.is_empty())
+                .collect::<BTreeSet<_>>()
+                .len();
+            if count != Some(found) {
+                problems.push(format!(
+                    "{}/README.md: states {}{what}; `cargo {}` counts {found}",
+                    krate.dir.strip_prefix(root).unwrap_or(&krate.dir).display(),
+                    count.map_or("no number".to_owned(), |n| n.to_string()),
+                    args.join(" "),
+                ));
+            }
+        }
+    }
+    Ok(())
+}
+
+/// The number `text` starts with.
+fn leading_count(text: &str) -> Option<usize> {
+    let digits: String = text.chars().take_while(char::is_ascii_digit).collect();
+    digits.parse().ok()
 }
 
 /// Compares each crate's workspace dependencies with its row of the table.
@@ -507,6 +582,50 @@ fn rust_files(dir: &Path) -> Result<Vec<PathBuf>> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_readme_dependency_count_is_cargo_trees() {
+        let root = crate::workspace_root();
+        let dir = tempfile::tempdir().unwrap();
+        let krate = |readme: &str| {
+            std::fs::write(dir.path().join("README.md"), readme).unwrap();
+            let krate = Crate {
+                dir: dir.path().to_owned(),
+                deps: BTreeSet::new(),
+                dev_deps: BTreeSet::new(),
+            };
+            let mut problems = Vec::new();
+            check_dependency_counts(
+                &root,
+                &BTreeMap::from([("ridi".into(), krate)]),
+                &mut problems,
+            )
+            .unwrap();
+            problems
+        };
+        let count = |flags: &[&str]| {
+            let mut args = vec!["tree", "-p", "ridi", "-e", "normal", "--prefix", "none"];
+            args.extend_from_slice(flags);
+            args.push("--no-dedupe");
+            let tree = crate::cargo_stdout(&root, &args, &[]).unwrap();
+            tree.lines().collect::<BTreeSet<_>>().len()
+        };
+        let (all, lean) = (count(&[]), count(&["--no-default-features"]));
+        let right = format!(
+            "**Dependencies:** {all} crates, itself included; {lean} with \
+             `default-features = false`, which"
+        );
+        assert_eq!(krate(&right), Vec::<String>::new());
+        let problems = krate(&right.replace(&format!(" {lean} with"), " 3 with"));
+        assert_eq!(problems.len(), 1, "{problems:?}");
+        assert!(problems[0].ends_with(&format!("--no-default-features` counts {lean}")));
+        let problems = krate(&format!("**Dependencies:** {} crates", all + 1));
+        assert!(
+            problems[0].contains(&format!("states {} crates;", all + 1)),
+            "{problems:?}"
+        );
+        assert_eq!(krate("no count stated"), Vec::<String>::new());
+    }
 
     #[test]
     fn profiles_name_every_crate_and_ridi_py_repeats_them() {

@@ -68,7 +68,7 @@ enum Command {
         ridi convert phone_at_100hz/ --out converted --rate 200   (train, track and eval need 200 Hz)\n\n\
         Writes <out>/<name>/processed/data.csv per sequence and list files \
         (`path,placement` per line): list_all.txt, list_<device>.txt per device (when the sources name \
-        theirs) and, for a Tyrex root, list_<person>.txt per person.")]
+        theirs) and, for Tyrex runs, list_<person>.txt per person.")]
     Convert(convert::Args),
 
     /// Train the placement classifier and velocity regressors on labelled recordings.

@@ -1,6 +1,6 @@
 //! Acceleration-bias correction, double integration and a streaming tracker for RIDI.
 //!
-//! RIDI regresses the horizontal velocity of a phone in its gravity-aligned frame S every few
+//! RIDI regresses the horizontal velocity of a phone in its stabilized frame S every few
 //! frames, then corrects the linear acceleration so that its integral agrees with those
 //! velocities, and integrates the corrected acceleration into a trajectory. This crate holds
 //! the second half: the correction (a linear least-squares problem solved exactly as one

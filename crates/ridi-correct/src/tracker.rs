@@ -167,7 +167,7 @@ pub struct Revision {
     pub first_frame: u64,
     /// Last frame re-integrated (the current frame).
     pub last_frame: u64,
-    /// The bias now applied to new frames, device frame.
+    /// The bias correction now added to new frames' linear acceleration, device frame.
     pub bias: DeviceVec,
 }
 

@@ -17,7 +17,8 @@
 //! [`FeatureExtractor::row_into`] computes one row for streaming use). [`compute_features`]
 //! does both steps. [`FeatureMatrixRef`] is the matrix's borrowed view, checked for whole rows
 //! of finite values: what ridi-regress's solvers take. Frames come from a
-//! [`SampleSchedule`]: every `step` frames from the first full window (training: step 10).
+//! [`SampleSchedule`]: every `step` frames from the first full window (`FeatureConfig`'s
+//! default step is 10; `ridi train` takes 20).
 //!
 //! # Configuration and standardization
 //!

@@ -134,7 +134,8 @@ impl Track {
         vecs_out(py, &self.inner.velocity)
     }
 
-    /// Estimated accelerometer bias, m/s², device frame, shape (N, 3).
+    /// The bias correction added to the linear acceleration (minus the accelerometer's
+    /// estimated bias), m/s², device frame, shape (N, 3).
     #[getter]
     fn bias<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<f64>> {
         vecs_out(py, &self.inner.bias)

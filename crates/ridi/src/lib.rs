@@ -29,7 +29,7 @@
 //!   tracking and evaluation all pass a sequence through [`oriented`] and derive the
 //!   correction's S from the model ([`TrackOptions::correction_for`]), so a model cannot be
 //!   applied to features it was not trained on.
-//! - **Batch and live tracking are one code path.** `ridi track --online` and [`track()`] with
+//! - **Online and live tracking are one code path.** `ridi track --online` and [`track()`] with
 //!   [`TrackOptions::online`] feed a recording through [`LiveTracker`] sample by sample, so the
 //!   streaming poses a program gets are the ones the command line tests. A recording whose
 //!   orientation was estimated before (`ridi track` estimates it once, for its plot) streams

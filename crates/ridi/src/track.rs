@@ -25,7 +25,8 @@ pub struct Track {
     pub position: Vec<WorldVec>,
     /// Velocity, world frame, m/s.
     pub velocity: Vec<WorldVec>,
-    /// Estimated accelerometer bias, device frame, m/s^2.
+    /// The bias correction added to the linear acceleration, device frame, m/s^2 (the
+    /// correction's `x` in `R (a + x)`: minus the accelerometer's estimated bias).
     pub bias: Vec<DeviceVec>,
     /// The regressed velocities the correction followed, at their frames.
     pub regressions: Vec<FrameVelocity>,
