@@ -160,3 +160,12 @@ def test_the_bundled_model_is_the_one_ridi_track_uses_without_a_model(ridi_bin, 
     ridi.track(seq, model).write_csv(tmp_path / "py.csv")
     same = (tmp_path / "py.csv").read_bytes() == out.read_bytes()
     assert same, "the bundled model tracks otherwise than `ridi track` without --model"
+
+
+def test_a_training_error_names_the_first_bad_sequence_whatever_the_threads():
+    seqs = ridi.read_list(SAMPLE / "list_Guillaume.txt", placement_map="tyrex4")
+    bare = [ridi.Sequence(s.time, s.gyro, s.acce, s.gravity, s.orientation, name=s.name,
+                          placement=s.placement) for s in seqs]
+    for jobs in (1, 2, 4, 4, 4):
+        with pytest.raises(ValueError, match=rf"sequence `{bare[0].name}`: has no ground truth"):
+            ridi.train(bare, grid="none", jobs=jobs)

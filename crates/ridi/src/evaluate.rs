@@ -343,6 +343,9 @@ pub fn evaluate(
     let done: Vec<Evaluated> = seqs
         .par_iter()
         .map(|s| evaluate_one(s, model, opts))
+        // The first error in the sequences' order, whatever the threads met first.
+        .collect::<Vec<Result<_>>>()
+        .into_iter()
         .collect::<Result<_>>()?;
     let reports = sequence_reports(done.iter().map(|e| &e.result));
     let summary = summarize(&reports)

@@ -172,13 +172,18 @@ pub fn training_data(seqs: &[Sequence], config: &FeatureConfig) -> Result<Traini
         })
         .collect::<Result<_>>()?;
     let names: Vec<String> = names.into_iter().map(str::to_string).collect();
+    // Every sequence before any work, in the order given: a bad one fails at once and the
+    // same one whatever the threads (the parallel pass below would report whichever it met).
+    for s in seqs {
+        check_frames(s, &config)?;
+        ground_truth_view(s)?;
+    }
     let ordered = canonical_order(seqs);
     let schedule = SampleSchedule::training(&config)?;
     let fx = FeatureExtractor::new(config.clone())?;
     let per_seq: Vec<(FeatureMatrix, Vec<StabHorizontal>)> = ordered
         .par_iter()
         .map(|s| {
-            check_frames(s, &config)?;
             // Features and targets do not see the heading (both live in S, and targets come
             // from the ground truth's orientation), so training skips its correction.
             let s = oriented(s, config.orientation, None)?;
@@ -188,6 +193,8 @@ pub fn training_data(seqs: &[Sequence], config: &FeatureConfig) -> Result<Traini
             let targets = compute_targets(&ground_truth_view(s)?, &config, &frames)?;
             Ok((features, targets.values))
         })
+        .collect::<Vec<Result<_>>>()
+        .into_iter()
         .collect::<Result<_>>()?;
     let mut data = TrainingData {
         features: FeatureMatrix::zeros(0, fx.dim()),
