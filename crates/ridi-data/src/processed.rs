@@ -3,10 +3,7 @@
 
 use std::path::Path;
 
-use ridi_frames::nalgebra::{Quaternion, UnitQuaternion};
-use ridi_frames::{
-    DeviceVec, EstimateError, FilterConfig, OrientationFilter, QuatError, WorldFromDevice,
-};
+use ridi_frames::{DeviceVec, EstimateError, FilterConfig, OrientationFilter, WorldFromDevice};
 
 use crate::error::{DataError, Location, Result};
 use crate::options::ReadOptions;
@@ -157,21 +154,6 @@ pub(crate) fn name_from_path(path: &Path) -> String {
     file_name(dir).filter(|n| !n.is_empty()).unwrap_or(stem)
 }
 
-/// A world-from-device rotation from `w, x, y, z`. Components already of unit norm to rounding
-/// are kept bit for bit (renormalizing would change the last bits and break exact round
-/// trips); others are checked against [`WorldFromDevice::NORM_TOLERANCE`] and normalized.
-pub(crate) fn rotation_wxyz(c: [f64; 4]) -> Result<WorldFromDevice, QuatError> {
-    let checked = WorldFromDevice::from_wxyz(c)?;
-    let q = Quaternion::new(c[0], c[1], c[2], c[3]);
-    if (q.norm() - 1.0).abs() <= 4.0 * f64::EPSILON {
-        Ok(WorldFromDevice::from_unit_quaternion(
-            UnitQuaternion::new_unchecked(q),
-        ))
-    } else {
-        Ok(checked)
-    }
-}
-
 fn vec3<F: ridi_frames::Frame>(rows: &[[f64; 27]], at: usize) -> Vec<ridi_frames::Vec3<F>> {
     rows.iter()
         .map(|r| ridi_frames::Vec3::new(r[at], r[at + 1], r[at + 2]))
@@ -194,7 +176,7 @@ pub(crate) fn rotation_at(
     path: &Path,
     line: usize,
 ) -> Result<WorldFromDevice> {
-    rotation_wxyz([r[at], r[at + 1], r[at + 2], r[at + 3]]).map_err(|e| {
+    WorldFromDevice::from_wxyz_as_given([r[at], r[at + 1], r[at + 2], r[at + 3]]).map_err(|e| {
         DataError::format(
             Location::line(path, line).with_field(PROCESSED_COLUMNS[at]),
             format!(
@@ -403,15 +385,5 @@ mod tests {
         assert_eq!(name_from_path(Path::new("seq3/data_plain.txt")), "seq3");
         assert_eq!(name_from_path(Path::new("/d/walk.csv")), "walk");
         assert_eq!(name_from_path(Path::new("data.csv")), "data");
-    }
-
-    #[test]
-    fn unit_quaternions_are_kept_bit_for_bit() {
-        let c = [0.5f64.sqrt(), 0.0, 0.0, 0.5f64.sqrt()];
-        let r = rotation_wxyz(c).unwrap();
-        assert_eq!(r.to_wxyz(), c);
-        assert!(rotation_wxyz([2.0, 0.0, 0.0, 0.0]).is_err());
-        let r = rotation_wxyz([1.001, 0.0, 0.0, 0.0]).unwrap();
-        assert_eq!(r.to_wxyz(), [1.0, 0.0, 0.0, 0.0]);
     }
 }

@@ -208,6 +208,20 @@ impl<To: Frame, From: Frame> Rot<To, From> {
         Self::checked(Quaternion::new(c[3], c[0], c[1], c[2]))
     }
 
+    /// From Hamilton components in `[w, x, y, z]` order as [`Self::from_wxyz`], except that
+    /// components already of unit norm to round-off (within 4 ulp of 1) are kept bit for bit:
+    /// normalizing them again would move their last bits, so that a rotation written and read
+    /// back, or rebuilt from its components, would differ from the original.
+    pub fn from_wxyz_as_given(c: [f64; 4]) -> Result<Self, QuatError> {
+        let checked = Self::from_wxyz(c)?;
+        let q = Quaternion::new(c[0], c[1], c[2], c[3]);
+        if (q.norm() - 1.0).abs() <= 4.0 * f64::EPSILON {
+            Ok(Self::from_unit_quaternion(UnitQuaternion::new_unchecked(q)))
+        } else {
+            Ok(checked)
+        }
+    }
+
     /// `q`, finite, normalized after checking the norm.
     fn checked(q: Quaternion<f64>) -> Result<Self, QuatError> {
         let norm = q.norm();
@@ -251,7 +265,11 @@ impl<To: Frame, From: Frame> Rot<To, From> {
         } else {
             other.q
         };
-        Self::from_unit_quaternion(self.q.try_slerp(&b, t, 1e-12).unwrap_or(self.q))
+        // nalgebra divides by the sine of half the angle between the two: for rotations a few
+        // microradians apart, its result strays from unit norm by up to 1e-9. Normalized again,
+        // it is unit to round-off, as every other rotation is.
+        let q = self.q.try_slerp(&b, t, 1e-12).unwrap_or(self.q);
+        Self::from_unit_quaternion(UnitQuaternion::new_normalize(q.into_inner()))
     }
 
     /// Angle of the relative rotation between `self` and `other`, radians in [0, pi].
@@ -330,6 +348,16 @@ impl<'de, To: Frame, From: Frame> Deserialize<'de> for Rot<To, From> {
 
 #[cfg(test)]
 mod tests {
+    #[test]
+    fn unit_quaternions_are_kept_bit_for_bit_as_given() {
+        let c = [0.5f64.sqrt(), 0.0, 0.0, 0.5f64.sqrt()];
+        let r = crate::WorldFromDevice::from_wxyz_as_given(c).unwrap();
+        assert_eq!(r.to_wxyz(), c);
+        assert!(crate::WorldFromDevice::from_wxyz_as_given([2.0, 0.0, 0.0, 0.0]).is_err());
+        let r = crate::WorldFromDevice::from_wxyz_as_given([1.001, 0.0, 0.0, 0.0]).unwrap();
+        assert_eq!(r.to_wxyz(), [1.0, 0.0, 0.0, 0.0]);
+    }
+
     use super::*;
 
     fn not_rotation(m: Matrix3<f64>) -> (f64, f64) {

@@ -17,8 +17,7 @@ use numpy::{
 use pyo3::exceptions::PyTypeError;
 use pyo3::prelude::*;
 use pyo3::types::{PyList, PyTuple};
-use ridi::frames::nalgebra::{Quaternion, UnitQuaternion};
-use ridi::frames::{Frame, QuatError, Vec3, WorldFromDevice};
+use ridi::frames::{Frame, Vec3, WorldFromDevice};
 
 use crate::errors;
 
@@ -166,28 +165,12 @@ pub(crate) fn rotations(view: ArrayView2<'_, f64>, name: &str) -> PyResult<Vec<W
         .into_iter()
         .enumerate()
         .map(|(i, r)| {
-            rotation([r[0], r[1], r[2], r[3]])
+            // As given when unit to round-off, so that a sequence rebuilt from another's
+            // arrays (or unpickled) tracks exactly as the original.
+            WorldFromDevice::from_wxyz_as_given([r[0], r[1], r[2], r[3]])
                 .map_err(|e| errors::value(format!("`{name}` at frame {i}: {e}")))
         })
         .collect()
-}
-
-/// `[w, x, y, z]` as a rotation, checked as the readers check one ([`Rot::from_wxyz`]). One
-/// already unit to round-off is kept as given: normalizing it again would move its last bits,
-/// and a sequence rebuilt from another's arrays, or a stream pushed from one, would not track
-/// exactly as the original.
-///
-/// [`Rot::from_wxyz`]: ridi::frames::Rot::from_wxyz
-pub(crate) fn rotation(c: [f64; 4]) -> Result<WorldFromDevice, QuatError> {
-    let checked = WorldFromDevice::from_wxyz(c)?;
-    let norm2: f64 = c.iter().map(|x| x * x).sum();
-    if (norm2 - 1.0).abs() > 8.0 * f64::EPSILON {
-        return Ok(checked);
-    }
-    let q = Quaternion::new(c[0], c[1], c[2], c[3]);
-    Ok(WorldFromDevice::from_unit_quaternion(
-        UnitQuaternion::new_unchecked(q),
-    ))
 }
 
 /// `rows` as a `(N, C)` float64 array.

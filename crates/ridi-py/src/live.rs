@@ -6,11 +6,11 @@ use pyo3::exceptions::PyTypeError;
 use pyo3::prelude::*;
 use ridi::correct::Update as RidiUpdate;
 use ridi::features::Orientation;
-use ridi::frames::DeviceVec;
+use ridi::frames::{DeviceVec, WorldFromDevice};
 use ridi::regress::Cascade;
 use ridi::{Recorded, SensorReading};
 
-use crate::arrays::{described, rotation};
+use crate::arrays::described;
 use crate::errors;
 use crate::model::Model;
 use crate::options;
@@ -207,7 +207,8 @@ impl LiveTracker {
         let linacce = linacce.map(|l| values::<3>(l, "linacce")).transpose()?;
         let estimated = self.model.feature_config().orientation == Orientation::Estimated;
         let quaternion = |q: [f64; 4]| {
-            rotation(q).map_err(|e| errors::value(format!("`orientation` at t = {time} s: {e}")))
+            WorldFromDevice::from_wxyz_as_given(q)
+                .map_err(|e| errors::value(format!("`orientation` at t = {time} s: {e}")))
         };
         let recorded = match (orientation, gravity, linacce) {
             (None, None, None) => None,
