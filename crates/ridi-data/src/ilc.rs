@@ -663,7 +663,8 @@ fn imu_spans(
             "{file}: dropouts of the accelerometer, gyroscope or rotation vector over \
              {MAX_SENSOR_GAP_S} s leave {} in the timeline (the longest {:.3} s, from {} to {} \
              ms), which `ridi track` refuses and `ridi convert --split-at-gaps \
-             {MAX_SENSOR_GAP_S}` cuts",
+             {MAX_SENSOR_GAP_S}` cuts (in Python `ridi.read_any(path, split_at_gaps=\
+             {MAX_SENSOR_GAP_S})`)",
             crate::counted(spans.len() - 1, "gap"),
             w[1].0 - w[0].1,
             ms(w[0].1),
@@ -1195,7 +1196,8 @@ mod tests {
                 "p/abc.txt: dropouts of the accelerometer, gyroscope or rotation vector over 0.1 \
                  s leave 1 gap in the timeline (the longest 0.5"
             ) && read.warnings[0].ends_with(
-                "which `ridi track` refuses and `ridi convert --split-at-gaps 0.1` cuts"
+                "which `ridi track` refuses and `ridi convert --split-at-gaps 0.1` cuts (in \
+                 Python `ridi.read_any(path, split_at_gaps=0.1)`)"
             ),
             "{}",
             read.warnings[0]

@@ -316,7 +316,8 @@ pub(crate) fn check_step(
                 next - prev,
                 short(max_gap_s),
                 if splittable {
-                    ": `ridi convert --split-at-gaps 0.1` does"
+                    ": `ridi convert --split-at-gaps 0.1` does; in Python \
+                     `ridi.read_any(path, split_at_gaps=0.1)`"
                 } else {
                     ""
                 }

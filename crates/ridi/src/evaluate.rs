@@ -398,6 +398,7 @@ pub fn evaluate(
         Vec::new()
     };
     warnings.extend(weak_alignment(&results, opts.metrics.align));
+    warnings.extend(still_ahead(&summary));
     Ok((
         Report {
             sequences: results,
@@ -414,6 +415,22 @@ pub fn evaluate(
         },
         traces,
     ))
+}
+
+/// The warning that standing still (`still`) scores a lower mean ATE than RIDI: the walks stay
+/// in an area small against RIDI's drift, where ATE rewards staying put and says little about
+/// tracking.
+fn still_ahead(summary: &BTreeMap<String, TrajectoryMetrics>) -> Option<String> {
+    let ridi = summary.get(Method::Ridi.key())?;
+    let still = summary.get(Method::Still.key())?;
+    (still.ate_m < ridi.ate_m).then(|| {
+        format!(
+            "standing still (`still`) has a lower mean ATE than ridi ({:.3} m against {:.3} m): \
+             the walks stay within an area small against ridi's error, where ATE rewards a \
+             trajectory that stays put; RTE 5 s and the path length ratio say more",
+            still.ate_m, ridi.ate_m
+        )
+    })
 }
 
 /// The warning about the sequences whose ground truth moves less than
@@ -782,6 +799,39 @@ impl Traces {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn standing_still_ahead_of_ridi_on_ate_is_a_warning() {
+        let metrics = |ate_m| TrajectoryMetrics {
+            mpe_m: 0.0,
+            mpe_pct: None,
+            ate_m,
+            rte_m: 0.0,
+            ate_ronin_m: 0.0,
+            rte_ronin_m: 0.0,
+            rte_5s_m: 0.0,
+            path_length_ratio: None,
+        };
+        let summary = |ridi, still| {
+            BTreeMap::from([
+                ("ridi".to_string(), metrics(ridi)),
+                ("still".to_string(), metrics(still)),
+            ])
+        };
+        let w = still_ahead(&summary(2.0, 1.5)).unwrap();
+        assert!(
+            w.starts_with(
+                "standing still (`still`) has a lower mean ATE than ridi (1.500 m against 2.000 m)"
+            ),
+            "{w}"
+        );
+        assert_eq!(still_ahead(&summary(1.0, 1.5)), None);
+        // Without either method there is nothing to compare.
+        assert_eq!(
+            still_ahead(&BTreeMap::from([("ridi".into(), metrics(2.0))])),
+            None
+        );
+    }
 
     fn result(name: &str, device: Option<&str>, rte: f64) -> SequenceResult {
         let metrics = TrajectoryMetrics {
