@@ -412,7 +412,9 @@ impl Validation {
         dd: f64,
         n: usize,
     ) -> Result<(), SequenceError> {
-        if n == 0 || (dd / n as f64).sqrt() < LINACCE_SCALE_MIN_RMS {
+        // NaN sums pass as too small to judge, not as a scale.
+        let rms = (dd / n as f64).sqrt();
+        if n == 0 || rms.is_nan() || rms < LINACCE_SCALE_MIN_RMS {
             return Ok(());
         }
         // acce - gravity ~ scale * linacce; an all-zero linear acceleration is no scale at all.

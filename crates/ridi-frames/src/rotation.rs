@@ -209,7 +209,8 @@ impl<To: Frame, From: Frame> Rot<To, From> {
     }
 
     /// From Hamilton components in `[w, x, y, z]` order as [`Self::from_wxyz`], except that
-    /// components already of unit norm to round-off (within 4 ulp of 1) are kept bit for bit:
+    /// components already of unit norm to round-off (a norm within 4 machine epsilons of 1) are
+    /// kept bit for bit:
     /// normalizing them again would move their last bits, so that a rotation written and read
     /// back, or rebuilt from its components, would differ from the original.
     pub fn from_wxyz_as_given(c: [f64; 4]) -> Result<Self, QuatError> {
@@ -342,12 +343,29 @@ impl<To: Frame, From: Frame> Serialize for Rot<To, From> {
 impl<'de, To: Frame, From: Frame> Deserialize<'de> for Rot<To, From> {
     fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
         let c = <[f64; 4]>::deserialize(d)?;
-        Self::from_wxyz(c).map_err(serde::de::Error::custom)
+        // Bit for bit when unit to round-off, so that a serde round trip changes nothing.
+        Self::from_wxyz_as_given(c).map_err(serde::de::Error::custom)
     }
 }
 
 #[cfg(test)]
 mod tests {
+    #[test]
+    fn slerp_between_close_rotations_stays_unit() {
+        use nalgebra::Vector3;
+        let a = crate::WorldFromDevice::from_scaled_axis(Vector3::new(0.3, -1.2, 0.7));
+        for gap in [1e-9, 1e-7, 1e-6, 1e-4] {
+            let b = crate::WorldFromDevice::from_scaled_axis(Vector3::new(0.3 + gap, -1.2, 0.7));
+            for t in [0.1, 0.5, 0.9] {
+                let norm = a.slerp(&b, t).quaternion().norm();
+                assert!(
+                    (norm - 1.0).abs() <= 4.0 * f64::EPSILON,
+                    "{gap} {t}: {norm}"
+                );
+            }
+        }
+    }
+
     #[test]
     fn unit_quaternions_are_kept_bit_for_bit_as_given() {
         let c = [0.5f64.sqrt(), 0.0, 0.0, 0.5f64.sqrt()];

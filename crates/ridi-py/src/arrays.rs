@@ -16,7 +16,7 @@ use numpy::{
 };
 use pyo3::exceptions::PyTypeError;
 use pyo3::prelude::*;
-use pyo3::types::{PyList, PyTuple};
+use pyo3::types::{PyBytes, PyString};
 use ridi::frames::{Frame, Vec3, WorldFromDevice};
 
 use crate::errors;
@@ -35,37 +35,31 @@ fn shape_text(shape: &[usize]) -> String {
 /// `obj` as a numpy array of float64, or a `TypeError` naming the argument `name`.
 ///
 /// A float64 array is taken as it is (read in place). Another array of real numbers (float32,
-/// integers) and what numpy reads as one (a list, a pandas column or frame) are converted, as
-/// `np.asarray(obj, dtype=np.float64)` would: a copy, exact for every float32 and for integers
-/// up to 2^53. `time` alone refuses float16 and float32: their 11 or 24 bits have rounded
-/// the timestamps already (to 0.24 ms an hour into a recording, to minutes at Unix times).
+/// integers, objects that are numbers: a pandas nullable column) and what numpy reads as one
+/// (a list, a pandas column or frame, an `array.array`) are converted as `np.asarray(obj,
+/// dtype=np.float64)` would: a copy, exact for every float32 and for integers up to 2^53.
+/// `time` alone refuses float16 and float32: their 11 or 24 bits have rounded the timestamps
+/// already (to 0.24 ms an hour into a recording, to minutes at Unix times).
 fn float64<'py>(obj: &Bound<'py, PyAny>, name: &str) -> PyResult<Bound<'py, PyUntypedArray>> {
     let py = obj.py();
+    let not_numbers = |why: String| {
+        PyTypeError::new_err(format!(
+            "`{name}` must be an array of numbers (a numpy array, a list of numbers or a pandas \
+             column), not {}{why}",
+            described(obj)
+        ))
+    };
     let array = match obj.cast::<PyUntypedArray>() {
         Ok(array) => array.clone(),
-        Err(_) => {
-            let readable = obj.is_instance_of::<PyList>()
-                || obj.is_instance_of::<PyTuple>()
-                || obj.hasattr("__array__")?;
-            let converted = readable
-                .then(|| {
-                    py.import("numpy")
-                        .and_then(|np| np.call_method1("asarray", (obj,)))
-                        .ok()
-                        .and_then(|a| a.cast_into::<PyUntypedArray>().ok())
-                })
-                .flatten();
-            match converted {
-                Some(array) => array,
-                None => {
-                    return Err(PyTypeError::new_err(format!(
-                        "`{name}` must be an array of numbers (a numpy array, a list of \
-                         numbers or a pandas column), not {}",
-                        described(obj)
-                    )));
-                }
-            }
+        // Text is a sequence numpy would read as one string, not numbers.
+        Err(_) if obj.is_instance_of::<PyString>() || obj.is_instance_of::<PyBytes>() => {
+            return Err(not_numbers(String::new()));
         }
+        Err(_) => py
+            .import("numpy")?
+            .call_method1("asarray", (obj,))
+            .map_err(|e| not_numbers(format!(" (numpy: {e})")))?
+            .cast_into::<PyUntypedArray>()?,
     };
     let found = array.dtype();
     if found.is_equiv_to(&dtype::<f64>(py)) {
@@ -73,11 +67,13 @@ fn float64<'py>(obj: &Bound<'py, PyAny>, name: &str) -> PyResult<Bound<'py, PyUn
     }
     let kind = found.kind();
     let coarse_time = name == "time" && kind == b'f' && found.itemsize() < 8;
-    if matches!(kind, b'f' | b'i' | b'u') && !coarse_time {
-        return array
-            .call_method1("astype", ("float64",))?
-            .cast_into::<PyUntypedArray>()
-            .map_err(PyErr::from);
+    if matches!(kind, b'f' | b'i' | b'u' | b'O') && !coarse_time {
+        return match array.call_method1("astype", ("float64",)) {
+            Ok(converted) => Ok(converted.cast_into::<PyUntypedArray>()?),
+            Err(e) => Err(PyTypeError::new_err(format!(
+                "`{name}` has dtype {found} and values that are not real numbers (numpy: {e})"
+            ))),
+        };
     }
     let convert = match kind {
         // Numpy dates and durations: a cast to float64 would give nanoseconds, not seconds.

@@ -176,16 +176,6 @@ impl Inputs {
                         later.name()
                     )));
                 }
-                // As a list refuses a copy of a recording it has: a renamed copy would count
-                // twice, or sit on both sides of a cross-validation split.
-                if let Some(i) = seqs[..j].iter().position(|s| s.is_same_recording(later)) {
-                    return Err(errors::value(format!(
-                        "sequences {i} (`{}`) and {j} (`{}`) are the same recording (the same \
-                         timestamps, gyro and accelerometer samples): it would count twice",
-                        seqs[i].name(),
-                        later.name()
-                    )));
-                }
             }
             return Ok(Inputs::Sequences(seqs));
         }

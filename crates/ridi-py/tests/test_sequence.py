@@ -188,6 +188,12 @@ def test_arrays_of_other_real_dtypes_and_array_likes_read_as_float64(seq):
     built, reference = ridi.Sequence(**given), ridi.Sequence(**expected)
     for key in ("time", "gyro", "acce", "gravity", "linacce", "orientation"):
         np.testing.assert_array_equal(getattr(built, key), getattr(reference, key), err_msg=key)
+    # Objects that are numbers (a pandas nullable column's values), array.array: as numpy reads.
+    import array
+    boxed = ridi.Sequence(**dict(args, gyro=args["gyro"].astype(object),
+                                 time=array.array("d", args["time"])))
+    np.testing.assert_array_equal(boxed.gyro, args["gyro"])
+    np.testing.assert_array_equal(boxed.time, args["time"])
     # Integers convert exactly.
     whole = np.round(args["acce"]).astype(np.int32)
     rounded = ridi.Sequence(**dict(args, acce=whole))
@@ -220,7 +226,9 @@ def test_linacce_defaults_to_acce_minus_gravity(seq):
          r"`acce` must be an array of numbers \(a numpy array, a list of numbers or a pandas "
          r"column\), not str of length 8"),
         (lambda a: a.update(acce=[[0.0, 1.0, 2.0], [3.0]]), TypeError,
-         r"`acce` must be an array of numbers"),
+         r"`acce` must be an array of numbers .*not list of length 2 \(numpy: .*inhomogeneous"),
+        (lambda a: a.update(acce=np.array([["x", 1.0, 2.0]] * len(a["time"]), dtype=object)),
+         TypeError, r"`acce` has dtype object and values that are not real numbers \(numpy: "),
         (lambda a: a.update(gyro=a["gyro"][:, :2]), ValueError,
          r"`gyro` must have shape \(\d+, 3\), one row per frame of `time`; it has shape \(\d+, 2\)"),
         (lambda a: a.update(gravity=a["gravity"][:-1]), ValueError,

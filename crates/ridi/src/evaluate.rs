@@ -336,6 +336,7 @@ pub fn evaluate(
     if seqs.is_empty() {
         return Err(PipelineError::NoSequences("evaluate"));
     }
+    crate::check_distinct_recordings(seqs)?;
     // Every sequence before any work: a bad one fails in a second, not after the others.
     for s in seqs {
         check_evaluable(s, model.feature_config(), opts)?;

@@ -120,7 +120,7 @@ pub use inspect::{
     Inspection, ModelInspection, PlacementModel, RegressorSummary, SeriesStats, inspect,
     inspect_model, inspect_stream,
 };
-pub use lists::{Purpose, load_listed};
+pub use lists::{Purpose, check_distinct_recordings, load_listed};
 pub use live::{
     CascadeRegressor, LiveTracker, Recorded, STREAM_ACCE_G, STREAM_CHECK_SAMPLES,
     STREAM_GYRO_CHECK_S, STREAM_MIN_GYRO_AGREEMENT, SensorReading,

@@ -139,3 +139,25 @@ impl PipelineError {
         }
     }
 }
+
+/// Refuses two of `seqs` that are one recording, whatever their names
+/// ([`Sequence::is_same_recording`]): it would count twice in every mean, or be tested on after
+/// training on it. [`Listed::load`] refuses copies within list files; this makes the same check
+/// for sequences given otherwise (built in a program, in Python). The error names the later
+/// one and the index of the earlier.
+pub fn check_distinct_recordings(seqs: &[Sequence]) -> Result<()> {
+    for (j, later) in seqs.iter().enumerate() {
+        if let Some(i) = seqs[..j].iter().position(|s| s.is_same_recording(later)) {
+            return Err(PipelineError::sequence(
+                later.name(),
+                format!(
+                    "is the same recording as sequence {i}, `{}` (the same timestamps, gyro and \
+                     accelerometer samples); given twice it would count twice, or be tested on \
+                     after training on it",
+                    ridi_data::shown(seqs[i].name())
+                ),
+            ));
+        }
+    }
+    Ok(())
+}

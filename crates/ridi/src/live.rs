@@ -199,7 +199,7 @@ impl SensorReading {
 /// [`STREAM_CHECK_SAMPLES`] are right (a sample given again is refused again). A stream whose
 /// gyro turns against the recorded orientation pushed with it (a sign flipped, most
 /// quaternions with their components in another order) is refused once
-/// [`STREAM_GYRO_CHECK_S`] of samples came with one, and from then on. Pushing after [`finish`](Self::finish) is refused
+/// consecutive samples with one cover [`STREAM_GYRO_CHECK_S`], and from then on. Pushing after [`finish`](Self::finish) is refused
 /// too. A gap longer than the correction integrates across (its `max_dt`, 0.1 s:
 /// a dropped sensor buffer, say) starts a new segment ([`GapPolicy::Restart`]): the position is
 /// held, velocity and bias start over, and the update says
@@ -301,9 +301,10 @@ impl<'m> LiveTracker<'m> {
         })
     }
 
-    /// This tracker, not judging the gyro against the recorded orientation: for a sequence
-    /// whose whole recording passed that check ([`ridi_data::Validation::check_gyro_scale`]),
-    /// whose stretches need not each agree as much.
+    /// This tracker, not judging the recorded orientation, gravity and linear acceleration
+    /// (the gyro against the orientation, gravity against its up axis, the linear
+    /// acceleration's scale): for a sequence whose whole recording passed those checks
+    /// ([`ridi_data::Validation`]), whose stretches need not each agree as much.
     pub(crate) fn judged_whole(mut self) -> Self {
         self.stream.judged_whole = true;
         self
@@ -379,10 +380,10 @@ impl<'m> LiveTracker<'m> {
         self.drain(out)
     }
 
-    /// Refuses a non-finite time, gyro or accelerometer, and a value no phone sensor gives (the
-    /// readers' [`Validation::limit`]s: a corrupt sample, or mm/s^2 for m/s^2), naming the
-    /// field, the sample and its time. A recorded orientation's non-finite fields are refused
-    /// where they are used.
+    /// Refuses a non-finite time, gyro, accelerometer, recorded gravity or linear acceleration
+    /// (the stream's check judges those two, whatever the model uses), and a value no phone
+    /// sensor gives (the readers' [`Validation::limit`]s: a corrupt sample, or mm/s^2 for
+    /// m/s^2), naming the field, the sample and its time.
     fn check_values(&self, sample: &SensorReading) -> Result<()> {
         let index = self.accepted();
         if !sample.time.is_finite() {
@@ -391,10 +392,16 @@ impl<'m> LiveTracker<'m> {
                 sample.time
             )));
         }
+        let recorded = sample.recorded.as_ref();
         for (name, v) in [
-            ("gyro", sample.gyro.to_array()),
-            ("acce", sample.acce.to_array()),
+            ("gyro", Some(sample.gyro)),
+            ("acce", Some(sample.acce)),
+            ("gravity", recorded.map(|r| r.gravity)),
+            ("linacce", recorded.map(|r| r.linacce)),
         ] {
+            let Some(v) = v.map(|v| v.to_array()) else {
+                continue;
+            };
             if let Some(axis) = (0..3).find(|&a| !v[a].is_finite()) {
                 return Err(PipelineError::Live(format!(
                     "`{name}.{}` of sample {index} is {}, not a finite number (t = {} s)",
@@ -404,7 +411,6 @@ impl<'m> LiveTracker<'m> {
                 )));
             }
         }
-        let recorded = sample.recorded.as_ref();
         let vectors = [
             (Channel::Gyro, Some(sample.gyro)),
             (Channel::Acce, Some(sample.acce)),
@@ -486,8 +492,8 @@ impl<'m> LiveTracker<'m> {
 /// regressed.
 pub const STREAM_CHECK_SAMPLES: usize = 200;
 
-/// Seconds of samples pushed with a recorded orientation after which [`LiveTracker`] judges
-/// the direction of the gyro against it, over all of them ([`ridi_data::GyroFit::agreement`]
+/// Seconds covered by pairs of consecutive samples pushed with a recorded orientation after
+/// which [`LiveTracker`] judges the direction of the gyro against it, over all of them ([`ridi_data::GyroFit::agreement`]
 /// against [`STREAM_MIN_GYRO_AGREEMENT`]): a gyro with its sign flipped, or most quaternions
 /// given in another component order, are refused from then on. (Samples pushed with a
 /// recorded orientation only every other time give no pair of consecutive ones to judge.)
@@ -547,16 +553,16 @@ impl Judged {
 /// The last [`STREAM_CHECK_SAMPLES`] of a stream, and whether the median of each quantity
 /// lies beyond its bounds, from counts ([`MedianTest`], as the readers judge a recording), so
 /// that a median is judged in constant time per sample; the linear acceleration's scale from
-/// sums kept over the same samples.
+/// sums over the same samples.
 #[derive(Debug, Default)]
 struct StreamCheck {
     last_time: Option<f64>,
     /// The last sample's time, gyro and recorded orientation, when it had one.
     last_recorded: Option<(f64, DeviceVec, WorldFromDevice)>,
-    /// The gyro against the recorded orientation, from the first pair of consecutive samples
-    /// with one (its first sample's time) on.
+    /// The gyro against the recorded orientation, over the pairs of consecutive samples with
+    /// one, and the seconds those pairs cover.
     gyro_fit: ridi_data::GyroFit,
-    gyro_since: Option<f64>,
+    gyro_covered: f64,
     /// Why the gyro was refused, once it was: it stays so.
     gyro_refused: Option<String>,
     /// The recorded orientation is not judged: a recording validated whole streamed
@@ -568,12 +574,6 @@ struct StreamCheck {
     /// accelerometer too strong, a gravity far from the orientation's up axis, a gravity too
     /// strong.
     medians: [MedianTest; 5],
-    /// Sums of the recent samples' [`JudgedRecorded::linacce_terms`], and how many.
-    linacce_sums: [f64; 3],
-    linacce_count: usize,
-    /// Samples dropped from `recent` since the sums were last added up afresh (they are, once
-    /// every window, so that rounding does not build up over a long stream).
-    dropped: usize,
     /// Why the last sample judged was refused, while the stream stays refused: a sample given
     /// again (its time not after the last one) gets the same answer.
     refused: Option<String>,
@@ -636,7 +636,7 @@ impl StreamCheck {
                 .map(|r| (sample.time, sample.gyro, r.orientation));
             if let (Some((t0, g0, q0)), Some((t1, g1, q1))) = (self.last_recorded, recorded) {
                 self.gyro_fit.add_steps(&[t0, t1], &[g0, g1], &[q0, q1]);
-                self.gyro_since.get_or_insert(t0);
+                self.gyro_covered += t1 - t0;
             }
             self.last_recorded = recorded;
         }
@@ -659,19 +659,9 @@ impl StreamCheck {
             && let Some(old) = self.recent.pop_front()
         {
             self.count(&old, limits, false);
-            self.dropped += 1;
-            if self.dropped >= STREAM_CHECK_SAMPLES {
-                self.dropped = 0;
-                self.linacce_sums = [0.0; 3];
-                for r in self.recent.iter().filter_map(|e| e.recorded) {
-                    for (sum, term) in self.linacce_sums.iter_mut().zip(r.linacce_terms) {
-                        *sum += term;
-                    }
-                }
-            }
         }
         if self.gyro_refused.is_none() {
-            self.gyro_refused = self.gyro_refusal(sample.time);
+            self.gyro_refused = self.gyro_refusal();
         }
         self.refused = self
             .gyro_refused
@@ -684,7 +674,7 @@ impl StreamCheck {
         }
     }
 
-    /// Counts `entry` into the medians and sums (`add`), or out of them.
+    /// Counts `entry` into the medians (`add`), or out of them.
     fn count(&mut self, entry: &Judged, limits: &Validation, add: bool) {
         for (m, (low, high)) in self.medians.iter_mut().zip(Self::properties(entry, limits)) {
             if add {
@@ -693,49 +683,45 @@ impl StreamCheck {
                 m.pop(low, high);
             }
         }
-        if let Some(r) = entry.recorded {
-            let sign = if add { 1.0 } else { -1.0 };
-            for (sum, term) in self.linacce_sums.iter_mut().zip(r.linacce_terms) {
-                *sum += sign * term;
-            }
-            if add {
-                self.linacce_count += 1;
-            } else {
-                self.linacce_count -= 1;
-            }
-        }
     }
 
     /// Why the last [`STREAM_CHECK_SAMPLES`] are refused, once there are that many and most
     /// came with a recorded linear acceleration: its scale against accelerometer minus gravity
-    /// ([`Validation::linacce_scale_verdict`]).
+    /// over those that did ([`Validation::linacce_scale_verdict`]). The sums are added up
+    /// afresh each time (600 products): kept by adding and taking away, they would leave a
+    /// residue of round-off that a still phone's zero sums cannot absorb.
     fn linacce_refusal(&self, limits: &Validation) -> Option<String> {
-        if self.recent.len() < STREAM_CHECK_SAMPLES || self.linacce_count * 2 < self.recent.len() {
+        if self.recent.len() < STREAM_CHECK_SAMPLES {
             return None;
         }
-        let [dl, ll, dd] = self.linacce_sums;
-        let e = limits
-            .linacce_scale_verdict(dl, ll, dd, self.linacce_count)
-            .err()?;
-        Some(format!(
-            "the stream's last {} samples: {e}",
-            self.recent.len()
-        ))
+        let (mut sums, mut count) = ([0.0; 3], 0);
+        for r in self.recent.iter().filter_map(|e| e.recorded) {
+            for (sum, term) in sums.iter_mut().zip(r.linacce_terms) {
+                *sum += term;
+            }
+            count += 1;
+        }
+        if count * 2 < self.recent.len() {
+            return None;
+        }
+        let [dl, ll, dd] = sums;
+        let e = limits.linacce_scale_verdict(dl, ll, dd, count).err()?;
+        Some(format!("the stream's last {count} samples with one: {e}"))
     }
 
-    /// Why the gyro is refused at `time`: it turns against the recorded orientation, judged
-    /// from [`STREAM_GYRO_CHECK_S`] of samples with one on.
-    fn gyro_refusal(&self, time: f64) -> Option<String> {
-        let since = time - self.gyro_since?;
+    /// Why the gyro is refused: it turns against the recorded orientation, judged once the
+    /// pairs of consecutive samples with one cover [`STREAM_GYRO_CHECK_S`].
+    fn gyro_refusal(&self) -> Option<String> {
+        let covered = self.gyro_covered;
         let agreement = self.gyro_fit.agreement()?;
-        (since >= STREAM_GYRO_CHECK_S && agreement < STREAM_MIN_GYRO_AGREEMENT).then(|| {
+        (covered >= STREAM_GYRO_CHECK_S && agreement < STREAM_MIN_GYRO_AGREEMENT).then(|| {
             let e = ridi_data::SequenceError::GyroDirection {
                 agreement,
                 min: STREAM_MIN_GYRO_AGREEMENT,
             };
             format!(
                 "the stream's {} s with a recorded orientation: {e}",
-                ridi_data::short(since)
+                ridi_data::short(covered)
             )
         })
     }

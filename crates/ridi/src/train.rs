@@ -155,6 +155,7 @@ pub fn training_data(seqs: &[Sequence], config: &FeatureConfig) -> Result<Traini
     if seqs.is_empty() {
         return Err(PipelineError::NoSequences("train on"));
     }
+    crate::check_distinct_recordings(seqs)?;
     let config = FeatureConfig {
         standardization: None,
         ..config.clone()

@@ -354,6 +354,26 @@ fn training_without_labels_or_ground_truth_names_the_sequence() {
         .unwrap_err()
         .to_string();
     assert!(err.contains("window"), "{err}");
+
+    // A renamed copy of a recording is the recording: refused by training and evaluation, as
+    // a list refuses it, naming the copy and the index of the original.
+    let mut seqs = load("list_Thibaud.txt");
+    let mut copy = seqs[1].clone();
+    copy.set_name("renamed");
+    seqs.push(copy);
+    let expected = format!(
+        "sequence `renamed`: is the same recording as sequence 1, `{}`",
+        seqs[1].name()
+    );
+    let err = ridi::train(&seqs, &TrainOptions::default(), &mut NoProgress)
+        .unwrap_err()
+        .to_string();
+    assert!(err.starts_with(&expected), "{err}");
+    let model = quick_model(&load("list_Guillaume.txt"));
+    let err = ridi::evaluate(&seqs, &model, &ridi::EvalOptions::default())
+        .unwrap_err()
+        .to_string();
+    assert!(err.starts_with(&expected), "{err}");
 }
 
 #[test]
@@ -770,14 +790,58 @@ fn a_live_stream_at_a_wrong_rate_or_unit_is_refused_by_its_first_window() {
         s
     };
     assert!(live.push(&flipped(i + 1), &mut updates).is_err());
-    // Stays so, also for samples that agree again (an agreement over the whole stream near 0
-    // would otherwise be refused and taken by turns).
-    let again = live.push(&SensorReading::of_frame(&seq, i + 2), &mut updates);
-    assert_eq!(again.unwrap_err().to_string(), err);
+    // Stays so, also through the rest of the recording as recorded and the whole of it again,
+    // which take the agreement over the whole stream back above 0 (the fit the check keeps,
+    // made here apart).
+    let again = seq.time()[seq.len() - 1] - t0 + 0.005;
+    let passes = (i + 2..seq.len()).map(|j| (j, 0.0));
+    for (j, shift) in passes.chain((0..seq.len()).map(|j| (j, again))) {
+        let mut s = SensorReading::of_frame(&seq, j);
+        s.time += shift;
+        let e = live.push(&s, &mut updates).unwrap_err().to_string();
+        assert_eq!(e, err, "sample {j} + {shift} s");
+    }
+    let mut gyro: Vec<DeviceVec> = seq.gyro().to_vec();
+    for g in &mut gyro[..=i + 1] {
+        *g = *g * -1.0;
+    }
+    let mut fit = ridi::data::GyroFit::default();
+    fit.add_steps(seq.time(), &gyro, seq.orientation());
+    fit.add_steps(seq.time(), seq.gyro(), seq.orientation());
+    assert!(fit.agreement().unwrap() > 0.0, "{:?}", fit.agreement());
     let mut live = LiveTracker::new(&model, &opts).unwrap();
     for i in 0..seq.len() {
         live.push(&SensorReading::of_frame(&seq, i), &mut updates)
             .unwrap();
+    }
+    // A phone lying still after 2 s of walking: accelerometer and gravity equal, the linear
+    // acceleration zero, exactly; no scale to judge (the walk's sums leave no residue).
+    let mut live = LiveTracker::new(&model, &opts).unwrap();
+    for i in 0..1000 {
+        let mut s = SensorReading::of_frame(&seq, i);
+        if i >= 400 {
+            let r = recorded(&mut s);
+            r.linacce = DeviceVec::ZERO;
+            s.acce = r.gravity;
+        }
+        live.push(&s, &mut updates).unwrap();
+    }
+    // A non-finite recorded linear acceleration or gravity is refused on its own sample, by
+    // name, and the stream goes on.
+    let mut live = LiveTracker::new(&model, &opts).unwrap();
+    for i in 0..600 {
+        let mut s = SensorReading::of_frame(&seq, i);
+        if i == 300 {
+            recorded(&mut s).linacce = DeviceVec::new(f64::NAN, 0.0, 0.0);
+            let e = live.push(&s, &mut updates).unwrap_err().to_string();
+            assert!(e.contains("`linacce.x` of sample 300 is NaN"), "{e}");
+            recorded(&mut s).linacce = DeviceVec::ZERO;
+            recorded(&mut s).gravity = DeviceVec::new(0.0, f64::INFINITY, 0.0);
+            let e = live.push(&s, &mut updates).unwrap_err().to_string();
+            assert!(e.contains("`gravity.y` of sample 300 is inf"), "{e}");
+            continue;
+        }
+        live.push(&s, &mut updates).unwrap();
     }
 
     // Two seconds at 100 Hz (frames 0-399 stretched twofold), then 200 Hz again: refused
