@@ -28,13 +28,14 @@ def print_table(report):
         f"\n{len(report['sequences'])} sequences; velocity MSE S-x {mse[0]:.3f} S-z {mse[1]:.3f}"
         f" (m/s)^2; placement accuracy {'-' if accuracy is None else f'{accuracy:.3f}'}"
     )
-    print(f"{'method':<10} {'RTE 5s m':>9} {'ATE m':>9} {'RTE m':>9} {'MPE m':>9} {'path ratio':>11}")
+    print(f"{'method':<10} {'RTE 5 s m':>9} {'ATE m':>9} {'RTE 60 s m':>10} {'MPE m':>9}"
+          f" {'path length ratio':>17}")
     for key in report["methods"]:
         m = report["summary"][key]
         ratio = "-" if m["path_length_ratio"] is None else f"{m['path_length_ratio']:.3f}"
         print(
-            f"{key:<10} {m['rte_5s_m']:>9.3f} {m['ate_m']:>9.3f} {m['rte_m']:>9.3f}"
-            f" {m['mpe_m']:>9.3f} {ratio:>11}"
+            f"{key:<10} {m['rte_5s_m']:>9.3f} {m['ate_m']:>9.3f} {m['rte_m']:>10.3f}"
+            f" {m['mpe_m']:>9.3f} {ratio:>17}"
         )
     # Each device's mean RTE 5 s when the sequences span phones (`ridi::Report::per_device`).
     devices = sorted({s["device"] for s in report["sequences"] if s.get("device")})

@@ -1269,6 +1269,7 @@ mod tests {
         let metrics = metrics_with_rte;
         SequenceResult {
             name: name.into(),
+            run: name.into(),
             placement: Some("hand".into()),
             device: None,
             path_length_m: 1.0,
@@ -1322,7 +1323,9 @@ mod tests {
         assert_eq!(runs[0].swapped_rte, [2.0, 1.0, 0.3]);
         // No RIDI-MAG in these results: the figure is missing, not zero.
         assert!(runs[0].values[7].is_nan());
-        let all: Vec<&RunFigures> = runs.iter().collect();
+        // Three copies of the two runs: enough runs for an interval (ridi_eval's
+        // MIN_INTERVAL_RUNS), the same means.
+        let all: Vec<&RunFigures> = runs.iter().cycle().take(6).collect();
         // Each run counts once: (4 + 2.5) / 2, and RIDI - PDR (3 + 0.5) / 2.
         assert_eq!(figure(&all, RTE).unwrap().mean, 3.25);
         assert_eq!(ridi_minus_pdr(&all).unwrap().mean, 1.75);
@@ -1331,32 +1334,35 @@ mod tests {
 
     #[test]
     fn two_reports_compare_run_by_run() {
-        let table = |rte: [f64; 3]| {
+        let table = |rte: [f64; 5]| {
             format!(
                 "# x\n\n## Both phones, per run\n\n| run | placement | RTE 5 s (m) | PDR RTE 5 s (m) | \
                  velocity MSE S-x / S-z | path length ratio | placement accuracy |\n| --- | --- | \
                  --- | --- | --- | --- | --- |\n\
                  | A_Nexus5_NoDist_AR | hand | {} | 2.0 | 0.1 / 0.2 | 0.9 | 1.0 |\n\
                  | B_iPhone4S_NoDist_AR | hand | {} | 2.0 | 0.1 / 0.2 | 0.9 | 1.0 |\n\
-                 | C_Nexus5_Dist_AR | hand | {} | 2.0 | 0.1 / 0.2 | 0.9 | 1.0 |\n\n## Training\n\n\
-                 | model | without |\n",
-                rte[0], rte[1], rte[2]
+                 | C_Nexus5_Dist_AR | hand | {} | 2.0 | 0.1 / 0.2 | 0.9 | 1.0 |\n\
+                 | D_Nexus5_NoDist_Texting | hand | {} | 2.0 | 0.1 / 0.2 | 0.9 | 1.0 |\n\
+                 | E_iPhone4S_NoDist_Texting | hand | {} | 2.0 | 0.1 / 0.2 | 0.9 | 1.0 |\n\n\
+                 ## Training\n\n| model | without |\n",
+                rte[0], rte[1], rte[2], rte[3], rte[4]
             )
         };
-        let rows = per_run_table(&table([1.0, 2.0, 3.0])).unwrap();
-        assert_eq!(rows.len(), 3);
+        let rows = per_run_table(&table([1.0, 2.0, 3.0, 4.0, 5.0])).unwrap();
+        assert_eq!(rows.len(), 5);
         assert_eq!(rows["B_iPhone4S_NoDist_AR"].mse, [0.1, 0.2]);
         let dir = tempfile::tempdir().unwrap();
         let (a, b) = (dir.path().join("a.md"), dir.path().join("b.md"));
-        std::fs::write(&a, table([1.0, 2.0, 3.0])).unwrap();
-        std::fs::write(&b, table([1.5, 2.5, 3.5])).unwrap();
+        std::fs::write(&a, table([1.0, 2.0, 3.0, 4.0, 5.0])).unwrap();
+        std::fs::write(&b, table([1.5, 2.5, 3.5, 4.5, 5.5])).unwrap();
         let md = compare(&a, &b).unwrap();
         // Every run 0.5 m worse: resolved, whatever the resample.
         assert!(
-            md.contains("| all | 3 | RTE 5 s (m) | 2.000 [1.00, 3.00] | 2.500 [1.50, 3.50] | **+0.500 [+0.500, +0.500]** |"),
+            md.contains("| all | 5 | RTE 5 s (m) | 3.000 [")
+                && md.contains("| **+0.500 [+0.500, +0.500]** |"),
             "{md}"
         );
-        assert!(md.contains("| iPhone 4S | 1 | RTE 5 s (m) |"), "{md}");
+        assert!(md.contains("| iPhone 4S | 2 | RTE 5 s (m) |"), "{md}");
         // A report without the table names the file.
         std::fs::write(&b, "# nothing\n").unwrap();
         let e = format!("{:#}", compare(&a, &b).unwrap_err());

@@ -845,6 +845,7 @@ pub(crate) mod tests {
         SeqRow {
             result: SequenceResult {
                 name: name.into(),
+                run: name.into(),
                 placement: None,
                 device: None,
                 path_length_m: 1.0,

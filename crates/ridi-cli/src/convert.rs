@@ -25,8 +25,9 @@ pub(crate) struct Args {
     rate: Option<f64>,
     /// Cut every sequence at each gap longer than this (before --rate), into parts named
     /// `<name>_part1`, `_part2`, ... (the plain name when one is left); parts shorter than 1 s
-    /// are dropped with a warning. 0.1 cuts where `ridi track` refuses a gap. The readers refuse
-    /// gaps longer than 1 s whatever this says.
+    /// are dropped with a warning. 0.1 cuts where `ridi track` refuses a gap. Below 1 s: a
+    /// recording paused for longer is read across its pauses and cut at them (processed files,
+    /// Tyrex, the competition's paths; a RIDI raw or RoNIN folder paused that long is refused).
     #[arg(long, value_name = "SECONDS", value_parser = gap_s)]
     split_at_gaps: Option<f64>,
 }

@@ -93,8 +93,14 @@ pub(crate) fn run(args: Args) -> Result<()> {
         },
     };
     let seqs = listed.sequences();
-    let (report, traces) = with_spinner(seqs.len(), || ridi::evaluate(seqs, &model, &opts))
+    let (mut report, traces) = with_spinner(seqs.len(), || ridi::evaluate(seqs, &model, &opts))
         .map_err(|e| e.locate_in(&listed))?;
+    if let Some(p) = &mut report.provenance {
+        p.model_source = Some(match &args.model {
+            Some(path) => path.display().to_string(),
+            None => "bundled".to_string(),
+        });
+    }
     let written = folder
         .write(&report, &traces, None)
         .map_err(|e| e.locate_in(&listed))?;
@@ -163,13 +169,13 @@ fn print_summary(report: &Report) {
     );
     let c = &report.config;
     outln!(
-        "{:<10} {:>26} {:>9} {:>9} {:>9} {:>11}",
+        "{:<10} {:>26} {:>9} {:>10} {:>9} {:>17}",
         "method",
-        format!("RTE {}s m [95 %]", c.short_rte_window_s),
+        format!("RTE {} s m [95 %]", c.short_rte_window_s),
         "ATE m",
-        format!("RTE {}s m", c.rte_window_s),
+        format!("RTE {} s m", c.rte_window_s),
         "MPE m",
-        "path ratio"
+        "path length ratio"
     );
     let opt = |v: Option<f64>| v.map_or("-".to_string(), |v| format!("{v:.3}"));
     for key in &report.methods {
@@ -180,7 +186,7 @@ fn print_summary(report: &Report) {
                 None => format!("{:.3}", m.rte_5s_m),
             };
             outln!(
-                "{key:<10} {rte_5s:>26} {:>9.3} {:>9.3} {:>9.3} {:>11}",
+                "{key:<10} {rte_5s:>26} {:>9.3} {:>10.3} {:>9.3} {:>17}",
                 m.ate_m,
                 m.rte_m,
                 m.mpe_m,
@@ -194,7 +200,7 @@ fn print_summary(report: &Report) {
         .and_then(|d| d.get(RTE_5S))
     {
         outln!(
-            "ridi - pdr, RTE {}s: {:+.3} m [{:+.3}, {:+.3}] (paired over sequences; every \
+            "ridi - pdr, RTE {} s: {:+.3} m [{:+.3}, {:+.3}] (paired over sequences; every \
              interval and difference in report.md)",
             c.short_rte_window_s,
             d.mean,

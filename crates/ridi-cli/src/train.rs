@@ -62,7 +62,8 @@ pub(crate) struct Args {
     landmarks: usize,
     /// Seed of training's random draws (the grid's folds; with `--solver nystrom`, its
     /// landmarks and its classifier's sweep order): models trained with other seeds show how
-    /// much a result owes to them.
+    /// much a result owes to them. The exact solver with `--grid none` draws nothing, so the
+    /// seed changes nothing there.
     #[arg(long, value_name = "N", default_value_t = 0)]
     seed: u64,
     /// Also train on N copies of each window turned about the vertical (features and

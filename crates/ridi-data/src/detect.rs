@@ -258,8 +258,10 @@ pub fn read_sequence(path: impl AsRef<Path>, opts: &ReadOptions) -> Result<Seque
                     Location::file(&file),
                     format!(
                         "the recording has {n} usable parts (split at long tracking or sensor \
-                         gaps): read it with `ridi_data::tyrex::read`, or convert it with \
-                         `ridi convert`, which writes each part"
+                         gaps), which cannot be read as one sequence: convert it with `ridi \
+                         convert`, which writes each part as a sequence of its own and lists \
+                         them, and use those (in Python `ridi.read_any`, in Rust \
+                         `ridi_data::tyrex::read`, give every part)"
                     ),
                 )),
             }

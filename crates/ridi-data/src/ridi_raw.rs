@@ -640,6 +640,9 @@ fn stream_file(e: &SequenceError) -> Option<&'static str> {
         SequenceError::AcceScale { .. } => "acce",
         SequenceError::LinacceScale { .. } => "linacce",
         SequenceError::GyroScale { .. } | SequenceError::GyroDirection { .. } => "gyro",
+        // The rotation vector against gravity: the rotation vector's file, whose component
+        // order is the likelier mistake.
+        SequenceError::OrientationGravity { .. } => "orientation",
         SequenceError::NonFinite { what, .. } | SequenceError::LengthMismatch { what, .. } => what,
         _ => return None,
     };

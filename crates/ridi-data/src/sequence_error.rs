@@ -339,8 +339,9 @@ pub enum SequenceError {
     /// Gravity is far from the up axis the orientation gives, over most frames.
     #[error(
         "gravity is {} degrees from the up axis the orientation gives (median over frames), \
-         more than {}: an orientation given as [x, y, z, w] for [w, x, y, z], or \
-         device-from-world for world-from-device?",
+         more than {}: a quaternion's components in another order ([x, y, z, w] for \
+         [w, x, y, z] or the reverse), device-from-world for world-from-device, or gravity's \
+         sign flipped?",
         short(*median_deg),
         short(*max_deg)
     )]

@@ -726,7 +726,8 @@ mod tests {
             let e = check(wrong).unwrap_err();
             assert!(
                 matches!(e, SequenceError::OrientationGravity { median_deg, .. } if median_deg > 45.0)
-                    && e.to_string().contains("[x, y, z, w] for [w, x, y, z]"),
+                    && e.to_string()
+                        .contains("([x, y, z, w] for [w, x, y, z] or the reverse)"),
                 "{e}"
             );
         }

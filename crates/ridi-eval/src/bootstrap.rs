@@ -17,6 +17,12 @@ use serde::{Deserialize, Serialize};
 /// seeds at this count on the Tyrex RTE values.
 pub const DRAWS: usize = 10_000;
 
+/// Fewest runs an interval is given for. Resampling fewer says nothing of a 95 % interval: one
+/// run resamples to itself (an interval of width 0), two to their mean and each alone (the
+/// interval is their range), and below five the percentiles rest on a handful of distinct
+/// means.
+pub const MIN_INTERVAL_RUNS: usize = 5;
+
 /// Fixed, so that a report is reproduced exactly.
 const SEED: u64 = 2018;
 
@@ -41,7 +47,8 @@ impl Interval {
 
 /// The mean of `values` (one per test sequence) and its 95 % percentile interval over
 /// [`DRAWS`] resamples of the clusters (`cluster[i]` names the run of sequence `i`). `None`
-/// without values, with `cluster` of another length, or with a non-finite value.
+/// with fewer than [`MIN_INTERVAL_RUNS`] clusters, with `cluster` of another length, or with a
+/// non-finite value.
 pub fn mean_interval(values: &[f64], cluster: &[&str]) -> Option<Interval> {
     if values.is_empty() || values.len() != cluster.len() || !values.iter().all(|v| v.is_finite()) {
         return None;
@@ -68,7 +75,7 @@ pub fn mean_interval(values: &[f64], cluster: &[&str]) -> Option<Interval> {
 }
 
 /// The mean of one value per run and its 95 % interval over [`DRAWS`] resamples of the runs.
-/// `None` without values or with a non-finite one.
+/// `None` with fewer than [`MIN_INTERVAL_RUNS`] values or with a non-finite one.
 pub fn runs_interval(values: &[f64]) -> Option<Interval> {
     if values.is_empty() || !values.iter().all(|v| v.is_finite()) {
         return None;
@@ -80,9 +87,9 @@ pub fn runs_interval(values: &[f64]) -> Option<Interval> {
 }
 
 /// The ratio of the means of paired per-run values, `mean(num) / mean(den)`, and its 95 %
-/// interval over resamples of the runs (a drawn run brings both its values). `None` without
-/// values, with slices of different lengths, a non-finite value or a mean of `den` that is not
-/// positive.
+/// interval over resamples of the runs (a drawn run brings both its values). `None` with fewer
+/// than [`MIN_INTERVAL_RUNS`] runs, slices of different lengths, a non-finite value or a mean
+/// of `den` that is not positive.
 pub fn ratio_interval(num: &[f64], den: &[f64]) -> Option<Interval> {
     let finite = |v: &[f64]| v.iter().all(|x| x.is_finite());
     if num.is_empty() || num.len() != den.len() || !finite(num) || !finite(den) {
@@ -108,8 +115,11 @@ pub fn ratio_interval(num: &[f64], den: &[f64]) -> Option<Interval> {
 }
 
 /// `point` and the 2.5 % and 97.5 % percentiles of `stat` over [`DRAWS`] draws of `n` cluster
-/// indices with replacement (fixed seed).
+/// indices with replacement (fixed seed); `None` for fewer than [`MIN_INTERVAL_RUNS`] clusters.
 fn percentile_interval(point: f64, n: usize, stat: impl Fn(&[usize]) -> f64) -> Option<Interval> {
+    if n < MIN_INTERVAL_RUNS {
+        return None;
+    }
     let mut rng = ChaCha8Rng::seed_from_u64(SEED);
     let mut draw = vec![0; n];
     let mut stats: Vec<f64> = (0..DRAWS)
@@ -136,7 +146,7 @@ mod tests {
 
     #[test]
     fn interval_of_identical_values_is_the_value() {
-        let i = mean_interval(&[0.7; 5], &["a", "b", "b", "c", "d"]).unwrap();
+        let i = mean_interval(&[0.7; 6], &["a", "b", "b", "c", "d", "e"]).unwrap();
         for x in [i.mean, i.low, i.high] {
             assert!((x - 0.7).abs() < 1e-12, "{i:?}");
         }
@@ -188,6 +198,21 @@ mod tests {
     }
 
     #[test]
+    fn fewer_runs_than_the_least_have_no_interval() {
+        // One run resamples to itself, two to their range: no 95 % interval at all.
+        let names = ["a", "b", "c", "d", "e"];
+        let values = [0.2, 0.9, 0.4, 1.3, 0.7];
+        for n in 1..MIN_INTERVAL_RUNS {
+            assert_eq!(mean_interval(&values[..n], &names[..n]), None, "{n}");
+            assert_eq!(runs_interval(&values[..n]), None, "{n}");
+            assert_eq!(ratio_interval(&values[..n], &values[..n]), None, "{n}");
+        }
+        // Five sequences of two runs are two runs.
+        assert_eq!(mean_interval(&values, &["a", "a", "a", "b", "b"]), None);
+        assert!(mean_interval(&values, &names).is_some());
+    }
+
+    #[test]
     fn one_value_per_run_is_one_cluster_per_value() {
         let values = [0.2, 0.9, 0.4, 1.3, 0.7];
         let names = ["a", "b", "c", "d", "e"];
@@ -199,16 +224,16 @@ mod tests {
     #[test]
     fn ratio_of_paired_means() {
         // A constant ratio has no spread, whatever the runs drawn.
-        let den = [1.0, 2.0, 4.0, 0.5];
+        let den = [1.0, 2.0, 4.0, 0.5, 3.0];
         let num = den.map(|d| 1.2 * d);
         let i = ratio_interval(&num, &den).unwrap();
         for x in [i.mean, i.low, i.high] {
             assert!((x - 1.2).abs() < 1e-12, "{i:?}");
         }
-        // The ratio of the means, not the mean of the ratios: (1 + 3) / (1 + 1) = 2.
-        let i = ratio_interval(&[1.0, 3.0], &[1.0, 1.0]).unwrap();
+        // The ratio of the means, not the mean of the ratios: (5 + 1 + 3 + 1 + 0) / 5 = 2.
+        let i = ratio_interval(&[5.0, 1.0, 3.0, 1.0, 0.0], &[1.0; 5]).unwrap();
         assert_eq!(i.mean, 2.0);
-        assert!(i.low >= 1.0 && i.high <= 3.0 && i.low < i.high, "{i:?}");
+        assert!(i.low >= 0.0 && i.high <= 5.0 && i.low < i.high, "{i:?}");
         assert_eq!(ratio_interval(&[1.0], &[0.0]), None);
         assert_eq!(ratio_interval(&[1.0], &[1.0, 2.0]), None);
         assert_eq!(ratio_interval(&[], &[]), None);

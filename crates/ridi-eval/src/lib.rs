@@ -71,7 +71,9 @@ pub use align::{
     AlignWindow, AlignmentFit, Rigid2, WEAK_ALIGNMENT_EXTENT_M, align_trajectory, fit_alignment,
     fit_rigid_2d, target_extent,
 };
-pub use bootstrap::{DRAWS, Interval, mean_interval, ratio_interval, runs_interval};
+pub use bootstrap::{
+    DRAWS, Interval, MIN_INTERVAL_RUNS, mean_interval, ratio_interval, runs_interval,
+};
 pub use error::{EvalError, Result};
 pub use metrics::{
     ConfusionMatrix, EvalConfig, RATE_TOLERANCE, TrajectoryEval, TrajectoryMetrics, accuracy, ate,

@@ -71,7 +71,7 @@ impl Metric {
             Self::AteRoninM => "ATE RoNIN (m)",
             Self::RteRoninM => "RTE RoNIN (m)",
             Self::Rte5sM => "RTE 5 s (m)",
-            Self::PathLengthRatio => "length ratio",
+            Self::PathLengthRatio => "path length ratio",
         }
     }
 
@@ -430,24 +430,45 @@ mod tests {
 
     #[test]
     fn intervals_hold_the_means_and_differences_pair_the_sequences() {
+        // Two runs: too few for any interval.
         let i = summary_intervals(&sample());
-        // ridi: MPE 1 and 3 over two runs; the mean between the bounds, which are values.
+        assert!(i.values().all(BTreeMap::is_empty), "{i:?}");
+        // Six runs: ridi's MPE alternates 1 and 3, pdr's is ridi's plus 9 on every run, and
+        // MPE % is defined on the first run alone.
+        let runs: Vec<SequenceReport> = (0..6)
+            .map(|k| {
+                let base = if k % 2 == 0 { 1.0 } else { 3.0 };
+                let pct = (k == 0).then_some(2.0);
+                SequenceReport {
+                    sequence: format!("run{k}"),
+                    placement: None,
+                    frames: 100,
+                    methods: vec![
+                        MethodMetrics {
+                            method: "ridi".into(),
+                            metrics: metrics(base, pct),
+                        },
+                        MethodMetrics {
+                            method: "pdr".into(),
+                            metrics: metrics(base + 9.0, pct),
+                        },
+                    ],
+                }
+            })
+            .collect();
+        let i = summary_intervals(&runs);
         let mpe = i["ridi"]["mpe_m"];
         assert_eq!(mpe.mean, 2.0);
         assert!(
             mpe.low >= 1.0 && mpe.high <= 3.0 && mpe.contains(2.0),
             "{mpe:?}"
         );
-        // Defined on one sequence only: its value, without spread.
-        let pct = i["ridi"]["mpe_pct"];
-        assert_eq!((pct.mean, pct.low, pct.high), (2.0, 2.0, 2.0));
-        assert!(i["pdr"].contains_key("rte_5s_m"));
-        // pdr ran on the first sequence alone: the difference is over that one.
-        let d = paired_differences(&sample(), "ridi");
+        assert!(!i["ridi"].contains_key("mpe_pct"));
+        let d = paired_differences(&runs, "ridi");
         assert!(!d.contains_key("ridi"));
         let rte = d["pdr"]["rte_5s_m"];
         assert_eq!((rte.mean, rte.low, rte.high), (-9.0, -9.0, -9.0));
-        assert!(paired_differences(&sample(), "nothing")["ridi"].is_empty());
+        assert!(paired_differences(&runs, "nothing")["ridi"].is_empty());
     }
 
     #[test]

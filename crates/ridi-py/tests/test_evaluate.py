@@ -14,6 +14,10 @@ from conftest import ROOT, SAMPLE
 
 RUNS = ["Thibaud_Nexus5_NoDist_Texting", "Thibaud_Nexus5_NoDist_FrontPocket"]
 
+# Two runs keep these tests quick, and are too few for intervals: the report says so (tested
+# once, below), every other test here leaves that warning aside.
+pytestmark = pytest.mark.filterwarnings("ignore:.*too few for 95 % intervals:UserWarning")
+
 
 @pytest.fixture()
 def test_list(tmp_path):
@@ -37,8 +41,12 @@ def test_evaluate_equals_report_json(model, model_file, ridi_bin, test_list, tmp
     ridi_bin("eval", "--list", test_list, "--model", model_file, "--out", tmp_path / "out",
              "--placement-map", "tyrex4", "--plots", "none")
     expected = json.loads((tmp_path / "out" / "report.json").read_text())
+    # The command line names the model's file; Python's model has none.
+    assert expected["provenance"].pop("model_source") == str(model_file)
+    expected["provenance"]["model_source"] = None
     report = ridi.evaluate(test_list, model, placement_map="tyrex4")
     assert same(report, expected), (report, expected)
+    assert len(report["provenance"]["model_fingerprint"]) == 16
     assert report["methods"] == list(ridi.METHODS)
     assert [s["name"] for s in report["sequences"]] == RUNS
 
@@ -48,6 +56,8 @@ def test_evaluate_options_reach_the_cli_flags(model, model_file, ridi_bin, test_
              "--placement-map", "tyrex4", "--plots", "none", "--methods", "ridi,pdr",
              "--align", "all", "--placement-window", "0", "--jobs", "1")
     expected = json.loads((tmp_path / "out" / "report.json").read_text())
+    expected["provenance"]["model_source"] = None
+    assert expected["provenance"]["placement_window_s"] is None
     report = ridi.evaluate([test_list], model, placement_map="tyrex4", methods=["ridi", "pdr"],
                            align="all", placement_window=0, jobs=1)
     assert same(report, expected)
@@ -136,3 +146,13 @@ def test_the_python_demo_runs_as_its_docstring_says(tmp_path):
     for line in set(done.stderr.splitlines()):
         if "Warning" in line:
             assert done.stderr.count(line) == 1, done.stderr
+
+
+@pytest.mark.filterwarnings("default")
+def test_fewer_runs_than_an_interval_needs_give_means_alone(model, test_list):
+    with pytest.warns(UserWarning, match=r"2 sequences \(2 runs, .*\): too few for 95 % "
+                                         r"intervals, which need 5 runs"):
+        report = ridi.evaluate(test_list, model, methods=["ridi", "pdr"], placement_map="tyrex4")
+    assert all(not v for v in report["intervals"].values()), report["intervals"]
+    assert all(not v for v in report["ridi_minus"].values()), report["ridi_minus"]
+    assert [s["run"] for s in report["sequences"]] == RUNS

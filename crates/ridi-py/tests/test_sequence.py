@@ -270,7 +270,7 @@ def test_linacce_defaults_to_acce_minus_gravity(seq):
         (lambda a: a["ground_truth_position"].__setitem__((5, 0), np.nan), ValueError,
          r"`ground_truth_position` is not finite at frame 5"),
         (lambda a: a.update(orientation=a["orientation"][:, [1, 2, 3, 0]]), ValueError,
-         r"an orientation given as \[x, y, z, w\] for \[w, x, y, z\]"),
+         r"a quaternion's components in another order \(\[x, y, z, w\] for \[w, x, y, z\]"),
     ],
 )
 def test_bad_arrays_are_refused_by_name(seq, change, error, message):

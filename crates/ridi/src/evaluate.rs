@@ -57,6 +57,11 @@ impl Default for EvalOptions {
 pub struct SequenceResult {
     /// Sequence name.
     pub name: String,
+    /// The run it is part of, which the intervals draw whole ([`ridi_eval::run_of`]: the name
+    /// without a `_part<N>` suffix, as `ridi convert --split-at-gaps` and the Tyrex reader
+    /// name the parts of a recording split at its gaps).
+    #[serde(default)]
+    pub run: String,
     /// Placement label.
     pub placement: Option<String>,
     /// The phone model it was recorded with ([`Sequence::device`]), when known.
@@ -135,6 +140,62 @@ pub struct Report {
     /// Things to know before reading the numbers, one sentence each ([`placement_warnings`]);
     /// also in `report.md`.
     pub warnings: Vec<String>,
+    /// What produced the numbers: the model and the tracking settings besides `config` and
+    /// `recorded_heading` (`None` in reports written before the field existed).
+    #[serde(default)]
+    pub provenance: Option<Provenance>,
+}
+
+/// What produced a report, so that a figure can be traced to its model and settings.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Provenance {
+    /// The version of the `ridi` crate that evaluated.
+    pub ridi_version: String,
+    /// Where the model came from, as the caller names it (`ridi eval`: the model file's path,
+    /// or `bundled`); `None` when the caller did not say.
+    pub model_source: Option<String>,
+    /// FNV-1a 64 of the model's bytes ([`Cascade::to_bytes`]), in hex: the same for the same
+    /// model, whatever its file is called.
+    pub model_fingerprint: String,
+    /// The model's solver, placements, feature window and orientation.
+    pub model: String,
+    /// Frames between regressions ([`TrackOptions::regress_every`]).
+    pub regress_every: usize,
+    /// The placement majority window, seconds (`None`: each regression's own placement).
+    pub placement_window_s: Option<f64>,
+}
+
+impl Provenance {
+    /// The provenance of an evaluation of `model` with `opts`.
+    pub fn of(model: &Cascade, opts: &EvalOptions) -> Result<Self> {
+        let bytes = model.to_bytes()?;
+        // FNV-1a: a stable, dependency-free fingerprint (not a cryptographic one).
+        let hash = bytes.iter().fold(0xcbf2_9ce4_8422_2325_u64, |h, &b| {
+            (h ^ u64::from(b)).wrapping_mul(0x0100_0000_01b3)
+        });
+        let config = model.feature_config();
+        Ok(Self {
+            ridi_version: env!("CARGO_PKG_VERSION").to_string(),
+            model_source: None,
+            model_fingerprint: format!("{hash:016x}"),
+            model: format!(
+                "{} solver; placements {}; a feature window of {} frames; the {} orientation",
+                match model.solver() {
+                    ridi_regress::Solver::Exact => "exact".to_string(),
+                    ridi_regress::Solver::Nystrom(n) =>
+                        format!("Nyström ({} landmarks, seed {})", n.landmarks(), n.seed()),
+                },
+                model.placement_names().join(", "),
+                config.window,
+                match config.orientation {
+                    ridi_features::Orientation::Recorded => "recorded",
+                    ridi_features::Orientation::Estimated => "estimated",
+                }
+            ),
+            regress_every: opts.track.regress_every,
+            placement_window_s: opts.track.placement_smoothing.map(|p| p.window_s),
+        })
+    }
 }
 
 /// A mean as report tables print it ([`Metric::format`]) with its interval when known, `1.033
@@ -223,6 +284,7 @@ fn evaluate_one(seq: &Sequence, model: &Cascade, opts: &EvalOptions) -> Result<E
     Ok(Evaluated {
         result: SequenceResult {
             name: seq.name().to_string(),
+            run: ridi_eval::run_of(seq.name()).to_string(),
             placement: seq.placement().map(str::to_string),
             device: seq.device().map(|d| d.model().to_string()),
             path_length_m: ridi_eval::path_length(&gt2)?,
@@ -400,6 +462,7 @@ pub fn evaluate(
     };
     warnings.extend(weak_alignment(&results, opts.metrics.align));
     warnings.extend(still_ahead(&summary));
+    warnings.extend(too_few_runs(&results));
     Ok((
         Report {
             sequences: results,
@@ -413,9 +476,29 @@ pub fn evaluate(
             recorded_heading: opts.track.recorded_heading,
             methods: opts.methods.iter().map(|m| m.key().to_string()).collect(),
             warnings,
+            provenance: Some(Provenance::of(model, opts)?),
         },
         traces,
     ))
+}
+
+/// The warning that the sequences hold fewer runs than an interval needs
+/// ([`ridi_eval::MIN_INTERVAL_RUNS`]): the report gives means alone.
+fn too_few_runs(sequences: &[SequenceResult]) -> Option<String> {
+    let runs: BTreeSet<&str> = sequences
+        .iter()
+        .map(|s| ridi_eval::run_of(&s.name))
+        .collect();
+    (runs.len() < ridi_eval::MIN_INTERVAL_RUNS).then(|| {
+        format!(
+            "{} ({}, the parts of a recording split at its gaps counted as one): too few for \
+             95 % intervals, which need {} runs; the means stand alone and no difference \
+             between methods is resolved",
+            ridi_data::counted(sequences.len(), "sequence"),
+            ridi_data::counted(runs.len(), "run"),
+            ridi_eval::MIN_INTERVAL_RUNS
+        )
+    })
 }
 
 /// The warning that standing still (`still`) scores a lower mean ATE than RIDI: the walks stay
@@ -473,12 +556,22 @@ fn sequence_reports<'a>(results: impl Iterator<Item = &'a SequenceResult>) -> Ve
             sequence: r.name.clone(),
             placement: r.placement.clone(),
             frames: 0,
-            methods: r
-                .methods
+            // In report order (ridi, raw, pdr, ...), as the summary's tables have them, not the
+            // map's alphabetical one; a key no method has (a report of another version) last.
+            methods: Method::ALL
                 .iter()
-                .map(|(k, m)| MethodMetrics {
-                    method: k.clone(),
-                    metrics: *m,
+                .map(|m| m.key())
+                .chain(
+                    r.methods
+                        .keys()
+                        .map(String::as_str)
+                        .filter(|k| Method::ALL.iter().all(|m| m.key() != *k)),
+                )
+                .filter_map(|k| {
+                    r.methods.get(k).map(|m| MethodMetrics {
+                        method: k.to_string(),
+                        metrics: *m,
+                    })
                 })
                 .collect(),
         })
@@ -538,9 +631,42 @@ impl Report {
             .collect()
     }
 
+    /// The section of `report.md` that says what each figure and method is.
+    fn definitions(&self) -> String {
+        let c = &self.config;
+        format!(
+            "\n## Definitions\n\n\
+             Every trajectory is horizontal, aligned on the ground truth as the header says (one \
+             turn and shift per sequence and method, no scale), and compared frame by frame.\n\n\
+             - **ATE**: the RMS of the position error, m. **ATE RoNIN**: RoNIN's per-coordinate \
+             RMS (ATE / sqrt 2).\n\
+             - **RTE**: the RMS, over every window of {long} s, of the error in the displacement \
+             across the window, m; a sequence shorter than the window gets its end-to-end drift \
+             scaled to {long} s (RoNIN's rule). **RTE 5 s**: the same over {short} s. **RTE \
+             RoNIN**: per coordinate (RTE / sqrt 2).\n\
+             - **MPE**: the mean position error, m; **MPE (%)**: over the ground truth's path \
+             length.\n\
+             - **path length ratio**: the trajectory's path length over the ground truth's.\n\
+             - **Means** are over sequences, each counting once; **intervals** are 95 % bootstrap \
+             percentiles over runs (the parts `_part1`, `_part2`, ... of a recording split at \
+             its gaps are one run), given for {min} runs or more. **Velocity MSE** and \
+             **placement accuracy** pool every regression of every sequence.\n\
+             - **Methods**: `ridi`, the regressed velocities corrected into a trajectory \
+             (RIDI); `raw`, the linear acceleration integrated twice; `pdr`, steps detected in \
+             the accelerometer, each as long as the ground truth's path over its steps (an \
+             oracle), along the device's heading; `ridi_mag`, the regressed speed along the \
+             device's forward direction; `ridi_ori`, the regressed direction at the ground \
+             truth's mean speed (an oracle); `velocity`, the regressed velocities followed \
+             closely (the correction's prior near 0); `still`, standing at the start.\n",
+            long = c.rte_window_s,
+            short = c.short_rte_window_s,
+            min = ridi_eval::MIN_INTERVAL_RUNS,
+        )
+    }
+
     /// The markdown report: overall summary, per placement, per device (when the sequences
-    /// name theirs), per sequence, velocity and placement results. Control characters in names
-    /// are escaped (`\u{1b}`), as in messages.
+    /// name theirs), per sequence, velocity and placement results, and what each figure and
+    /// method is. Control characters in names are escaped (`\u{1b}`), as in messages.
     pub fn to_markdown(&self) -> String {
         let mut out = String::new();
         let _ = writeln!(out, "# RIDI evaluation\n");
@@ -568,6 +694,24 @@ impl Report {
                 None => "the gyro's alone".to_string(),
             }
         );
+        if let Some(p) = &self.provenance {
+            let _ = writeln!(
+                out,
+                "Model: {} (fingerprint {}{}); regressions every {} frames, placement {}; ridi \
+                 {}.\n",
+                p.model,
+                p.model_fingerprint,
+                p.model_source
+                    .as_deref()
+                    .map_or(String::new(), |s| format!(", {s}")),
+                p.regress_every,
+                p.placement_window_s
+                    .map_or("per regression".to_string(), |w| format!(
+                        "by majority over {w} s"
+                    )),
+                p.ridi_version
+            );
+        }
         let mse = match self.velocity_mse {
             [x, z] if x.is_finite() && z.is_finite() => format!("S-x {x:.4}, S-z {z:.4} (m/s)^2"),
             // Methods without a model regress nothing.
@@ -689,6 +833,7 @@ impl Report {
             let _ = writeln!(out, "\n## Placement confusion (rows: truth)\n");
             out.push_str(&markdown_confusion(cm));
         }
+        out.push_str(&self.definitions());
         // Names come from folders and list files: a control character in one (a terminal
         // escape) is written escaped, as every message shows it, so that `cat report.md` cannot
         // retitle or clear the terminal.
@@ -847,6 +992,7 @@ mod tests {
         };
         SequenceResult {
             name: name.into(),
+            run: name.into(),
             placement: Some("hand".into()),
             device: device.map(str::to_string),
             path_length_m: 10.0,
@@ -870,6 +1016,7 @@ mod tests {
             recorded_heading: None,
             methods: vec!["ridi".into()],
             warnings: Vec::new(),
+            provenance: None,
         }
     }
 

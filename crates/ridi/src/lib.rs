@@ -113,8 +113,8 @@ pub use convert::{
 pub use demo::Demo;
 pub use error::{PipelineError, Result};
 pub use evaluate::{
-    EvalOptions, GroupSummary, Report, SequenceResult, Traces, check_evaluable, evaluate,
-    placement_warnings,
+    EvalOptions, GroupSummary, Provenance, Report, SequenceResult, Traces, check_evaluable,
+    evaluate, placement_warnings,
 };
 pub use inspect::{
     Inspection, ModelInspection, PlacementModel, RegressorSummary, SeriesStats, inspect,

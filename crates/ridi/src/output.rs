@@ -690,6 +690,7 @@ mod tests {
                 .iter()
                 .map(|name| SequenceResult {
                     name: name.to_string(),
+                    run: name.to_string(),
                     placement: None,
                     device: None,
                     path_length_m: 12.5,
@@ -709,6 +710,7 @@ mod tests {
             recorded_heading: Some(ridi_frames::HeadingConfig::default()),
             methods: Vec::new(),
             warnings: vec!["a warning".into()],
+            provenance: None,
         }
     }
 

@@ -273,7 +273,15 @@ fn labels_the_model_does_not_know_are_a_warning_in_the_report() {
         ..EvalOptions::default()
     };
     let (report, _) = ridi::evaluate(&test, &model, &opts).unwrap();
-    assert_eq!(report.warnings, [want]);
+    // Then the one about intervals: two runs are too few.
+    assert_eq!(report.warnings[0], want);
+    assert!(
+        report.warnings[1].starts_with("2 sequences (2 runs, the parts of a recording split at")
+            && report.warnings[1].contains("too few for 95 % intervals, which need 5 runs"),
+        "{:?}",
+        report.warnings
+    );
+    assert_eq!(report.warnings.len(), 2);
     assert_eq!(report.sequences[0].placement_accuracy, Some(0.0));
     assert!(report.to_markdown().contains(want));
     let json = serde_json::to_value(&report).unwrap();
@@ -284,7 +292,11 @@ fn labels_the_model_does_not_know_are_a_warning_in_the_report() {
         ..EvalOptions::default()
     };
     let (report, _) = ridi::evaluate(&test, &model, &pdr).unwrap();
-    assert!(report.warnings.is_empty(), "{:?}", report.warnings);
+    assert!(
+        report.warnings.len() == 1 && report.warnings[0].contains("too few for 95 % intervals"),
+        "{:?}",
+        report.warnings
+    );
 
     // Nothing to evaluate or train on is an error, not an empty result.
     assert!(ridi::evaluate(&[], &model, &opts).is_err());
