@@ -116,7 +116,7 @@ fn is_model_file(path: &Path) -> bool {
 /// it escapes U+0000-U+001F: they are valid JSON raw, but a terminal may obey them (U+009B
 /// starts an escape sequence on some). They can only be inside strings (JSON's own syntax is
 /// ASCII), where the escape stands for the same character.
-fn escaped(json: String) -> String {
+pub(crate) fn escaped(json: String) -> String {
     let raw = |c: char| ('\u{7f}'..='\u{9f}').contains(&c);
     if !json.contains(raw) {
         return json;

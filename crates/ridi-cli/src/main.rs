@@ -31,6 +31,7 @@ macro_rules! out {
     }};
 }
 
+mod compare;
 mod convert;
 mod demo;
 mod eval;
@@ -96,6 +97,14 @@ enum Command {
         ridi eval --list test.txt --model model.ridi --out report-whole --align all\n\n\
         Methods: ridi, raw, pdr, ridi_mag, ridi_ori, velocity, still.")]
     Eval(eval::Args),
+    /// Compare two evaluations of the same sequences: each figure's paired difference.
+    #[command(after_help = "Examples:\n  \
+        ridi compare eval-before eval-after\n  \
+        ridi compare a/report.json b/report.json --json\n\n\
+        Pairs the sequences by name: for each method both evaluated and each figure, the means \
+        in both and the second minus the first with its 95 % interval (a bootstrap over the \
+        runs, from 5 runs on; bold when it leaves out 0).")]
+    Compare(compare::Args),
     /// Train on the bundled sample (two people) and evaluate on the held-out person.
     #[command(after_help = "Example:\n  ridi demo --out demo-out\n\n\
         Uses datasets/sample (list_train.txt, list_test.txt) with the four Tyrex placement \
@@ -291,6 +300,7 @@ fn main() -> ExitCode {
         Command::Train(args) => train::run(args),
         Command::Track(args) => track::run(args),
         Command::Eval(args) => eval::run(args),
+        Command::Compare(args) => compare::run(args),
         Command::Demo(args) => demo::run(args),
     };
     match result {

@@ -518,21 +518,23 @@ fn convert_train_track_and_eval() {
 
     let report = dir.path().join("report");
     let test_list = sample_dataset().join("list_Jakob.txt");
-    let out = ridi(&[
-        "eval",
-        "--list",
-        s(&test_list),
-        "--model",
-        s(&model),
-        "--out",
-        s(&report),
-        "--methods",
-        "ridi,raw,still",
-        "--placement-map",
-        "tyrex4",
-        "--plots",
-        "svg",
-    ]);
+    // `ridi eval` of Jakob's runs with `model` into `out`, and `extra` flags.
+    let eval_jakob = |out: &Path, extra: &[&str]| {
+        let mut args = vec![
+            "eval",
+            "--list",
+            s(&test_list),
+            "--model",
+            s(&model),
+            "--out",
+            s(out),
+            "--placement-map",
+            "tyrex4",
+        ];
+        args.extend_from_slice(extra);
+        ridi(&args)
+    };
+    let out = eval_jakob(&report, &["--methods", "ridi,raw,still", "--plots", "svg"]);
     assert!(out.status.success(), "{}", stderr(&out));
     let json: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(report.join("report.json")).unwrap())
@@ -542,6 +544,47 @@ fn convert_train_track_and_eval() {
         report
             .join("plots/Jakob_Nexus5_NoDist_Texting.trajectory.svg")
             .is_file()
+    );
+
+    // The same sequences evaluated otherwise, compared sequence by sequence: what differs is
+    // named, and each figure's paired difference listed.
+    let other = dir.path().join("report-other");
+    let out = eval_jakob(
+        &other,
+        &[
+            "--methods",
+            "ridi,still",
+            "--placement-window",
+            "0",
+            "--plots",
+            "none",
+        ],
+    );
+    assert!(out.status.success(), "{}", stderr(&out));
+    let out = ridi(&["compare", s(&report), s(&other.join("report.json"))]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let md = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        md.contains("- placement window: 10 s against per regression")
+            && md.contains("- methods: ridi, raw, still against ridi, still")
+            && md.contains("| ridi | RTE 5 s (m) | ")
+            && md.contains("| still | RTE 5 s (m) | ")
+            && !md.contains("| raw |"),
+        "{md}"
+    );
+    let out = ridi(&["compare", s(&report), s(&report), "--json"]);
+    let compared: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(compared["settings"], serde_json::json!([]));
+    let figures = compared["figures"].as_array().unwrap();
+    assert!(
+        figures.iter().all(|f| f["difference"] == 0.0),
+        "{figures:?}"
+    );
+    let out = ridi(&["compare", s(&report), s(&report.join("report.md"))]);
+    assert!(
+        stderr(&out).contains("report.md: not a report.json of `ridi eval`"),
+        "{}",
+        stderr(&out)
     );
 
     let out = ridi(&[

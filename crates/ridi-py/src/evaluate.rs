@@ -123,3 +123,47 @@ pub(crate) fn evaluate<'py>(
     let json = serde_json::to_string(&report).map_err(|e| errors::value(e.to_string()))?;
     json_dict(py, &json)
 }
+
+/// Compares two evaluations of the same sequences, as ``ridi compare`` does: ``first`` and
+/// ``second`` are reports of ``ridi.evaluate`` (dicts) or of ``ridi eval`` (a report.json, or
+/// the folder holding it). Returns a dict: ``sequences`` and ``runs`` both hold, ``settings``
+/// (what differs between the two: model, regression step, placement window, heading,
+/// methods, version), ``figures`` (per method both have and metric: ``before`` and ``after``
+/// means over the shared sequences, ``difference``, ``after - before`` paired by sequence,
+/// and its 95 % ``interval``, None with fewer than 5 runs) and ``warnings`` (also emitted as
+/// ``UserWarning``\ s).
+#[pyfunction]
+pub(crate) fn compare<'py>(
+    py: Python<'py>,
+    first: &Bound<'py, PyAny>,
+    second: &Bound<'py, PyAny>,
+) -> PyResult<Bound<'py, PyDict>> {
+    let before = report_of(py, first, "first")?;
+    let after = report_of(py, second, "second")?;
+    let comparison = ridi::compare_reports(&before, &after);
+    crate::sequence::warn(py, &comparison.warnings)?;
+    let json = serde_json::to_string(&comparison).map_err(|e| errors::value(e.to_string()))?;
+    json_dict(py, &json)
+}
+
+/// Argument `name` of [`compare`] as a report: a dict of `ridi.evaluate`, or a path.
+fn report_of(py: Python<'_>, obj: &Bound<'_, PyAny>, name: &str) -> PyResult<Report> {
+    if let Ok(dict) = obj.cast::<PyDict>() {
+        let text: String = py
+            .import("json")?
+            .call_method1("dumps", (dict,))?
+            .extract()?;
+        return serde_json::from_str(&text).map_err(|e| {
+            errors::value(format!(
+                "`{name}` is not a report of `ridi.evaluate` (a dict of report.json's keys): {e}"
+            ))
+        });
+    }
+    let path: PathBuf = obj.extract().map_err(|_| {
+        pyo3::exceptions::PyTypeError::new_err(format!(
+            "`{name}` must be a report of `ridi.evaluate` (a dict) or the path of a report.json \
+             (or of its folder)"
+        ))
+    })?;
+    Report::read(&path).map_err(errors::pipeline)
+}

@@ -39,6 +39,7 @@ fn _ridi(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(track::regress, m)?)?;
     m.add_function(wrap_pyfunction!(track::track, m)?)?;
     m.add_function(wrap_pyfunction!(evaluate::evaluate, m)?)?;
+    m.add_function(wrap_pyfunction!(evaluate::compare, m)?)?;
     let methods: Vec<&str> = ridi::Method::ALL.iter().map(|m| m.key()).collect();
     m.add("METHODS", pyo3::types::PyTuple::new(m.py(), methods)?)?;
     m.add("RATE_HZ", ridi::TRACK_RATE_HZ)?;

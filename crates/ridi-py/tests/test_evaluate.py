@@ -156,3 +156,37 @@ def test_fewer_runs_than_an_interval_needs_give_means_alone(model, test_list):
     assert all(not v for v in report["intervals"].values()), report["intervals"]
     assert all(not v for v in report["ridi_minus"].values()), report["ridi_minus"]
     assert [s["run"] for s in report["sequences"]] == RUNS
+
+
+def test_compare_pairs_two_evaluations_as_the_command_does(model, model_file, ridi_bin, tmp_path):
+    # Five runs of the sample, evaluated twice: as is, and with each regression's own placement.
+    runs = ["Thibaud_Nexus5_NoDist_Texting", "Thibaud_Nexus5_NoDist_FrontPocket",
+            "Thibaud_Nexus5_NoDist_BackPocket", "Thibaud_Nexus5_NoDist_Swinging",
+            "Thibaud_Nexus5_NoDist_Phoning"]
+    listed = tmp_path / "five.txt"
+    listed.write_text("".join(f"{SAMPLE / r},{r.rsplit('_', 1)[1]}\n" for r in runs))
+    first = ridi.evaluate(listed, model, methods=["ridi", "pdr"], placement_map="tyrex4")
+    second = ridi.evaluate(listed, model, methods=["ridi", "pdr"], placement_map="tyrex4",
+                           placement_window=0)
+    c = ridi.compare(first, second)
+    assert c["settings"] == ["placement window: 10 s against per regression"]
+    assert (c["sequences"], c["runs"], c["warnings"]) == (5, 5, [])
+    rte = {(f["method"], f["metric"]): f for f in c["figures"]}
+    assert rte[("pdr", "rte_5s_m")]["difference"] == 0.0
+    ridi_rte = rte[("ridi", "rte_5s_m")]
+    assert ridi_rte["before"] == first["summary"]["ridi"]["rte_5s_m"]
+    assert ridi_rte["after"] == second["summary"]["ridi"]["rte_5s_m"]
+    assert ridi_rte["interval"]["low"] <= ridi_rte["difference"] <= ridi_rte["interval"]["high"]
+    # The same from the command's files, the folder or its report.json.
+    out = tmp_path / "eval"
+    ridi_bin("eval", "--list", listed, "--model", model_file, "--out", out, "--methods",
+             "ridi,pdr", "--placement-map", "tyrex4", "--plots", "none")
+    same_model = ridi.compare(out, out / "report.json")
+    assert same_model["settings"] == [] and all(
+        f["difference"] == 0.0 for f in same_model["figures"])
+    printed = ridi_bin("compare", out, out)
+    assert "The two were produced alike" in printed
+    with pytest.raises(TypeError, match=r"`second` must be a report of `ridi.evaluate`"):
+        ridi.compare(first, 5)
+    with pytest.raises(ValueError, match=r"`first` is not a report of `ridi.evaluate`"):
+        ridi.compare({"sequences": 3}, first)

@@ -200,7 +200,7 @@ impl Provenance {
 
 /// A mean as report tables print it ([`Metric::format`]) with its interval when known, `1.033
 /// [0.90, 1.19]`; a difference (`signed`) with its sign, bold when the interval leaves out 0.
-fn with_interval(
+pub(crate) fn with_interval(
     metric: Metric,
     mean: Option<f64>,
     interval: Option<&ridi_eval::Interval>,
@@ -843,15 +843,24 @@ impl Report {
             .join("\n")
     }
 
-    /// Reads a `report.json` that [`Report::write`] wrote.
+    /// Reads a `report.json` that [`Report::write`] wrote: `path` is the file, or the folder
+    /// holding it (a `ridi eval --out`).
     pub fn read(path: &Path) -> Result<Report> {
+        let joined;
+        let path = if path.is_dir() {
+            joined = path.join("report.json");
+            joined.as_path()
+        } else {
+            path
+        };
         let file = |message: String| PipelineError::File {
             path: path.to_path_buf(),
             message,
         };
         // Bounded: a report holds figures per sequence, far below this for any dataset.
         let text = ridi_data::read_text(path, 1 << 30)?;
-        serde_json::from_str(&text).map_err(|e| file(e.to_string()))
+        serde_json::from_str(&text)
+            .map_err(|e| file(format!("not a report.json of `ridi eval`: {e}")))
     }
 
     /// Writes `report.json` and `report.md` into `dir` (created if needed), atomically.

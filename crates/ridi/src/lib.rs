@@ -85,6 +85,7 @@ pub use ridi_regress as regress;
 mod baselines;
 #[cfg(feature = "bundled-model")]
 mod bundled;
+mod compare;
 mod convert;
 mod demo;
 mod error;
@@ -106,6 +107,7 @@ mod train;
 pub use baselines::{Method, baseline_trajectory, device_heading};
 #[cfg(feature = "bundled-model")]
 pub use bundled::{BUNDLED_MODEL_SUMMARY, bundled_model};
+pub use compare::{ComparedFigure, Comparison, compare_reports};
 pub use convert::{
     ConvertOptions, ConvertSummary, Converted, SPLIT_MIN_PART_S, convert, read_split,
     resample_max_gap, split_limit,

@@ -20,7 +20,7 @@ the same numbers.
 
 Files that cannot be read or written raise ``OSError``; wrong data, lists and options raise
 ``ValueError`` naming the file, line and field, or the sequence, array and frame, as the
-command line does; an array of another dtype than float64 raises ``TypeError``.
+command line does; an array of what is not a real number raises ``TypeError``.
 """
 
 from ._ridi import (
@@ -34,6 +34,7 @@ from ._ridi import (
     Track,
     Update,
     bundled_model,
+    compare,
     evaluate,
     load,
     read,
@@ -55,6 +56,7 @@ __all__ = [
     "Track",
     "Update",
     "bundled_model",
+    "compare",
     "evaluate",
     "load",
     "read",

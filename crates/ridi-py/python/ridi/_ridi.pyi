@@ -279,3 +279,10 @@ def evaluate(
     jobs: Optional[int] = None,
 ) -> Dict[str, Any]:
     """RIDI and its baselines against ground truth: the dict of ``report.json``."""
+
+def compare(
+    first: Union[Dict[str, Any], StrPath],
+    second: Union[Dict[str, Any], StrPath],
+) -> Dict[str, Any]:
+    """Two evaluations of the same sequences, as ``ridi compare``: what differs and each
+    figure's paired difference."""
