@@ -24,7 +24,7 @@ pub(crate) fn run(
 ) -> Result<()> {
     let before = ridi::Report::read(&first)?;
     let after = ridi::Report::read(&second)?;
-    let comparison = ridi::compare_reports(&before, &after);
+    let comparison = ridi::compare_reports(&before, &after)?;
     if json {
         outln!(
             "{}",

@@ -565,14 +565,15 @@ fn convert_train_track_and_eval() {
     assert!(out.status.success(), "{}", stderr(&out));
     let md = String::from_utf8_lossy(&out.stdout);
     assert!(
-        md.contains("- placement window: 10 s against per regression")
-            && md.contains("- methods: ridi, raw, still against ridi, still")
+        md.contains("- placement: 10 s against per regression")
+            && md.contains("- methods: raw, ridi, still against ridi, still")
             && md.contains("| ridi | RTE 5 s (m) | ")
             && md.contains("| still | RTE 5 s (m) | ")
             && !md.contains("| raw |"),
         "{md}"
     );
     let out = ridi(&["compare", s(&report), s(&report), "--json"]);
+    assert!(out.status.success(), "{}", stderr(&out));
     let compared: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
     assert_eq!(compared["settings"], serde_json::json!([]));
     let figures = compared["figures"].as_array().unwrap();

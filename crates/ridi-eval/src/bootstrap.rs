@@ -234,7 +234,7 @@ mod tests {
         let i = ratio_interval(&[5.0, 1.0, 3.0, 1.0, 0.0], &[1.0; 5]).unwrap();
         assert_eq!(i.mean, 2.0);
         assert!(i.low >= 0.0 && i.high <= 5.0 && i.low < i.high, "{i:?}");
-        assert_eq!(ratio_interval(&[1.0], &[0.0]), None);
+        assert_eq!(ratio_interval(&[1.0; 5], &[0.0; 5]), None);
         assert_eq!(ratio_interval(&[1.0], &[1.0, 2.0]), None);
         assert_eq!(ratio_interval(&[], &[]), None);
     }

@@ -179,13 +179,18 @@ pub fn summarize(sequences: &[SequenceReport]) -> Vec<MethodSummary> {
         .collect()
 }
 
-/// The run a sequence belongs to: its name without the `_partN` suffix of a recording split at
-/// its gaps. A bootstrap draws a run's parts together.
+/// The run a sequence belongs to: its name without the `_partN` suffixes of a recording split
+/// at its gaps (a reader's part, `_part2`, split again at a gap, `_part2_part1`). A bootstrap
+/// draws a run's parts together.
 pub fn run_of(sequence: &str) -> &str {
-    match sequence.rsplit_once("_part") {
-        Some((run, n)) if !n.is_empty() && n.bytes().all(|b| b.is_ascii_digit()) => run,
-        _ => sequence,
+    let mut run = sequence;
+    while let Some((before, n)) = run.rsplit_once("_part") {
+        if n.is_empty() || !n.bytes().all(|b| b.is_ascii_digit()) {
+            break;
+        }
+        run = before;
     }
+    run
 }
 
 /// Per method and metric key, the 95 % interval of the method's mean over `sequences`
@@ -475,6 +480,7 @@ mod tests {
     fn parts_of_a_split_recording_are_one_run() {
         assert_eq!(run_of("walk_part2"), "walk");
         assert_eq!(run_of("walk_part12"), "walk");
+        assert_eq!(run_of("walk_part2_part1"), "walk");
         for whole in ["walk", "walk_part", "walk_partial", "walk_part2b", "part3"] {
             assert_eq!(run_of(whole), whole);
         }

@@ -13,8 +13,9 @@ use crate::options::{self, Inputs};
 
 /// Evaluates RIDI and its baselines against ground truth, as ``ridi eval`` does, and returns
 /// the report as a dict with the keys of its ``report.json`` (``sequences``, ``summary``,
-/// ``velocity_mse``, ``placement_accuracy``, ``placement_confusion``, ``config``, ``methods``,
-/// ``warnings``; a NaN is None, as ``null`` in the file). Nothing is written. The report's
+/// ``intervals``, ``ridi_minus``, ``velocity_mse``, ``placement_accuracy``,
+/// ``placement_confusion``, ``config``, ``recorded_heading``, ``methods``, ``warnings``,
+/// ``provenance``; a NaN is None, as ``null`` in the file). Nothing is written. The report's
 /// warnings are also emitted as ``UserWarning``\ s.
 ///
 /// ``data`` is a list file, several, or a list of ``ridi.Sequence`` with ground truth.
@@ -128,10 +129,10 @@ pub(crate) fn evaluate<'py>(
 /// ``second`` are reports of ``ridi.evaluate`` (dicts) or of ``ridi eval`` (a report.json, or
 /// the folder holding it). Returns a dict: ``sequences`` and ``runs`` both hold, ``settings``
 /// (what differs between the two: model, regression step, placement window, heading,
-/// methods, version), ``figures`` (per method both have and metric: ``before`` and ``after``
-/// means over the shared sequences, ``difference``, ``after - before`` paired by sequence,
-/// and its 95 % ``interval``, None with fewer than 5 runs) and ``warnings`` (also emitted as
-/// ``UserWarning``\ s).
+/// alignment, methods, version), ``figures`` (per method both have and metric: the ``first``
+/// and ``second`` means over the shared sequences, ``difference``, second minus first paired
+/// by sequence, and its 95 % ``interval``, None with fewer than 5 runs) and ``warnings``
+/// (also emitted as ``UserWarning``\ s).
 #[pyfunction]
 pub(crate) fn compare<'py>(
     py: Python<'py>,
@@ -140,7 +141,7 @@ pub(crate) fn compare<'py>(
 ) -> PyResult<Bound<'py, PyDict>> {
     let before = report_of(py, first, "first")?;
     let after = report_of(py, second, "second")?;
-    let comparison = ridi::compare_reports(&before, &after);
+    let comparison = ridi::compare_reports(&before, &after).map_err(errors::pipeline)?;
     crate::sequence::warn(py, &comparison.warnings)?;
     let json = serde_json::to_string(&comparison).map_err(|e| errors::value(e.to_string()))?;
     json_dict(py, &json)
@@ -149,9 +150,17 @@ pub(crate) fn compare<'py>(
 /// Argument `name` of [`compare`] as a report: a dict of `ridi.evaluate`, or a path.
 fn report_of(py: Python<'_>, obj: &Bound<'_, PyAny>, name: &str) -> PyResult<Report> {
     if let Ok(dict) = obj.cast::<PyDict>() {
+        // NaN as report.json writes it (null), not as JSON cannot hold it.
+        let kwargs = PyDict::new(py);
+        kwargs.set_item("allow_nan", false)?;
         let text: String = py
             .import("json")?
-            .call_method1("dumps", (dict,))?
+            .call_method("dumps", (dict,), Some(&kwargs))
+            .map_err(|e| {
+                errors::value(format!(
+                    "`{name}` is not a report of `ridi.evaluate`: {e} (a NaN there is None)"
+                ))
+            })?
             .extract()?;
         return serde_json::from_str(&text).map_err(|e| {
             errors::value(format!(

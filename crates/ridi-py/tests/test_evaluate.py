@@ -169,13 +169,13 @@ def test_compare_pairs_two_evaluations_as_the_command_does(model, model_file, ri
     second = ridi.evaluate(listed, model, methods=["ridi", "pdr"], placement_map="tyrex4",
                            placement_window=0)
     c = ridi.compare(first, second)
-    assert c["settings"] == ["placement window: 10 s against per regression"]
+    assert c["settings"] == ["placement: 10 s against per regression"]
     assert (c["sequences"], c["runs"], c["warnings"]) == (5, 5, [])
     rte = {(f["method"], f["metric"]): f for f in c["figures"]}
     assert rte[("pdr", "rte_5s_m")]["difference"] == 0.0
     ridi_rte = rte[("ridi", "rte_5s_m")]
-    assert ridi_rte["before"] == first["summary"]["ridi"]["rte_5s_m"]
-    assert ridi_rte["after"] == second["summary"]["ridi"]["rte_5s_m"]
+    assert ridi_rte["first"] == first["summary"]["ridi"]["rte_5s_m"]
+    assert ridi_rte["second"] == second["summary"]["ridi"]["rte_5s_m"]
     assert ridi_rte["interval"]["low"] <= ridi_rte["difference"] <= ridi_rte["interval"]["high"]
     # The same from the command's files, the folder or its report.json.
     out = tmp_path / "eval"
@@ -185,7 +185,12 @@ def test_compare_pairs_two_evaluations_as_the_command_does(model, model_file, ri
     assert same_model["settings"] == [] and all(
         f["difference"] == 0.0 for f in same_model["figures"])
     printed = ridi_bin("compare", out, out)
-    assert "The two were produced alike" in printed
+    assert "Nothing recorded differs between the two" in printed
+    # The command's JSON is ridi.compare's on the same files.
+    other = tmp_path / "eval-other"
+    ridi_bin("eval", "--list", listed, "--model", model_file, "--out", other, "--methods",
+             "ridi,pdr", "--placement-map", "tyrex4", "--plots", "none", "--placement-window", "0")
+    assert same(json.loads(ridi_bin("compare", out, other, "--json")), ridi.compare(out, other))
     with pytest.raises(TypeError, match=r"`second` must be a report of `ridi.evaluate`"):
         ridi.compare(first, 5)
     with pytest.raises(ValueError, match=r"`first` is not a report of `ridi.evaluate`"):

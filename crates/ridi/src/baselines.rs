@@ -40,7 +40,8 @@ pub enum Method {
     RidiOri,
     /// Regressed velocities followed closely.
     Velocity,
-    /// Standing still.
+    /// Standing still: one point, which the alignment puts at the ground truth's mean
+    /// position over the alignment window.
     Still,
 }
 
@@ -66,6 +67,38 @@ impl Method {
             Method::RidiOri => "ridi_ori",
             Method::Velocity => "velocity",
             Method::Still => "still",
+        }
+    }
+
+    /// What the method's trajectory is, as report.md's definitions say it.
+    pub fn definition(self) -> &'static str {
+        match self {
+            Method::Ridi => {
+                "RIDI: the regressed velocities, a bias correction solved to follow \
+                 them, integrated"
+            }
+            Method::Raw => "the linear acceleration integrated twice in the world frame",
+            Method::Pdr => {
+                "steps detected in the accelerometer, every step as long as the \
+                 ground truth's path length over the number of steps (an oracle; no step \
+                 detected, it stays put), along the device's forward heading"
+            }
+            Method::RidiMag => {
+                "each regressed velocity's size along S's forward axis, then \
+                 corrected as ridi"
+            }
+            Method::RidiOri => {
+                "each regressed velocity's direction at the ground truth's mean \
+                 speed (an oracle), then corrected as ridi"
+            }
+            Method::Velocity => {
+                "the regressed velocities, corrected as ridi with a bias prior \
+                 (lambda) of 1e-6 instead of ridi's: followed closely"
+            }
+            Method::Still => {
+                "one point, aligned as the others: the ground truth's mean \
+                 position over the alignment window"
+            }
         }
     }
 

@@ -8,6 +8,7 @@ use std::fmt::Write as _;
 use ridi_eval::{Interval, Metric};
 use serde::Serialize;
 
+use crate::error::{PipelineError, Result};
 use crate::evaluate::{Report, with_interval};
 
 /// One method and metric of a [`Comparison`].
@@ -20,14 +21,13 @@ pub struct ComparedFigure {
     /// Sequences where both reports have the figure.
     pub sequences: usize,
     /// Its mean over those sequences in the first report.
-    pub before: f64,
+    pub first: f64,
     /// Its mean over them in the second.
-    pub after: f64,
-    /// `after - before`, paired by sequence: its mean and, with
-    /// [`ridi_eval::MIN_INTERVAL_RUNS`] runs or more, its 95 % interval (the parts of a run
-    /// drawn together).
+    pub second: f64,
+    /// The mean over those sequences of `second - first`, paired by sequence.
     pub difference: f64,
-    /// The difference's 95 % interval; `None` with too few runs.
+    /// The difference's 95 % interval: a bootstrap over the runs, the parts of a run drawn
+    /// together; `None` with fewer than [`ridi_eval::MIN_INTERVAL_RUNS`] runs.
     pub interval: Option<Interval>,
 }
 
@@ -41,54 +41,75 @@ pub struct Comparison {
     /// What produced the two reports that differs, one item each (`model: ... against ...`):
     /// what the differences measure.
     pub settings: Vec<String>,
-    /// Every method both reports have, every metric, in report order.
+    /// Every method both reports have, every metric, in the first report's order.
     pub figures: Vec<ComparedFigure>,
-    /// What to know before reading the differences: sequences in one report only, settings
-    /// that differ, too few runs for intervals.
+    /// What to know before reading the differences: sequences in one report only or named
+    /// twice in one, a sequence whose ground truth differs between the two, a report that
+    /// does not record what produced it, too few runs for intervals.
     pub warnings: Vec<String>,
 }
 
-/// Compares `after` with `before` sequence by sequence (by name): for each method both have
-/// and each metric, the paired difference `after - before`. Settings that make the figures
-/// incomparable (another alignment or metric window) are warnings, not errors: the
-/// comparison still says what differs.
-pub fn compare_reports(before: &Report, after: &Report) -> Comparison {
-    let by_name = |r: &Report| -> BTreeMap<String, usize> {
-        r.sequences
-            .iter()
-            .enumerate()
-            .map(|(i, s)| (s.name.clone(), i))
-            .collect()
-    };
-    let (a, b) = (by_name(before), by_name(after));
-    let both: Vec<&String> = a.keys().filter(|n| b.contains_key(*n)).collect();
+/// Compares `second` with `first` sequence by sequence (by name): for each method both have
+/// and each metric, the paired difference `second - first`.
+///
+/// # Errors
+/// The two reports hold no sequence of the same name.
+pub fn compare_reports(first: &Report, second: &Report) -> Result<Comparison> {
     let mut warnings = Vec::new();
-    let only_in = |x: &BTreeMap<String, usize>, y: &BTreeMap<String, usize>| -> Vec<String> {
+    let (a, b) = (
+        by_name(first, "first", &mut warnings),
+        by_name(second, "second", &mut warnings),
+    );
+    let both: Vec<&str> = a.keys().filter(|n| b.contains_key(*n)).copied().collect();
+    if both.is_empty() {
+        return Err(PipelineError::NoSequences(
+            "compare: the two reports share no sequence name",
+        ));
+    }
+    let only_in = |x: &BTreeMap<&str, usize>, y: &BTreeMap<&str, usize>| -> Vec<String> {
         x.keys()
             .filter(|n| !y.contains_key(*n))
             .map(ridi_data::shown)
             .collect()
     };
-    for (which, only) in [
-        ("the first", only_in(&a, &b)),
-        ("the second", only_in(&b, &a)),
-    ] {
+    for (which, only) in [("first", only_in(&a, &b)), ("second", only_in(&b, &a))] {
         if !only.is_empty() {
             warnings.push(format!(
-                "{} only in {which} report, left out: {}",
+                "{} only in the {which} report, left out: {}",
                 ridi_data::counted(only.len(), "sequence"),
                 ridi_data::first_few(only.into_iter(), 5)
             ));
         }
     }
-    if before.config != after.config {
+    // Paired by name: the same name over another ground truth is another recording, or the
+    // same one read otherwise.
+    let other_truth: Vec<String> = both
+        .iter()
+        .filter(|n| {
+            let (x, y) = (
+                first.sequences[a[**n]].path_length_m,
+                second.sequences[b[**n]].path_length_m,
+            );
+            (x - y).abs() > 1e-6 * x.abs().max(y.abs()).max(1.0)
+        })
+        .map(ridi_data::shown)
+        .collect();
+    if !other_truth.is_empty() {
         warnings.push(format!(
-            "the reports' alignment or metric windows differ ({:?} against {:?}): their \
-             figures measure different things",
-            before.config, after.config
+            "{} a ground-truth path of another length in each report (another recording, or \
+             the same read otherwise): {}",
+            ridi_data::counted(other_truth.len(), "sequence has"),
+            ridi_data::first_few(other_truth.into_iter(), 5)
         ));
     }
-    let settings = differing_settings(before, after);
+    for (which, r) in [("first", first), ("second", second)] {
+        if r.provenance.is_none() {
+            warnings.push(format!(
+                "the {which} report does not record its model and tracking settings (a report \
+                 of an older ridi): what differs between the two is known only in part"
+            ));
+        }
+    }
     let runs: BTreeSet<&str> = both.iter().map(|n| ridi_eval::run_of(n)).collect();
     if runs.len() < ridi_eval::MIN_INTERVAL_RUNS {
         warnings.push(format!(
@@ -99,7 +120,7 @@ pub fn compare_reports(before: &Report, after: &Report) -> Comparison {
         ));
     }
     let mut figures = Vec::new();
-    for method in before.methods.iter().filter(|m| after.methods.contains(m)) {
+    for method in first.methods.iter().filter(|m| second.methods.contains(m)) {
         for metric in Metric::ALL {
             let mut rows: Vec<(f64, f64, &str)> = Vec::new();
             for name in &both {
@@ -110,7 +131,7 @@ pub fn compare_reports(before: &Report, after: &Report) -> Comparison {
                         .and_then(|m| metric.value(m))
                         .filter(|v| v.is_finite())
                 };
-                if let (Some(x), Some(y)) = (value(before, a[*name]), value(after, b[*name])) {
+                if let (Some(x), Some(y)) = (value(first, a[name]), value(second, b[name])) {
                     rows.push((x, y, ridi_eval::run_of(name)));
                 }
             }
@@ -124,83 +145,128 @@ pub fn compare_reports(before: &Report, after: &Report) -> Comparison {
                 method: method.clone(),
                 metric: metric.key().to_string(),
                 sequences: rows.len(),
-                before: rows.iter().map(|r| r.0).sum::<f64>() / n,
-                after: rows.iter().map(|r| r.1).sum::<f64>() / n,
+                first: rows.iter().map(|r| r.0).sum::<f64>() / n,
+                second: rows.iter().map(|r| r.1).sum::<f64>() / n,
                 difference: diffs.iter().sum::<f64>() / n,
                 interval: ridi_eval::mean_interval(&diffs, &clusters),
             });
         }
     }
-    Comparison {
+    Ok(Comparison {
         sequences: both.len(),
         runs: runs.len(),
-        settings,
+        settings: differing_settings(first, second),
         figures,
         warnings,
+    })
+}
+
+/// The index of each sequence of `r` by name; a name held twice keeps its first sequence, and
+/// a warning says so.
+fn by_name<'r>(r: &'r Report, which: &str, warnings: &mut Vec<String>) -> BTreeMap<&'r str, usize> {
+    let mut index = BTreeMap::new();
+    let mut twice = Vec::new();
+    for (i, s) in r.sequences.iter().enumerate() {
+        if index.contains_key(s.name.as_str()) {
+            twice.push(ridi_data::shown(&s.name));
+        } else {
+            index.insert(s.name.as_str(), i);
+        }
     }
+    if !twice.is_empty() {
+        warnings.push(format!(
+            "the {which} report names {} twice; each is compared by its first: {}",
+            ridi_data::counted(twice.len(), "sequence"),
+            ridi_data::first_few(twice.into_iter(), 5)
+        ));
+    }
+    index
 }
 
 /// The settings of two reports that differ, as `name: first against second`.
-fn differing_settings(before: &Report, after: &Report) -> Vec<String> {
-    let shown = |v: Option<String>| v.unwrap_or_else(|| "(not recorded)".to_string());
-    let p = |r: &Report, f: &dyn Fn(&crate::Provenance) -> String| r.provenance.as_ref().map(f);
+fn differing_settings(first: &Report, second: &Report) -> Vec<String> {
+    let provenance =
+        |r: &Report, f: &dyn Fn(&crate::Provenance) -> String| r.provenance.as_ref().map(f);
     let window = |w: Option<f64>| w.map_or("per regression".to_string(), |w| format!("{w} s"));
-    let fields: [(&str, Option<String>, Option<String>); 6] = [
+    let methods = |r: &Report| {
+        let mut m = r.methods.clone();
+        m.sort_unstable();
+        m.join(", ")
+    };
+    let windows = |r: &Report| {
+        format!(
+            "{} s and {} s",
+            r.config.rte_window_s, r.config.short_rte_window_s
+        )
+    };
+    let settings: [(&str, Option<String>, Option<String>); 8] = [
         (
             "model",
-            p(before, &|p| {
+            provenance(first, &|p| format!("{} ({})", p.model, p.model_fingerprint)),
+            provenance(second, &|p| {
                 format!("{} ({})", p.model, p.model_fingerprint)
             }),
-            p(after, &|p| format!("{} ({})", p.model, p.model_fingerprint)),
         ),
         (
             "regressions every",
-            p(before, &|p| format!("{} frames", p.regress_every)),
-            p(after, &|p| format!("{} frames", p.regress_every)),
+            provenance(first, &|p| format!("{} frames", p.regress_every)),
+            provenance(second, &|p| format!("{} frames", p.regress_every)),
         ),
         (
-            "placement window",
-            p(before, &|p| window(p.placement_window_s)),
-            p(after, &|p| window(p.placement_window_s)),
+            "placement",
+            provenance(first, &|p| window(p.placement_window_s)),
+            provenance(second, &|p| window(p.placement_window_s)),
         ),
         (
             "heading",
-            Some(format!("{:?}", before.recorded_heading)),
-            Some(format!("{:?}", after.recorded_heading)),
+            Some(first.heading_text()),
+            Some(second.heading_text()),
         ),
         (
-            "methods",
-            Some(before.methods.join(", ")),
-            Some(after.methods.join(", ")),
+            "alignment",
+            Some(first.alignment_text()),
+            Some(second.alignment_text()),
         ),
+        ("RTE windows", Some(windows(first)), Some(windows(second))),
+        ("methods", Some(methods(first)), Some(methods(second))),
         (
             "ridi version",
-            p(before, &|p| p.ridi_version.clone()),
-            p(after, &|p| p.ridi_version.clone()),
+            provenance(first, &|p| p.ridi_version.clone()),
+            provenance(second, &|p| p.ridi_version.clone()),
         ),
     ];
-    fields
+    settings
         .into_iter()
+        // A setting one report does not record is no difference it can show.
+        .filter_map(|(name, a, b)| Some((name, a?, b?)))
         .filter(|(_, a, b)| a != b)
-        .map(|(name, a, b)| format!("{name}: {} against {}", shown(a), shown(b)))
+        .map(|(name, a, b)| format!("{name}: {a} against {b}"))
         .collect()
 }
 
 impl Comparison {
-    /// The comparison as markdown: the warnings, then one table row per method and metric.
+    /// The comparison as markdown: the warnings, what differs, then one table row per method
+    /// and metric.
     pub fn to_markdown(&self) -> String {
+        let with_intervals = self.figures.iter().any(|f| f.interval.is_some());
         let mut out = format!(
             "# Comparison: second report minus first\n\n{} in both ({}); differences paired by \
-             sequence, 95 % intervals by a bootstrap over the runs; bold: the interval leaves \
-             out 0.\n\n",
+             sequence{}.\n\n",
             ridi_data::counted(self.sequences, "sequence"),
-            ridi_data::counted(self.runs, "run")
+            ridi_data::counted(self.runs, "run"),
+            if with_intervals {
+                ", 95 % intervals by a bootstrap over the runs; bold: the interval leaves out 0"
+            } else {
+                "; too few runs for intervals"
+            }
         );
         for w in &self.warnings {
             let _ = writeln!(out, "**Warning**: {w}.\n");
         }
         if self.settings.is_empty() {
-            out.push_str("The two were produced alike (model, tracking settings, methods).\n\n");
+            out.push_str(
+                "Nothing recorded differs between the two (model, tracking settings, methods).\n\n",
+            );
         } else {
             out.push_str("What differs between the two:\n\n");
             for s in &self.settings {
@@ -220,8 +286,8 @@ impl Comparison {
                 f.method,
                 metric.label(),
                 f.sequences,
-                metric.format(Some(f.before)),
-                metric.format(Some(f.after)),
+                metric.format(Some(f.first)),
+                metric.format(Some(f.second)),
                 with_interval(metric, Some(f.difference), f.interval.as_ref(), true)
             );
         }
@@ -229,5 +295,95 @@ impl Comparison {
             .map(ridi_data::shown)
             .collect::<Vec<_>>()
             .join("\n")
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::SequenceResult;
+    use ridi_eval::{EvalConfig, TrajectoryMetrics};
+
+    fn report(rows: &[(&str, f64)]) -> Report {
+        let metrics = |rte| TrajectoryMetrics {
+            mpe_m: rte,
+            mpe_pct: None,
+            ate_m: rte,
+            rte_m: rte,
+            ate_ronin_m: rte,
+            rte_ronin_m: rte,
+            rte_5s_m: rte,
+            path_length_ratio: Some(1.0),
+        };
+        Report {
+            sequences: rows
+                .iter()
+                .map(|&(name, rte)| SequenceResult {
+                    name: name.into(),
+                    run: ridi_eval::run_of(name).into(),
+                    placement: None,
+                    device: None,
+                    path_length_m: 10.0,
+                    alignment_extent_m: 5.0,
+                    placement_accuracy: None,
+                    velocity_mse: [f64::NAN; 2],
+                    methods: [("ridi".to_string(), metrics(rte))].into(),
+                })
+                .collect(),
+            summary: BTreeMap::new(),
+            intervals: BTreeMap::new(),
+            ridi_minus: BTreeMap::new(),
+            velocity_mse: [f64::NAN; 2],
+            placement_accuracy: None,
+            placement_confusion: None,
+            config: EvalConfig::default(),
+            recorded_heading: None,
+            methods: vec!["ridi".into()],
+            warnings: Vec::new(),
+            provenance: None,
+        }
+    }
+
+    #[test]
+    fn pairs_by_name_and_says_what_it_cannot_pair() {
+        let first = report(&[("a", 1.0), ("b", 2.0), ("c_part1", 3.0), ("c_part2", 3.0)]);
+        let mut second = report(&[("b", 2.5), ("a", 1.5), ("c_part1", 3.5), ("c_part2", 3.5)]);
+        second.sequences.push(second.sequences[0].clone());
+        second.sequences[4]
+            .methods
+            .get_mut("ridi")
+            .unwrap()
+            .rte_5s_m = 99.0;
+        second.sequences.push(SequenceResult {
+            name: "d".into(),
+            ..second.sequences[0].clone()
+        });
+        let c = compare_reports(&first, &second).unwrap();
+        assert_eq!((c.sequences, c.runs), (4, 3));
+        let rte = c.figures.iter().find(|f| f.metric == "rte_5s_m").unwrap();
+        // Every pair 0.5 apart; `b` named twice is compared by its first row, not the 99.
+        assert_eq!((rte.first, rte.second, rte.difference), (2.25, 2.75, 0.5));
+        assert_eq!(rte.interval, None);
+        let warnings = c.warnings.join("\n");
+        for expected in [
+            "1 sequence only in the second report, left out: d",
+            "the second report names 1 sequence twice; each is compared by its first: b",
+            "the first report does not record its model and tracking settings",
+            "(3 runs): too few for 95 % intervals, which need 5 runs",
+        ] {
+            assert!(warnings.contains(expected), "{expected}: {warnings}");
+        }
+        // Nothing recorded but what both reports hold: no claim about the model.
+        assert!(c.settings.is_empty(), "{:?}", c.settings);
+        assert!(
+            c.to_markdown()
+                .contains("| ridi | RTE 5 s (m) | 4 | 2.250 | 2.750 | +0.500 |")
+        );
+        // No name in common: nothing to pair.
+        let other = report(&[("x", 1.0)]);
+        assert!(matches!(
+            compare_reports(&first, &other),
+            Err(PipelineError::NoSequences(_))
+        ));
     }
 }

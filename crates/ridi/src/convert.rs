@@ -498,14 +498,7 @@ fn unlisted_warning(
 /// The person of a Tyrex run name `<Person>_<Phone>_<Dist>_<Motion>`, also for the parts
 /// of a split run (`..._<Motion>_part2`).
 fn tyrex_subject(name: &str) -> Option<&str> {
-    // A reader's part (`_part2`), split again at a gap (`_part2_part1`).
-    let mut run = name;
-    while let Some((before, n)) = run.rsplit_once("_part") {
-        if n.is_empty() || !n.bytes().all(|b| b.is_ascii_digit()) {
-            break;
-        }
-        run = before;
-    }
+    let run = ridi_eval::run_of(name);
     tyrex::motion_of(run)?;
     let mut parts = run.split('_');
     let person = parts.next();

@@ -58,8 +58,9 @@ pub struct SequenceResult {
     /// Sequence name.
     pub name: String,
     /// The run it is part of, which the intervals draw whole ([`ridi_eval::run_of`]: the name
-    /// without a `_part<N>` suffix, as `ridi convert --split-at-gaps` and the Tyrex reader
-    /// name the parts of a recording split at its gaps).
+    /// without its `_part<N>` suffixes, as `ridi convert --split-at-gaps` and the Tyrex reader
+    /// name the parts of a recording split at its gaps). Derived from the name, which the
+    /// intervals and `ridi compare` take it from; written for a reader of `report.json`.
     #[serde(default)]
     pub run: String,
     /// Placement label.
@@ -206,14 +207,14 @@ pub(crate) fn with_interval(
     interval: Option<&ridi_eval::Interval>,
     signed: bool,
 ) -> String {
-    let Some(i) = interval.filter(|_| mean.is_some()) else {
-        return metric.format(mean);
-    };
     let value = metric.format(mean);
-    let value = if signed && !value.starts_with('-') {
+    let value = if signed && mean.is_some() && !value.starts_with('-') {
         format!("+{value}")
     } else {
         value
+    };
+    let Some(i) = interval.filter(|_| mean.is_some()) else {
+        return value;
     };
     let text = format!("{value} [{:.2}, {:.2}]", i.low, i.high);
     if signed && (i.low > 0.0 || i.high < 0.0) {
@@ -410,7 +411,8 @@ pub fn evaluate(
         .collect::<Vec<Result<_>>>()
         .into_iter()
         .collect::<Result<_>>()?;
-    let reports = sequence_reports(done.iter().map(|e| &e.result));
+    let order: Vec<String> = opts.methods.iter().map(|m| m.key().to_string()).collect();
+    let reports = sequence_reports(done.iter().map(|e| &e.result), &order);
     let summary = summarize(&reports)
         .into_iter()
         .map(|s| (s.method, s.mean))
@@ -474,7 +476,7 @@ pub fn evaluate(
             placement_confusion,
             config: opts.metrics,
             recorded_heading: opts.track.recorded_heading,
-            methods: opts.methods.iter().map(|m| m.key().to_string()).collect(),
+            methods: order,
             warnings,
             provenance: Some(Provenance::of(model, opts)?),
         },
@@ -550,22 +552,27 @@ fn weak_alignment(sequences: &[SequenceResult], align: ridi_eval::AlignWindow) -
     })
 }
 
-fn sequence_reports<'a>(results: impl Iterator<Item = &'a SequenceResult>) -> Vec<SequenceReport> {
+/// `results` as ridi-eval's tables take them, each sequence's methods in `order` (a report's
+/// `methods`; a key not in it, as from a report of another version, last).
+fn sequence_reports<'a>(
+    results: impl Iterator<Item = &'a SequenceResult>,
+    order: &[String],
+) -> Vec<SequenceReport> {
     results
         .map(|r| SequenceReport {
             sequence: r.name.clone(),
             placement: r.placement.clone(),
             frames: 0,
-            // In report order (ridi, raw, pdr, ...), as the summary's tables have them, not the
-            // map's alphabetical one; a key no method has (a report of another version) last.
-            methods: Method::ALL
+            // In the report's order, as its other tables have them, not the map's alphabetical
+            // one.
+            methods: order
                 .iter()
-                .map(|m| m.key())
+                .map(String::as_str)
                 .chain(
                     r.methods
                         .keys()
                         .map(String::as_str)
-                        .filter(|k| Method::ALL.iter().all(|m| m.key() != *k)),
+                        .filter(|k| !order.iter().any(|o| o == k)),
                 )
                 .filter_map(|k| {
                     r.methods.get(k).map(|m| MethodMetrics {
@@ -617,8 +624,10 @@ impl Report {
         let keys: BTreeSet<&str> = self.sequences.iter().filter_map(key_of).collect();
         keys.into_iter()
             .map(|k| {
-                let subset =
-                    sequence_reports(self.sequences.iter().filter(|s| key_of(s) == Some(k)));
+                let subset = sequence_reports(
+                    self.sequences.iter().filter(|s| key_of(s) == Some(k)),
+                    &self.methods,
+                );
                 GroupSummary {
                     group: k.to_string(),
                     sequences: subset.len(),
@@ -631,9 +640,32 @@ impl Report {
             .collect()
     }
 
+    /// The mean over the sequences where both have `metric` of `ridi - method`: the paired
+    /// difference without its interval (too few runs for one).
+    fn paired_mean(&self, method: &str, metric: Metric) -> Option<f64> {
+        let diffs: Vec<f64> = self
+            .sequences
+            .iter()
+            .filter_map(|s| {
+                let of = |k: &str| s.methods.get(k).and_then(|m| metric.value(m));
+                Some(of(Method::Ridi.key())? - of(method)?)
+            })
+            .collect();
+        (!diffs.is_empty()).then(|| diffs.iter().sum::<f64>() / diffs.len() as f64)
+    }
+
     /// The section of `report.md` that says what each figure and method is.
     fn definitions(&self) -> String {
         let c = &self.config;
+        let methods: Vec<String> = self
+            .methods
+            .iter()
+            .filter_map(|key| {
+                let method = Method::ALL.into_iter().find(|m| m.key() == key)?;
+                Some(format!("`{key}`, {}", method.definition()))
+            })
+            .collect();
+        let methods = methods.join("; ");
         format!(
             "\n## Definitions\n\n\
              Every trajectory is horizontal, aligned on the ground truth as the header says (one \
@@ -651,17 +683,32 @@ impl Report {
              percentiles over runs (the parts `_part1`, `_part2`, ... of a recording split at \
              its gaps are one run), given for {min} runs or more. **Velocity MSE** and \
              **placement accuracy** pool every regression of every sequence.\n\
-             - **Methods**: `ridi`, the regressed velocities corrected into a trajectory \
-             (RIDI); `raw`, the linear acceleration integrated twice; `pdr`, steps detected in \
-             the accelerometer, each as long as the ground truth's path over its steps (an \
-             oracle), along the device's heading; `ridi_mag`, the regressed speed along the \
-             device's forward direction; `ridi_ori`, the regressed direction at the ground \
-             truth's mean speed (an oracle); `velocity`, the regressed velocities followed \
-             closely (the correction's prior near 0); `still`, standing at the start.\n",
+             - **Methods**: {methods}.\n",
             long = c.rte_window_s,
             short = c.short_rte_window_s,
             min = ridi_eval::MIN_INTERVAL_RUNS,
         )
+    }
+
+    /// Where the trajectories were aligned, as report.md's header says it.
+    pub(crate) fn alignment_text(&self) -> String {
+        match self.config.align {
+            ridi_eval::AlignWindow::Seconds(s) => format!("the first {s} s"),
+            ridi_eval::AlignWindow::Frames(n) => format!("the first {n} frames"),
+            ridi_eval::AlignWindow::All => "the whole trajectory".to_string(),
+        }
+    }
+
+    /// The heading a model on the estimated orientation tracked with, as report.md says it.
+    pub(crate) fn heading_text(&self) -> String {
+        match self.recorded_heading {
+            Some(h) => format!(
+                "the gyro's, its drift corrected by the recorded orientation's slow heading \
+                 (time constant {} s, changes clamped at {} rad/s)",
+                h.time_constant, h.max_rate
+            ),
+            None => "the gyro's alone".to_string(),
+        }
     }
 
     /// The markdown report: overall summary, per placement, per device (when the sequences
@@ -674,25 +721,14 @@ impl Report {
             out,
             "{}; trajectories aligned on {} (2D rigid, no scale); RTE window {} s, short RTE {} s.\n",
             ridi_data::counted(self.sequences.len(), "sequence"),
-            match self.config.align {
-                ridi_eval::AlignWindow::Seconds(s) => format!("the first {s} s"),
-                ridi_eval::AlignWindow::Frames(n) => format!("the first {n} frames"),
-                ridi_eval::AlignWindow::All => "the whole trajectory".to_string(),
-            },
+            self.alignment_text(),
             self.config.rte_window_s,
             self.config.short_rte_window_s
         );
         let _ = writeln!(
             out,
             "Heading with a model on the estimated orientation: {}.\n",
-            match self.recorded_heading {
-                Some(h) => format!(
-                    "the gyro's, its drift corrected by the recorded orientation's slow heading \
-                     (time constant {} s, changes clamped at {} rad/s)",
-                    h.time_constant, h.max_rate
-                ),
-                None => "the gyro's alone".to_string(),
-            }
+            self.heading_text()
         );
         if let Some(p) = &self.provenance {
             let _ = writeln!(
@@ -725,14 +761,22 @@ impl Report {
         for w in &self.warnings {
             let _ = writeln!(out, "**Warning**: {w}.\n");
         }
-        let _ = writeln!(
-            out,
-            "## Overall (mean over sequences [95 % interval])\n\nIntervals: a bootstrap over \
-             the sequences ({} resamples, the parts of a run drawn together); they say how \
-             well these runs pin a mean down, not how far it carries to other people or \
-             phones.\n",
-            ridi_eval::DRAWS
-        );
+        let has_intervals = self.intervals.values().any(|m| !m.is_empty());
+        if has_intervals {
+            let _ = writeln!(
+                out,
+                "## Overall (mean over sequences [95 % interval])\n\nIntervals: a bootstrap \
+                 over the sequences ({} resamples, the parts of a run drawn together); they say \
+                 how well these runs pin a mean down, not how far it carries to other people \
+                 or phones.\n",
+                ridi_eval::DRAWS
+            );
+        } else {
+            let _ = writeln!(
+                out,
+                "## Overall (mean over sequences; too few runs for intervals)\n"
+            );
+        }
         let mut head = "| method |".to_string();
         let mut rule = "| --- |".to_string();
         for m in Metric::ALL {
@@ -754,22 +798,31 @@ impl Report {
                 let _ = writeln!(out);
             }
         }
+        let ridi = Method::Ridi.key();
         let others: Vec<&String> = self
             .methods
             .iter()
-            .filter(|k| self.ridi_minus.contains_key(*k))
+            .filter(|k| k.as_str() != ridi && self.summary.contains_key(*k))
             .collect();
-        if !others.is_empty() {
+        if self.summary.contains_key(ridi) && !others.is_empty() {
             let _ = writeln!(
                 out,
-                "\n## ridi minus each method (paired over sequences [95 % interval]; bold: the \
-                 interval leaves out 0)\n\n{head}\n{rule}"
+                "\n## ridi minus each method (paired over sequences{})\n\n{head}\n{rule}",
+                if has_intervals {
+                    " [95 % interval]; bold: the interval leaves out 0"
+                } else {
+                    "; too few runs for intervals"
+                }
             );
             for key in others {
                 let _ = write!(out, "| {key} |");
                 for m in Metric::ALL {
-                    let d = self.ridi_minus[key].get(m.key());
-                    let _ = write!(out, " {} |", with_interval(m, d.map(|d| d.mean), d, true));
+                    let d = self
+                        .ridi_minus
+                        .get(key.as_str())
+                        .and_then(|d| d.get(m.key()));
+                    let mean = d.map(|d| d.mean).or_else(|| self.paired_mean(key, m));
+                    let _ = write!(out, " {} |", with_interval(m, mean, d, true));
                 }
                 let _ = writeln!(out);
             }
@@ -801,7 +854,7 @@ impl Report {
                 let _ = writeln!(out);
             }
         }
-        let reports = sequence_reports(self.sequences.iter());
+        let reports = sequence_reports(self.sequences.iter(), &self.methods);
         for metric in [
             Metric::Rte5sM,
             Metric::PathLengthRatio,
