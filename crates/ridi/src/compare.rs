@@ -302,7 +302,7 @@ impl Comparison {
 mod tests {
     use super::*;
     use crate::SequenceResult;
-    use ridi_eval::{EvalConfig, TrajectoryMetrics};
+    use ridi_eval::TrajectoryMetrics;
 
     fn report(rows: &[(&str, f64)]) -> Report {
         let metrics = |rte| TrajectoryMetrics {
@@ -315,9 +315,8 @@ mod tests {
             rte_5s_m: rte,
             path_length_ratio: Some(1.0),
         };
-        Report {
-            sequences: rows
-                .iter()
+        Report::of_sequences(
+            rows.iter()
                 .map(|&(name, rte)| SequenceResult {
                     name: name.into(),
                     run: ridi_eval::run_of(name).into(),
@@ -330,18 +329,7 @@ mod tests {
                     methods: [("ridi".to_string(), metrics(rte))].into(),
                 })
                 .collect(),
-            summary: BTreeMap::new(),
-            intervals: BTreeMap::new(),
-            ridi_minus: BTreeMap::new(),
-            velocity_mse: [f64::NAN; 2],
-            placement_accuracy: None,
-            placement_confusion: None,
-            config: EvalConfig::default(),
-            recorded_heading: None,
-            methods: vec!["ridi".into()],
-            warnings: Vec::new(),
-            provenance: None,
-        }
+        )
     }
 
     #[test]

@@ -199,6 +199,27 @@ impl Provenance {
     }
 }
 
+#[cfg(test)]
+impl Report {
+    /// A report of `sequences` of `ridi` alone and nothing else, for tests to change.
+    pub(crate) fn of_sequences(sequences: Vec<SequenceResult>) -> Report {
+        Report {
+            sequences,
+            summary: BTreeMap::new(),
+            intervals: BTreeMap::new(),
+            ridi_minus: BTreeMap::new(),
+            velocity_mse: [f64::NAN; 2],
+            placement_accuracy: None,
+            placement_confusion: None,
+            config: EvalConfig::default(),
+            recorded_heading: None,
+            methods: vec!["ridi".into()],
+            warnings: Vec::new(),
+            provenance: None,
+        }
+    }
+}
+
 /// A mean as report tables print it ([`Metric::format`]) with its interval when known, `1.033
 /// [0.90, 1.19]`; a difference (`signed`) with its sign, bold when the interval leaves out 0.
 pub(crate) fn with_interval(
@@ -1067,18 +1088,9 @@ mod tests {
 
     fn report(sequences: Vec<SequenceResult>) -> Report {
         Report {
-            sequences,
-            summary: BTreeMap::new(),
-            intervals: BTreeMap::new(),
-            ridi_minus: BTreeMap::new(),
             velocity_mse: [0.1, 0.1],
             placement_accuracy: Some(1.0),
-            placement_confusion: None,
-            config: EvalConfig::default(),
-            recorded_heading: None,
-            methods: vec!["ridi".into()],
-            warnings: Vec::new(),
-            provenance: None,
+            ..Report::of_sequences(sequences)
         }
     }
 

@@ -700,17 +700,10 @@ mod tests {
                     methods: BTreeMap::new(),
                 })
                 .collect(),
-            summary: BTreeMap::new(),
-            intervals: BTreeMap::new(),
-            ridi_minus: BTreeMap::new(),
-            velocity_mse: [f64::NAN; 2],
-            placement_accuracy: None,
-            placement_confusion: None,
-            config: ridi_eval::EvalConfig::default(),
             recorded_heading: Some(ridi_frames::HeadingConfig::default()),
             methods: Vec::new(),
             warnings: vec!["a warning".into()],
-            provenance: None,
+            ..Report::of_sequences(Vec::new())
         }
     }
 
