@@ -485,6 +485,7 @@ pub fn evaluate(
     };
     warnings.extend(weak_alignment(&results, opts.metrics.align));
     warnings.extend(still_ahead(&summary));
+    warnings.extend(pdr_without_steps(&results));
     warnings.extend(too_few_runs(&results));
     Ok((
         Report {
@@ -520,6 +521,29 @@ fn too_few_runs(sequences: &[SequenceResult]) -> Option<String> {
             ridi_data::counted(sequences.len(), "sequence"),
             ridi_data::counted(runs.len(), "run"),
             ridi_eval::MIN_INTERVAL_RUNS
+        )
+    })
+}
+
+/// The warning naming the sequences where PDR detected no step: its trajectory there stays
+/// put (path length ratio 0), and its figures are standing still's, not a step counter's.
+fn pdr_without_steps(sequences: &[SequenceResult]) -> Option<String> {
+    let still: Vec<String> = sequences
+        .iter()
+        .filter(|s| {
+            s.methods
+                .get(Method::Pdr.key())
+                .is_some_and(|m| m.path_length_ratio == Some(0.0))
+        })
+        .map(|s| ridi_data::shown(&s.name))
+        .collect();
+    (!still.is_empty()).then(|| {
+        format!(
+            "pdr detected no step in {} of {}, where it stands still and its figures are not a \
+             step counter's: {}",
+            still.len(),
+            ridi_data::counted(sequences.len(), "sequence"),
+            ridi_data::first_few(still.into_iter(), 5)
         )
     })
 }
@@ -1028,6 +1052,29 @@ impl Traces {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn pdr_without_a_step_is_a_warning() {
+        let with_pdr = |name: &str, ratio: f64| {
+            let mut r = result(name, None, 1.0);
+            let ridi = r.methods["ridi"];
+            r.methods.insert(
+                "pdr".into(),
+                TrajectoryMetrics {
+                    path_length_ratio: Some(ratio),
+                    ..ridi
+                },
+            );
+            r
+        };
+        let results = [with_pdr("walk", 0.9), with_pdr("ar", 0.0)];
+        assert_eq!(
+            pdr_without_steps(&results).unwrap(),
+            "pdr detected no step in 1 of 2 sequences, where it stands still and its figures \
+             are not a step counter's: ar"
+        );
+        assert_eq!(pdr_without_steps(&results[..1]), None);
+    }
 
     #[test]
     fn standing_still_ahead_of_ridi_on_ate_is_a_warning() {
