@@ -115,5 +115,8 @@ pub(crate) fn run(
     for l in &summary.lists {
         outln!("list: {}", shown(l));
     }
+    if let Some(w) = &summary.warnings_file {
+        outln!("warnings: {}", shown(w));
+    }
     Ok(())
 }

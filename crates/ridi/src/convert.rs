@@ -44,7 +44,14 @@ pub struct ConvertSummary {
     pub lists: Vec<PathBuf>,
     /// Splits, dropped parts and other things to know.
     pub warnings: Vec<String>,
+    /// The file the warnings were also written to ([`WARNINGS_FILE`] in the output folder),
+    /// when there were any: what a conversion split or dropped stays beside its output.
+    pub warnings_file: Option<PathBuf>,
 }
+
+/// The file in a conversion's output folder that keeps its warnings, one per line; a
+/// conversion without warnings removes an earlier one.
+pub const WARNINGS_FILE: &str = "convert-warnings.txt";
 
 /// How to convert.
 #[derive(Debug, Clone, Default)]
@@ -735,6 +742,19 @@ pub fn convert(
         written_lists.push(out.join(name));
     }
     check_overwrites(&dirs, &listed.lists, &summary.sequences, &written_lists)?;
+    let warnings_file = Path::new(WARNINGS_FILE);
+    if summary.warnings.is_empty() {
+        staging.remove(warnings_file);
+    } else {
+        write_atomically(&staging.file(warnings_file)?, |w| {
+            writeln!(w, "# warnings of `ridi convert {}`", source.display())?;
+            for warning in &summary.warnings {
+                writeln!(w, "{}", ridi_data::shown(warning))?;
+            }
+            Ok(())
+        })?;
+        summary.warnings_file = Some(out.join(WARNINGS_FILE));
+    }
     staging.commit()?;
     summary.lists = written_lists;
     Ok(summary)

@@ -109,8 +109,8 @@ pub use baselines::{Method, baseline_trajectory, device_heading};
 pub use bundled::{BUNDLED_MODEL_SUMMARY, bundled_model};
 pub use compare::{ComparedFigure, Comparison, compare_reports};
 pub use convert::{
-    ConvertOptions, ConvertSummary, Converted, SPLIT_MIN_PART_S, convert, read_split,
-    resample_max_gap, split_limit,
+    ConvertOptions, ConvertSummary, Converted, SPLIT_MIN_PART_S, WARNINGS_FILE, convert,
+    read_split, resample_max_gap, split_limit,
 };
 pub use demo::Demo;
 pub use error::{PipelineError, Result};

@@ -430,6 +430,20 @@ fn rate_resamples_every_sequence_and_refuses_to_fill_gaps() {
         "{:?}",
         summary.warnings
     );
+    // The warnings stay beside the output, one per line after a header.
+    let file = dir.path().join("out6").join(ridi::WARNINGS_FILE);
+    assert_eq!(summary.warnings_file.as_deref(), Some(file.as_path()));
+    let kept = std::fs::read_to_string(&file).unwrap();
+    assert_eq!(
+        kept.lines().skip(1).collect::<Vec<_>>(),
+        summary
+            .warnings
+            .iter()
+            .map(String::as_str)
+            .collect::<Vec<_>>()
+    );
+    assert!(kept.starts_with("# warnings of `ridi convert "), "{kept}");
+
     let split_hard = ConvertOptions {
         split_gaps_s: Some(0.001),
         ..split.clone()
@@ -481,8 +495,16 @@ fn devices_are_kept_with_one_list_per_device() {
     write("Bo_iPhone4S_NoDist_Texting", device("iPhone 4S", 90.2));
     write("plain", None);
     let out = dir.path().join("out");
+    // An earlier conversion's warnings, which this one, without any, removes.
+    std::fs::create_dir_all(&out).unwrap();
+    std::fs::write(
+        out.join(ridi::WARNINGS_FILE),
+        "# warnings of an earlier run\nold\n",
+    )
+    .unwrap();
     let summary = convert(&src, &out, &ConvertOptions::default()).unwrap();
     assert!(summary.warnings.is_empty(), "{:?}", summary.warnings);
+    assert!(summary.warnings_file.is_none() && !out.join(ridi::WARNINGS_FILE).exists());
     let lists: Vec<String> = summary
         .lists
         .iter()
