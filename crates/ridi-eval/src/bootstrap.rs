@@ -45,6 +45,15 @@ impl Interval {
     }
 }
 
+/// The mean of `values`, summed in ascending order: the same bits whatever order the values
+/// come in (a list file's order, say), so that a report reproduces to the last digit. NaN for
+/// no values.
+pub fn ordered_mean(values: &[f64]) -> f64 {
+    let mut sorted = values.to_vec();
+    sorted.sort_unstable_by(f64::total_cmp);
+    sorted.iter().sum::<f64>() / sorted.len() as f64
+}
+
 /// The mean of `values` (one per test sequence) and its 95 % percentile interval over
 /// [`DRAWS`] resamples of the clusters (`cluster[i]` names the run of sequence `i`). `None`
 /// with fewer than [`MIN_INTERVAL_RUNS`] clusters, with `cluster` of another length, or with a
@@ -56,14 +65,19 @@ pub fn mean_interval(values: &[f64], cluster: &[&str]) -> Option<Interval> {
     let mut names: Vec<&str> = cluster.to_vec();
     names.sort_unstable();
     names.dedup();
-    // Sum and count of each cluster: a draw only adds them up.
+    // Sum and count of each cluster, its values added in ascending order (as `ordered_mean`):
+    // a draw only adds them up.
+    let mut sorted: Vec<(usize, f64)> = Vec::with_capacity(values.len());
+    for (&v, c) in values.iter().zip(cluster) {
+        sorted.push((names.binary_search(c).ok()?, v));
+    }
+    sorted.sort_unstable_by(|a, b| a.0.cmp(&b.0).then(a.1.total_cmp(&b.1)));
     let mut sums = vec![(0.0, 0usize); names.len()];
-    for (v, c) in values.iter().zip(cluster) {
-        let k = names.binary_search(c).ok()?;
+    for (k, v) in sorted {
         sums[k].0 += v;
         sums[k].1 += 1;
     }
-    let mean = values.iter().sum::<f64>() / values.len() as f64;
+    let mean = ordered_mean(values);
     percentile_interval(mean, sums.len(), |draw| {
         let (mut s, mut n) = (0.0, 0usize);
         for &k in draw {
@@ -80,7 +94,7 @@ pub fn runs_interval(values: &[f64]) -> Option<Interval> {
     if values.is_empty() || !values.iter().all(|v| v.is_finite()) {
         return None;
     }
-    let mean = values.iter().sum::<f64>() / values.len() as f64;
+    let mean = ordered_mean(values);
     percentile_interval(mean, values.len(), |draw| {
         draw.iter().map(|&k| values[k]).sum::<f64>() / draw.len() as f64
     })

@@ -72,7 +72,7 @@ pub use align::{
     fit_rigid_2d, target_extent,
 };
 pub use bootstrap::{
-    DRAWS, Interval, MIN_INTERVAL_RUNS, mean_interval, ratio_interval, runs_interval,
+    DRAWS, Interval, MIN_INTERVAL_RUNS, mean_interval, ordered_mean, ratio_interval, runs_interval,
 };
 pub use error::{EvalError, Result};
 pub use metrics::{

@@ -262,8 +262,8 @@ fn per_method(
 }
 
 fn mean(values: impl Iterator<Item = f64>) -> Option<f64> {
-    let (sum, n) = values.fold((0.0, 0usize), |(s, n), v| (s + v, n + 1));
-    (n > 0).then(|| sum / n as f64)
+    let values: Vec<f64> = values.collect();
+    (!values.is_empty()).then(|| crate::bootstrap::ordered_mean(&values))
 }
 
 /// Markdown-safe cell text: pipes would split the cell, newlines would end the row.

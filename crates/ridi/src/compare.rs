@@ -138,16 +138,16 @@ pub fn compare_reports(first: &Report, second: &Report) -> Result<Comparison> {
             if rows.is_empty() {
                 continue;
             }
-            let n = rows.len() as f64;
             let diffs: Vec<f64> = rows.iter().map(|(x, y, _)| y - x).collect();
             let clusters: Vec<&str> = rows.iter().map(|r| r.2).collect();
+            let column = |f: fn(&(f64, f64, &str)) -> f64| rows.iter().map(f).collect::<Vec<_>>();
             figures.push(ComparedFigure {
                 method: method.clone(),
                 metric: metric.key().to_string(),
                 sequences: rows.len(),
-                first: rows.iter().map(|r| r.0).sum::<f64>() / n,
-                second: rows.iter().map(|r| r.1).sum::<f64>() / n,
-                difference: diffs.iter().sum::<f64>() / n,
+                first: ridi_eval::ordered_mean(&column(|r| r.0)),
+                second: ridi_eval::ordered_mean(&column(|r| r.1)),
+                difference: ridi_eval::ordered_mean(&diffs),
                 interval: ridi_eval::mean_interval(&diffs, &clusters),
             });
         }

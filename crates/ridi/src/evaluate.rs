@@ -447,10 +447,11 @@ pub fn evaluate(
     let velocity_mse = if squared.is_empty() {
         [f64::NAN; 2]
     } else {
-        let n = squared.len() as f64;
+        // Summed in an order that does not depend on the sequences'.
+        let channel = |c: usize| squared.iter().map(|s| s[c]).collect::<Vec<f64>>();
         [
-            squared.iter().map(|s| s[0]).sum::<f64>() / n,
-            squared.iter().map(|s| s[1]).sum::<f64>() / n,
+            ridi_eval::ordered_mean(&channel(0)),
+            ridi_eval::ordered_mean(&channel(1)),
         ]
     };
     let truth: Vec<&str> = done
@@ -696,7 +697,7 @@ impl Report {
                 Some(of(Method::Ridi.key())? - of(method)?)
             })
             .collect();
-        (!diffs.is_empty()).then(|| diffs.iter().sum::<f64>() / diffs.len() as f64)
+        (!diffs.is_empty()).then(|| ridi_eval::ordered_mean(&diffs))
     }
 
     /// The section of `report.md` that says what each figure and method is.

@@ -88,6 +88,18 @@ fn train_track_and_evaluate_on_the_sample_dataset() {
     assert!(back.feature_config().standardization.is_some());
 
     let (report, traces) = ridi::evaluate(&test, &model, &EvalOptions::default()).unwrap();
+    // The same figures, to the last bit, whatever order the sequences come in.
+    let reversed: Vec<Sequence> = test.iter().rev().cloned().collect();
+    let (again, _) = ridi::evaluate(&reversed, &model, &EvalOptions::default()).unwrap();
+    assert_eq!(again.summary, report.summary);
+    assert_eq!(
+        (&again.intervals, &again.ridi_minus),
+        (&report.intervals, &report.ridi_minus)
+    );
+    assert_eq!(
+        again.velocity_mse.map(f64::to_bits),
+        report.velocity_mse.map(f64::to_bits)
+    );
     assert_eq!(report.sequences.len(), 10);
     assert_eq!(traces.len(), 10);
     let ridi = report.summary["ridi"];
