@@ -16,7 +16,9 @@
 //!   (`report.md`).
 //! - PDR ([`pdr_trajectory`], [`detect_steps`]): the step-counting baseline: step detection and step-and-heading integration.
 //! - Intervals ([`mean_interval`], [`runs_interval`], [`ratio_interval`]): how far a mean over
-//!   runs can be trusted, by a bootstrap over whole runs (a run's parts drawn together).
+//!   runs can be trusted, by a bootstrap over whole runs (a run's parts drawn together), given
+//!   from [`MIN_INTERVAL_RUNS`] runs on; means summed in an order that does not depend on the
+//!   runs' ([`ordered_mean`]), so that a report reproduces to the last bit.
 //!
 //! Inputs are validated: empty, mismatched or non-finite inputs give an [`EvalError`], never a
 //! panic.
