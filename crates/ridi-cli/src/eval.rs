@@ -168,10 +168,19 @@ fn print_summary(report: &Report) {
             .map_or("-".into(), |a| format!("{a:.3}"))
     );
     let c = &report.config;
+    let bounded = report
+        .intervals
+        .values()
+        .flat_map(|m| m.values())
+        .any(ridi::eval::Interval::is_bounded);
     outln!(
         "{:<10} {:>26} {:>9} {:>10} {:>9} {:>17}",
         "method",
-        format!("RTE {} s m [95 %]", c.short_rte_window_s),
+        format!(
+            "RTE {} s m{}",
+            c.short_rte_window_s,
+            if bounded { " [95 %]" } else { "" }
+        ),
         "ATE m",
         format!("RTE {} s m", c.rte_window_s),
         "MPE m",
@@ -180,7 +189,11 @@ fn print_summary(report: &Report) {
     let opt = |v: Option<f64>| v.map_or("-".to_string(), |v| format!("{v:.3}"));
     for key in &report.methods {
         if let Some(m) = report.summary.get(key) {
-            let interval = report.intervals.get(key).and_then(|i| i.get(RTE_5S));
+            let interval = report
+                .intervals
+                .get(key)
+                .and_then(|i| i.get(RTE_5S))
+                .filter(|i| i.is_bounded());
             let rte_5s = match interval {
                 Some(i) => format!("{:.3} [{:.3}, {:.3}]", m.rte_5s_m, i.low, i.high),
                 None => format!("{:.3}", m.rte_5s_m),
@@ -199,13 +212,16 @@ fn print_summary(report: &Report) {
         .get(ridi::Method::Pdr.key())
         .and_then(|d| d.get(RTE_5S))
     {
+        let bounds = if d.is_bounded() {
+            format!(" [{:+.3}, {:+.3}]", d.low, d.high)
+        } else {
+            " (too few runs for an interval)".to_string()
+        };
         outln!(
-            "ridi - pdr, RTE {} s: {:+.3} m [{:+.3}, {:+.3}] (paired over sequences; every \
-             interval and difference in report.md)",
+            "ridi - pdr, RTE {} s: {:+.3} m{bounds} (paired over sequences; every difference \
+             in report.md)",
             c.short_rte_window_s,
             d.mean,
-            d.low,
-            d.high
         );
     }
     // A test set that spans phones says how each fared: the question a new phone asks.

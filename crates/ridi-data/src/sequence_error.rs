@@ -2,6 +2,18 @@
 
 use crate::sequence::Channel;
 
+/// The likeliest cause of a linear acceleration `scale` times off accelerometer minus gravity.
+fn linacce_cause(scale: f64) -> &'static str {
+    match scale {
+        s if (5.0..20.0).contains(&s) => "linear acceleration in g instead of m/s^2",
+        s if (0.0005..0.002).contains(&s) => "linear acceleration in mm/s^2 instead of m/s^2",
+        // Gravity left in: the accelerometer's reading given for the linear acceleration.
+        s if s.abs() < 0.3 => "gravity not taken out of the linear acceleration",
+        s if s.is_infinite() => "a linear acceleration of zero where the phone accelerates",
+        _ => "linear acceleration in another unit than m/s^2, or another column",
+    }
+}
+
 /// A number for a message: plain with at most 3 decimals, or in scientific notation when very
 /// large or small (`1e308`, not 309 digits).
 pub fn short(v: f64) -> String {
@@ -272,9 +284,9 @@ pub enum SequenceError {
     /// The linear acceleration does not match accelerometer minus gravity in size.
     #[error(
         "accelerometer minus gravity is {} times the linear acceleration (least squares), \
-         outside {min}..{max}: linear acceleration in {}?",
+         outside {min}..{max}: {}?",
         short(*scale),
-        if *scale > 5.0 && *scale < 20.0 { "g instead of m/s^2" } else { "another unit than m/s^2, or another column" }
+        linacce_cause(*scale)
     )]
     LinacceScale {
         /// The fitted scale.

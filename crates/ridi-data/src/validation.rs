@@ -412,14 +412,24 @@ impl Validation {
         dd: f64,
         n: usize,
     ) -> Result<(), SequenceError> {
-        // NaN sums pass as too small to judge, not as a scale.
-        let rms = (dd / n as f64).sqrt();
-        if n == 0 || rms.is_nan() || rms < LINACCE_SCALE_MIN_RMS {
+        if n == 0 {
             return Ok(());
         }
         // acce - gravity ~ scale * linacce; an all-zero linear acceleration is no scale at all.
         let scale = if ll > 0.0 { dl / ll } else { f64::INFINITY };
         let (min, max) = self.linacce_scale_range;
+        let (rms, linacce_rms) = ((dd / n as f64).sqrt(), (ll / n as f64).sqrt());
+        // NaN sums pass as too small to judge, not as a scale.
+        if rms.is_nan() || rms < LINACCE_SCALE_MIN_RMS {
+            // A phone too still to fit a scale still has no linear acceleration of its own: a
+            // large one there is gravity left in it (the accelerometer given for it).
+            let still_but_large = linacce_rms > LINACCE_STILL_MAX_RMS && linacce_rms > 4.0 * rms;
+            return if still_but_large {
+                Err(SequenceError::LinacceScale { scale, min, max })
+            } else {
+                Ok(())
+            };
+        }
         if (min..=max).contains(&scale) {
             Ok(())
         } else {
@@ -665,6 +675,12 @@ pub(crate) fn orientation_jump_warning(file: &str, jumps: &[OrientationJump]) ->
 /// [`Validation::check_gyro_scale`] judges the gyro's scale (the Tyrex and competition walks
 /// turn at 0.5-2.6 rad/s RMS).
 pub const GYRO_SCALE_MIN_RATE: f64 = 0.1;
+
+/// Largest RMS linear acceleration, m/s^2, that [`Validation::check_linacce_scale`] accepts
+/// where accelerometer minus gravity is too small to fit a scale (below
+/// [`LINACCE_SCALE_MIN_RMS`]): a still phone's is noise (hundredths), one with gravity left in
+/// it about 9.8.
+pub const LINACCE_STILL_MAX_RMS: f64 = 2.0;
 
 /// Smallest RMS of accelerometer minus gravity, m/s^2, at which [`Validation::check_linacce_scale`]
 /// judges the linear acceleration's scale: a phone lying still has mostly sensor noise there,
@@ -1013,11 +1029,29 @@ mod tests {
             "{e}"
         );
         let e = v.check_linacce_scale(frames(2.0, 1e-3)).unwrap_err();
-        assert!(e.to_string().contains("another unit than m/s^2"), "{e}");
+        assert!(
+            e.to_string().ends_with("in mm/s^2 instead of m/s^2?"),
+            "{e}"
+        );
         // All zero while the phone moves: no linear acceleration at all.
         let zero = frames(2.0, 1.0).map(|(a, g, _)| (a, g, [0.0; 3]));
-        assert!(v.check_linacce_scale(zero).is_err());
-        // A phone lying still (sensor noise only) is not judged, whatever the unit.
+        let e = v.check_linacce_scale(zero).unwrap_err();
+        assert!(
+            e.to_string()
+                .ends_with("of zero where the phone accelerates?"),
+            "{e}"
+        );
+        // The accelerometer given for the linear acceleration: gravity left in, moving or not.
+        let with_gravity = |motion| frames(motion, 1.0).map(|(a, g, _)| (a, g, a));
+        for motion in [2.0, 0.05, 0.0] {
+            let e = v.check_linacce_scale(with_gravity(motion)).unwrap_err();
+            assert!(
+                e.to_string()
+                    .ends_with("gravity not taken out of the linear acceleration?"),
+                "{motion}: {e}"
+            );
+        }
+        // A phone lying still (sensor noise only) is not judged in another unit.
         v.check_linacce_scale(frames(0.05, 9.80665)).unwrap();
         v.check_linacce_scale(std::iter::empty()).unwrap();
     }

@@ -31,13 +31,36 @@ const SEED: u64 = 2018;
 pub struct Interval {
     /// The mean over every value (not over the resamples).
     pub mean: f64,
-    /// The 2.5 % percentile of the resampled means.
+    /// The 2.5 % percentile of the resampled means; NaN (`null` in JSON) for a mean without
+    /// bounds ([`Interval::unbounded`]).
+    #[serde(deserialize_with = "nan_if_null")]
     pub low: f64,
-    /// The 97.5 % percentile of the resampled means.
+    /// The 97.5 % percentile of the resampled means; NaN as `low`.
+    #[serde(deserialize_with = "nan_if_null")]
     pub high: f64,
 }
 
+/// A float that JSON holds as `null` where it is NaN (serde_json writes a NaN as `null`).
+pub(crate) fn nan_if_null<'de, D: serde::Deserializer<'de>>(d: D) -> Result<f64, D::Error> {
+    Ok(Option::<f64>::deserialize(d)?.unwrap_or(f64::NAN))
+}
+
 impl Interval {
+    /// `mean` without bounds: a report's entry for a mean over fewer runs than an interval
+    /// needs ([`MIN_INTERVAL_RUNS`]), so that the mean (a paired difference, say) is kept.
+    pub fn unbounded(mean: f64) -> Self {
+        Self {
+            mean,
+            low: f64::NAN,
+            high: f64::NAN,
+        }
+    }
+
+    /// Whether the interval has its bounds (it was resampled from enough runs).
+    pub fn is_bounded(&self) -> bool {
+        self.low.is_finite() && self.high.is_finite()
+    }
+
     /// `true` when the interval holds `x` (for a difference: the protocol cannot tell the two
     /// apart).
     pub fn contains(&self, x: f64) -> bool {

@@ -195,7 +195,8 @@ pub fn run_of(sequence: &str) -> &str {
 
 /// Per method and metric key, the 95 % interval of the method's mean over `sequences`
 /// ([`mean_interval`](crate::mean_interval), the parts of a run drawn together), over the
-/// sequences where the metric is defined; none for a metric defined nowhere.
+/// sequences where the metric is defined; none for a metric defined nowhere, and the mean
+/// unbounded ([`Interval::unbounded`]) over fewer runs than an interval needs.
 pub fn summary_intervals(
     sequences: &[SequenceReport],
 ) -> BTreeMap<String, BTreeMap<String, Interval>> {
@@ -210,8 +211,9 @@ pub fn summary_intervals(
 
 /// Per method other than `reference` and per metric key, the paired difference `reference -
 /// method`: its mean over the sequences where both have the metric and its 95 % interval
-/// ([`mean_interval`](crate::mean_interval), the parts of a run drawn together). An interval
-/// that leaves out 0 tells the two apart on these runs.
+/// ([`mean_interval`](crate::mean_interval), the parts of a run drawn together; unbounded
+/// over fewer runs than an interval needs). An interval that leaves out 0 tells the two apart
+/// on these runs.
 pub fn paired_differences(
     sequences: &[SequenceReport],
     reference: &str,
@@ -252,7 +254,11 @@ fn per_method(
                 .iter()
                 .filter_map(|(run, row)| Some((row[k]?, *run)))
                 .unzip();
-            if let Some(i) = crate::mean_interval(&v, &runs) {
+            // Too few runs for bounds: the mean, unbounded, so that it is not lost.
+            let finite = !v.is_empty() && v.iter().all(|x| x.is_finite());
+            let interval = crate::mean_interval(&v, &runs)
+                .or_else(|| finite.then(|| Interval::unbounded(crate::ordered_mean(&v))));
+            if let Some(i) = interval {
                 metrics.insert(metric.key().to_owned(), i);
             }
         }
@@ -435,9 +441,15 @@ mod tests {
 
     #[test]
     fn intervals_hold_the_means_and_differences_pair_the_sequences() {
-        // Two runs: too few for any interval.
+        // Two runs: too few for any bounds; the means stay.
         let i = summary_intervals(&sample());
-        assert!(i.values().all(BTreeMap::is_empty), "{i:?}");
+        assert!(
+            i.values()
+                .flat_map(BTreeMap::values)
+                .all(|i| !i.is_bounded()),
+            "{i:?}"
+        );
+        assert_eq!(i["ridi"]["mpe_m"].mean, 2.0);
         // Six runs: ridi's MPE alternates 1 and 3, pdr's is ridi's plus 9 on every run, and
         // MPE % is defined on the first run alone.
         let runs: Vec<SequenceReport> = (0..6)
@@ -468,7 +480,7 @@ mod tests {
             mpe.low >= 1.0 && mpe.high <= 3.0 && mpe.contains(2.0),
             "{mpe:?}"
         );
-        assert!(!i["ridi"].contains_key("mpe_pct"));
+        assert!(!i["ridi"]["mpe_pct"].is_bounded());
         let d = paired_differences(&runs, "ridi");
         assert!(!d.contains_key("ridi"));
         let rte = d["pdr"]["rte_5s_m"];

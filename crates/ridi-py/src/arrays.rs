@@ -49,6 +49,19 @@ fn float64<'py>(obj: &Bound<'py, PyAny>, name: &str) -> PyResult<Bound<'py, PyUn
             described(obj)
         ))
     };
+    // A masked array's masked values would be read as the values under the mask.
+    if obj.hasattr("mask")?
+        && py
+            .import("numpy")?
+            .getattr("ma")?
+            .call_method1("is_masked", (obj,))?
+            .is_truthy()?
+    {
+        return Err(PyTypeError::new_err(format!(
+            "`{name}` is a masked array with masked values: fill them (`{name}.filled(...)`) or \
+             drop those frames first"
+        )));
+    }
     let array = match obj.cast::<PyUntypedArray>() {
         Ok(array) => array.clone(),
         // Text is a sequence numpy would read as one string, not numbers.
@@ -77,8 +90,13 @@ fn float64<'py>(obj: &Bound<'py, PyAny>, name: &str) -> PyResult<Bound<'py, PyUn
     }
     let convert = match kind {
         // Numpy dates and durations: a cast to float64 would give nanoseconds, not seconds.
-        b'M' => format!("seconds as float64: ({name} - {name}[0]) / np.timedelta64(1, 's')"),
-        b'm' => format!("seconds as float64: {name} / np.timedelta64(1, 's')"),
+        b'M' if name == "time" => {
+            format!("seconds as float64: ({name} - {name}[0]) / np.timedelta64(1, 's')")
+        }
+        b'm' if name == "time" => format!("seconds as float64: {name} / np.timedelta64(1, 's')"),
+        b'M' | b'm' => {
+            "dates and durations are for `time`; a sensor's readings are numbers".to_string()
+        }
         _ if coarse_time => "its bits have rounded the timestamps already (to 0.24 ms an hour \
              into a recording, to minutes at Unix times): compute them in float64"
             .to_string(),

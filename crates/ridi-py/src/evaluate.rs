@@ -157,8 +157,13 @@ fn report_of(py: Python<'_>, obj: &Bound<'_, PyAny>, name: &str) -> PyResult<Rep
             .import("json")?
             .call_method("dumps", (dict,), Some(&kwargs))
             .map_err(|e| {
+                let hint = if e.to_string().contains("Out of range float") {
+                    " (NaN and infinity are None there, as report.json's null)"
+                } else {
+                    ""
+                };
                 errors::value(format!(
-                    "`{name}` is not a report of `ridi.evaluate`: {e} (a NaN there is None)"
+                    "`{name}` is not a report of `ridi.evaluate`: {e}{hint}"
                 ))
             })?
             .extract()?;

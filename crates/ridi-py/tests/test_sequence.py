@@ -222,6 +222,11 @@ def test_linacce_defaults_to_acce_minus_gravity(seq):
             "timedelta64[ns]")), TypeError,
          r"`time` has dtype datetime64\[ns\]; ridi takes float64 \(seconds as float64: "
          r"\(time - time\[0\]\) / np.timedelta64\(1, 's'\)\)"),
+        (lambda a: a.update(gyro=np.ma.masked_greater(a["gyro"], 1.0)), TypeError,
+         r"`gyro` is a masked array with masked values: fill them"),
+        (lambda a: a.update(gyro=(a["gyro"] * 1e9).astype("timedelta64[ns]")), TypeError,
+         r"`gyro` has dtype timedelta64\[ns\]; ridi takes float64 \(dates and durations are "
+         r"for `time`"),
         (lambda a: a.update(acce="acce.csv"), TypeError,
          r"`acce` must be an array of numbers \(a numpy array, a list of numbers or a pandas "
          r"column\), not str of length 8"),

@@ -80,8 +80,9 @@ impl Method {
             Method::Raw => "the linear acceleration integrated twice in the world frame",
             Method::Pdr => {
                 "steps detected in the accelerometer, every step as long as the \
-                 ground truth's path length over the number of steps (an oracle; no step \
-                 detected, it stays put), along the device's forward heading"
+                 ground truth's path length over the number of steps (an oracle for the \
+                 total length; no step detected, it stays put), along the device's forward \
+                 heading"
             }
             Method::RidiMag => {
                 "each regressed velocity's size along S's forward axis, then \

@@ -147,8 +147,10 @@ pub struct Report {
     pub provenance: Option<Provenance>,
 }
 
-/// What produced a report, so that a figure can be traced to its model and settings.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+/// What produced a report, so that a figure can be traced to its model and settings. A field
+/// a report lacks reads as empty (`""`, 0, `None`).
+#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
+#[serde(default)]
 pub struct Provenance {
     /// The version of the `ridi` crate that evaluated.
     pub ridi_version: String,
@@ -234,7 +236,7 @@ pub(crate) fn with_interval(
     } else {
         value
     };
-    let Some(i) = interval.filter(|_| mean.is_some()) else {
+    let Some(i) = interval.filter(|i| mean.is_some() && i.is_bounded()) else {
         return value;
     };
     let text = format!("{value} [{:.2}, {:.2}]", i.low, i.high);
@@ -727,8 +729,12 @@ impl Report {
              - **path length ratio**: the trajectory's path length over the ground truth's.\n\
              - **Means** are over sequences, each counting once; **intervals** are 95 % bootstrap \
              percentiles over runs (the parts `_part1`, `_part2`, ... of a recording split at \
-             its gaps are one run), given for {min} runs or more. **Velocity MSE** and \
-             **placement accuracy** pool every regression of every sequence.\n\
+             its gaps are one run), given for {min} runs or more. **Velocity MSE**: the \
+             squared error of each regressed velocity against the ground truth's, both \
+             horizontal in S (the phone's frame with its tilt taken out; the ground truth \
+             smoothed as the training targets are), per channel; **placement accuracy**: the \
+             share of regressions whose placement is the sequence's label; both pool every \
+             regression of every sequence.\n\
              - **Methods**: {methods}.\n",
             long = c.rte_window_s,
             short = c.short_rte_window_s,
@@ -807,7 +813,11 @@ impl Report {
         for w in &self.warnings {
             let _ = writeln!(out, "**Warning**: {w}.\n");
         }
-        let has_intervals = self.intervals.values().any(|m| !m.is_empty());
+        let has_intervals = self
+            .intervals
+            .values()
+            .flat_map(BTreeMap::values)
+            .any(ridi_eval::Interval::is_bounded);
         if has_intervals {
             let _ = writeln!(
                 out,
