@@ -113,8 +113,11 @@ impl Update {
 /// previous one) raises ``ValueError`` and leaves the tracking as it was; from the 201st
 /// sample on, the last 200 samples' median rate (200 Hz within 10 %), |gyro| and |acce| are
 /// judged, so a stream in milliseconds, deg/s or g is refused by then (refused samples count
-/// towards the last 200); once 10 s of samples came with an ``orientation``, a gyro turning
-/// against it (a sign flipped, most quaternions in x, y, z, w order) is refused, and stays so.
+/// towards the last 200), and so are the ``gravity`` and ``linacce`` pushed against the
+/// orientation and accelerometer, as ``ridi.Sequence`` judges a recording (gravity negated or
+/// in g, gravity left in ``linacce``); once consecutive samples with an ``orientation`` cover
+/// 10 s, a gyro turning against it (a sign flipped, most quaternions in x, y, z, w order) is
+/// refused, and stays so.
 /// A gap longer than 0.1 s starts a new segment (``Update.restarted``); pushing after
 /// ``finish()`` raises.
 ///
