@@ -183,6 +183,14 @@ fn by_name<'r>(r: &'r Report, which: &str, warnings: &mut Vec<String>) -> BTreeM
     index
 }
 
+/// Whether `r`'s heading settings were used: its model is on the estimated orientation, or
+/// the report does not say.
+fn heading_matters(r: &Report) -> bool {
+    r.provenance
+        .as_ref()
+        .is_none_or(|p| p.orientation != "recorded")
+}
+
 /// The settings of two reports that differ, as `name: first against second`.
 fn differing_settings(first: &Report, second: &Report) -> Vec<String> {
     let provenance =
@@ -217,10 +225,11 @@ fn differing_settings(first: &Report, second: &Report) -> Vec<String> {
             provenance(first, &|p| window(p.placement_window_s)),
             provenance(second, &|p| window(p.placement_window_s)),
         ),
+        // The heading settings change nothing for models on the recorded orientation.
         (
             "heading",
-            Some(first.heading_text()),
-            Some(second.heading_text()),
+            Some(first.heading_text()).filter(|_| heading_matters(first)),
+            Some(second.heading_text()).filter(|_| heading_matters(second)),
         ),
         (
             "alignment",
@@ -366,6 +375,24 @@ mod tests {
         assert!(
             c.to_markdown()
                 .contains("| ridi | RTE 5 s (m) | 4 | 2.250 | 2.750 | +0.500 |")
+        );
+        // The heading matters only for models on the estimated orientation.
+        let with = |orientation: &str, heading| Report {
+            provenance: Some(crate::Provenance {
+                orientation: orientation.into(),
+                ..Default::default()
+            }),
+            recorded_heading: heading,
+            ..report(&[("a", 1.0)])
+        };
+        let corrected = Some(ridi_frames::HeadingConfig::default());
+        let recorded = compare_reports(&with("recorded", None), &with("recorded", corrected));
+        assert!(recorded.unwrap().settings.is_empty());
+        let estimated = compare_reports(&with("estimated", None), &with("estimated", corrected));
+        let settings = estimated.unwrap().settings;
+        assert!(
+            settings.len() == 1 && settings[0].starts_with("heading: the gyro's alone against"),
+            "{settings:?}"
         );
         // No name in common: nothing to pair.
         let other = report(&[("x", 1.0)]);

@@ -162,6 +162,9 @@ pub struct Provenance {
     pub model_fingerprint: String,
     /// The model's solver, placements, feature window and orientation.
     pub model: String,
+    /// The orientation the model was trained on, `estimated` or `recorded` (the heading
+    /// settings matter only with `estimated`).
+    pub orientation: String,
     /// Frames between regressions ([`TrackOptions::regress_every`]).
     pub regress_every: usize,
     /// The placement majority window, seconds (`None`: each regression's own placement).
@@ -177,6 +180,10 @@ impl Provenance {
             (h ^ u64::from(b)).wrapping_mul(0x0100_0000_01b3)
         });
         let config = model.feature_config();
+        let orientation = match config.orientation {
+            ridi_features::Orientation::Recorded => "recorded",
+            ridi_features::Orientation::Estimated => "estimated",
+        };
         Ok(Self {
             ridi_version: env!("CARGO_PKG_VERSION").to_string(),
             model_source: None,
@@ -190,11 +197,9 @@ impl Provenance {
                 },
                 model.placement_names().join(", "),
                 config.window,
-                match config.orientation {
-                    ridi_features::Orientation::Recorded => "recorded",
-                    ridi_features::Orientation::Estimated => "estimated",
-                }
+                orientation
             ),
+            orientation: orientation.to_string(),
             regress_every: opts.track.regress_every,
             placement_window_s: opts.track.placement_smoothing.map(|p| p.window_s),
         })
