@@ -100,6 +100,7 @@ pub(crate) fn run(args: Args) -> Result<()> {
             Some(path) => path.display().to_string(),
             None => "bundled".to_string(),
         });
+        p.placement_map = args.placement_map.clone();
     }
     let written = folder
         .write(&report, &traces, None)

@@ -89,6 +89,7 @@ pub(crate) fn evaluate<'py>(
             ..EvalConfig::default()
         },
     };
+    let map_name = placement_map.as_ref().map(|p| p.display().to_string());
     let map = options::placement_map(placement_map)?;
     let model = &model.get().inner;
     let report = py
@@ -121,6 +122,10 @@ pub(crate) fn evaluate<'py>(
         .map_err(errors::pipeline)?;
     // Also in the report's `warnings`, but a caller reading one figure would not see them.
     crate::sequence::warn(py, &report.warnings)?;
+    let mut report = report;
+    if let Some(p) = &mut report.provenance {
+        p.placement_map = map_name;
+    }
     let json = serde_json::to_string(&report).map_err(|e| errors::value(e.to_string()))?;
     json_dict(py, &json)
 }

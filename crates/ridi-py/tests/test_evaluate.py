@@ -47,6 +47,7 @@ def test_evaluate_equals_report_json(model, model_file, ridi_bin, test_list, tmp
     report = ridi.evaluate(test_list, model, placement_map="tyrex4")
     assert same(report, expected), (report, expected)
     assert len(report["provenance"]["model_fingerprint"]) == 16
+    assert report["provenance"]["placement_map"] == "tyrex4"
     assert report["methods"] == list(ridi.METHODS)
     assert [s["name"] for s in report["sequences"]] == RUNS
 
@@ -66,8 +67,13 @@ def test_evaluate_options_reach_the_cli_flags(model, model_file, ridi_bin, test_
 
 def test_evaluate_sequences_equals_the_list(model, test_list):
     seqs = ridi.read_list(test_list, placement_map="tyrex4", purpose="evaluation")
-    assert same(ridi.evaluate(seqs, model, methods=["ridi"]),
-                ridi.evaluate(test_list, model, placement_map="tyrex4", methods=["ridi"]))
+    given = ridi.evaluate(seqs, model, methods=["ridi"])
+    listed = ridi.evaluate(test_list, model, placement_map="tyrex4", methods=["ridi"])
+    # The same but for the map, applied when the sequences were read, not by evaluate.
+    assert (given["provenance"]["placement_map"], listed["provenance"]["placement_map"]) == (
+        None, "tyrex4")
+    given["provenance"]["placement_map"] = "tyrex4"
+    assert same(given, listed)
 
 
 def test_bad_evaluations_are_refused(model, test_list, tmp_path):

@@ -207,7 +207,7 @@ fn differing_settings(first: &Report, second: &Report) -> Vec<String> {
             r.config.rte_window_s, r.config.short_rte_window_s
         )
     };
-    let settings: [(&str, Option<String>, Option<String>); 8] = [
+    let settings: [(&str, Option<String>, Option<String>); 9] = [
         (
             "model",
             provenance(first, &|p| format!("{} ({})", p.model, p.model_fingerprint)),
@@ -224,6 +224,13 @@ fn differing_settings(first: &Report, second: &Report) -> Vec<String> {
             "placement",
             provenance(first, &|p| window(p.placement_window_s)),
             provenance(second, &|p| window(p.placement_window_s)),
+        ),
+        (
+            "placement map",
+            provenance(first, &|p| p.placement_map.clone().unwrap_or("none".into())),
+            provenance(second, &|p| {
+                p.placement_map.clone().unwrap_or("none".into())
+            }),
         ),
         // The heading settings change nothing for models on the recorded orientation.
         (

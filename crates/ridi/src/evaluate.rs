@@ -169,6 +169,10 @@ pub struct Provenance {
     pub regress_every: usize,
     /// The placement majority window, seconds (`None`: each regression's own placement).
     pub placement_window_s: Option<f64>,
+    /// The placement map the labels were grouped by, as the caller names it (`ridi eval
+    /// --placement-map`: `tyrex4` or a file); `None` without one, or when the caller did not
+    /// say.
+    pub placement_map: Option<String>,
 }
 
 impl Provenance {
@@ -202,6 +206,7 @@ impl Provenance {
             orientation: orientation.to_string(),
             regress_every: opts.track.regress_every,
             placement_window_s: opts.track.placement_smoothing.map(|p| p.window_s),
+            placement_map: None,
         })
     }
 }
