@@ -254,37 +254,44 @@ fn check_dependency_counts(
             ));
         }
         for (count, what, flag) in stated {
-            let mut args = vec![
-                "tree",
-                "--locked",
-                "--target",
-                COUNTED_TARGET,
-                "-p",
-                name,
-                "-e",
-                "normal",
-                "--prefix",
-                "none",
-                "--no-dedupe",
-            ];
-            args.extend(flag);
-            let tree = crate::cargo_stdout(root, &args, &[])?;
-            let found = tree
-                .lines()
-                .filter(|l| !l.is_empty())
-                .collect::<BTreeSet<_>>()
-                .len();
+            let (found, command) = dependency_count(root, name, flag)?;
             if count != Some(found) {
                 problems.push(format!(
                     "{}/README.md: states {}{what}; `cargo {}` counts {found}",
                     krate.dir.strip_prefix(root).unwrap_or(&krate.dir).display(),
                     count.map_or("no number".to_owned(), |n| n.to_string()),
-                    args.join(" "),
+                    command,
                 ));
             }
         }
     }
     Ok(())
+}
+
+/// The distinct crates of `name`'s normal dependency tree on [`COUNTED_TARGET`], itself
+/// included, with `flag` (`--no-default-features`) when given; and the `cargo` arguments
+/// that counted them.
+fn dependency_count(root: &Path, name: &str, flag: Option<&str>) -> Result<(usize, String)> {
+    let mut args = vec![
+        "tree",
+        "--locked",
+        "--target",
+        COUNTED_TARGET,
+        "-p",
+        name,
+        "-e",
+        "normal",
+        "--prefix",
+        "none",
+        "--no-dedupe",
+    ];
+    args.extend(flag);
+    let tree = crate::cargo_stdout(root, &args, &[])?;
+    let found = tree
+        .lines()
+        .filter(|l| !l.is_empty())
+        .collect::<BTreeSet<_>>();
+    Ok((found.len(), args.join(" ")))
 }
 
 /// The number `text` starts with.
@@ -611,23 +618,8 @@ mod tests {
             .unwrap();
             problems
         };
-        let count = |flags: &[&str]| {
-            let mut args = vec![
-                "tree",
-                "--target",
-                COUNTED_TARGET,
-                "-p",
-                "ridi",
-                "-e",
-                "normal",
-            ];
-            args.extend_from_slice(&["--prefix", "none"]);
-            args.extend_from_slice(flags);
-            args.push("--no-dedupe");
-            let tree = crate::cargo_stdout(&root, &args, &[]).unwrap();
-            tree.lines().collect::<BTreeSet<_>>().len()
-        };
-        let (all, lean) = (count(&[]), count(&["--no-default-features"]));
+        let count = |flag| dependency_count(&root, "ridi", flag).unwrap().0;
+        let (all, lean) = (count(None), count(Some("--no-default-features")));
         let right = format!(
             "**Dependencies:** {all} crates, itself included; {lean} with \
              `default-features = false`, which"

@@ -236,10 +236,8 @@ impl Listed {
                 Ok(seq)
             })
             .collect::<Result<_>>()?;
-        for (i, (seq, e)) in sequences.iter().zip(&entries).enumerate() {
-            if let Some(j) = sequences[..i].iter().position(|s| s.is_same_recording(seq)) {
-                return Err(copy_error(e, &entries[j]));
-            }
+        if let Some((first, later)) = Sequence::first_repeated(&sequences) {
+            return Err(copy_error(&entries[later], &entries[first]));
         }
         Ok(Self { sequences, entries })
     }

@@ -515,6 +515,17 @@ impl Sequence {
         self.time() == other.time() && self.gyro() == other.gyro() && self.acce() == other.acce()
     }
 
+    /// The first pair `(earlier, later)` of `seqs` that are one recording
+    /// ([`Sequence::is_same_recording`]), by the later one's position; `None` when all differ.
+    pub fn first_repeated(seqs: &[Sequence]) -> Option<(usize, usize)> {
+        seqs.iter().enumerate().find_map(|(j, later)| {
+            seqs[..j]
+                .iter()
+                .position(|s| s.is_same_recording(later))
+                .map(|i| (i, j))
+        })
+    }
+
     /// Timestamps, seconds.
     pub fn time(&self) -> &[f64] {
         &self.parts.time

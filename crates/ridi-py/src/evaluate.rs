@@ -92,7 +92,7 @@ pub(crate) fn evaluate<'py>(
     let map_name = placement_map.as_ref().map(|p| p.display().to_string());
     let map = options::placement_map(placement_map)?;
     let model = &model.get().inner;
-    let report = py
+    let mut report = py
         .detach(|| {
             options::with_jobs(jobs, || -> ridi::Result<Report> {
                 match inputs {
@@ -122,7 +122,6 @@ pub(crate) fn evaluate<'py>(
         .map_err(errors::pipeline)?;
     // Also in the report's `warnings`, but a caller reading one figure would not see them.
     crate::sequence::warn(py, &report.warnings)?;
-    let mut report = report;
     if let Some(p) = &mut report.provenance {
         p.placement_map = map_name;
     }

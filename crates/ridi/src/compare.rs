@@ -188,77 +188,60 @@ fn by_name<'r>(r: &'r Report, which: &str, warnings: &mut Vec<String>) -> BTreeM
 fn heading_matters(r: &Report) -> bool {
     r.provenance
         .as_ref()
-        .is_none_or(|p| p.orientation != "recorded")
+        .is_none_or(|p| p.orientation != Some(ridi_features::Orientation::Recorded))
 }
 
 /// The settings of two reports that differ, as `name: first against second`.
 fn differing_settings(first: &Report, second: &Report) -> Vec<String> {
-    let provenance =
-        |r: &Report, f: &dyn Fn(&crate::Provenance) -> String| r.provenance.as_ref().map(f);
-    let window = |w: Option<f64>| w.map_or("per regression".to_string(), |w| format!("{w} s"));
-    let methods = |r: &Report| {
-        let mut m = r.methods.clone();
-        m.sort_unstable();
-        m.join(", ")
-    };
-    let windows = |r: &Report| {
-        format!(
-            "{} s and {} s",
-            r.config.rte_window_s, r.config.short_rte_window_s
-        )
-    };
-    let settings: [(&str, Option<String>, Option<String>); 9] = [
-        (
-            "model",
-            provenance(first, &|p| format!("{} ({})", p.model, p.model_fingerprint)),
-            provenance(second, &|p| {
-                format!("{} ({})", p.model, p.model_fingerprint)
-            }),
-        ),
-        (
-            "regressions every",
-            provenance(first, &|p| format!("{} frames", p.regress_every)),
-            provenance(second, &|p| format!("{} frames", p.regress_every)),
-        ),
-        (
-            "placement",
-            provenance(first, &|p| window(p.placement_window_s)),
-            provenance(second, &|p| window(p.placement_window_s)),
-        ),
-        (
-            "placement map",
-            provenance(first, &|p| p.placement_map.clone().unwrap_or("none".into())),
-            provenance(second, &|p| {
-                p.placement_map.clone().unwrap_or("none".into())
-            }),
-        ),
-        // The heading settings change nothing for models on the recorded orientation.
-        (
-            "heading",
-            Some(first.heading_text()).filter(|_| heading_matters(first)),
-            Some(second.heading_text()).filter(|_| heading_matters(second)),
-        ),
-        (
-            "alignment",
-            Some(first.alignment_text()),
-            Some(second.alignment_text()),
-        ),
-        ("RTE windows", Some(windows(first)), Some(windows(second))),
-        ("methods", Some(methods(first)), Some(methods(second))),
-        (
-            "ridi version",
-            provenance(first, &|p| p.ridi_version.clone()),
-            provenance(second, &|p| p.ridi_version.clone()),
-        ),
-    ];
-    settings
-        .into_iter()
+    SETTINGS
+        .iter()
         // A setting one report does not record is no difference it can show.
-        .filter_map(|(name, a, b)| Some((name, a?, b?)))
+        .filter_map(|(name, of)| Some((name, of(first)?, of(second)?)))
         .filter(|(_, a, b)| a != b)
         .map(|(name, a, b)| format!("{name}: {a} against {b}"))
         .collect()
 }
+
+/// A setting [`differing_settings`] compares: its name, and its value in a report (`None`
+/// where the report does not record it).
+type Setting = (&'static str, fn(&Report) -> Option<String>);
+
+/// Every setting that makes two reports' figures differ, in the order they are listed.
+const SETTINGS: [Setting; 9] = [
+    ("model", |r| {
+        let p = r.provenance.as_ref()?;
+        Some(format!("{} ({})", p.model, p.model_fingerprint))
+    }),
+    ("regressions every", |r| {
+        Some(format!("{} frames", r.provenance.as_ref()?.regress_every))
+    }),
+    ("placement", |r| {
+        let window = r.provenance.as_ref()?.placement_window_s;
+        Some(window.map_or("per regression".to_string(), |w| format!("{w} s")))
+    }),
+    ("placement map", |r| {
+        let map = r.provenance.as_ref()?.placement_map.clone();
+        Some(map.unwrap_or_else(|| "none".to_string()))
+    }),
+    // The heading settings change nothing for models on the recorded orientation.
+    ("heading", |r| heading_matters(r).then(|| r.heading_text())),
+    ("alignment", |r| Some(r.alignment_text())),
+    ("RTE windows", |r| {
+        let c = &r.config;
+        Some(format!(
+            "{} s and {} s",
+            c.rte_window_s, c.short_rte_window_s
+        ))
+    }),
+    ("methods", |r| {
+        let mut m = r.methods.clone();
+        m.sort_unstable();
+        Some(m.join(", "))
+    }),
+    ("ridi version", |r| {
+        Some(r.provenance.as_ref()?.ridi_version.clone())
+    }),
+];
 
 impl Comparison {
     /// The comparison as markdown: the warnings, what differs, then one table row per method
@@ -319,6 +302,7 @@ mod tests {
     use super::*;
     use crate::SequenceResult;
     use ridi_eval::TrajectoryMetrics;
+    use ridi_features::Orientation;
 
     fn report(rows: &[(&str, f64)]) -> Report {
         let metrics = |rte| TrajectoryMetrics {
@@ -384,18 +368,19 @@ mod tests {
                 .contains("| ridi | RTE 5 s (m) | 4 | 2.250 | 2.750 | +0.500 |")
         );
         // The heading matters only for models on the estimated orientation.
-        let with = |orientation: &str, heading| Report {
+        let with = |orientation, heading| Report {
             provenance: Some(crate::Provenance {
-                orientation: orientation.into(),
+                orientation: Some(orientation),
                 ..Default::default()
             }),
             recorded_heading: heading,
             ..report(&[("a", 1.0)])
         };
         let corrected = Some(ridi_frames::HeadingConfig::default());
-        let recorded = compare_reports(&with("recorded", None), &with("recorded", corrected));
+        let (recorded, estimated) = (Orientation::Recorded, Orientation::Estimated);
+        let recorded = compare_reports(&with(recorded, None), &with(recorded, corrected));
         assert!(recorded.unwrap().settings.is_empty());
-        let estimated = compare_reports(&with("estimated", None), &with("estimated", corrected));
+        let estimated = compare_reports(&with(estimated, None), &with(estimated, corrected));
         let settings = estimated.unwrap().settings;
         assert!(
             settings.len() == 1 && settings[0].starts_with("heading: the gyro's alone against"),

@@ -162,9 +162,9 @@ pub struct Provenance {
     pub model_fingerprint: String,
     /// The model's solver, placements, feature window and orientation.
     pub model: String,
-    /// The orientation the model was trained on, `estimated` or `recorded` (the heading
-    /// settings matter only with `estimated`).
-    pub orientation: String,
+    /// The orientation the model was trained on (`estimated` or `recorded` in JSON; the
+    /// heading settings matter only with `estimated`).
+    pub orientation: Option<ridi_features::Orientation>,
     /// Frames between regressions ([`TrackOptions::regress_every`]).
     pub regress_every: usize,
     /// The placement majority window, seconds (`None`: each regression's own placement).
@@ -185,15 +185,15 @@ impl Provenance {
         });
         let config = model.feature_config();
         let orientation = match config.orientation {
-            ridi_features::Orientation::Recorded => "recorded",
-            ridi_features::Orientation::Estimated => "estimated",
+            ridi_features::Orientation::Recorded => "the recorded orientation",
+            ridi_features::Orientation::Estimated => "the estimated orientation",
         };
         Ok(Self {
             ridi_version: env!("CARGO_PKG_VERSION").to_string(),
             model_source: None,
             model_fingerprint: format!("{hash:016x}"),
             model: format!(
-                "{} solver; placements {}; a feature window of {} frames; the {} orientation",
+                "{} solver; placements {}; a feature window of {} frames; {}",
                 match model.solver() {
                     ridi_regress::Solver::Exact => "exact".to_string(),
                     ridi_regress::Solver::Nystrom(n) =>
@@ -203,7 +203,7 @@ impl Provenance {
                 config.window,
                 orientation
             ),
-            orientation: orientation.to_string(),
+            orientation: Some(config.orientation),
             regress_every: opts.track.regress_every,
             placement_window_s: opts.track.placement_smoothing.map(|p| p.window_s),
             placement_map: None,
@@ -698,20 +698,6 @@ impl Report {
             .collect()
     }
 
-    /// The mean over the sequences where both have `metric` of `ridi - method`: the paired
-    /// difference without its interval (too few runs for one).
-    fn paired_mean(&self, method: &str, metric: Metric) -> Option<f64> {
-        let diffs: Vec<f64> = self
-            .sequences
-            .iter()
-            .filter_map(|s| {
-                let of = |k: &str| s.methods.get(k).and_then(|m| metric.value(m));
-                Some(of(Method::Ridi.key())? - of(method)?)
-            })
-            .collect();
-        (!diffs.is_empty()).then(|| ridi_eval::ordered_mean(&diffs))
-    }
-
     /// The section of `report.md` that says what each figure and method is.
     fn definitions(&self) -> String {
         let c = &self.config;
@@ -887,8 +873,8 @@ impl Report {
                         .ridi_minus
                         .get(key.as_str())
                         .and_then(|d| d.get(m.key()));
-                    let mean = d.map(|d| d.mean).or_else(|| self.paired_mean(key, m));
-                    let _ = write!(out, " {} |", with_interval(m, mean, d, true));
+                    // Under too few runs for bounds, the mean alone (`Interval::unbounded`).
+                    let _ = write!(out, " {} |", with_interval(m, d.map(|d| d.mean), d, true));
                 }
                 let _ = writeln!(out);
             }

@@ -146,18 +146,16 @@ impl PipelineError {
 /// for sequences given otherwise (built in a program, in Python). The error names the later
 /// one and the index of the earlier.
 pub fn check_distinct_recordings(seqs: &[Sequence]) -> Result<()> {
-    for (j, later) in seqs.iter().enumerate() {
-        if let Some(i) = seqs[..j].iter().position(|s| s.is_same_recording(later)) {
-            return Err(PipelineError::sequence(
-                later.name(),
-                format!(
-                    "is the same recording as sequence {i}, `{}` (the same timestamps, gyro and \
-                     accelerometer samples); given twice it would count twice, or be tested on \
-                     after training on it",
-                    ridi_data::shown(seqs[i].name())
-                ),
-            ));
-        }
+    match Sequence::first_repeated(seqs) {
+        Some((i, j)) => Err(PipelineError::sequence(
+            seqs[j].name(),
+            format!(
+                "is the same recording as sequence {i}, `{}` (the same timestamps, gyro and \
+                 accelerometer samples); given twice it would count twice, or be tested on \
+                 after training on it",
+                ridi_data::shown(seqs[i].name())
+            ),
+        )),
+        None => Ok(()),
     }
-    Ok(())
 }
