@@ -659,12 +659,20 @@ fn imu_spans(
         .windows(2)
         .max_by(|a, b| (a[1].0 - a[0].1).total_cmp(&(b[1].0 - b[0].1)))
     {
+        // Read to describe or cut the pauses (`ReadOptions::reading_pauses`): no advice to cut.
+        let advice = if max_gap_s.is_finite() {
+            format!(
+                ", which `ridi track` refuses and `ridi convert --split-at-gaps \
+                 {MAX_SENSOR_GAP_S}` cuts (in Python `ridi.read_any(path, split_at_gaps=\
+                 {MAX_SENSOR_GAP_S})`)"
+            )
+        } else {
+            String::new()
+        };
         warnings.push(format!(
             "{file}: dropouts of the accelerometer, gyroscope or rotation vector over \
              {MAX_SENSOR_GAP_S} s leave {} in the timeline (the longest {:.3} s, from {} to {} \
-             ms), which `ridi track` refuses and `ridi convert --split-at-gaps \
-             {MAX_SENSOR_GAP_S}` cuts (in Python `ridi.read_any(path, split_at_gaps=\
-             {MAX_SENSOR_GAP_S})`)",
+             ms){advice}",
             crate::counted(spans.len() - 1, "gap"),
             w[1].0 - w[0].1,
             ms(w[0].1),
@@ -1201,6 +1209,18 @@ mod tests {
             ),
             "{}",
             read.warnings[0]
+        );
+        // Read to describe or cut its pauses (`ridi inspect`, `ridi convert --split-at-gaps`):
+        // the gap is said, with no advice to cut it.
+        let mut pauses = IlcOptions::default();
+        pauses.validation.max_gap_s = f64::INFINITY;
+        let read = parse(dropout.as_bytes(), Path::new("p/abc.txt"), &pauses).unwrap();
+        assert!(
+            read.warnings.len() == 1
+                && read.warnings[0].contains("leave 1 gap")
+                && read.warnings[0].ends_with(" ms)"),
+            "{:?}",
+            read.warnings
         );
         // Every sensor stopping at once (a stalled logger) leaves a gap; the magnetometer is
         // not interpolated there, so no warning of its own.

@@ -84,14 +84,23 @@ impl ListEntry {
                 read.push((id, path));
             }
             let bytes = text::read_file_bounded(path, MAX_LIST_BYTES)?;
-            entries.extend(parse_list(&bytes, path).map_err(|e| match recording(path) {
-                Some(format) => DataError::format(
+            let not_a_list = |format| {
+                DataError::format(
                     Location::file(path),
                     format!(
                         "is a recording ({format}), not a list file (one `path,placement` \
                          line per sequence)"
                     ),
-                ),
+                )
+            };
+            // A competition path file is told by its records, which parse as a list of
+            // missing paths; a `.csv` only by its name, so only once it fails to parse.
+            let format = recording(path);
+            if let Some(f @ crate::Format::Ilc) = format {
+                return Err(not_a_list(f));
+            }
+            entries.extend(parse_list(&bytes, path).map_err(|e| match format {
+                Some(f) => not_a_list(f),
                 None => e,
             })?);
         }
@@ -99,9 +108,9 @@ impl ListEntry {
     }
 }
 
-/// The format of a list file that does not parse, when it is a recording: a `.csv` (`.csv.gz`)
-/// or a competition path file (a `.txt` of a list cannot be told from a `data_plain.txt` by its
-/// name).
+/// The format of a list file when it may be a recording: a `.csv` (`.csv.gz`, by its name) or
+/// a competition path file (by its records); a `.txt` of a list cannot be told from a
+/// `data_plain.txt` by its name.
 fn recording(path: &Path) -> Option<crate::Format> {
     crate::detect(path)
         .ok()
@@ -380,6 +389,18 @@ mod tests {
             e.ends_with(
                 "data.csv: is a recording (RIDI processed csv), not a list file (one \
                  `path,placement` line per sequence)"
+            ),
+            "{e}"
+        );
+        // Its records would parse as a list of paths that do not exist.
+        let ilc = dir.path().join("5dd9e7abc5b77e0006b1732d.txt");
+        let records = "#\tstartTime:1574559495000\n1574559495000\tTYPE_ACCELEROMETER\t0\t0\t9.8\n";
+        std::fs::write(&ilc, records).unwrap();
+        let e = ListEntry::read(&[&ilc]).unwrap_err().to_string();
+        assert!(
+            e.ends_with(
+                "5dd9e7abc5b77e0006b1732d.txt: is a recording (Indoor Location Competition \
+                 path file), not a list file (one `path,placement` line per sequence)"
             ),
             "{e}"
         );

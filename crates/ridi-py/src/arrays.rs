@@ -79,6 +79,9 @@ fn float64<'py>(obj: &Bound<'py, PyAny>, name: &str) -> PyResult<Bound<'py, PyUn
         return Ok(array);
     }
     let kind = found.kind();
+    if kind == b'O' {
+        object_elements(&array, name)?;
+    }
     let coarse_time = name == "time" && kind == b'f' && found.itemsize() < 8;
     if matches!(kind, b'f' | b'i' | b'u' | b'O') && !coarse_time {
         return match array.call_method1("astype", ("float64",)) {
@@ -105,6 +108,40 @@ fn float64<'py>(obj: &Bound<'py, PyAny>, name: &str) -> PyResult<Bound<'py, PyUn
     Err(PyTypeError::new_err(format!(
         "`{name}` has dtype {found}; ridi takes float64 ({convert})"
     )))
+}
+
+/// Refuses an object array whose elements numpy would convert but ridi should not take:
+/// numbers as text (`"1.5"`: a column read without parsing, where a typo converts or fails
+/// far from its cause) and, for `time`, numpy float16/float32 scalars (rounded as a float32
+/// array's are).
+fn object_elements(array: &Bound<'_, PyUntypedArray>, name: &str) -> PyResult<()> {
+    let py = array.py();
+    let builtins = py.import("builtins")?;
+    let types = builtins
+        .getattr("map")?
+        .call1((builtins.getattr("type")?, array.getattr("flat")?))?;
+    let types = builtins.getattr("set")?.call1((types,))?;
+    let numpy = py.import("numpy")?;
+    let coarse = [numpy.getattr("float16")?, numpy.getattr("float32")?];
+    for t in types.try_iter()? {
+        let t = t?;
+        let type_name = t.getattr("__name__")?.to_string();
+        if t.is(py.get_type::<PyString>()) || t.is(py.get_type::<PyBytes>()) {
+            return Err(PyTypeError::new_err(format!(
+                "`{name}` has dtype object and holds text ({type_name}): parse the numbers \
+                 first (`np.asarray({name}, dtype=np.float64)`, or `pd.to_numeric` for a column \
+                 read as text), so that a value that is no number fails where it is read"
+            )));
+        }
+        if name == "time" && coarse.iter().any(|c| t.is(c)) {
+            return Err(PyTypeError::new_err(format!(
+                "`time` has dtype object and holds numpy {type_name} values, whose bits have \
+                 rounded the timestamps already (to 0.24 ms an hour into a recording, to \
+                 minutes at Unix times): compute them in float64"
+            )));
+        }
+    }
+    Ok(())
 }
 
 /// What `obj` is, for a message: its type, and its shape when it has one.

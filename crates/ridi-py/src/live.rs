@@ -286,10 +286,17 @@ impl LiveTracker {
 /// names neither the argument nor what it wants).
 fn values<const N: usize>(obj: &Bound<'_, PyAny>, name: &str) -> PyResult<[f64; N]> {
     obj.extract().map_err(|_| {
-        PyTypeError::new_err(format!(
+        let message = format!(
             "`{name}` must be {N} numbers (push takes one sample; push a chunk row by row), not \
              {}",
             described(obj)
-        ))
+        );
+        // Numbers of another count (or a chunk's rows) are a wrong value, as a wrong shape is
+        // for `Sequence`; anything else is a wrong type.
+        let numbers = obj.extract::<Vec<f64>>().is_ok() || obj.extract::<Vec<Vec<f64>>>().is_ok();
+        match numbers {
+            true => errors::value(message),
+            false => PyTypeError::new_err(message),
+        }
     })
 }

@@ -172,6 +172,12 @@ def test_live_tracker_refuses_bad_samples_and_stays_usable(seq, recorded_model):
         live.push(seq.time[2], None, seq.acce[2], **recorded)
     with pytest.raises(TypeError, match=r"`time` must be one number.*ndarray of shape \(5,\)"):
         live.push(seq.time[2:7], seq.gyro[2:7], seq.acce[2:7], **recorded)
+    # Numbers of another count are a wrong value, as a wrong shape is for `Sequence`.
+    with pytest.raises(ValueError, match=r"`gravity` must be 3 numbers .* list of length 2"):
+        live.push(seq.time[2], seq.gyro[2], seq.acce[2], orientation=seq.orientation[2],
+                  gravity=[0.0, 9.8], linacce=seq.linacce[2])
+    with pytest.raises(ValueError, match=r"`gyro` must be 3 numbers .* of shape \(5, 3\)"):
+        live.push(seq.time[2], seq.gyro[2:7], seq.acce[2], **recorded)
     with pytest.raises(ValueError, match=r"`time` of sample 2 is NaN"):
         live.push(float("nan"), seq.gyro[2], seq.acce[2], **recorded)
     live.finish()

@@ -44,8 +44,9 @@ pub struct Comparison {
     /// Every method both reports have, every metric, in the first report's order.
     pub figures: Vec<ComparedFigure>,
     /// What to know before reading the differences: sequences in one report only or named
-    /// twice in one, a sequence whose ground truth differs between the two, a report that
-    /// does not record what produced it, too few runs for intervals.
+    /// twice in one, a sequence whose ground truth differs between the two, a figure one
+    /// report lacks for some sequences, a report that does not record what produced it, too
+    /// few runs for intervals.
     pub warnings: Vec<String>,
 }
 
@@ -120,9 +121,12 @@ pub fn compare_reports(first: &Report, second: &Report) -> Result<Comparison> {
         ));
     }
     let mut figures = Vec::new();
+    // Figures one report has for a sequence and the other lacks: compared over fewer sequences.
+    let mut one_sided = Vec::new();
     for method in first.methods.iter().filter(|m| second.methods.contains(m)) {
         for metric in Metric::ALL {
             let mut rows: Vec<(f64, f64, &str)> = Vec::new();
+            let mut lacking = 0;
             for name in &both {
                 let value = |r: &Report, i: usize| {
                     r.sequences[i]
@@ -131,9 +135,18 @@ pub fn compare_reports(first: &Report, second: &Report) -> Result<Comparison> {
                         .and_then(|m| metric.value(m))
                         .filter(|v| v.is_finite())
                 };
-                if let (Some(x), Some(y)) = (value(first, a[name]), value(second, b[name])) {
-                    rows.push((x, y, ridi_eval::run_of(name)));
+                match (value(first, a[name]), value(second, b[name])) {
+                    (Some(x), Some(y)) => rows.push((x, y, ridi_eval::run_of(name))),
+                    (None, None) => {}
+                    _ => lacking += 1,
                 }
+            }
+            if lacking > 0 {
+                one_sided.push(format!(
+                    "{method} {}: {lacking} of {}",
+                    metric.label(),
+                    rows.len() + lacking
+                ));
             }
             if rows.is_empty() {
                 continue;
@@ -151,6 +164,13 @@ pub fn compare_reports(first: &Report, second: &Report) -> Result<Comparison> {
                 interval: ridi_eval::mean_interval(&diffs, &clusters),
             });
         }
+    }
+    if !one_sided.is_empty() {
+        warnings.push(format!(
+            "figures one report has and the other lacks (missing or not finite) for some \
+             sequences, each compared over the sequences that have it in both: {}",
+            ridi_data::first_few(one_sided.into_iter(), 5)
+        ));
     }
     Ok(Comparison {
         sequences: both.len(),
@@ -346,8 +366,16 @@ mod tests {
             name: "d".into(),
             ..second.sequences[0].clone()
         });
+        // A figure one report lacks for a sequence: compared over the others, and said.
+        second.sequences[1]
+            .methods
+            .get_mut("ridi")
+            .unwrap()
+            .path_length_ratio = None;
         let c = compare_reports(&first, &second).unwrap();
         assert_eq!((c.sequences, c.runs), (4, 3));
+        let ratio = c.figures.iter().find(|f| f.metric == "path_length_ratio");
+        assert_eq!(ratio.unwrap().sequences, 3);
         let rte = c.figures.iter().find(|f| f.metric == "rte_5s_m").unwrap();
         // Every pair 0.5 apart; `b` named twice is compared by its first row, not the 99.
         assert_eq!((rte.first, rte.second, rte.difference), (2.25, 2.75, 0.5));
@@ -358,6 +386,9 @@ mod tests {
             "the second report names 1 sequence twice; each is compared by its first: b",
             "the first report does not record its model and tracking settings",
             "(3 runs): too few for 95 % intervals, which need 5 runs",
+            "figures one report has and the other lacks (missing or not finite) for some \
+             sequences, each compared over the sequences that have it in both: ridi path \
+             length ratio: 1 of 4",
         ] {
             assert!(warnings.contains(expected), "{expected}: {warnings}");
         }
