@@ -10,11 +10,14 @@ w, x, y, z, and the reverse), and with its conjugate (device-from-world given fo
 world-from-device). With `--stream`, instead, streams started every 2 s into each
 recording as `ridi::LiveTracker` sums them: the lowest agreement once 5 s and once 10 s
 (`ridi::STREAM_GYRO_CHECK_S`) have passed, and how many of the reordered quaternions' streams
-fall under `ridi::STREAM_MIN_GYRO_AGREEMENT` (0) after 10 s. Sequences the reader refuses (the
+fall under `ridi::STREAM_MIN_GYRO_AGREEMENT` (0) after 10 s. With `--axes`, each gyro axis's
+least-squares scale against the orientation's rotation rate about that device axis, where the
+orientation turns about it at 0.1 rad/s RMS (`ridi_data::GYRO_SCALE_MIN_RATE`): the bounds
+behind `ridi_data::MIN_GYRO_AXIS_SCALE` (a dead axis reads 0). Sequences the reader refuses (the
 whole-recording check included) are counted apart. Needs the Python package (`pip install
 ./crates/ridi-py`).
 
-    python benchmarks/gyro_direction.py [--stream] \
+    python benchmarks/gyro_direction.py [--stream | --axes] \
         ../shared/data/raw/tyrex-attitude-smartphones/datasets/{android,ios}/* \
         ../shared/data/raw/indoor-location-competition-20/data/*/*/path_data_files/*
 """
@@ -37,9 +40,9 @@ def qmul(a, b):
                      w1 * z2 + x1 * y2 - y1 * x2 + z1 * w2], axis=1)
 
 
-def step_sums(t, gyro, q):
-    """Per step: the rate vectors' dot product, the magnitudes' product, the orientation rate
-    squared, and whether the step is no orientation jump."""
+def step_vectors(t, gyro, q):
+    """Per step: the orientation's and the gyro's rotation-rate vectors in the device frame,
+    and whether the step is no orientation jump."""
     step = qmul(q[:-1] * np.array([1, -1, -1, -1]), q[1:])  # q_{k-1}^-1 q_k, device frame
     step *= np.where(step[:, :1] < 0, -1.0, 1.0)
     v = step[:, 1:]
@@ -48,8 +51,24 @@ def step_sums(t, gyro, q):
     dt = np.diff(t)
     rate = v / np.maximum(s, 1e-300)[:, None] * (angle / dt)[:, None]
     g = 0.5 * (gyro[1:] + gyro[:-1])
-    w, gn = angle / dt, np.linalg.norm(g, axis=1)
-    return np.sum(g * rate, axis=1), gn * w, w * w, ~(w - gn > JUMP_RATE)
+    return rate, g, ~(angle / dt - np.linalg.norm(g, axis=1) > JUMP_RATE)
+
+
+def step_sums(t, gyro, q):
+    """Per step: the rate vectors' dot product, the magnitudes' product, the orientation rate
+    squared, and whether the step is no orientation jump."""
+    rate, g, kept = step_vectors(t, gyro, q)
+    w, gn = np.linalg.norm(rate, axis=1), np.linalg.norm(g, axis=1)
+    return np.sum(g * rate, axis=1), gn * w, w * w, kept
+
+
+def axis_scales(t, gyro, q):
+    """Per device axis: the orientation's RMS rotation rate about it and the gyro's
+    least-squares scale against it, as `Validation::check_gyro_scale` sums them."""
+    rate, g, kept = step_vectors(t, gyro, q)
+    keep = kept if (~kept).mean() <= 0.05 else np.ones_like(kept)
+    r, g = rate[keep], g[keep]
+    return np.sqrt(np.mean(r * r, axis=0)), np.sum(g * r, axis=0) / np.sum(r * r, axis=0)
 
 
 def agreement(t, gyro, q):
@@ -76,8 +95,8 @@ def stream_minimum(t, gyro, q, after_s, every_s=2.0):
 
 def main(paths):
     warnings.simplefilter("ignore")
-    stream = "--stream" in paths
-    paths = [p for p in paths if p != "--stream"]
+    stream, axes = "--stream" in paths, "--axes" in paths
+    paths = [p for p in paths if p not in ("--stream", "--axes")]
     rows, refused = [], []
     for path in paths:
         try:
@@ -87,6 +106,12 @@ def main(paths):
             continue
         for s in seqs:
             t, g, q = s.time, s.gyro, s.orientation
+            if axes:
+                rms, scale = axis_scales(t, g, q)
+                rows.append((rms, scale))
+                print(f"{s.name:48s} rms " + " ".join(f"{x:5.2f}" for x in rms)
+                      + "  scale " + " ".join(f"{x:5.2f}" for x in scale))
+                continue
             if stream:
                 row = (np.nanmin(stream_minimum(t, g, q, 5.0)),
                        np.nanmin(stream_minimum(t, g, q, 10.0)),
@@ -101,6 +126,12 @@ def main(paths):
                   + (f" reordered refused {np.mean(row[2][~np.isnan(row[2])] < 0):.0%}"
                      if stream else " " + " ".join(f"{x:+.2f}" for x in row[2:])))
     print(f"\n{len(refused)} paths refused by the reader:", *refused, sep="\n  ")
+    if axes:
+        judged = np.array([sc for rms, scale in rows for r, sc in zip(rms, scale) if r >= 0.1])
+        print(f"{len(rows)} sequences, {len(judged)} axes turning at 0.1 rad/s RMS or more: "
+              f"gyro scale {judged.min():.2f}..{judged.max():.2f}, "
+              f"1 % under {np.percentile(judged, 1):.2f}")
+        return
     if stream:
         low5, low10 = (np.nanmin([r[i] for r in rows]) for i in (0, 1))
         reordered = np.concatenate([r[2] for r in rows])

@@ -117,6 +117,10 @@ pub(crate) fn locate(path: &Path) -> Result<(Format, PathBuf)> {
         ));
     }
     if !path.is_dir() {
+        // A symbolic link that leads to no file: the error says so.
+        if let (true, Err(e)) = (crate::text::present(path), std::fs::metadata(path)) {
+            return Err(DataError::io(path, e));
+        }
         return Err(DataError::format(
             Location::file(path),
             if path.exists() {
@@ -126,7 +130,7 @@ pub(crate) fn locate(path: &Path) -> Result<(Format, PathBuf)> {
             },
         ));
     }
-    let has = |p: &str| path.join(p).is_file();
+    let has = |p: &str| crate::text::present(&path.join(p));
     // A RIDI capture folder often holds the raw files and `processed/`: the processed file is
     // what the published dataset ships, with the trimmed, synchronized timeline, so it wins.
     for (rel, format) in [

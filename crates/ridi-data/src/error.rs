@@ -172,15 +172,33 @@ pub enum DataError {
 impl DataError {
     /// An I/O error on `path`. A missing file reads "no such file or folder", as the readers
     /// say it for a path that names neither (the error's kind is kept).
+    ///
+    /// A symbolic link that leads to no file (its target missing, or links in a loop) says so:
+    /// the name is there, so "no such file" would contradict what the user sees.
     pub fn io(path: impl AsRef<Path>, error: std::io::Error) -> Self {
+        let path = path.as_ref();
+        let link = std::fs::symlink_metadata(path).is_ok_and(|m| m.file_type().is_symlink());
         let error = match error.kind() {
+            _ if link && std::fs::metadata(path).is_err() => {
+                let to = std::fs::read_link(path)
+                    .map(|t| format!(" to {}", shown(&t)))
+                    .unwrap_or_default();
+                let why = match error.kind() {
+                    std::io::ErrorKind::NotFound => "its target does not exist".to_string(),
+                    _ => error.to_string(),
+                };
+                std::io::Error::new(
+                    error.kind(),
+                    format!("is a symbolic link{to} that leads to no file ({why})"),
+                )
+            }
             std::io::ErrorKind::NotFound => {
                 std::io::Error::new(error.kind(), "no such file or folder")
             }
             _ => error,
         };
         DataError::Io {
-            path: path.as_ref().to_path_buf(),
+            path: path.to_path_buf(),
             error,
         }
     }

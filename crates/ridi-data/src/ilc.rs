@@ -101,7 +101,7 @@
 use std::io::Read as _;
 use std::path::{Path, PathBuf};
 
-use ridi_frames::{Frame, STANDARD_GRAVITY, Vec3, World, WorldFromDevice};
+use ridi_frames::{Frame, STANDARD_GRAVITY, Vec3, World, WorldFromDevice, WorldVec};
 
 use crate::android;
 use crate::error::{DataError, Location, Result};
@@ -431,6 +431,16 @@ pub fn parse(bytes: &[u8], path: &Path, options: &IlcOptions) -> Result<IlcPath>
         text::check_time(&s.time, &s.lines, path, "unix_ms", gap)?;
     }
 
+    // A waypoint far off is named on its line here: resampled, it would be a frame's.
+    let marks: Vec<WorldVec> = wp
+        .values
+        .iter()
+        .map(|v| WorldVec::new(v[0], v[1], 0.0))
+        .collect();
+    limits
+        .check_speed(&wp.time, &marks)
+        .map_err(|e| text::sequence_error(path, Some(&wp.lines), &IlcFields, e))?;
+
     let rv = &streams[RV];
     let rotations = rv
         .values
@@ -522,10 +532,22 @@ fn parse_records(content: &str, path: &Path) -> Result<([Stream; 5], Header)> {
         let stamp = cells.next().unwrap_or("");
         let ty = cells.next().map(str::trim).unwrap_or("");
         if !ty.starts_with("TYPE_") {
+            // A file re-saved with other separators: say which.
+            let separator = [(',', "commas"), (';', "semicolons"), (' ', "spaces")]
+                .into_iter()
+                .find(|(c, _)| {
+                    stamp
+                        .split(*c)
+                        .nth(1)
+                        .is_some_and(|t| t.starts_with("TYPE_"))
+                })
+                .map_or(String::new(), |(_, name)| {
+                    format!(": its cells are separated by {name}, the format's by tabs")
+                });
             return Err(DataError::format(
                 Location::line(path, line).with_field("type"),
                 format!(
-                    "expected a record `unix_ms<TAB>TYPE_...<TAB>values`, found `{}`",
+                    "expected a record `unix_ms<TAB>TYPE_...<TAB>values`, found `{}`{separator}",
                     text::snippet(l)
                 ),
             ));
@@ -770,18 +792,25 @@ fn span(streams: &[Stream; 5], with_waypoints: bool, path: &Path) -> Result<(f64
 const SNIFF_BYTES: u64 = 8192;
 
 /// Whether `head`, the first bytes of a file, look like a path file: a `#\tstartTime:` line or
-/// a `unix_ms<TAB>TYPE_...` record among its first lines.
+/// a `unix_ms<TAB>TYPE_...` record among its first lines, also with commas, semicolons or
+/// spaces for the tabs.
 pub fn looks_like_path_file(head: &[u8]) -> bool {
     let head = String::from_utf8_lossy(head);
+    // Also with another separator than the tab (a file re-saved by a spreadsheet), so that
+    // its reader, not the data_plain.txt one, names the separator.
+    fn after_separator(rest: &str) -> Option<&str> {
+        let cells = rest.trim_start_matches(['\t', ',', ';', ' ']);
+        (cells.len() < rest.len()).then_some(cells)
+    }
     head.lines().take(64).any(|l| {
-        if l.starts_with("#\tstartTime:") {
+        if l.strip_prefix('#')
+            .and_then(after_separator)
+            .is_some_and(|rest| rest.starts_with("startTime:"))
+        {
             return true;
         }
-        let mut cells = l.split('\t');
-        let stamp = cells.next().unwrap_or("");
-        !stamp.is_empty()
-            && stamp.bytes().all(|b| b.is_ascii_digit())
-            && cells.next().is_some_and(|t| t.starts_with("TYPE_"))
+        let digits = l.bytes().take_while(u8::is_ascii_digit).count();
+        digits > 0 && after_separator(&l[digits..]).is_some_and(|rest| rest.starts_with("TYPE_"))
     })
 }
 
@@ -1017,7 +1046,8 @@ mod tests {
                 "1574559494300\tTYPE_WIFI",
                 "1574559494300 TYPE_WIFI",
                 "p/abc.txt:9: field `type`: expected a record `unix_ms<TAB>TYPE_...<TAB>values`, \
-                 found `1574559494300 TYPE_WIFI\\tssid\\tbssid\\t-60\\t5...`",
+                 found `1574559494300 TYPE_WIFI\\tssid\\tbssid\\t-60\\t5...`: its cells are \
+                 separated by spaces, the format's by tabs",
             ),
             (
                 "1574559496000\tTYPE_WAYPOINT\t1\t5",
@@ -1283,6 +1313,22 @@ mod tests {
         assert!(e.to_string().contains("rate must be positive"), "{e}");
     }
 
+    /// A waypoint far off is named on its line, not on a frame of the resampled timeline.
+    #[test]
+    fn a_waypoint_far_off_is_named_on_its_line() {
+        let good = synthetic(10);
+        let far = good.replacen("TYPE_WAYPOINT\t2\t5", "TYPE_WAYPOINT\t100000\t5", 1);
+        assert_ne!(far, good);
+        let line = far.lines().position(|l| l.contains("\t100000\t")).unwrap() + 1;
+        let e = err(&far);
+        assert!(
+            e.starts_with(&format!(
+                "p/abc.txt:{line}: field `TYPE_WAYPOINT x`: jumps 99999 m in 1 s (99999 m/s)"
+            )),
+            "{e}"
+        );
+    }
+
     #[test]
     fn path_files_are_recognized_by_their_first_lines() {
         assert!(looks_like_path_file(synthetic(1).as_bytes()));
@@ -1292,5 +1338,15 @@ mod tests {
         assert!(!looks_like_path_file(b"3 27\n1\t2\t3\n"));
         assert!(!looks_like_path_file(b"# t x y z\n12 0.1 0.2 0.3\n"));
         assert!(!looks_like_path_file(b""));
+        // Re-saved with other separators: its reader names them.
+        assert!(looks_like_path_file(b"#,startTime:1574559529168\n"));
+        assert!(looks_like_path_file(b"1574559495263 TYPE_WAYPOINT 1 2\n"));
+        assert!(looks_like_path_file(b"1574559495263;TYPE_WAYPOINT;1;2\n"));
+        assert!(!looks_like_path_file(b"1574559495263TYPE_WAYPOINT\n"));
+        let e = err(&synthetic(1).replace('\t', ","));
+        assert!(
+            e.ends_with("its cells are separated by commas, the format's by tabs"),
+            "{e}"
+        );
     }
 }

@@ -220,7 +220,7 @@ impl Listed {
     pub fn load(entries: Vec<ListEntry>, opts: &ReadOptions) -> Result<Self> {
         let mut seen: Vec<(Vec<FileId>, &ListEntry)> = Vec::new();
         for e in &entries {
-            if !e.path.exists() {
+            if !crate::text::present(&e.path) {
                 return Err(DataError::format(
                     e.location().with_field("path"),
                     format!("sequence `{}` does not exist", shown(&e.path)),

@@ -177,14 +177,14 @@ pub const REQUIRED: [&str; 5] = [
 /// Whether `folder` holds any of the [`REQUIRED`] files: a RIDI raw folder, complete or not
 /// (the reader names what is missing).
 pub fn looks_like(folder: &Path) -> bool {
-    REQUIRED.iter().any(|f| folder.join(f).is_file())
+    REQUIRED.iter().any(|f| text::present(&folder.join(f)))
 }
 
 /// Fails naming every [`REQUIRED`] file `folder` lacks.
 fn check_required(folder: &Path) -> Result<()> {
     let missing: Vec<&str> = REQUIRED
         .into_iter()
-        .filter(|f| !folder.join(f).is_file())
+        .filter(|f| !text::present(&folder.join(f)))
         .collect();
     if missing.is_empty() {
         return Ok(());
@@ -396,7 +396,14 @@ struct RecordReader<S> {
     last_record: Option<usize>,
     /// The error of the first step refused.
     step: Option<DataError>,
+    /// Records dropped in a row for the time of `previous`.
+    repeats: usize,
 }
+
+/// Most records in a row a raw file may repeat a timestamp with: a record repeated now and
+/// then is dropped, but a clock that stopped leaves records whose times are unknown (20 in a
+/// row moved a track by 0.7 m; 3 hours of them were 97 % of a file, dropped).
+pub const MAX_REPEATED_TIMESTAMPS: usize = 10;
 
 impl<S: LineSource> RecordReader<S> {
     /// The records of the file `spec` names, at `path`, from its `lines`, with gaps refused
@@ -410,6 +417,7 @@ impl<S: LineSource> RecordReader<S> {
             previous: None,
             last_record: None,
             step: None,
+            repeats: 0,
         }
     }
 
@@ -432,8 +440,22 @@ impl<S: LineSource> RecordReader<S> {
             let next = (record.time, line);
             if let Some(previous) = self.previous {
                 if previous.0 == record.time {
+                    self.repeats += 1;
+                    if self.repeats == MAX_REPEATED_TIMESTAMPS + 1 && self.step.is_none() {
+                        self.step = Some(DataError::format(
+                            Location::line(&self.path, line).with_field("t"),
+                            format!(
+                                "the timestamp of line {} repeated by more than \
+                                 {MAX_REPEATED_TIMESTAMPS} records in a row: a clock that \
+                                 stopped, whose records' times are unknown (fewer repeats are \
+                                 dropped as duplicates)",
+                                previous.1
+                            ),
+                        ));
+                    }
                     continue;
                 }
+                self.repeats = 0;
                 if self.step.is_none() {
                     let (path, gap) = (&self.path, self.max_gap_s);
                     self.step = text::check_step(previous, next, path, "t", (gap, false)).err();
@@ -498,7 +520,7 @@ fn parse_records(bytes: &[u8], path: &Path, spec: &Spec, limits: &Validation) ->
 /// `Ok(None)` when it is optional and absent, or without rows ([`required`] refuses that).
 fn read_records(folder: &Path, spec: &Spec, limits: &Validation) -> Result<Option<Records>> {
     let path = folder.join(spec.name);
-    if !spec.required() && !path.exists() {
+    if !spec.required() && !text::present(&path) {
         return Ok(None);
     }
     let rec = parse_records(&text::read_file(&path)?, &path, spec, limits)?;
@@ -639,10 +661,14 @@ fn stream_file(e: &SequenceError) -> Option<&'static str> {
         SequenceError::Gravity { .. } => "gravity",
         SequenceError::AcceScale { .. } => "acce",
         SequenceError::LinacceScale { .. } => "linacce",
-        SequenceError::GyroScale { .. } | SequenceError::GyroDirection { .. } => "gyro",
+        SequenceError::GyroScale { .. }
+        | SequenceError::GyroDirection { .. }
+        | SequenceError::GyroAxis { .. } => "gyro",
         // The rotation vector against gravity: the rotation vector's file, whose component
         // order is the likelier mistake.
-        SequenceError::OrientationGravity { .. } => "orientation",
+        SequenceError::OrientationGravity { .. } | SequenceError::OrientationStill { .. } => {
+            "orientation"
+        }
         SequenceError::NonFinite { what, .. } | SequenceError::LengthMismatch { what, .. } => what,
         _ => return None,
     };

@@ -198,7 +198,7 @@ pub struct RoninSequence {
 
 /// Whether `folder` looks like a RoNIN sequence folder: it holds a `data.hdf5`.
 pub fn looks_like(folder: &Path) -> bool {
-    folder.join(DATA_FILE).is_file()
+    crate::text::present(&folder.join(DATA_FILE))
 }
 
 /// The files a read of `folder` takes.
@@ -566,6 +566,13 @@ struct Info {
     device: Option<String>,
 }
 
+/// Largest |component| of `imu_init_gyro_bias` accepted, rad/s.
+const MAX_GYRO_BIAS: f64 = 1.0;
+/// Largest |component| of `imu_acce_bias` accepted, m/s^2.
+const MAX_ACCE_BIAS: f64 = 5.0;
+/// Accepted range of each component of `imu_acce_scale`.
+const ACCE_SCALE_RANGE: (f64, f64) = (0.5, 2.0);
+
 impl Info {
     fn parse(bytes: &[u8], path: &Path) -> Result<Info> {
         let text = text::as_text(bytes, path)?;
@@ -643,10 +650,38 @@ impl Info {
                     )
                 })?,
         };
+        // A calibration far from any phone's would be blamed on the data it is applied to.
+        let calibration = |field: &str, (min, max): (f64, f64), what: &str| -> Result<[f64; 3]> {
+            let v = vec3(field)?;
+            match v.iter().find(|x| !(min..=max).contains(*x)) {
+                Some(x) => Err(err(
+                    field,
+                    format!(
+                        "{} is outside {}..{}: {what}",
+                        crate::short(*x),
+                        crate::short(min),
+                        crate::short(max)
+                    ),
+                )),
+                None => Ok(v),
+            }
+        };
         Ok(Info {
-            gyro_bias: vec3("imu_init_gyro_bias")?,
-            acce_bias: vec3("imu_acce_bias")?,
-            acce_scale: vec3("imu_acce_scale")?,
+            gyro_bias: calibration(
+                "imu_init_gyro_bias",
+                (-MAX_GYRO_BIAS, MAX_GYRO_BIAS),
+                "a gyro bias in rad/s (phones: under 0.05)",
+            )?,
+            acce_bias: calibration(
+                "imu_acce_bias",
+                (-MAX_ACCE_BIAS, MAX_ACCE_BIAS),
+                "an accelerometer bias in m/s^2 (phones: under 0.5)",
+            )?,
+            acce_scale: calibration(
+                "imu_acce_scale",
+                ACCE_SCALE_RANGE,
+                "an accelerometer scale near 1 (phones: within 0.05 of it)",
+            )?,
             start_calibration,
             ori_errors: [e0?, e1?, e2?],
             start_frame,

@@ -281,6 +281,23 @@ pub enum SequenceError {
         /// Lowest accepted agreement.
         min: f64,
     },
+    /// A gyro axis reads far less than the orientation turns about it
+    /// (`crate::MIN_GYRO_AXIS_SCALE`).
+    #[error(
+        "the gyro's {} axis reads {} times the orientation's rotation rate about it (least \
+         squares over frames; at least {min} expected, where the other axes agree): a dead or \
+         stuck gyro axis?",
+        ["x", "y", "z"][*axis],
+        short(*scale)
+    )]
+    GyroAxis {
+        /// The device axis, 0..3.
+        axis: usize,
+        /// The fitted scale.
+        scale: f64,
+        /// Lowest accepted scale.
+        min: f64,
+    },
     /// The linear acceleration does not match accelerometer minus gravity in size.
     #[error(
         "accelerometer minus gravity is {} times the linear acceleration (least squares), \
@@ -362,6 +379,21 @@ pub enum SequenceError {
         median_deg: f64,
         /// The limit ([`Validation::max_orientation_gravity_deg`](crate::Validation::max_orientation_gravity_deg)).
         max_deg: f64,
+    },
+    /// The orientation stays put while the gyro turns
+    /// ([`ORIENTATION_STILL_GYRO_RATE`](crate::ORIENTATION_STILL_GYRO_RATE)).
+    #[error(
+        "the orientation turns at {} rad/s RMS while the gyro turns at {} rad/s RMS: an \
+         orientation that stays put while the phone turns (a placeholder such as the identity \
+         quaternion, or an orientation of another recording)?",
+        short(*orientation_rms),
+        short(*gyro_rms)
+    )]
+    OrientationStill {
+        /// RMS rotation rate of the orientation, rad/s.
+        orientation_rms: f64,
+        /// RMS rotation rate of the gyro, rad/s.
+        gyro_rms: f64,
     },
     /// Mean gravity magnitude outside the plausible range: wrong units or a wrong column.
     #[error(

@@ -93,7 +93,9 @@ pub fn sidecar_path(data: &Path) -> PathBuf {
 pub(crate) fn read(data: &Path) -> Result<Sidecar> {
     let path = sidecar_path(data);
     match std::fs::metadata(&path) {
-        Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(Sidecar::default()),
+        Err(e) if !text::present(&path) && e.kind() == std::io::ErrorKind::NotFound => {
+            return Ok(Sidecar::default());
+        }
         Err(e) => return Err(DataError::io(&path, e)),
         Ok(_) => {}
     }

@@ -733,10 +733,9 @@ impl RowReader {
         }
         if s.gyro.median_high() {
             let median = self.median(Quantity::GyroNorm, s.gyro.len())?;
-            return Err(self.error(SequenceError::GyroUnits {
-                median,
-                max: limits.max_median_gyro,
-            }));
+            if let Some(e) = limits.gyro_units_error(median) {
+                return Err(self.error(e));
+            }
         }
         let d = std::mem::take(&mut self.deferred);
         let has_magnet = self.has_magnet();
@@ -903,13 +902,13 @@ impl RowReader {
             s.interval.push(dt < min, dt > max);
             let (time, gyro) = ([p.time, row.time], [p.gyro, row.gyro]);
             let orientation = [p.orientation, row.orientation];
-            for (_, _, w, g, dot) in crate::validation::step_rates(&time, &gyro, &orientation) {
+            for step in crate::validation::step_rates(&time, &gyro, &orientation) {
                 s.rates += 1;
-                s.all.add(w, g, dot);
-                if w - g > crate::ORIENTATION_JUMP_RATE {
+                s.all.add(&step);
+                if step.is_jump() {
                     s.jumps += 1;
                 } else {
-                    s.kept.add(w, g, dot);
+                    s.kept.add(&step);
                 }
             }
             if let (Some((pp, _)), Some((rp, _))) = (p.ground_truth, row.ground_truth) {

@@ -41,6 +41,13 @@ pub fn read_text(path: impl AsRef<Path>, max: u64) -> Result<String> {
     as_text(&bytes, path).map(str::to_owned)
 }
 
+/// Whether there is a directory entry `path`: a folder, a device or a symbolic link that leads
+/// to no file counts, so that an optional file of that name is read (and the read says what
+/// it is) rather than taken as absent.
+pub(crate) fn present(path: &Path) -> bool {
+    std::fs::symlink_metadata(path).is_ok()
+}
+
 /// The metadata of `path`, refused when it is not a regular file (a folder, `/dev/zero`, a
 /// pipe): a device can hand out bytes for ever.
 pub(crate) fn regular_file(path: &Path) -> Result<std::fs::Metadata> {
@@ -406,6 +413,10 @@ pub(crate) fn sequence_error_at(
         | SequenceError::GyroScale { .. }
         | SequenceError::GyroDirection { .. } => {
             return whole(Channel::Gyro, e.to_string());
+        }
+        &SequenceError::GyroAxis { axis, .. } => {
+            let at = Location::file(path).with_field(fields.field(Channel::Gyro, Some(axis)));
+            return DataError::format(at, e.to_string());
         }
         SequenceError::AcceScale { .. } => return whole(Channel::Acce, e.to_string()),
         SequenceError::LinacceScale { .. } => return whole(Channel::Linacce, e.to_string()),

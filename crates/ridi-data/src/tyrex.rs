@@ -852,7 +852,7 @@ fn read_time_diff(path: &Path) -> Result<f64> {
 /// there (`record.properties` is optional) or has no such key. A small hand-written file: its
 /// last line needs no line break.
 fn ini_value(path: &Path, section: Option<&str>, key: &str) -> Result<Option<(usize, String)>> {
-    if !path.is_file() {
+    if !text::present(path) {
         return Ok(None);
     }
     let bytes = text::read_file(path)?;
@@ -1351,7 +1351,9 @@ pub fn read(dir: impl AsRef<Path>, options: &TyrexOptions) -> Result<TyrexRead> 
             // The accelerometer's scale is the one check the streams could not make alone.
             let path = match e {
                 SequenceError::AcceScale { .. } => &acce.path,
-                SequenceError::GyroScale { .. } | SequenceError::GyroDirection { .. } => &gyro.path,
+                SequenceError::GyroScale { .. }
+                | SequenceError::GyroDirection { .. }
+                | SequenceError::GyroAxis { .. } => &gyro.path,
                 _ => dir,
             };
             text::sequence_error(path, None, &TyrexFields, e)

@@ -128,8 +128,14 @@ pub struct Validation {
     pub max_orientation_gravity_deg: f64,
     /// Least agreement in direction between the gyro and the orientation's rotation rate
     /// ([`GyroFit::agreement`]): [`MIN_GYRO_AGREEMENT`], 0.5. `-1` (or below) turns the check
-    /// off, for an orientation given for another device frame than the gyro's.
+    /// off, and the per-axis one of [`Self::min_gyro_axis_scale`], for an orientation given
+    /// for another device frame than the gyro's.
     pub min_gyro_agreement: f64,
+    /// Least scale of each gyro axis against the orientation's rotation rate about that
+    /// device axis, where the orientation turns about it at [`GYRO_SCALE_MIN_RATE`] RMS or
+    /// more: [`MIN_GYRO_AXIS_SCALE`], 0.15. A dead or stuck axis reads about 0; `0` (or below)
+    /// turns the check off (as a `min_gyro_agreement` of -1 does).
+    pub min_gyro_axis_scale: f64,
 }
 
 impl Default for Validation {
@@ -151,6 +157,7 @@ impl Default for Validation {
             max_speed: 100.0,
             max_orientation_gravity_deg: 45.0,
             min_gyro_agreement: MIN_GYRO_AGREEMENT,
+            min_gyro_axis_scale: MIN_GYRO_AXIS_SCALE,
         }
     }
 }
@@ -180,18 +187,26 @@ impl Validation {
         let values = values.into_iter();
         if channel == Channel::Gyro {
             let mut norms: Vec<f64> = values.clone().map(norm).collect();
-            let median = median(&mut norms);
-            if median > self.max_median_gyro {
-                return Err(SequenceError::GyroUnits {
-                    median,
-                    max: self.max_median_gyro,
-                });
+            if let Some(e) = self.gyro_units_error(median(&mut norms)) {
+                return Err(e);
             }
         }
         for (index, v) in values.enumerate() {
             self.check_value(channel, index, v)?;
         }
         Ok(())
+    }
+
+    /// The error for a median |gyro| of `median` rad/s: a gyroscope in deg/s above
+    /// [`Self::max_median_gyro`], unless beyond what any gyroscope reads in deg/s
+    /// ([`Self::max_gyro`] in deg/s on each axis; corrupt values, which the per-value check
+    /// then names on their line).
+    pub(crate) fn gyro_units_error(&self, median: f64) -> Option<SequenceError> {
+        let in_deg_s = 3f64.sqrt() * self.max_gyro.to_degrees();
+        (median > self.max_median_gyro && median <= in_deg_s).then_some(SequenceError::GyroUnits {
+            median,
+            max: self.max_median_gyro,
+        })
     }
 
     /// Checks one 3-vector of `channel`, frame `index`, against [`Self::limit`] (for a stream
@@ -347,39 +362,66 @@ impl Validation {
         gyro: &[DeviceVec],
         orientation: &[WorldFromDevice],
     ) -> Result<(), SequenceError> {
-        let rates: Vec<(f64, f64, f64)> = step_rates(time, gyro, orientation)
-            .map(|(_, _, w, g, dot)| (w, g, dot))
-            .collect();
-        let is_jump = |&(w, g, _): &(f64, f64, f64)| w - g > ORIENTATION_JUMP_RATE;
-        let jumps = rates.iter().filter(|r| is_jump(r)).count();
+        let rates: Vec<StepRate> = step_rates(time, gyro, orientation).collect();
+        let jumps = rates.iter().filter(|r| r.is_jump()).count();
         let leave_out = jumps as f64 <= MAX_JUMP_SHARE * rates.len() as f64;
         let mut fit = GyroFit::default();
-        for &(w, g, dot) in rates.iter().filter(|r| !(leave_out && is_jump(r))) {
-            fit.add(w, g, dot);
+        for step in rates.iter().filter(|r| !(leave_out && r.is_jump())) {
+            fit.add(step);
         }
         self.gyro_verdict(&fit)
     }
 
     /// [`Self::check_gyro_scale`] of the sums of its steps.
     pub(crate) fn gyro_verdict(&self, fit: &GyroFit) -> Result<(), SequenceError> {
-        let GyroFit { gw, ww, n, .. } = *fit;
-        if n == 0 || (ww / n as f64).sqrt() < GYRO_SCALE_MIN_RATE {
+        let GyroFit { gw, ww, gg, n, .. } = *fit;
+        if n == 0 {
             return Ok(());
+        }
+        let (orientation_rms, gyro_rms) = ((ww / n as f64).sqrt(), (gg / n as f64).sqrt());
+        if orientation_rms < GYRO_SCALE_MIN_RATE {
+            // Too still to fit a scale, unless the gyro turns: then the orientation stays put
+            // while the phone turns, or a slow turn reads in deg/s.
+            if gyro_rms < ORIENTATION_STILL_GYRO_RATE {
+                return Ok(());
+            }
+            let scale = gw / ww;
+            let (min, max) = self.gyro_scale_range;
+            return Err(match ww > 0.0 && (20.0..200.0).contains(&scale) {
+                true => SequenceError::GyroScale { scale, min, max },
+                false => SequenceError::OrientationStill {
+                    orientation_rms,
+                    gyro_rms,
+                },
+            });
         }
         let scale = gw / ww;
         let (min, max) = self.gyro_scale_range;
         if !(min..=max).contains(&scale) {
             return Err(SequenceError::GyroScale { scale, min, max });
         }
-        match fit.agreement() {
-            Some(agreement) if agreement < self.min_gyro_agreement => {
-                Err(SequenceError::GyroDirection {
-                    agreement,
-                    min: self.min_gyro_agreement,
-                })
-            }
-            _ => Ok(()),
+        if let Some(agreement) = fit.agreement()
+            && agreement < self.min_gyro_agreement
+        {
+            return Err(SequenceError::GyroDirection {
+                agreement,
+                min: self.min_gyro_agreement,
+            });
         }
+        // A dead axis leaves the others' agreement high: each axis on its own (but for an
+        // orientation of another device frame, the direction check off).
+        let axes_comparable = self.min_gyro_agreement > -1.0 && n >= GYRO_AXIS_MIN_STEPS;
+        for axis in (0..3).filter(|_| axes_comparable) {
+            let (gw, ww) = (fit.axis_gw[axis], fit.axis_ww[axis]);
+            if (ww / n as f64).sqrt() >= GYRO_SCALE_MIN_RATE && gw < self.min_gyro_axis_scale * ww {
+                return Err(SequenceError::GyroAxis {
+                    axis,
+                    scale: gw / ww,
+                    min: self.min_gyro_axis_scale,
+                });
+            }
+        }
+        Ok(())
     }
 
     /// Checks the linear acceleration's scale against accelerometer minus gravity (all in the
@@ -447,6 +489,12 @@ pub struct GyroFit {
     pub(crate) gw: f64,
     /// Orientation rate squared, summed.
     pub(crate) ww: f64,
+    /// Gyro rate squared, summed.
+    pub(crate) gg: f64,
+    /// Per device axis: gyro rate times orientation rate, summed.
+    pub(crate) axis_gw: [f64; 3],
+    /// Per device axis: orientation rate squared, summed.
+    pub(crate) axis_ww: [f64; 3],
     /// Dot product of the two rate vectors, summed.
     pub(crate) dot: f64,
     /// Steps.
@@ -454,11 +502,17 @@ pub struct GyroFit {
 }
 
 impl GyroFit {
-    /// Adds a step: the orientation's rate `w`, the gyro's `g`, their vectors' dot product.
-    pub(crate) fn add(&mut self, w: f64, g: f64, dot: f64) {
+    /// Adds a step.
+    pub(crate) fn add(&mut self, step: &StepRate) {
+        let (w, g) = (step.w(), step.g());
         self.gw += g * w;
         self.ww += w * w;
-        self.dot += dot;
+        self.gg += g * g;
+        self.dot += step.gyro.dot(&step.rate);
+        for k in 0..3 {
+            self.axis_gw[k] += step.gyro[k] * step.rate[k];
+            self.axis_ww[k] += step.rate[k] * step.rate[k];
+        }
         self.n += 1;
     }
 
@@ -466,10 +520,8 @@ impl GyroFit {
     /// but for those of an orientation jump (turning more than [`ORIENTATION_JUMP_RATE`] faster
     /// than the gyro) and those whose time does not increase.
     pub fn add_steps(&mut self, time: &[f64], gyro: &[DeviceVec], orientation: &[WorldFromDevice]) {
-        for (_, _, w, g, dot) in step_rates(time, gyro, orientation) {
-            if w - g <= ORIENTATION_JUMP_RATE {
-                self.add(w, g, dot);
-            }
+        for step in step_rates(time, gyro, orientation).filter(|s| !s.is_jump()) {
+            self.add(&step);
         }
     }
 
@@ -495,6 +547,20 @@ impl GyroFit {
 /// another order (x, y, z, w read as w, x, y, z, or the reverse), 94 % of them under 0.5
 /// and so refused.
 pub const MIN_GYRO_AGREEMENT: f64 = 0.5;
+
+/// The least scale of a gyro axis against the orientation's rotation rate about that device
+/// axis that [`Validation::check_gyro_scale`] accepts by default
+/// ([`Validation::min_gyro_axis_scale`]): least squares over the steps, where the orientation
+/// turns about the axis at [`GYRO_SCALE_MIN_RATE`] RMS or more. Measured on real recordings
+/// (`benchmarks/gyro_direction.py --axes`, 127 sequences, 381 axes: every Tyrex run of both
+/// phones and conditions, the 12 Indoor Location Competition walks): 0.33-1.02, 1 % under 0.53
+/// (the lowest near magnetic disturbance); a dead axis reads 0, one stuck at a constant about 0.
+pub const MIN_GYRO_AXIS_SCALE: f64 = 0.15;
+
+/// Fewest steps over which [`Validation::check_gyro_scale`] judges each gyro axis
+/// ([`MIN_GYRO_AXIS_SCALE`]): a second at 200 Hz, four at 50 Hz; over a few steps one axis's
+/// noise can read any scale.
+pub const GYRO_AXIS_MIN_STEPS: usize = 200;
 
 /// How much faster than the gyro the orientation may turn between two frames, rad/s, before
 /// the step belongs to an orientation jump (see [`orientation_jumps`]). Where the orientation
@@ -532,14 +598,40 @@ pub struct OrientationJump {
     pub excess_angle: f64,
 }
 
-/// Per step `k - 1 -> k`: `k`, the time step, the orientation's rotation rate and the gyro's
-/// (the mean of the two readings), rad/s, and the dot product of the two rotation-rate vectors
-/// in the device frame, (rad/s)^2; steps whose time does not increase are skipped.
+/// One step `k - 1 -> k` of [`step_rates`]: the orientation's rotation rate and the gyro's
+/// (the mean of the two readings), rad/s, both vectors in the device frame.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct StepRate {
+    pub(crate) k: usize,
+    pub(crate) dt: f64,
+    pub(crate) rate: Vector3<f64>,
+    pub(crate) gyro: Vector3<f64>,
+}
+
+impl StepRate {
+    /// The orientation's rotation rate, rad/s.
+    pub(crate) fn w(&self) -> f64 {
+        self.rate.norm()
+    }
+
+    /// The gyro's rotation rate, rad/s.
+    pub(crate) fn g(&self) -> f64 {
+        self.gyro.norm()
+    }
+
+    /// Whether the orientation turns so much faster than the gyro that the step belongs to an
+    /// orientation jump ([`ORIENTATION_JUMP_RATE`]).
+    pub(crate) fn is_jump(&self) -> bool {
+        self.w() - self.g() > ORIENTATION_JUMP_RATE
+    }
+}
+
+/// The steps `k - 1 -> k` of a recording, those whose time does not increase skipped.
 pub(crate) fn step_rates<'a>(
     time: &'a [f64],
     gyro: &'a [DeviceVec],
     orientation: &'a [WorldFromDevice],
-) -> impl Iterator<Item = (usize, f64, f64, f64, f64)> + 'a {
+) -> impl Iterator<Item = StepRate> + 'a {
     let n = time.len().min(gyro.len()).min(orientation.len());
     (1..n).filter_map(move |k| {
         let dt = time[k] - time[k - 1];
@@ -547,9 +639,12 @@ pub(crate) fn step_rates<'a>(
             // The step's rotation in the device frame (world-from-device q_k = q_{k-1} * step),
             // as a rotation vector: the rate the gyro should read, direction included.
             let step = orientation[k - 1].inverse() * orientation[k];
-            let rate = step.quaternion().scaled_axis() / dt;
-            let gyro_mean = (*gyro[k - 1].vector() + *gyro[k].vector()) * 0.5;
-            (k, dt, rate.norm(), gyro_mean.norm(), gyro_mean.dot(&rate))
+            StepRate {
+                k,
+                dt,
+                rate: step.quaternion().scaled_axis() / dt,
+                gyro: (*gyro[k - 1].vector() + *gyro[k].vector()) * 0.5,
+            }
         })
     })
 }
@@ -564,10 +659,11 @@ pub fn orientation_jumps(
     orientation: &[WorldFromDevice],
 ) -> Vec<OrientationJump> {
     let mut out: Vec<OrientationJump> = Vec::new();
-    for (k, dt, w, g, _) in step_rates(time, gyro, orientation) {
-        if w - g <= ORIENTATION_JUMP_RATE {
+    for step in step_rates(time, gyro, orientation) {
+        if !step.is_jump() {
             continue;
         }
+        let (k, dt, w, g) = (step.k, step.dt, step.w(), step.g());
         let excess = (w - g) * dt;
         match out.last_mut() {
             Some(j) if time[k - 1] - j.time.1 <= JUMP_JOIN_S => {
@@ -675,6 +771,13 @@ pub(crate) fn orientation_jump_warning(file: &str, jumps: &[OrientationJump]) ->
 /// [`Validation::check_gyro_scale`] judges the gyro's scale (the Tyrex and competition walks
 /// turn at 0.5-2.6 rad/s RMS).
 pub const GYRO_SCALE_MIN_RATE: f64 = 0.1;
+
+/// RMS rotation rate of the gyro, rad/s, from which [`Validation::check_gyro_scale`] refuses
+/// an orientation that turns under [`GYRO_SCALE_MIN_RATE`] RMS: one that stays put while the
+/// phone turns (a placeholder such as the identity, or an orientation of another, still
+/// recording). A phone lying still reads about 0.01; the slowest Tyrex and competition walks
+/// turn at 0.5.
+pub const ORIENTATION_STILL_GYRO_RATE: f64 = 0.3;
 
 /// Largest RMS linear acceleration, m/s^2, that [`Validation::check_linacce_scale`] accepts
 /// where accelerometer minus gravity is too small to fit a scale (below
@@ -825,6 +928,15 @@ mod tests {
             e.to_string(),
             "`gyro.y` at frame 1: -200 rad/s is beyond any phone gyroscope (|value| <= 100 rad/s)"
         );
+        // Every value corrupt (beyond any gyroscope in deg/s too): named on its frame, not
+        // taken for deg/s.
+        let gyro = [[1e308, 0.0, 0.0]; 3];
+        let e = v.check_channel(Channel::Gyro, gyro).unwrap_err();
+        assert!(
+            e.to_string()
+                .starts_with("`gyro.x` at frame 0: 1e308 rad/s is beyond"),
+            "{e}"
+        );
     }
 
     #[test]
@@ -860,7 +972,70 @@ mod tests {
         let e = turn(0.15, 0.0).unwrap_err();
         assert!(e.to_string().contains("another recording or device"), "{e}");
         // Turning at 0.05 rad/s is too little to judge, whatever the gyro says.
-        turn(0.05, 57.3).unwrap();
+        // Turning at 0.05 rad/s is too little to fit a scale on, but a gyro reading 2.9 rad/s
+        // there is in deg/s.
+        turn(0.05, 1.5).unwrap();
+        let e = turn(0.05, 57.3).unwrap_err();
+        assert!(e.to_string().ends_with("deg/s instead of rad/s?"), "{e}");
+        // An orientation that stays put (a placeholder identity) under a turning gyro.
+        let time: Vec<f64> = (0..400).map(|i| i as f64 * 0.005).collect();
+        let still = vec![WorldFromDevice::identity(); time.len()];
+        let gyro = |rate| vec![DeviceVec::new(0.0, 0.0, rate); time.len()];
+        let e = v.check_gyro_scale(&time, &gyro(0.5), &still).unwrap_err();
+        assert!(
+            e.to_string().starts_with(
+                "the orientation turns at 0 rad/s RMS while the gyro turns at 0.5 rad/s RMS: an \
+                 orientation that stays put while the phone turns"
+            ),
+            "{e}"
+        );
+        // A phone lying still: its gyro's noise says nothing.
+        v.check_gyro_scale(&time, &gyro(0.02), &still).unwrap();
+    }
+
+    /// A dead gyro axis (reading 0 while the orientation turns about it) is refused by name,
+    /// although the other axes agree in direction; the check off, it passes.
+    #[test]
+    fn a_dead_gyro_axis_is_refused() {
+        let time: Vec<f64> = (0..1000).map(|i| i as f64 * 0.005).collect();
+        // Turning about device z at 0.5 rad/s, and rocking about x.
+        let rate = |t: f64| Vector3::new(0.4 * (3.0 * t).cos(), 0.0, 0.5);
+        let mut orientation = vec![WorldFromDevice::identity()];
+        for w in time.windows(2) {
+            let step = ridi_frames::Rot::from_scaled_axis(rate(w[0]) * (w[1] - w[0]));
+            orientation.push(*orientation.last().unwrap() * step);
+        }
+        let gyro = |dead: Option<usize>| -> Vec<DeviceVec> {
+            time.iter()
+                .map(|&t| {
+                    let mut g = rate(t);
+                    if let Some(axis) = dead {
+                        g[axis] = 0.0;
+                    }
+                    DeviceVec::new(g.x, g.y, g.z)
+                })
+                .collect()
+        };
+        let v = Validation::default();
+        v.check_gyro_scale(&time, &gyro(None), &orientation)
+            .unwrap();
+        // y: the orientation does not turn about it, nothing to judge.
+        v.check_gyro_scale(&time, &gyro(Some(1)), &orientation)
+            .unwrap();
+        let e = v
+            .check_gyro_scale(&time, &gyro(Some(2)), &orientation)
+            .unwrap_err();
+        assert!(
+            matches!(e, SequenceError::GyroAxis { axis: 2, scale, .. } if scale.abs() < 0.01),
+            "{e}"
+        );
+        assert!(e.to_string().starts_with("the gyro's z axis reads"), "{e}");
+        let off = Validation {
+            min_gyro_axis_scale: 0.0,
+            ..Validation::default()
+        };
+        off.check_gyro_scale(&time, &gyro(Some(2)), &orientation)
+            .unwrap();
     }
 
     #[test]

@@ -10,7 +10,7 @@ use std::path::Path;
 use common::*;
 use ridi_data::ridi_frames::DeviceVec;
 use ridi_data::{ReadOptions, Sequence, ridi_csv, ridi_plain, write_ridi_csv, write_ridi_plain};
-use ridi_test_support::{assert_err, edit_cells, edit_file, with_cell};
+use ridi_test_support::{assert_err, edit_cells, edit_file, with_cell, write_files};
 
 /// `text` without its final line break and the last `n` characters of its last value, and the
 /// number of its last line.
@@ -212,4 +212,76 @@ fn a_gzip_bomb_is_refused_while_decompressing() {
     // A valid recording through gzip reads.
     let ok = gz("ok/data.csv.gz", &|w| w.write_all(&valid_csv(500)).unwrap());
     ridi_csv::read(&ok, &ReadOptions::default()).unwrap();
+}
+
+/// An optional file (`pose.txt`) or a required one that is a symbolic link to nothing, or a
+/// folder, is named as such: it was taken as absent (a recording read without its ground
+/// truth) or as missing.
+#[cfg(unix)]
+#[test]
+fn files_that_are_broken_links_or_folders_are_named_not_skipped() {
+    let folder = || {
+        let dir = tempfile::tempdir().unwrap();
+        write_files(dir.path(), &raw_files(60, true));
+        dir
+    };
+    let read = |dir: &Path| ridi_data::read_sequence(dir, &raw_options());
+    for (file, target) in [("pose.txt", "missing.txt"), ("gyro.txt", "gyro.txt")] {
+        let dir = folder();
+        std::fs::remove_file(dir.path().join(file)).unwrap();
+        std::os::unix::fs::symlink(target, dir.path().join(file)).unwrap();
+        let why = match target == file {
+            true => "that leads to no file (",
+            false => "that leads to no file (its target does not exist)",
+        };
+        assert_err(
+            read(dir.path()),
+            &[&format!("{file}: is a symbolic link to {target} "), why],
+        );
+    }
+    let dir = folder();
+    std::fs::remove_file(dir.path().join("gyro.txt")).unwrap();
+    std::fs::create_dir(dir.path().join("gyro.txt")).unwrap();
+    assert_err(
+        read(dir.path()),
+        &["gyro.txt: is a folder: it is not a regular file"],
+    );
+    // The file given itself, a link in a loop.
+    let dir = tempfile::tempdir().unwrap();
+    let csv = dir.path().join("data.csv");
+    std::os::unix::fs::symlink("data.csv", &csv).unwrap();
+    assert_err(
+        ridi_data::read_sequence(&csv, &ReadOptions::default()),
+        &["data.csv: is a symbolic link to data.csv that leads to no file"],
+    );
+}
+
+/// A raw file whose clock stops: up to `MAX_REPEATED_TIMESTAMPS` records repeating a
+/// timestamp are dropped as duplicates, more are refused on the line where they exceed it
+/// (their times are unknown: 3 hours of them were read as 97 % of a file, dropped unsaid).
+#[test]
+fn a_raw_clock_that_stops_is_refused_beyond_a_few_repeats() {
+    let stall = |repeats: usize| {
+        raw_with(|f| {
+            edit_file(f, "gyro.txt", |s| {
+                let mut lines: Vec<String> = s.lines().map(str::to_owned).collect();
+                // Record i is on line i + 2 (after the header); records 10.. repeat record 9's.
+                let frozen = lines[10].split(' ').next().unwrap().to_owned();
+                for line in &mut lines[11..11 + repeats] {
+                    let rest = line.split_once(' ').unwrap().1.to_owned();
+                    *line = format!("{frozen} {rest}");
+                }
+                lines.join("\n") + "\n"
+            })
+        })
+    };
+    let max = ridi_data::ridi_raw::MAX_REPEATED_TIMESTAMPS;
+    assert!(stall(max).1.is_ok());
+    assert_err(
+        stall(max + 1).1,
+        &[&format!(
+            "gyro.txt:22: field `t`: the timestamp of line 11 repeated by more than {max} \
+             records in a row: a clock that stopped"
+        )],
+    );
 }

@@ -280,12 +280,31 @@ fn corrupt_bytes_give_errors_never_panics() {
 fn info_json_problems_name_the_field() {
     let dir = tempfile::tempdir().unwrap();
     let original = std::fs::read_to_string(fixtures().join("a000_1/info.json")).unwrap();
-    let cases: [(&str, &str, &str, &str); 4] = [
+    let cases: [(&str, &str, &str, &str); 7] = [
         (
             "\"imu_acce_scale\": [",
             "\"imu_acce_scale\": [\"x\", ",
             "imu_acce_scale",
             "expected a list of 3 numbers",
+        ),
+        // Calibrations far from any phone's, named here, not on the data they would scale.
+        (
+            "\"imu_acce_scale\": [\n  1.01",
+            "\"imu_acce_scale\": [\n  1e308",
+            "imu_acce_scale",
+            "1e308 is outside 0.5..2: an accelerometer scale near 1",
+        ),
+        (
+            "\"imu_init_gyro_bias\": [\n  0.012",
+            "\"imu_init_gyro_bias\": [\n  50",
+            "imu_init_gyro_bias",
+            "50 is outside -1..1: a gyro bias in rad/s",
+        ),
+        (
+            "\"imu_acce_bias\": [\n  0.11",
+            "\"imu_acce_bias\": [\n  9.81",
+            "imu_acce_bias",
+            "9.81 is outside -5..5: an accelerometer bias in m/s^2",
         ),
         (
             "\"start_frame\": 20",

@@ -36,6 +36,10 @@ pub(crate) fn is_a(path: &Path, want: Format) -> bool {
 /// something known, and what a `want` looks like.
 pub(crate) fn not_a(path: &Path, want: Format) -> DataError {
     let found = match detect(path) {
+        // Told by its name alone, an empty file is of no format.
+        _ if std::fs::metadata(path).is_ok_and(|m| m.is_file() && m.len() == 0) => {
+            " (it is empty)".to_string()
+        }
         Ok(found) => format!(" (it is {})", with_article(&found.to_string())),
         Err(_) if !path.exists() => " (no such file or folder)".to_string(),
         Err(_) => String::new(),

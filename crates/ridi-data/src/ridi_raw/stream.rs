@@ -216,7 +216,7 @@ impl Scan {
         keep: Option<Keep>,
     ) -> Result<Option<Scan>> {
         let path = folder.join(spec.name);
-        if !spec.required() && !path.exists() {
+        if !spec.required() && !text::present(&path) {
             return Ok(None);
         }
         let limits = &opts.validation;
