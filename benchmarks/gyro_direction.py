@@ -12,7 +12,8 @@ recording as `ridi::LiveTracker` sums them: the lowest agreement once 5 s and on
 (`ridi::STREAM_GYRO_CHECK_S`) have passed, and how many of the reordered quaternions' streams
 fall under `ridi::STREAM_MIN_GYRO_AGREEMENT` (0) after 10 s. With `--axes`, each gyro axis's
 least-squares scale against the orientation's rotation rate about that device axis, where the
-orientation turns about it at 0.1 rad/s RMS (`ridi_data::GYRO_SCALE_MIN_RATE`): the bounds
+orientation turns about it at 0.1 rad/s RMS (`ridi_data::GYRO_SCALE_MIN_RATE`) and with a tenth
+of its squared rate (`ridi_data::GYRO_AXIS_MIN_SHARE`): the bounds
 behind `ridi_data::MIN_GYRO_AXIS_SCALE` (a dead axis reads 0). Sequences the reader refuses (the
 whole-recording check included) are counted apart. Needs the Python package (`pip install
 ./crates/ridi-py`).
@@ -63,12 +64,15 @@ def step_sums(t, gyro, q):
 
 
 def axis_scales(t, gyro, q):
-    """Per device axis: the orientation's RMS rotation rate about it and the gyro's
-    least-squares scale against it, as `Validation::check_gyro_scale` sums them."""
+    """Per device axis: whether `Validation::check_gyro_scale` judges it (the orientation
+    turning about it at 0.1 rad/s RMS, with a tenth of its squared rate:
+    `ridi_data::GYRO_AXIS_MIN_SHARE`), and the gyro's least-squares scale against it."""
     rate, g, kept = step_vectors(t, gyro, q)
     keep = kept if (~kept).mean() <= 0.05 else np.ones_like(kept)
     r, g = rate[keep], g[keep]
-    return np.sqrt(np.mean(r * r, axis=0)), np.sum(g * r, axis=0) / np.sum(r * r, axis=0)
+    ww = np.sum(r * r, axis=0)
+    judged = (np.sqrt(ww / len(r)) >= 0.1) & (ww >= 0.1 * ww.sum())
+    return judged, np.sum(g * r, axis=0) / ww
 
 
 def agreement(t, gyro, q):
@@ -107,10 +111,10 @@ def main(paths):
         for s in seqs:
             t, g, q = s.time, s.gyro, s.orientation
             if axes:
-                rms, scale = axis_scales(t, g, q)
-                rows.append((rms, scale))
-                print(f"{s.name:48s} rms " + " ".join(f"{x:5.2f}" for x in rms)
-                      + "  scale " + " ".join(f"{x:5.2f}" for x in scale))
+                judged, scale = axis_scales(t, g, q)
+                rows.append((judged, scale))
+                print(f"{s.name:48s} scale " + " ".join(
+                    f"{x:5.2f}" if j else "    -" for j, x in zip(judged, scale)))
                 continue
             if stream:
                 row = (np.nanmin(stream_minimum(t, g, q, 5.0)),
@@ -127,10 +131,9 @@ def main(paths):
                      if stream else " " + " ".join(f"{x:+.2f}" for x in row[2:])))
     print(f"\n{len(refused)} paths refused by the reader:", *refused, sep="\n  ")
     if axes:
-        judged = np.array([sc for rms, scale in rows for r, sc in zip(rms, scale) if r >= 0.1])
-        print(f"{len(rows)} sequences, {len(judged)} axes turning at 0.1 rad/s RMS or more: "
-              f"gyro scale {judged.min():.2f}..{judged.max():.2f}, "
-              f"1 % under {np.percentile(judged, 1):.2f}")
+        judged = np.array([sc for j, scale in rows for k, sc in zip(j, scale) if k])
+        print(f"{len(rows)} sequences, {len(judged)} of {3 * len(rows)} axes judged: gyro scale "
+              f"{judged.min():.2f}..{judged.max():.2f}, 1 % under {np.percentile(judged, 1):.2f}")
         return
     if stream:
         low5, low10 = (np.nanmin([r[i] for r in rows]) for i in (0, 1))

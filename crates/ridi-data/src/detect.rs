@@ -117,7 +117,7 @@ pub(crate) fn locate(path: &Path) -> Result<(Format, PathBuf)> {
         ));
     }
     if !path.is_dir() {
-        // A symbolic link that leads to no file: the error says so.
+        // A symbolic link that cannot be followed: the error says so.
         if let (true, Err(e)) = (crate::text::present(path), std::fs::metadata(path)) {
             return Err(DataError::io(path, e));
         }

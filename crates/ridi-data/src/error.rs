@@ -173,15 +173,17 @@ impl DataError {
     /// An I/O error on `path`. A missing file reads "no such file or folder", as the readers
     /// say it for a path that names neither (the error's kind is kept).
     ///
-    /// A symbolic link that leads to no file (its target missing, or links in a loop) says so:
-    /// the name is there, so "no such file" would contradict what the user sees.
+    /// A symbolic link that cannot be followed (its target missing, links in a loop) says
+    /// so, with its target (a relative one joined to the link's folder): the name is there,
+    /// so "no such file" would contradict what the user sees.
     pub fn io(path: impl AsRef<Path>, error: std::io::Error) -> Self {
         let path = path.as_ref();
         let link = std::fs::symlink_metadata(path).is_ok_and(|m| m.file_type().is_symlink());
         let error = match error.kind() {
             _ if link && std::fs::metadata(path).is_err() => {
+                let folder = path.parent().unwrap_or(Path::new(""));
                 let to = std::fs::read_link(path)
-                    .map(|t| format!(" to {}", shown(&t)))
+                    .map(|t| format!(" to {}", shown(folder.join(t))))
                     .unwrap_or_default();
                 let why = match error.kind() {
                     std::io::ErrorKind::NotFound => "its target does not exist".to_string(),
@@ -189,7 +191,7 @@ impl DataError {
                 };
                 std::io::Error::new(
                     error.kind(),
-                    format!("is a symbolic link{to} that leads to no file ({why})"),
+                    format!("is a symbolic link{to} that cannot be followed ({why})"),
                 )
             }
             std::io::ErrorKind::NotFound => {

@@ -533,17 +533,9 @@ fn parse_records(content: &str, path: &Path) -> Result<([Stream; 5], Header)> {
         let ty = cells.next().map(str::trim).unwrap_or("");
         if !ty.starts_with("TYPE_") {
             // A file re-saved with other separators: say which.
-            let separator = [(',', "commas"), (';', "semicolons"), (' ', "spaces")]
-                .into_iter()
-                .find(|(c, _)| {
-                    stamp
-                        .split(*c)
-                        .nth(1)
-                        .is_some_and(|t| t.starts_with("TYPE_"))
-                })
-                .map_or(String::new(), |(_, name)| {
-                    format!(": its cells are separated by {name}, the format's by tabs")
-                });
+            let separator = other_separator(l).map_or(String::new(), |name| {
+                format!(": its cells are separated by {name}, the format's by tabs")
+            });
             return Err(DataError::format(
                 Location::line(path, line).with_field("type"),
                 format!(
@@ -798,10 +790,6 @@ pub fn looks_like_path_file(head: &[u8]) -> bool {
     let head = String::from_utf8_lossy(head);
     // Also with another separator than the tab (a file re-saved by a spreadsheet), so that
     // its reader, not the data_plain.txt one, names the separator.
-    fn after_separator(rest: &str) -> Option<&str> {
-        let cells = rest.trim_start_matches(['\t', ',', ';', ' ']);
-        (cells.len() < rest.len()).then_some(cells)
-    }
     head.lines().take(64).any(|l| {
         if l.strip_prefix('#')
             .and_then(after_separator)
@@ -812,6 +800,27 @@ pub fn looks_like_path_file(head: &[u8]) -> bool {
         let digits = l.bytes().take_while(u8::is_ascii_digit).count();
         digits > 0 && after_separator(&l[digits..]).is_some_and(|rest| rest.starts_with("TYPE_"))
     })
+}
+
+/// `rest` after the separators it starts with (tabs, or what a file re-saved by a spreadsheet
+/// has instead: commas, semicolons, spaces); `None` if it starts with none.
+fn after_separator(rest: &str) -> Option<&str> {
+    let cells = rest.trim_start_matches(['\t', ',', ';', ' ']);
+    (cells.len() < rest.len()).then_some(cells)
+}
+
+/// The separator of a record `l` re-saved without tabs (`unix_ms`, then commas, semicolons or
+/// spaces before `TYPE_`), named for a message.
+fn other_separator(l: &str) -> Option<&'static str> {
+    let digits = l.bytes().take_while(u8::is_ascii_digit).count();
+    let rest = &l[digits..];
+    after_separator(rest).filter(|cells| digits > 0 && cells.starts_with("TYPE_"))?;
+    match rest.chars().next()? {
+        ',' => Some("commas"),
+        ';' => Some("semicolons"),
+        ' ' => Some("spaces"),
+        _ => None,
+    }
 }
 
 /// Whether the file at `path` is a path file (plain or gzip-compressed), judged by its first
@@ -1343,10 +1352,14 @@ mod tests {
         assert!(looks_like_path_file(b"1574559495263 TYPE_WAYPOINT 1 2\n"));
         assert!(looks_like_path_file(b"1574559495263;TYPE_WAYPOINT;1;2\n"));
         assert!(!looks_like_path_file(b"1574559495263TYPE_WAYPOINT\n"));
-        let e = err(&synthetic(1).replace('\t', ","));
-        assert!(
-            e.ends_with("its cells are separated by commas, the format's by tabs"),
-            "{e}"
-        );
+        for (separator, name) in [(",", "commas"), (", ", "commas"), (";", "semicolons")] {
+            let e = err(&synthetic(1).replace('\t', separator));
+            assert!(
+                e.ends_with(&format!(
+                    "its cells are separated by {name}, the format's by tabs"
+                )),
+                "{e}"
+            );
+        }
     }
 }

@@ -139,7 +139,7 @@ pub use temporaries::{
 };
 pub use text::read_text;
 pub use validation::{
-    GYRO_AXIS_MIN_STEPS, GYRO_SCALE_MIN_RATE, GyroFit, LINACCE_SCALE_MIN_RMS,
+    GYRO_AXIS_MIN_SHARE, GYRO_AXIS_MIN_STEPS, GYRO_SCALE_MIN_RATE, GyroFit, LINACCE_SCALE_MIN_RMS,
     LINACCE_STILL_MAX_RMS, MAX_JUMP_SHARE, MIN_GYRO_AGREEMENT, MIN_GYRO_AXIS_SCALE,
     ORIENTATION_JUMP_RATE, ORIENTATION_STILL_GYRO_RATE, OrientationJump, Validation,
     bridge_orientation_jumps, orientation_jumps, up_angle_deg,

@@ -66,6 +66,16 @@ pub(crate) struct Header {
 
 pub(crate) fn parse_header(line: usize, content: &str, path: &Path) -> Result<Header> {
     let at = |field: &str| Location::line(path, line).with_field(field);
+    // A line break is `\n` or `\r\n`: a `\r` left inside is a file of `\r` alone, read as
+    // one line.
+    if content.trim_end().contains('\r') {
+        return Err(DataError::format(
+            Location::line(path, line),
+            "the header runs on past a carriage return: the file's lines end in a carriage \
+             return alone (classic Mac OS line endings); convert them to line feeds (`tr '\\r' \
+             '\\n'`)",
+        ));
+    }
     let mut slots = Vec::new();
     let mut found = [false; 27];
     // Names of no column of the layout, for the error about a missing one (a typo, `gyroy`).

@@ -400,9 +400,10 @@ struct RecordReader<S> {
     repeats: usize,
 }
 
-/// Most records in a row a raw file may repeat a timestamp with: a record repeated now and
-/// then is dropped, but a clock that stopped leaves records whose times are unknown (20 in a
-/// row moved a track by 0.7 m; 3 hours of them were 97 % of a file, dropped).
+/// Most records in a row a raw sensor file may repeat a timestamp with: a record repeated now
+/// and then is dropped, but a clock that stopped leaves records whose times are unknown (20 in
+/// a row moved a track by 0.7 m; 3 hours of them were 97 % of a file, dropped). Not for
+/// `step.txt` and `pose.txt`, whose gaps are not judged on their own clocks either.
 pub const MAX_REPEATED_TIMESTAMPS: usize = 10;
 
 impl<S: LineSource> RecordReader<S> {
@@ -441,7 +442,10 @@ impl<S: LineSource> RecordReader<S> {
             if let Some(previous) = self.previous {
                 if previous.0 == record.time {
                     self.repeats += 1;
-                    if self.repeats == MAX_REPEATED_TIMESTAMPS + 1 && self.step.is_none() {
+                    // Where gaps are judged (not step.txt, nor pose.txt, judged once trimmed).
+                    let judged = self.max_gap_s.is_finite();
+                    if judged && self.repeats == MAX_REPEATED_TIMESTAMPS + 1 && self.step.is_none()
+                    {
                         self.step = Some(DataError::format(
                             Location::line(&self.path, line).with_field("t"),
                             format!(

@@ -285,10 +285,10 @@ pub enum SequenceError {
     /// (`crate::MIN_GYRO_AXIS_SCALE`).
     #[error(
         "the gyro's {} axis reads {} times the orientation's rotation rate about it (least \
-         squares over frames; at least {min} expected, where the other axes agree): a dead or \
-         stuck gyro axis?",
+         squares over frames; at least {min} expected, where the other axes agree): {}?",
         ["x", "y", "z"][*axis],
-        short(*scale)
+        short(*scale),
+        if *scale < -0.5 { "a gyro axis with its sign reversed" } else { "a dead or stuck gyro axis" }
     )]
     GyroAxis {
         /// The device axis, 0..3.
@@ -385,9 +385,15 @@ pub enum SequenceError {
     #[error(
         "the orientation turns at {} rad/s RMS while the gyro turns at {} rad/s RMS: an \
          orientation that stays put while the phone turns (a placeholder such as the identity \
-         quaternion, or an orientation of another recording)?",
+         quaternion, or an orientation of another recording){}?",
         short(*orientation_rms),
-        short(*gyro_rms)
+        short(*gyro_rms),
+        // In deg/s the gyro of a phone that hardly turns reads this much too.
+        if gyro_rms.to_radians() < crate::ORIENTATION_STILL_GYRO_RATE {
+            ", or a gyroscope in deg/s on a phone that hardly turns"
+        } else {
+            ""
+        }
     )]
     OrientationStill {
         /// RMS rotation rate of the orientation, rad/s.

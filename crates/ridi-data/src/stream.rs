@@ -907,6 +907,7 @@ impl RowReader {
                 s.all.add(&step);
                 if step.is_jump() {
                     s.jumps += 1;
+                    s.kept.left_out += 1;
                 } else {
                     s.kept.add(&step);
                 }

@@ -53,11 +53,11 @@ pub fn up_angle_deg(orientation: WorldFromDevice, gravity: DeviceVec) -> Option<
 /// | largest ground-truth speed between consecutive frames (also over 2-20 frames) | 5.7 m/s | 100 m/s |
 /// | median angle of gravity from the orientation's up axis | 0 degrees | 45 degrees |
 ///
-/// Not caught: a gyro in deg/s on a phone that hardly turns (median |gyro| under 0.17 rad/s
-/// and the orientation turning at under [`GYRO_SCALE_MIN_RATE`] RMS), and a linear
-/// acceleration alone in g on a phone that hardly moves (RMS of accelerometer minus
-/// gravity under [`LINACCE_SCALE_MIN_RMS`]; there is then too little of it to judge, and too
-/// little to matter).
+/// Not caught: a gyro in deg/s on a phone that hardly turns (the orientation turning at under
+/// [`GYRO_SCALE_MIN_RATE`] RMS and the gyro, in deg/s, under [`ORIENTATION_STILL_GYRO_RATE`]),
+/// and a linear acceleration alone in g on a phone that hardly moves (RMS of accelerometer
+/// minus gravity under [`LINACCE_SCALE_MIN_RMS`]; there is then too little of it to judge, and
+/// too little to matter).
 #[derive(Debug, Clone, PartialEq)]
 pub struct Validation {
     /// Largest accepted interval between two frames, seconds.
@@ -132,9 +132,9 @@ pub struct Validation {
     /// for another device frame than the gyro's.
     pub min_gyro_agreement: f64,
     /// Least scale of each gyro axis against the orientation's rotation rate about that
-    /// device axis, where the orientation turns about it at [`GYRO_SCALE_MIN_RATE`] RMS or
-    /// more: [`MIN_GYRO_AXIS_SCALE`], 0.15. A dead or stuck axis reads about 0; `0` (or below)
-    /// turns the check off (as a `min_gyro_agreement` of -1 does).
+    /// device axis, where the orientation turns about it enough to judge (see
+    /// [`MIN_GYRO_AXIS_SCALE`]): 0.15. A dead axis reads about 0, one with its sign reversed
+    /// -1; `0` (or below) turns the check off (as a `min_gyro_agreement` of -1 does).
     pub min_gyro_axis_scale: f64,
 }
 
@@ -349,8 +349,10 @@ impl Validation {
 
     /// Checks the gyro against the rotation rate of `orientation` over `time`: its scale with
     /// [`Self::gyro_scale_range`] (magnitudes), then its direction with
-    /// [`Self::min_gyro_agreement`]; passes when the orientation hardly turns
-    /// ([`GYRO_SCALE_MIN_RATE`]). The steps where the orientation turns more
+    /// [`Self::min_gyro_agreement`], then each axis with [`Self::min_gyro_axis_scale`]. Where
+    /// the orientation hardly turns ([`GYRO_SCALE_MIN_RATE`]) it passes, unless the gyro turns
+    /// ([`ORIENTATION_STILL_GYRO_RATE`]) and no orientation jump was left out: an orientation
+    /// that stays put (or a slow turn read in deg/s). The steps where the orientation turns more
     /// than [`ORIENTATION_JUMP_RATE`] faster than the gyro are left out of the fit while they
     /// are at most [`MAX_JUMP_SHARE`] of the steps: a few frames of an OS orientation turning
     /// at hundreds of rad/s would otherwise outweigh thousands that agree. More such steps are
@@ -366,8 +368,11 @@ impl Validation {
         let jumps = rates.iter().filter(|r| r.is_jump()).count();
         let leave_out = jumps as f64 <= MAX_JUMP_SHARE * rates.len() as f64;
         let mut fit = GyroFit::default();
-        for step in rates.iter().filter(|r| !(leave_out && r.is_jump())) {
-            fit.add(step);
+        for step in &rates {
+            match leave_out && step.is_jump() {
+                true => fit.left_out += 1,
+                false => fit.add(step),
+            }
         }
         self.gyro_verdict(&fit)
     }
@@ -381,13 +386,15 @@ impl Validation {
         let (orientation_rms, gyro_rms) = ((ww / n as f64).sqrt(), (gg / n as f64).sqrt());
         if orientation_rms < GYRO_SCALE_MIN_RATE {
             // Too still to fit a scale, unless the gyro turns: then the orientation stays put
-            // while the phone turns, or a slow turn reads in deg/s.
-            if gyro_rms < ORIENTATION_STILL_GYRO_RATE {
+            // while the phone turns, or a slow turn reads in deg/s. An orientation that turns
+            // in the steps left out as jumps (one held between updates at a lower rate) does
+            // not stay put.
+            if gyro_rms < ORIENTATION_STILL_GYRO_RATE || fit.left_out > 0 {
                 return Ok(());
             }
             let scale = gw / ww;
             let (min, max) = self.gyro_scale_range;
-            return Err(match ww > 0.0 && (20.0..200.0).contains(&scale) {
+            return Err(match ww > 0.0 && DEG_S_SCALES.contains(&scale) {
                 true => SequenceError::GyroScale { scale, min, max },
                 false => SequenceError::OrientationStill {
                     orientation_rms,
@@ -410,13 +417,18 @@ impl Validation {
         }
         // A dead axis leaves the others' agreement high: each axis on its own (but for an
         // orientation of another device frame, the direction check off).
-        let axes_comparable = self.min_gyro_agreement > -1.0 && n >= GYRO_AXIS_MIN_STEPS;
+        let axes_comparable = self.min_gyro_agreement > -1.0
+            && self.min_gyro_axis_scale > 0.0
+            && n >= GYRO_AXIS_MIN_STEPS;
         for axis in (0..3).filter(|_| axes_comparable) {
-            let (gw, ww) = (fit.axis_gw[axis], fit.axis_ww[axis]);
-            if (ww / n as f64).sqrt() >= GYRO_SCALE_MIN_RATE && gw < self.min_gyro_axis_scale * ww {
+            let (axis_gw, axis_ww) = (fit.axis_gw[axis], fit.axis_ww[axis]);
+            // An axis the phone hardly turns about holds mostly the orientation's noise.
+            let judged = (axis_ww / n as f64).sqrt() >= GYRO_SCALE_MIN_RATE
+                && axis_ww >= GYRO_AXIS_MIN_SHARE * ww;
+            if judged && axis_gw < self.min_gyro_axis_scale * axis_ww {
                 return Err(SequenceError::GyroAxis {
                     axis,
-                    scale: gw / ww,
+                    scale: axis_gw / axis_ww,
                     min: self.min_gyro_axis_scale,
                 });
             }
@@ -495,6 +507,8 @@ pub struct GyroFit {
     pub(crate) axis_gw: [f64; 3],
     /// Per device axis: orientation rate squared, summed.
     pub(crate) axis_ww: [f64; 3],
+    /// Steps left out as orientation jumps.
+    pub(crate) left_out: usize,
     /// Dot product of the two rate vectors, summed.
     pub(crate) dot: f64,
     /// Steps.
@@ -520,8 +534,11 @@ impl GyroFit {
     /// but for those of an orientation jump (turning more than [`ORIENTATION_JUMP_RATE`] faster
     /// than the gyro) and those whose time does not increase.
     pub fn add_steps(&mut self, time: &[f64], gyro: &[DeviceVec], orientation: &[WorldFromDevice]) {
-        for step in step_rates(time, gyro, orientation).filter(|s| !s.is_jump()) {
-            self.add(&step);
+        for step in step_rates(time, gyro, orientation) {
+            match step.is_jump() {
+                true => self.left_out += 1,
+                false => self.add(&step),
+            }
         }
     }
 
@@ -551,11 +568,23 @@ pub const MIN_GYRO_AGREEMENT: f64 = 0.5;
 /// The least scale of a gyro axis against the orientation's rotation rate about that device
 /// axis that [`Validation::check_gyro_scale`] accepts by default
 /// ([`Validation::min_gyro_axis_scale`]): least squares over the steps, where the orientation
-/// turns about the axis at [`GYRO_SCALE_MIN_RATE`] RMS or more. Measured on real recordings
-/// (`benchmarks/gyro_direction.py --axes`, 127 sequences, 381 axes: every Tyrex run of both
-/// phones and conditions, the 12 Indoor Location Competition walks): 0.33-1.02, 1 % under 0.53
-/// (the lowest near magnetic disturbance); a dead axis reads 0, one stuck at a constant about 0.
+/// turns about the axis at [`GYRO_SCALE_MIN_RATE`] RMS or more and with
+/// [`GYRO_AXIS_MIN_SHARE`] of its rotation, over [`GYRO_AXIS_MIN_STEPS`] steps or more.
+/// Measured on real recordings (`benchmarks/gyro_direction.py --axes`, 127 sequences: every
+/// Tyrex run of both phones and conditions, the 12 Indoor Location Competition walks):
+/// 333 of their 381 axes judged, 0.33-1.02, 1 % under 0.51 (the lowest near magnetic
+/// disturbance); a dead axis reads 0, one with its sign reversed -1.
 pub const MIN_GYRO_AXIS_SCALE: f64 = 0.15;
+
+/// Least share of the orientation's squared rotation rate about a device axis for
+/// [`Validation::check_gyro_scale`] to judge that gyro axis ([`MIN_GYRO_AXIS_SCALE`]): an
+/// axis the phone hardly turns about holds mostly the orientation's noise (quaternions written
+/// with 3 decimals read 0.2 rad/s of it at 200 Hz).
+pub const GYRO_AXIS_MIN_SHARE: f64 = 0.1;
+
+/// Scales of the gyro against the orientation's rotation rate that read as a gyroscope in
+/// deg/s (57.3) where the orientation turns too little to judge the scale otherwise.
+const DEG_S_SCALES: std::ops::Range<f64> = 20.0..200.0;
 
 /// Fewest steps over which [`Validation::check_gyro_scale`] judges each gyro axis
 /// ([`MIN_GYRO_AXIS_SCALE`]): a second at 200 Hz, four at 50 Hz; over a few steps one axis's
@@ -971,7 +1000,6 @@ mod tests {
         );
         let e = turn(0.15, 0.0).unwrap_err();
         assert!(e.to_string().contains("another recording or device"), "{e}");
-        // Turning at 0.05 rad/s is too little to judge, whatever the gyro says.
         // Turning at 0.05 rad/s is too little to fit a scale on, but a gyro reading 2.9 rad/s
         // there is in deg/s.
         turn(0.05, 1.5).unwrap();
@@ -991,6 +1019,19 @@ mod tests {
         );
         // A phone lying still: its gyro's noise says nothing.
         v.check_gyro_scale(&time, &gyro(0.02), &still).unwrap();
+        // Still, with a gyro in deg/s: that is named too.
+        let e = v.check_gyro_scale(&time, &gyro(0.4), &still).unwrap_err();
+        assert!(
+            e.to_string()
+                .ends_with("in deg/s on a phone that hardly turns?"),
+            "{e}"
+        );
+        // An orientation held between updates at a tenth of the rate: its turns are in the
+        // steps left out as jumps, so it does not stay put.
+        let turning = |t: f64| WorldFromDevice::from_axis_angle(&Vector3::z_axis(), 1.0 * t);
+        let held: Vec<WorldFromDevice> =
+            (0..time.len()).map(|k| turning(time[k - k % 20])).collect();
+        v.check_gyro_scale(&time, &gyro(1.0), &held).unwrap();
     }
 
     /// A dead gyro axis (reading 0 while the orientation turns about it) is refused by name,
@@ -1036,6 +1077,31 @@ mod tests {
         };
         off.check_gyro_scale(&time, &gyro(Some(2)), &orientation)
             .unwrap();
+        // Rocking about x with its sign reversed there: named as such, and off is off.
+        let reversed: Vec<DeviceVec> = gyro(None)
+            .iter()
+            .map(|g| DeviceVec::new(-g.x(), g.y(), g.z()))
+            .collect();
+        let e = v
+            .check_gyro_scale(&time, &reversed, &orientation)
+            .unwrap_err();
+        assert!(
+            e.to_string()
+                .ends_with("a gyro axis with its sign reversed?"),
+            "{e}"
+        );
+        off.check_gyro_scale(&time, &reversed, &orientation)
+            .unwrap();
+        // Quaternions written with 3 decimals: their rounding turns every axis at about 0.2
+        // rad/s at 200 Hz; an axis the phone hardly turns about is not judged on it.
+        let rounded: Vec<WorldFromDevice> = orientation
+            .iter()
+            .map(|q| {
+                let c = q.to_wxyz().map(|v| (v * 1000.0).round() / 1000.0);
+                WorldFromDevice::from_wxyz(c).unwrap()
+            })
+            .collect();
+        v.check_gyro_scale(&time, &gyro(None), &rounded).unwrap();
     }
 
     #[test]

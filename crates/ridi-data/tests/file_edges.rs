@@ -231,12 +231,17 @@ fn files_that_are_broken_links_or_folders_are_named_not_skipped() {
         std::fs::remove_file(dir.path().join(file)).unwrap();
         std::os::unix::fs::symlink(target, dir.path().join(file)).unwrap();
         let why = match target == file {
-            true => "that leads to no file (",
-            false => "that leads to no file (its target does not exist)",
+            true => "that cannot be followed (",
+            false => "that cannot be followed (its target does not exist)",
         };
+        // A relative target, shown joined to the link's folder.
+        let to = dir.path().join(target);
         assert_err(
             read(dir.path()),
-            &[&format!("{file}: is a symbolic link to {target} "), why],
+            &[
+                &format!("{file}: is a symbolic link to {} ", to.display()),
+                why,
+            ],
         );
     }
     let dir = folder();
@@ -246,13 +251,28 @@ fn files_that_are_broken_links_or_folders_are_named_not_skipped() {
         read(dir.path()),
         &["gyro.txt: is a folder: it is not a regular file"],
     );
+    // A processed file's sidecar, a link to nothing: named, not read as no sidecar.
+    let dir = tempfile::tempdir().unwrap();
+    let csv = dir.path().join("data.csv");
+    ridi_data::write_ridi_csv(&read(folder().path()).unwrap(), &csv).unwrap();
+    std::os::unix::fs::symlink("gone.meta", dir.path().join("data.csv.meta")).unwrap();
+    assert_err(
+        ridi_data::read_sequence(&csv, &ReadOptions::default()),
+        &[
+            "data.csv.meta: is a symbolic link to ",
+            "(its target does not exist)",
+        ],
+    );
     // The file given itself, a link in a loop.
     let dir = tempfile::tempdir().unwrap();
     let csv = dir.path().join("data.csv");
     std::os::unix::fs::symlink("data.csv", &csv).unwrap();
     assert_err(
         ridi_data::read_sequence(&csv, &ReadOptions::default()),
-        &["data.csv: is a symbolic link to data.csv that leads to no file"],
+        &[
+            "data.csv: is a symbolic link to ",
+            "data.csv that cannot be followed",
+        ],
     );
 }
 

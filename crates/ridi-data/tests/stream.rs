@@ -58,6 +58,46 @@ fn walk(n: usize) -> Sequence {
     .unwrap()
 }
 
+/// A phone of `n` frames rocking about its x axis and turning about z at 0.25 rad/s (a sixth
+/// of its squared rate), its gyro's z axis `gyro_z` times the true rate (built with the
+/// per-axis check off).
+fn rocking(n: usize, gyro_z: f64) -> Sequence {
+    use ridi_data::ridi_frames::nalgebra::Vector3;
+    let time: Vec<f64> = (0..n).map(|i| 1.0 + 0.005 * i as f64).collect();
+    let rate = |t: f64| Vector3::new(0.8 * (3.0 * t).cos(), 0.0, 0.25);
+    let mut orientation = vec![WorldFromDevice::identity()];
+    for w in time.windows(2) {
+        let step = ridi_data::ridi_frames::Rot::from_scaled_axis(rate(w[0]) * (w[1] - w[0]));
+        orientation.push(*orientation.last().unwrap() * step);
+    }
+    let gravity: Vec<DeviceVec> = orientation
+        .iter()
+        .map(|q| q.inverse() * WorldVec::new(0.0, 0.0, 9.8))
+        .collect();
+    let parts = SequenceParts {
+        name: "rocking".into(),
+        gyro: time
+            .iter()
+            .map(|&t| {
+                let g = rate(t);
+                DeviceVec::new(g.x, g.y, gyro_z * g.z)
+            })
+            .collect(),
+        acce: gravity.clone(),
+        linacce: vec![DeviceVec::ZERO; n],
+        gravity,
+        orientation,
+        orientation_source: Some(OrientationSource::GameRotationVector),
+        time,
+        ..Default::default()
+    };
+    let off = ridi_data::Validation {
+        min_gyro_axis_scale: 0.0,
+        ..Default::default()
+    };
+    Sequence::with_validation(parts, &off).unwrap()
+}
+
 /// `bytes` gzip-compressed.
 fn gzip(bytes: &[u8]) -> Vec<u8> {
     let mut enc = flate2::write::GzEncoder::new(Vec::new(), flate2::Compression::fast());
@@ -189,7 +229,17 @@ fn a_recording_with_one_fault_gets_the_whole_file_readers_error() {
         ("ground truth jump", edit(&[300], &set("pos_y", "900"))),
         ("not a number", edit(&[17], &set("linacce_y", "x1"))),
         ("not a rotation", edit(&[9], &set("rv_w", "3"))),
+        ("an orientation that stays put", {
+            let identity = [
+                set("rv_w", "1"),
+                set("rv_x", "0"),
+                set("rv_y", "0"),
+                set("rv_z", "0"),
+            ];
+            edit(&all, &|c| identity.iter().for_each(|f| f(c)))
+        }),
         ("cut off", text.trim_end().to_string()),
+        ("carriage returns alone", text.replace('\n', "\r")),
         ("header only", format!("{}\n", lines[0])),
         ("empty", String::new()),
     ];
@@ -201,13 +251,41 @@ fn a_recording_with_one_fault_gets_the_whole_file_readers_error() {
         let stream = streamed(&path, &ReadOptions::default()).map(|_| ());
         assert!(whole.is_err(), "{what}: the whole-file reader accepts it");
         assert_eq!(stream, whole, "{what}");
-        if what.starts_with("gyro turning") {
-            let e = whole.unwrap_err();
-            assert!(
-                e.contains("gyro_x..gyro_z") && e.contains("sign flipped"),
-                "{e}"
-            );
+        let e = whole.unwrap_err();
+        let expected: &[&str] = match what {
+            "gyro turning against the orientation" => &["gyro_x..gyro_z", "sign flipped"],
+            "an orientation that stays put" => &["an orientation that stays put"],
+            "carriage returns alone" => &["bad.csv:1: ", "classic Mac OS line endings"],
+            _ => &[],
+        };
+        for part in expected {
+            assert!(e.contains(part), "{what}: {e}");
         }
+    }
+    // A gyro axis dead or reversed, on a phone turning about two axes (the walk turns about
+    // one, where either is a wrong scale or direction).
+    for (what, gyro_z, expected) in [
+        (
+            "dead",
+            0.0,
+            "reads 0 times the orientation's rotation rate about it",
+        ),
+        (
+            "reversed",
+            -1.0,
+            "reads -1 times the orientation's rotation rate about it",
+        ),
+    ] {
+        let path = dir.path().join(format!("{what}.csv"));
+        write_ridi_csv(&rocking(600, gyro_z), &path).unwrap();
+        let whole = read_sequence(&path, &ReadOptions::default()).map_err(|e| e.to_string());
+        let e = whole.clone().unwrap_err();
+        assert!(
+            e.contains("field `gyro_z`") && e.contains(expected),
+            "{what}: {e}"
+        );
+        let stream = streamed(&path, &ReadOptions::default()).map(|_| ());
+        assert_eq!(stream, whole.map(|_| ()), "{what}");
     }
     // data_plain.txt: fewer rows than announced.
     let plain = dir.path().join("p_plain.txt");

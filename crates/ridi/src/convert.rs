@@ -811,6 +811,14 @@ mod tests {
             ),
             "{e}"
         );
+        // Empty, a `.txt` is of no format: said so, not "a RIDI data_plain.txt".
+        std::fs::write(floor.join("empty.txt"), "").unwrap();
+        let e = sources(&floor.join("empty.txt"), Some(Format::Ilc)).unwrap_err();
+        assert!(
+            e.to_string()
+                .contains("empty.txt: not an Indoor Location Competition path file (it is empty)"),
+            "{e}"
+        );
         let e = sources(&floor.join("floor_info.json"), None).unwrap_err();
         assert!(e.to_string().contains("unknown file type"), "{e}");
     }

@@ -497,6 +497,9 @@ pub const STREAM_CHECK_SAMPLES: usize = 200;
 /// against [`STREAM_MIN_GYRO_AGREEMENT`]): a gyro with its sign flipped, or most quaternions
 /// given in another component order, are refused from then on. (Samples pushed with a
 /// recorded orientation only every other time give no pair of consecutive ones to judge.)
+/// A stream's gyro is judged by its direction alone: not axis by axis (a dead axis,
+/// [`ridi_data::MIN_GYRO_AXIS_SCALE`]), nor against an orientation that stays put, as a
+/// recording's is when read.
 pub const STREAM_GYRO_CHECK_S: f64 = 10.0;
 
 /// The least agreement [`LiveTracker`] accepts from [`STREAM_GYRO_CHECK_S`] on: 0, below the

@@ -41,6 +41,8 @@ pub(crate) fn not_a(path: &Path, want: Format) -> DataError {
             " (it is empty)".to_string()
         }
         Ok(found) => format!(" (it is {})", with_article(&found.to_string())),
+        // A link that cannot be followed says why.
+        Err(DataError::Io { error, .. }) => format!(" ({error})"),
         Err(_) if !path.exists() => " (no such file or folder)".to_string(),
         Err(_) => String::new(),
     };
