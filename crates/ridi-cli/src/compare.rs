@@ -25,13 +25,9 @@ pub(crate) fn run(
     let before = ridi::Report::read(&first)?;
     let after = ridi::Report::read(&second)?;
     let comparison = ridi::compare_reports(&before, &after)?;
-    if json {
-        outln!(
-            "{}",
-            crate::inspect::escaped(serde_json::to_string_pretty(&comparison)?)
-        );
+    crate::print_result(&if json {
+        crate::inspect::escaped(serde_json::to_string_pretty(&comparison)?) + "\n"
     } else {
-        out!("{}", comparison.to_markdown());
-    }
-    Ok(())
+        comparison.to_markdown()
+    })
 }

@@ -24,12 +24,11 @@ pub(crate) fn run(Args { sequence, json }: Args) -> Result<()> {
     if is_model_file(&sequence) {
         let model = crate::load_model(&sequence)?;
         let report = ridi::inspect_model(&model);
-        if json {
-            outln!("{}", escaped(serde_json::to_string_pretty(&report)?));
+        return crate::print_result(&if json {
+            escaped(serde_json::to_string_pretty(&report)?) + "\n"
         } else {
-            out!("{report}");
-        }
-        return Ok(());
+            report.to_string()
+        });
     }
     // A recording that streams is summed up as it is read, in memory that does not grow with
     // its length.
@@ -43,12 +42,11 @@ pub(crate) fn run(Args { sequence, json }: Args) -> Result<()> {
     if format.as_ref().is_ok_and(|f| f.streams()) {
         let rows = ridi::data::RowReader::open(&sequence, &opts)?;
         let report = ridi::inspect_stream(rows)?;
-        if json {
-            outln!("{}", escaped(serde_json::to_string_pretty(&report)?));
+        return crate::print_result(&if json {
+            escaped(serde_json::to_string_pretty(&report)?) + "\n"
         } else {
-            out!("{report}");
-        }
-        return Ok(());
+            report.to_string()
+        });
     }
     let loaded = ridi::read_any(&sequence, None, &opts)?;
     let mut reports = Vec::new();
@@ -68,20 +66,21 @@ pub(crate) fn run(Args { sequence, json }: Args) -> Result<()> {
             [one] => serde_json::to_string_pretty(one)?,
             parts => serde_json::to_string_pretty(parts)?,
         };
-        outln!("{}", escaped(text));
+        crate::print_result(&(escaped(text) + "\n"))
     } else {
+        let mut text = String::new();
         for (i, report) in reports.iter().enumerate() {
             if i > 0 {
-                outln!();
+                text.push('\n');
             }
-            out!("{report}");
+            let _ = write!(text, "{report}");
         }
         // Once for the recording, not once per part.
         for w in &loaded.warnings {
-            outln!("warning:      {}", shown(w));
+            let _ = writeln!(text, "warning:      {}", shown(w));
         }
+        crate::print_result(&text)
     }
-    Ok(())
 }
 
 /// `true` for a `.ridi` file, or a file that starts like a model file or is a model file's

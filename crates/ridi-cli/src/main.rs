@@ -31,6 +31,23 @@ macro_rules! out {
     }};
 }
 
+/// Prints `text`, a command's result, to stdout (`ridi inspect`, `ridi compare`, whose
+/// results are no files): a failed write is an error (a full disk under `> out.json` must not
+/// pass for success), but a reader that stopped reading (`| head`) is not.
+fn print_result(text: &str) -> Result<()> {
+    use std::io::Write as _;
+    let mut stdout = std::io::stdout().lock();
+    match stdout
+        .write_all(text.as_bytes())
+        .and_then(|()| stdout.flush())
+    {
+        Err(e) if e.kind() != std::io::ErrorKind::BrokenPipe => {
+            Err(anyhow::anyhow!("cannot write the result to stdout: {e}"))
+        }
+        _ => Ok(()),
+    }
+}
+
 mod compare;
 mod convert;
 mod demo;

@@ -56,10 +56,9 @@ pub(crate) struct Args {
     /// Landmarks per machine of `--solver nystrom` (rows drawn at random with `--seed`:
     /// the classifier's from all rows, each placement's regressors' from its own), 2 to 16384:
     /// more approximate the kernel machines more closely, at a cost per query linear in them
-    /// and in training quadratic.
-    #[arg(long, value_name = "N", default_value_t = Nystrom::DEFAULT_LANDMARKS,
-          value_parser = |s: &str| count(s, 2, Nystrom::MAX_LANDMARKS))]
-    landmarks: usize,
+    /// and in training quadratic. Default 2048; only with `--solver nystrom`.
+    #[arg(long, value_name = "N", value_parser = |s: &str| count(s, 2, Nystrom::MAX_LANDMARKS))]
+    landmarks: Option<usize>,
     /// Seed of training's random draws (the grid's folds; with `--solver nystrom`, its
     /// landmarks and its classifier's sweep order): models trained with other seeds show how
     /// much a result owes to them. The exact solver with `--grid none` draws nothing, so the
@@ -188,12 +187,19 @@ fn exact_solver_note(windows: usize) -> Option<String> {
 }
 
 pub(crate) fn run(args: Args) -> Result<()> {
+    if args.landmarks.is_some() && matches!(args.solver, SolverArg::Exact) {
+        anyhow::bail!(
+            "--landmarks is for --solver nystrom: the exact solver keeps every training window"
+        );
+    }
     crate::set_jobs(args.jobs)?;
     let out = &args.out;
     check_output_file(out)?;
     let entries = ListEntry::read(&args.list)?;
     let mut read = args.list.clone();
     read.extend(entries.iter().map(|e| e.path.clone()));
+    // A map file is read too (a named map such as `tyrex4` names no file there).
+    read.extend(args.placement_map.iter().map(PathBuf::from));
     check_not_input(out, &ReadFiles::of(&read), &[])?;
     let listed = crate::load_listed(entries, args.placement_map.as_deref(), Purpose::Training)?;
     let defaults = TrainOptions::default();
@@ -214,7 +220,10 @@ pub(crate) fn run(args: Args) -> Result<()> {
     opts.cascade.speed = !args.no_speed;
     opts.cascade.method = match args.solver {
         SolverArg::Exact => Solver::Exact,
-        SolverArg::Nystrom => Solver::Nystrom(Nystrom::new(args.landmarks, 0)?),
+        SolverArg::Nystrom => Solver::Nystrom(Nystrom::new(
+            args.landmarks.unwrap_or(Nystrom::DEFAULT_LANDMARKS),
+            0,
+        )?),
     };
     opts.cascade.set_seed(args.seed);
     opts.cascade.storage = args.storage.storage(&opts.cascade.method);

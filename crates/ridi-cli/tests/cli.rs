@@ -27,6 +27,35 @@ fn inspect_prints_text_and_json() {
     assert_eq!(json["placement"], serde_json::Value::Null);
     assert!(json["path_length_m"].as_f64().unwrap() > 5.0);
     assert_eq!(json["upside_down_fraction"], 0.0);
+    // Its result is stdout: a write that fails there fails the command (a full disk under
+    // `> out.json`); a reader that stops reading (`| head`) does not.
+    #[cfg(target_os = "linux")]
+    {
+        let full = std::fs::OpenOptions::new()
+            .write(true)
+            .open("/dev/full")
+            .unwrap();
+        let out = Command::new(env!("CARGO_BIN_EXE_ridi"))
+            .args(["inspect", s(&seq), "--json"])
+            .stdout(full)
+            .output()
+            .unwrap();
+        assert!(
+            !out.status.success()
+                && stderr(&out).contains("cannot write the result to stdout: No space left"),
+            "{}",
+            stderr(&out)
+        );
+        let mut child = Command::new(env!("CARGO_BIN_EXE_ridi"))
+            .args(["inspect", s(&seq)])
+            .stdout(std::process::Stdio::piped())
+            .stderr(std::process::Stdio::piped())
+            .spawn()
+            .unwrap();
+        drop(child.stdout.take());
+        let out = child.wait_with_output().unwrap();
+        assert!(out.status.success(), "{}", stderr(&out));
+    }
 
     // Guillaume swings the phone top down: inspect says so.
     let seq = sample_dataset().join("Guillaume_Nexus5_NoDist_Swinging");
@@ -782,6 +811,43 @@ fn convert_train_track_and_eval() {
         "{}",
         stderr(&out)
     );
+    // Nor the placement map it reads.
+    let map = dir.path().join("map.txt");
+    std::fs::write(&map, "AR,hand\n").unwrap();
+    let out = ridi(&[
+        "train",
+        "--list",
+        s(&one),
+        "--out",
+        s(&map),
+        "--grid",
+        "none",
+        "--placement-map",
+        s(&map),
+    ]);
+    assert!(
+        !out.status.success() && stderr(&out).contains("the command reads it"),
+        "{}",
+        stderr(&out)
+    );
+    assert_eq!(std::fs::read(&map).unwrap(), b"AR,hand\n");
+    // A device is no output: the rename would replace it with a regular file.
+    #[cfg(unix)]
+    {
+        let out = track_to(&recording, Path::new("/dev/null"), &[]);
+        assert!(
+            !out.status.success() && stderr(&out).contains("is a device, a pipe or a socket"),
+            "{}",
+            stderr(&out)
+        );
+        use std::os::unix::fs::FileTypeExt as _;
+        assert!(
+            std::fs::metadata("/dev/null")
+                .unwrap()
+                .file_type()
+                .is_char_device()
+        );
+    }
     // The model at a name the evaluation writes inside --out: refused before anything moves.
     let inside = dir.path().join("eval-into-model");
     std::fs::create_dir_all(&inside).unwrap();

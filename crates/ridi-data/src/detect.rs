@@ -130,7 +130,7 @@ pub(crate) fn locate(path: &Path) -> Result<(Format, PathBuf)> {
             },
         ));
     }
-    let has = |p: &str| crate::text::present(&path.join(p));
+    let has = |p: &str| crate::text::present_or_error(&path.join(p));
     // A RIDI capture folder often holds the raw files and `processed/`: the processed file is
     // what the published dataset ships, with the trimmed, synchronized timeline, so it wins.
     for (rel, format) in [
@@ -141,20 +141,21 @@ pub(crate) fn locate(path: &Path) -> Result<(Format, PathBuf)> {
         ("processed/data_plain.txt", Format::RidiPlain),
         ("data_plain.txt", Format::RidiPlain),
     ] {
-        if has(rel) {
+        if has(rel)? {
             return Ok((format, path.join(rel)));
         }
     }
     // Any of the files a format's folder must have makes it one: its reader then names the
     // others it lacks.
-    if [
+    let mut tyrex = false;
+    for f in [
         "accelerometer.txt",
         "gyroscope-calibrated.txt",
         "attitude.txt",
-    ]
-    .iter()
-    .any(|f| has(f))
-    {
+    ] {
+        tyrex |= has(f)?;
+    }
+    if tyrex {
         return Ok((Format::Tyrex, path.to_path_buf()));
     }
     if ronin::looks_like(path) {

@@ -145,6 +145,6 @@ pub use validation::{
     bridge_orientation_jumps, orientation_jumps, up_angle_deg,
 };
 pub use write::{
-    PendingFile, Precision, RoundTrip, write_atomically, write_pending, write_ridi_csv,
-    write_ridi_csv_with, write_ridi_plain,
+    PendingFile, Precision, RoundTrip, output_target, write_atomically, write_pending,
+    write_ridi_csv, write_ridi_csv_with, write_ridi_plain,
 };

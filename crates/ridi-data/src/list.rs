@@ -84,6 +84,13 @@ impl ListEntry {
                 read.push((id, path));
             }
             let bytes = text::read_file_bounded(path, MAX_LIST_BYTES)?;
+            if bytes.starts_with(MODEL_MAGIC) {
+                return Err(DataError::format(
+                    Location::file(path),
+                    "is a model file of `ridi train` (it goes to `--model`), not a list file \
+                     (one `path,placement` line per sequence)",
+                ));
+            }
             let not_a_list = |format| {
                 DataError::format(
                     Location::file(path),
@@ -220,7 +227,7 @@ impl Listed {
     pub fn load(entries: Vec<ListEntry>, opts: &ReadOptions) -> Result<Self> {
         let mut seen: Vec<(Vec<FileId>, &ListEntry)> = Vec::new();
         for e in &entries {
-            if !crate::text::present(&e.path) {
+            if !text::present(&e.path) {
                 return Err(DataError::format(
                     e.location().with_field("path"),
                     format!("sequence `{}` does not exist", shown(&e.path)),
@@ -238,7 +245,8 @@ impl Listed {
         let sequences: Vec<Sequence> = entries
             .iter()
             .map(|e| {
-                let mut seq = read_sequence(&e.path, opts)?;
+                let mut seq =
+                    read_sequence(&e.path, opts).map_err(|err| misplaced(e).unwrap_or(err))?;
                 if e.placement.is_some() {
                     seq.set_placement(e.placement.clone());
                 }
@@ -293,6 +301,32 @@ impl Listed {
         }
         Ok(())
     }
+}
+
+/// How a model file of `ridi train` starts (`ridi_regress::MODEL_MAGIC`, a crate above this
+/// one): a list or an entry that is one gets an error that says so.
+const MODEL_MAGIC: &[u8] = b"RIDIREG\0";
+
+/// The error for an entry that names no recording but a list file (lists do not nest) or a
+/// model file, at the entry's line; `None` for anything else (its reader's error stands).
+fn misplaced(e: &ListEntry) -> Option<DataError> {
+    if !e.path.is_file() {
+        return None;
+    }
+    let bytes = text::read_file_bounded(&e.path, MAX_LIST_BYTES).ok()?;
+    let what = if bytes.starts_with(MODEL_MAGIC) {
+        "a model file of `ridi train` (it goes to `--model`)"
+    } else if parse_list(&bytes, &e.path)
+        .is_ok_and(|inner| inner.iter().any(|i| text::present(&i.path)))
+    {
+        "a list file: lists do not nest (give it to `--list` itself)"
+    } else {
+        return None;
+    };
+    Some(DataError::format(
+        e.location().with_field("path"),
+        format!("`{}` is {what}, not a recording", shown(&e.path)),
+    ))
 }
 
 /// The files a read of `e` takes data from, by identity ([`FileId`]: also through hard links
@@ -392,6 +426,37 @@ mod tests {
             ),
             "{e}"
         );
+        // A list naming a list (itself, here) or a model: named at the entry's line.
+        let nested = dir.path().join("nested.txt");
+        std::fs::write(&nested, "nested.txt,AR\n").unwrap();
+        let entries = ListEntry::read(&[&nested]).unwrap();
+        let e = Listed::load(entries, &ReadOptions::default())
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("nested.txt:1: field `path`: `")
+                && e.ends_with(
+                    "nested.txt` is a list file: lists do not nest (give it to `--list` itself), \
+                     not a recording"
+                ),
+            "{e}"
+        );
+        let model = dir.path().join("m.ridi");
+        std::fs::write(&model, b"RIDIREG\0\x08\0\0\0").unwrap();
+        let e = ListEntry::read(&[&model]).unwrap_err().to_string();
+        assert!(
+            e.ends_with(
+                "m.ridi: is a model file of `ridi train` (it goes to `--model`), not \
+             a list file (one `path,placement` line per sequence)"
+            ),
+            "{e}"
+        );
+        std::fs::write(&nested, "m.ridi,AR\n").unwrap();
+        let entries = ListEntry::read(&[&nested]).unwrap();
+        let e = Listed::load(entries, &ReadOptions::default())
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("m.ridi` is a model file of `ridi train`"), "{e}");
         // Its records would parse as a list of paths that do not exist.
         let ilc = dir.path().join("5dd9e7abc5b77e0006b1732d.txt");
         let records = "#\tstartTime:1574559495000\n1574559495000\tTYPE_ACCELEROMETER\t0\t0\t9.8\n";

@@ -48,6 +48,16 @@ pub(crate) fn present(path: &Path) -> bool {
     std::fs::symlink_metadata(path).is_ok()
 }
 
+/// [`present`], but an entry that cannot be looked at (a folder on its path that may not be
+/// entered) is an error naming it: not "absent", which would blame the recording's layout.
+pub(crate) fn present_or_error(path: &Path) -> Result<bool> {
+    match std::fs::symlink_metadata(path) {
+        Ok(_) => Ok(true),
+        Err(e) if e.kind() == std::io::ErrorKind::PermissionDenied => Err(DataError::io(path, e)),
+        Err(_) => Ok(false),
+    }
+}
+
 /// The metadata of `path`, refused when it is not a regular file (a folder, `/dev/zero`, a
 /// pipe): a device can hand out bytes for ever.
 pub(crate) fn regular_file(path: &Path) -> Result<std::fs::Metadata> {

@@ -86,6 +86,32 @@ pub fn write_atomically(
     write_pending(path, content)?.commit()
 }
 
+/// Where a write to `path` lands: `path` itself, or, where it is a symbolic link, the file it
+/// leads to (created if missing, as `cp` does), so that the link stays a link. Refused: a
+/// device, a pipe or a socket (the rename into place would replace the node with a regular
+/// file: `/dev/null` written as root would be one no more) and links in a loop.
+pub fn output_target(path: &Path) -> std::io::Result<std::path::PathBuf> {
+    let mut target = path.to_path_buf();
+    for _ in 0..40 {
+        match std::fs::symlink_metadata(&target) {
+            Ok(m) if m.file_type().is_symlink() => {
+                let to = std::fs::read_link(&target)?;
+                target = target.parent().unwrap_or(Path::new("")).join(to);
+            }
+            Ok(m) if !m.is_file() && !m.is_dir() => {
+                return Err(std::io::Error::other(
+                    "is a device, a pipe or a socket, which ridi's atomic write (a new file \
+                     renamed into place) would replace with a regular file",
+                ));
+            }
+            _ => return Ok(target),
+        }
+    }
+    Err(std::io::Error::other(
+        "is a symbolic link that cannot be followed (links in a loop)",
+    ))
+}
+
 /// [`write_atomically`] up to the rename: `content` is written in full (and synced) to a temporary
 /// file in `path`'s folder (`.ridi-tmp-<pid>-XXXXXX`, locked while written: see
 /// [`register_temporary`](crate::register_temporary), and those that killed runs left there are
@@ -96,11 +122,12 @@ pub fn write_pending(
     path: &Path,
     content: impl FnOnce(&mut dyn Write) -> std::io::Result<()>,
 ) -> Result<PendingFile> {
-    let dir = match path.parent() {
+    let io = |e| DataError::io(path, e);
+    let target = output_target(path).map_err(io)?;
+    let dir = match target.parent() {
         Some(d) if !d.as_os_str().is_empty() => d,
         _ => Path::new("."),
     };
-    let io = |e| DataError::io(path, e);
     // What a killed run of any ridi-rs program left here goes first.
     for stale in stale_temporaries(dir, TEMPORARY_FILE_PREFIX) {
         remove_temporary(&stale.path);
@@ -131,6 +158,7 @@ pub fn write_pending(
     Ok(PendingFile {
         tmp,
         path: path.to_path_buf(),
+        target,
         _registered: registered,
     })
 }
@@ -140,6 +168,8 @@ pub fn write_pending(
 pub struct PendingFile {
     tmp: tempfile::NamedTempFile,
     path: std::path::PathBuf,
+    /// Where it is renamed to: `path`, or the file a link there leads to ([`output_target`]).
+    target: std::path::PathBuf,
     _registered: Temporary,
 }
 
@@ -149,11 +179,12 @@ impl PendingFile {
         &self.path
     }
 
-    /// Renames the file into place, replacing any file of that name.
+    /// Renames the file into place, replacing any file of that name (through a symbolic link
+    /// there, the file it leads to).
     pub fn commit(self) -> Result<()> {
         let path = self.path;
         self.tmp
-            .persist(&path)
+            .persist(&self.target)
             .map_err(|e| DataError::io(&path, e.error))?;
         Ok(())
     }

@@ -5,6 +5,8 @@
 mod common;
 
 use std::io::Write as _;
+#[cfg(unix)]
+use std::os::unix::fs::FileTypeExt as _;
 use std::path::Path;
 
 use common::*;
@@ -304,4 +306,45 @@ fn a_raw_clock_that_stops_is_refused_beyond_a_few_repeats() {
              records in a row: a clock that stopped"
         )],
     );
+}
+
+/// An output path that is a symbolic link is written through it (the link stays); a pipe, a
+/// device or a link in a loop is refused, never replaced by a regular file.
+#[cfg(unix)]
+#[test]
+fn outputs_write_through_links_and_refuse_pipes_and_devices() {
+    let dir = tempfile::tempdir().unwrap();
+    let write = |path: &Path| {
+        ridi_data::write_atomically(path, |w: &mut dyn std::io::Write| w.write_all(b"x\n"))
+    };
+    let link = dir.path().join("latest.txt");
+    std::os::unix::fs::symlink("v3.txt", &link).unwrap();
+    write(&link).unwrap();
+    assert!(
+        std::fs::symlink_metadata(&link)
+            .unwrap()
+            .file_type()
+            .is_symlink()
+    );
+    assert_eq!(std::fs::read(dir.path().join("v3.txt")).unwrap(), b"x\n");
+    let fifo = dir.path().join("pipe");
+    assert!(
+        std::process::Command::new("mkfifo")
+            .arg(&fifo)
+            .status()
+            .unwrap()
+            .success()
+    );
+    for refused in [fifo.as_path(), Path::new("/dev/null")] {
+        assert_err(write(refused), &["is a device, a pipe or a socket"]);
+    }
+    assert!(
+        std::fs::symlink_metadata(&fifo)
+            .unwrap()
+            .file_type()
+            .is_fifo()
+    );
+    let looped = dir.path().join("loop.txt");
+    std::os::unix::fs::symlink("loop.txt", &looped).unwrap();
+    assert_err(write(&looped), &["links in a loop"]);
 }

@@ -38,30 +38,51 @@ use crate::error::{
 ///
 /// The RTE windows are counted in frames at [`EvalConfig::rate_hz`] (60 s = 12000 frames at the
 /// default 200 Hz), so they last their nominal seconds only on data at that rate, which
-/// [`evaluate_trajectory`] checks. A figure written as `null` (a NaN) reads back as NaN.
+/// [`evaluate_trajectory`] checks. A figure written as `null` (a NaN), or left out of a
+/// hand-edited file, reads back as NaN (`None` for the optional ones).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct TrajectoryMetrics {
     /// Mean positional error, metres.
-    #[serde(deserialize_with = "crate::bootstrap::nan_if_null")]
+    #[serde(
+        deserialize_with = "crate::bootstrap::nan_if_null",
+        default = "crate::bootstrap::nan"
+    )]
     pub mpe_m: f64,
     /// Mean positional error, % of the ground-truth path length.
+    #[serde(default)]
     pub mpe_pct: Option<f64>,
     /// Absolute trajectory error, Euclidean RMS, metres.
-    #[serde(deserialize_with = "crate::bootstrap::nan_if_null")]
+    #[serde(
+        deserialize_with = "crate::bootstrap::nan_if_null",
+        default = "crate::bootstrap::nan"
+    )]
     pub ate_m: f64,
     /// Relative trajectory error (long window), Euclidean RMS, metres.
-    #[serde(deserialize_with = "crate::bootstrap::nan_if_null")]
+    #[serde(
+        deserialize_with = "crate::bootstrap::nan_if_null",
+        default = "crate::bootstrap::nan"
+    )]
     pub rte_m: f64,
     /// Absolute trajectory error, RoNIN per-coordinate RMS, metres.
-    #[serde(deserialize_with = "crate::bootstrap::nan_if_null")]
+    #[serde(
+        deserialize_with = "crate::bootstrap::nan_if_null",
+        default = "crate::bootstrap::nan"
+    )]
     pub ate_ronin_m: f64,
     /// Relative trajectory error (long window), RoNIN per-coordinate RMS, metres.
-    #[serde(deserialize_with = "crate::bootstrap::nan_if_null")]
+    #[serde(
+        deserialize_with = "crate::bootstrap::nan_if_null",
+        default = "crate::bootstrap::nan"
+    )]
     pub rte_ronin_m: f64,
     /// Relative trajectory error (short window), Euclidean RMS, metres.
-    #[serde(deserialize_with = "crate::bootstrap::nan_if_null")]
+    #[serde(
+        deserialize_with = "crate::bootstrap::nan_if_null",
+        default = "crate::bootstrap::nan"
+    )]
     pub rte_5s_m: f64,
     /// Estimated over ground-truth horizontal path length.
+    #[serde(default)]
     pub path_length_ratio: Option<f64>,
 }
 

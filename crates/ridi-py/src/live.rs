@@ -196,6 +196,22 @@ impl LiveTracker {
         gravity: Option<&Bound<'_, PyAny>>,
         linacce: Option<&Bound<'_, PyAny>>,
     ) -> PyResult<Vec<Update>> {
+        // As `Sequence` refuses them: a bool is no reading, a float16/32 time is rounded.
+        for (name, obj) in [
+            ("time", Some(time)),
+            ("gyro", Some(gyro)),
+            ("acce", Some(acce)),
+        ]
+        .into_iter()
+        .chain([
+            ("orientation", orientation),
+            ("gravity", gravity),
+            ("linacce", linacce),
+        ]) {
+            if let Some(obj) = obj {
+                refuse_unreadable(obj, name)?;
+            }
+        }
         let time: f64 = time.extract().map_err(|_| {
             PyTypeError::new_err(format!(
                 "`time` must be one number, seconds (push takes one sample), not {}",
@@ -284,6 +300,44 @@ impl LiveTracker {
 
 /// `N` numbers of one sample for argument `name`, or a `TypeError` that says so (pyo3's own
 /// names neither the argument nor what it wants).
+/// Refuses a pushed value numpy or Python would read as numbers but a sample cannot hold:
+/// bools (`True` read as 1), and for `time` a float16/float32 scalar (rounded already: to
+/// minutes at Unix times).
+fn refuse_unreadable(obj: &Bound<'_, PyAny>, name: &str) -> PyResult<()> {
+    let kind = |o: &Bound<'_, PyAny>| -> Option<(u8, usize)> {
+        if o.is_instance_of::<pyo3::types::PyBool>() {
+            return Some((b'b', 1));
+        }
+        let dtype = o.getattr("dtype").ok()?;
+        let kind = dtype.getattr("kind").ok()?.extract::<String>().ok()?;
+        let size = dtype.getattr("itemsize").ok()?.extract::<usize>().ok()?;
+        Some((*kind.as_bytes().first()?, size))
+    };
+    let items: Vec<Bound<'_, PyAny>> = match obj.try_iter() {
+        Ok(iter) if kind(obj).is_none() => iter.flatten().collect(),
+        _ => vec![obj.clone()],
+    };
+    for item in items.iter().chain(std::iter::once(obj)) {
+        match kind(item) {
+            Some((b'b', _)) => {
+                return Err(PyTypeError::new_err(format!(
+                    "`{name}` holds bools; a sample's readings are numbers"
+                )));
+            }
+            Some((b'f', size)) if name == "time" && size < 8 => {
+                return Err(PyTypeError::new_err(format!(
+                    "`time` is a float{}: its bits have rounded the timestamp already (to 0.24 \
+                     ms an hour into a recording, to minutes at Unix times): give it as a \
+                     Python float or float64",
+                    size * 8
+                )));
+            }
+            _ => {}
+        }
+    }
+    Ok(())
+}
+
 fn values<const N: usize>(obj: &Bound<'_, PyAny>, name: &str) -> PyResult<[f64; N]> {
     obj.extract().map_err(|_| {
         let message = format!(

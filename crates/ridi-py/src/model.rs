@@ -313,15 +313,13 @@ pub(crate) fn train(
     opts.cascade.classifier_c = options::positive("classifier_c", classifier_c)?;
     opts.cascade.regressors = grid.regressors();
     opts.cascade.speed = speed;
+    // Checked whatever the solver, so that a wrong value is never passed over unsaid.
+    let landmarks = options::count("landmarks", landmarks, 2, Nystrom::MAX_LANDMARKS)?;
     opts.cascade.method = match choice("solver", solver, &[("exact", false), ("nystrom", true)])? {
         false => Solver::Exact,
-        true => Solver::Nystrom(
-            Nystrom::new(
-                options::count("landmarks", landmarks, 2, Nystrom::MAX_LANDMARKS)?,
-                0,
-            )
-            .map_err(|e| errors::value(e.to_string()))?,
-        ),
+        true => {
+            Solver::Nystrom(Nystrom::new(landmarks, 0).map_err(|e| errors::value(e.to_string()))?)
+        }
     };
     opts.cascade.set_seed(u64::try_from(seed).map_err(|_| {
         errors::value(format!(

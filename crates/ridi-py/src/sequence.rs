@@ -562,6 +562,14 @@ pub(crate) fn read(
     split_at_gaps: Option<f64>,
 ) -> PyResult<Sequence> {
     let mut seqs = read_sequences(py, &path, format, split_at_gaps)?;
+    if seqs.is_empty() {
+        // Every part cut at the gaps was shorter than a part may be (the warning said so).
+        return Err(errors::value(format!(
+            "{}: no part left once cut at its gaps, each shorter than a sequence may be: cut \
+             at longer gaps (a larger `split_at_gaps`)",
+            ridi::data::shown(&path)
+        )));
+    }
     if seqs.len() != 1 {
         return Err(errors::value(format!(
             "{} holds {} sequences; read them with `ridi.read_any`, or convert it with `ridi \

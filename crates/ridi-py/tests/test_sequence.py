@@ -425,6 +425,10 @@ def test_a_recording_paused_for_seconds_is_read_split_at_its_gaps(seq, tmp_path)
         ridi.read_any(path, split_at_gaps=-1.0)
     with pytest.raises(ValueError, match="the readers accept gaps of up to 1 s, so a split must"):
         ridi.read_any(path, split_at_gaps=1.0)
+    # Cut at every step, no part is long enough: said, with what to do.
+    with pytest.raises(ValueError, match=r"no part left once cut at its gaps, .*a larger "
+                                         r"`split_at_gaps`"), pytest.warns(UserWarning):
+        ridi.read(path, split_at_gaps=0.001)
 
 def same_sequence(a, b):
     """Every constructor argument of `a` and `b` agrees (so a new argument the pickling misses

@@ -123,6 +123,19 @@ def test_live_tracker_gives_the_online_poses(seq, model):
     assert "Update(frame=0" in repr(updates[0])
 
 
+def test_a_clock_that_jumped_ahead_is_named_when_the_stream_goes_back(seq, model):
+    # A timestamp glitch ahead is taken for a pause (a new segment); every sample after it
+    # then goes back, and the error says why and what to do.
+    live = ridi.LiveTracker(model)
+    t, g, a, q = seq.time, seq.gyro, seq.acce, seq.orientation
+    for i in range(300):
+        live.push(t[i], g[i], a[i], orientation=q[i])
+    live.push(t[300] + 1000.0, g[300], a[300], orientation=q[300])
+    with pytest.raises(ValueError, match=r"which came 100\d.\d+ s after the one before it \(taken "
+                       r"for a pause, .*if that timestamp was a glitch, start a new tracker"):
+        live.push(t[301], g[301], a[301], orientation=q[301])
+
+
 def test_live_tracker_refuses_a_gyro_turning_against_the_orientation(seq, model):
     # The gyro's sign flipped: it turns against the orientation pushed with it; refused once
     # 10 s of samples came with one (here from the second second on), and from then on.
@@ -178,6 +191,13 @@ def test_live_tracker_refuses_bad_samples_and_stays_usable(seq, recorded_model):
                   gravity=[0.0, 9.8], linacce=seq.linacce[2])
     with pytest.raises(ValueError, match=r"`gyro` must be 3 numbers .* of shape \(5, 3\)"):
         live.push(seq.time[2], seq.gyro[2:7], seq.acce[2], **recorded)
+    # What numbers would read but a sample cannot hold: bools, a float32 time.
+    with pytest.raises(TypeError, match=r"`gyro` holds bools"):
+        live.push(seq.time[2], [True, False, True], seq.acce[2], **recorded)
+    with pytest.raises(TypeError, match=r"`time` holds bools"):
+        live.push(True, seq.gyro[2], seq.acce[2], **recorded)
+    with pytest.raises(TypeError, match=r"`time` is a float32: its bits have rounded"):
+        live.push(np.float32(seq.time[2]), seq.gyro[2], seq.acce[2], **recorded)
     with pytest.raises(ValueError, match=r"`time` of sample 2 is NaN"):
         live.push(float("nan"), seq.gyro[2], seq.acce[2], **recorded)
     live.finish()

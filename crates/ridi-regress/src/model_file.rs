@@ -276,7 +276,16 @@ fn read_bounded(path: &Path) -> Result<Vec<u8>, RegressError> {
         .read_to_end(&mut bytes)
         .map_err(io_err(path))?;
     let Header { len, .. } = check_header(&bytes, meta.len())?;
-    bytes.reserve_exact(len as usize);
+    // A payload this machine cannot hold is an error, not an abort in the allocator.
+    bytes.try_reserve_exact(len as usize).map_err(|_| {
+        io_err(path)(std::io::Error::new(
+            std::io::ErrorKind::OutOfMemory,
+            format!(
+                "a model of {len} bytes: more than this machine can allocate (ridi's models are \
+                 megabytes; a file this large is likely not one)"
+            ),
+        ))
+    })?;
     file.take(len)
         .read_to_end(&mut bytes)
         .map_err(io_err(path))?;

@@ -1080,3 +1080,34 @@ fn a_projected_nystrom_model_answers_as_it_was_trained() {
         model
     );
 }
+
+/// A model file whose header declares more than the machine can allocate (a sparse file of
+/// half a tebibyte, its size matching) is an error naming the file, not an abort in the
+/// allocator.
+#[cfg(target_os = "linux")]
+#[test]
+fn a_model_too_large_to_allocate_is_an_error() {
+    let dir = std::env::temp_dir().join(format!("ridi-regress-huge-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join("huge.ridi");
+    let len: u64 = 1 << 39;
+    let mut header = ridi_regress::MODEL_MAGIC.to_vec();
+    header.extend_from_slice(&ridi_regress::MODEL_FORMAT_VERSION.to_le_bytes());
+    header.extend_from_slice(&len.to_le_bytes());
+    header.extend_from_slice(&0u32.to_le_bytes());
+    std::fs::write(&path, &header).unwrap();
+    std::fs::OpenOptions::new()
+        .write(true)
+        .open(&path)
+        .unwrap()
+        .set_len(24 + len)
+        .unwrap();
+    let e = Cascade::load(&path).unwrap_err();
+    assert_names_file(&e, &path);
+    assert!(
+        e.to_string()
+            .contains("more than this machine can allocate"),
+        "{e}"
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}

@@ -165,6 +165,13 @@ pub fn compare_reports(first: &Report, second: &Report) -> Result<Comparison> {
             });
         }
     }
+    if !first.methods.iter().any(|m| second.methods.contains(m)) {
+        warnings.push(format!(
+            "the two reports share no method ({} against {}): no figure to compare",
+            first.methods.join(", "),
+            second.methods.join(", ")
+        ));
+    }
     if !one_sided.is_empty() {
         warnings.push(format!(
             "figures one report has and the other lacks (missing or not finite) for some \
@@ -416,6 +423,53 @@ mod tests {
         assert!(
             settings.len() == 1 && settings[0].starts_with("heading: the gyro's alone against"),
             "{settings:?}"
+        );
+        // A figure's key left out of a hand-edited report reads as a missing figure.
+        let mut edited = serde_json::to_value(report(&[("a", 1.0), ("b", 2.0)])).unwrap();
+        let ridi = &mut edited["sequences"][1]["methods"]["ridi"];
+        ridi.as_object_mut().unwrap().remove("rte_5s_m");
+        let edited: Report = serde_json::from_value(edited).unwrap();
+        let c = compare_reports(&report(&[("a", 1.0), ("b", 2.0)]), &edited).unwrap();
+        let rte = c.figures.iter().find(|f| f.metric == "rte_5s_m").unwrap();
+        assert_eq!(rte.sequences, 1);
+        assert!(
+            c.warnings
+                .iter()
+                .any(|w| w.contains("ridi RTE 5 s (m): 1 of 2"))
+        );
+        // What no evaluation writes is refused when read: a negative figure, a window of 0.
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("report.json");
+        for (edit, expected) in [
+            (
+                (
+                    "/sequences/0/methods/ridi/rte_5s_m",
+                    serde_json::json!(-5.0),
+                ),
+                "sequence `a`, method `ridi`: `rte_5s_m` is -5, a figure that cannot be negative",
+            ),
+            (
+                ("/config/rte_window_s", serde_json::json!(0.0)),
+                "`config.rte_window_s` is 0; an evaluation's is a positive number",
+            ),
+        ] {
+            let mut v = serde_json::to_value(report(&[("a", 1.0)])).unwrap();
+            *v.pointer_mut(edit.0).unwrap() = edit.1;
+            std::fs::write(&path, v.to_string()).unwrap();
+            let e = Report::read(&path).unwrap_err().to_string();
+            assert!(e.ends_with(expected), "{e}");
+        }
+        // No method in common: said, as nothing is compared.
+        let mut other = report(&[("a", 1.0)]);
+        other.methods = vec!["pdr".into()];
+        let c = compare_reports(&report(&[("a", 1.0)]), &other).unwrap();
+        assert!(c.figures.is_empty());
+        assert!(
+            c.warnings
+                .iter()
+                .any(|w| w.starts_with("the two reports share no method (ridi against pdr)")),
+            "{:?}",
+            c.warnings
         );
         // No name in common: nothing to pair.
         let other = report(&[("x", 1.0)]);

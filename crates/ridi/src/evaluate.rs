@@ -964,8 +964,48 @@ impl Report {
         };
         // Bounded: a report holds figures per sequence, far below this for any dataset.
         let text = ridi_data::read_text(path, 1 << 30)?;
-        serde_json::from_str(&text)
-            .map_err(|e| file(format!("not a report.json of `ridi eval`: {e}")))
+        let report: Report = serde_json::from_str(&text)
+            .map_err(|e| file(format!("not a report.json of `ridi eval`: {e}")))?;
+        report.check_read().map_err(file)?;
+        Ok(report)
+    }
+
+    /// Refuses what no evaluation writes (a hand-edited report): a negative figure, RTE
+    /// windows, an alignment or a rate that are not positive.
+    fn check_read(&self) -> std::result::Result<(), String> {
+        let c = &self.config;
+        let window = match c.align {
+            ridi_eval::AlignWindow::Seconds(s) => s,
+            ridi_eval::AlignWindow::Frames(n) => n as f64,
+            ridi_eval::AlignWindow::All => 1.0,
+        };
+        for (name, v) in [
+            ("config.rte_window_s", c.rte_window_s),
+            ("config.short_rte_window_s", c.short_rte_window_s),
+            ("config.rate_hz", c.rate_hz),
+            ("config.align", window),
+        ] {
+            if !(v.is_finite() && v > 0.0) {
+                return Err(format!(
+                    "`{name}` is {v}; an evaluation's is a positive number"
+                ));
+            }
+        }
+        for s in &self.sequences {
+            for (method, m) in &s.methods {
+                for metric in Metric::ALL {
+                    if let Some(v) = metric.value(m).filter(|v| *v < 0.0) {
+                        return Err(format!(
+                            "sequence `{}`, method `{method}`: `{}` is {v}, a figure that \
+                             cannot be negative",
+                            ridi_data::shown(&s.name),
+                            metric.key()
+                        ));
+                    }
+                }
+            }
+        }
+        Ok(())
     }
 
     /// Writes `report.json` and `report.md` into `dir` (created if needed), atomically.

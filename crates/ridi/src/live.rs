@@ -239,6 +239,9 @@ pub struct LiveTracker<'m> {
     limits: Validation,
     stream: StreamCheck,
     finished: bool,
+    /// The last sample taken, and the pause before it when it came more than the readers'
+    /// longest gap after the one before: for the error of a sample that goes back after it.
+    last: Option<(f64, Option<f64>)>,
 }
 
 type Waiting = (f64, DeviceVec, DeviceVec, Option<WorldFromDevice>);
@@ -287,6 +290,7 @@ impl<'m> LiveTracker<'m> {
             limits: Validation::default(),
             stream: StreamCheck::default(),
             finished: false,
+            last: None,
         })
     }
 
@@ -318,6 +322,35 @@ impl<'m> LiveTracker<'m> {
     /// given a sample without its recorded orientation; the tracking is unchanged (the
     /// sample still counts towards the stream's last second, as the type's docs say).
     pub fn push(&mut self, sample: &SensorReading, out: &mut Vec<Update>) -> Result<()> {
+        match self.push_checked(sample, out) {
+            Ok(()) => {
+                let pause = self
+                    .last
+                    .map(|(t, _)| sample.time - t)
+                    .filter(|dt| *dt > self.limits.max_gap_s);
+                self.last = Some((sample.time, pause));
+                Ok(())
+            }
+            // After a clock that jumped ahead (a glitch taken for a pause), every sample
+            // would go back: say why, and what to do.
+            Err(PipelineError::Track(TrackError::TimeNotIncreasing { time, previous })) => {
+                let Some((_, Some(pause))) = self.last else {
+                    return Err(TrackError::TimeNotIncreasing { time, previous }.into());
+                };
+                Err(PipelineError::Live(format!(
+                    "sample time {time} is not after the previous sample's {previous}, which \
+                     came {} s after the one before it (taken for a pause, where a new segment \
+                     started): a stream cannot go back in time; if that timestamp was a glitch, \
+                     start a new tracker",
+                    ridi_data::short(pause)
+                )))
+            }
+            Err(e) => Err(e),
+        }
+    }
+
+    /// [`Self::push`] but for the pause it remembers.
+    fn push_checked(&mut self, sample: &SensorReading, out: &mut Vec<Update>) -> Result<()> {
         if self.finished {
             return Err(PipelineError::Live(
                 "the stream was finished: a new stream needs a new tracker".into(),

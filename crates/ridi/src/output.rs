@@ -74,6 +74,15 @@ pub enum OutputError {
         /// The output file.
         path: PathBuf,
     },
+    /// An output file's path is no file ridi writes ([`ridi_data::output_target`]): a device,
+    /// a pipe or a socket, or a link in a loop.
+    #[error("cannot write {}: it {error}", ridi_data::shown(path))]
+    NotRegular {
+        /// The output file.
+        path: PathBuf,
+        /// Why.
+        error: std::io::Error,
+    },
     /// The folder of an output file takes no new files.
     #[error(
         "cannot write {}: cannot create files in {} ({kind})",
@@ -205,7 +214,12 @@ pub fn check_output_file(path: &Path) -> Result<(), OutputError> {
             path: path.to_path_buf(),
         });
     }
-    let folder = folder_of(path);
+    // Through a symbolic link, the file it leads to is the one written.
+    let target = ridi_data::output_target(path).map_err(|error| OutputError::NotRegular {
+        path: path.to_path_buf(),
+        error,
+    })?;
+    let folder = folder_of(&target);
     if let Some(file) = folder.ancestors().find(|d| d.exists() && !d.is_dir()) {
         return Err(OutputError::FolderIsFile {
             path: path.to_path_buf(),
@@ -218,7 +232,7 @@ pub fn check_output_file(path: &Path) -> Result<(), OutputError> {
             folder: folder.to_path_buf(),
         });
     }
-    if path.is_dir() {
+    if target.is_dir() {
         return Err(OutputError::IsFolder {
             path: path.to_path_buf(),
         });
