@@ -83,14 +83,14 @@ impl ListEntry {
                 }
                 read.push((id, path));
             }
-            let bytes = text::read_file_bounded(path, MAX_LIST_BYTES)?;
-            if bytes.starts_with(MODEL_MAGIC) {
+            if is_model_file(path) {
                 return Err(DataError::format(
                     Location::file(path),
                     "is a model file of `ridi train` (it goes to `--model`), not a list file \
                      (one `path,placement` line per sequence)",
                 ));
             }
+            let bytes = text::read_file_bounded(path, MAX_LIST_BYTES)?;
             let not_a_list = |format| {
                 DataError::format(
                     Location::file(path),
@@ -307,17 +307,26 @@ impl Listed {
 /// one): a list or an entry that is one gets an error that says so.
 const MODEL_MAGIC: &[u8] = b"RIDIREG\0";
 
+/// Whether `path` is a regular file that starts as a model file does (whatever its size; only
+/// a regular file is opened: a pipe would wait for a writer).
+fn is_model_file(path: &Path) -> bool {
+    use std::io::Read as _;
+    let mut head = [0u8; 8];
+    path.is_file()
+        && std::fs::File::open(path).is_ok_and(|mut f| f.read_exact(&mut head).is_ok())
+        && head == MODEL_MAGIC
+}
+
 /// The error for an entry that names no recording but a list file (lists do not nest) or a
 /// model file, at the entry's line; `None` for anything else (its reader's error stands).
 fn misplaced(e: &ListEntry) -> Option<DataError> {
-    if !e.path.is_file() {
-        return None;
-    }
-    let bytes = text::read_file_bounded(&e.path, MAX_LIST_BYTES).ok()?;
-    let what = if bytes.starts_with(MODEL_MAGIC) {
+    let what = if is_model_file(&e.path) {
         "a model file of `ridi train` (it goes to `--model`)"
-    } else if parse_list(&bytes, &e.path)
-        .is_ok_and(|inner| inner.iter().any(|i| text::present(&i.path)))
+    } else if e.path.is_file()
+        && text::read_file_bounded(&e.path, MAX_LIST_BYTES).is_ok_and(|bytes| {
+            parse_list(&bytes, &e.path)
+                .is_ok_and(|inner| inner.iter().any(|i| text::present(&i.path)))
+        })
     {
         "a list file: lists do not nest (give it to `--list` itself)"
     } else {

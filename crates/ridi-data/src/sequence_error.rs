@@ -190,9 +190,8 @@ pub enum SequenceError {
     /// A resampling rate outside [`RESAMPLE_RATE_HZ`](crate::RESAMPLE_RATE_HZ), or a gap
     /// limit that is not a number above 0 ([`Sequence::resampled`](crate::Sequence::resampled)).
     #[error(
-        "cannot resample to {} Hz across gaps of up to {} s: the rate must be from {} to {} Hz \
-         (the steps a sequence may have), the gap limit a number above 0",
-        short(*rate_hz),
+        "cannot resample to {rate_hz} Hz across gaps of up to {} s: the rate must be from {} \
+         to {} Hz (the steps a sequence may have), the gap limit a number above 0",
         short(*max_gap_s),
         crate::RESAMPLE_RATE_HZ.0,
         crate::RESAMPLE_RATE_HZ.1

@@ -389,7 +389,8 @@ impl Validation {
             // while the phone turns, or a slow turn reads in deg/s. An orientation that turns
             // in the steps left out as jumps (one held between updates at a lower rate) does
             // not stay put.
-            if gyro_rms < ORIENTATION_STILL_GYRO_RATE || fit.left_out > 0 {
+            let held = fit.left_out as f64 >= HELD_ORIENTATION_SHARE * (n + fit.left_out) as f64;
+            if gyro_rms < ORIENTATION_STILL_GYRO_RATE || held {
                 return Ok(());
             }
             let scale = gw / ww;
@@ -581,6 +582,12 @@ pub const MIN_GYRO_AXIS_SCALE: f64 = 0.15;
 /// axis the phone hardly turns about holds mostly the orientation's noise (quaternions written
 /// with 3 decimals read 0.2 rad/s of it at 200 Hz).
 pub const GYRO_AXIS_MIN_SHARE: f64 = 0.1;
+
+/// Least share of a recording's steps left out as orientation jumps for
+/// [`Validation::check_gyro_scale`] to take a still orientation under a turning gyro for one
+/// held between updates at a lower rate (a 2 Hz orientation in a 200 Hz recording jumps at 1 %
+/// of the steps), rather than for one that stays put with a glitch or two.
+const HELD_ORIENTATION_SHARE: f64 = 0.01;
 
 /// Scales of the gyro against the orientation's rotation rate that read as a gyroscope in
 /// deg/s (57.3) where the orientation turns too little to judge the scale otherwise.
@@ -1026,12 +1033,17 @@ mod tests {
                 .ends_with("in deg/s on a phone that hardly turns?"),
             "{e}"
         );
-        // An orientation held between updates at a tenth of the rate: its turns are in the
-        // steps left out as jumps, so it does not stay put.
+        // An orientation held between updates at a twentieth of the rate: its turns are in
+        // the steps left out as jumps, so it does not stay put.
         let turning = |t: f64| WorldFromDevice::from_axis_angle(&Vector3::z_axis(), 1.0 * t);
         let held: Vec<WorldFromDevice> =
             (0..time.len()).map(|k| turning(time[k - k % 20])).collect();
         v.check_gyro_scale(&time, &gyro(1.0), &held).unwrap();
+        // One glitch in an orientation that stays put does not pass for that.
+        let mut glitch = still.clone();
+        glitch[200] = turning(1.0);
+        let e = v.check_gyro_scale(&time, &gyro(0.6), &glitch).unwrap_err();
+        assert!(matches!(e, SequenceError::OrientationStill { .. }), "{e}");
     }
 
     /// A dead gyro axis (reading 0 while the orientation turns about it) is refused by name,

@@ -41,6 +41,8 @@ use crate::error::{
 /// [`evaluate_trajectory`] checks. A figure written as `null` (a NaN), or left out of a
 /// hand-edited file, reads back as NaN (`None` for the optional ones).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+// A misspelled figure in a hand-edited report is an error, not a missing figure.
+#[serde(deny_unknown_fields)]
 pub struct TrajectoryMetrics {
     /// Mean positional error, metres.
     #[serde(

@@ -112,8 +112,8 @@ fn float64<'py>(obj: &Bound<'py, PyAny>, name: &str) -> PyResult<Bound<'py, PyUn
 
 /// Refuses an object array whose elements numpy would convert but ridi should not take:
 /// numbers as text (`"1.5"`: a column read without parsing, where a typo converts or fails
-/// far from its cause) and, for `time`, numpy float16/float32 scalars (rounded as a float32
-/// array's are).
+/// far from its cause), bools (as a bool array is refused) and, for `time`, numpy
+/// float16/float32 scalars (rounded as a float32 array's are).
 fn object_elements(array: &Bound<'_, PyUntypedArray>, name: &str) -> PyResult<()> {
     let py = array.py();
     let builtins = py.import("builtins")?;
@@ -131,6 +131,12 @@ fn object_elements(array: &Bound<'_, PyUntypedArray>, name: &str) -> PyResult<()
                 "`{name}` has dtype object and holds text ({type_name}): parse the numbers \
                  first (`np.asarray({name}, dtype=np.float64)`, or `pd.to_numeric` for a column \
                  read as text), so that a value that is no number fails where it is read"
+            )));
+        }
+        if t.is(py.get_type::<pyo3::types::PyBool>()) || t.is(numpy.getattr("bool_")?) {
+            return Err(PyTypeError::new_err(format!(
+                "`{name}` has dtype object and holds bools; ridi takes float64 (an array of real \
+                 numbers)"
             )));
         }
         if name == "time" && coarse.iter().any(|c| t.is(c)) {

@@ -313,8 +313,9 @@ fn refuse_unreadable(obj: &Bound<'_, PyAny>, name: &str) -> PyResult<()> {
         let size = dtype.getattr("itemsize").ok()?.extract::<usize>().ok()?;
         Some((*kind.as_bytes().first()?, size))
     };
+    // The items of a list, a tuple or an object array; an array of numbers says by its dtype.
     let items: Vec<Bound<'_, PyAny>> = match obj.try_iter() {
-        Ok(iter) if kind(obj).is_none() => iter.flatten().collect(),
+        Ok(iter) if kind(obj).is_none_or(|(k, _)| k == b'O') => iter.flatten().collect(),
         _ => vec![obj.clone()],
     };
     for item in items.iter().chain(std::iter::once(obj)) {

@@ -236,6 +236,8 @@ def test_linacce_defaults_to_acce_minus_gravity(seq):
          TypeError, r"`acce` has dtype object and holds text \(str\): parse the numbers first"),
         (lambda a: a.update(acce=a["acce"].astype(str).astype(object)), TypeError,
          r"`acce` has dtype object and holds text"),
+        (lambda a: a.update(gyro=(a["gyro"] > 0).astype(object)), TypeError,
+         r"`gyro` has dtype object and holds bools"),
         (lambda a: a.update(acce=np.array([[{}, 1.0, 2.0]] * len(a["time"]), dtype=object)),
          TypeError,
          r"`acce` has dtype object and values that are not real numbers \(numpy: "),
@@ -306,6 +308,9 @@ def test_arrays_without_orientation_are_checked_before_the_estimate(seq):
 def test_resampling_refuses_rates_and_gap_limits_no_sequence_may_have(seq):
     with pytest.raises(ValueError, match=r"cannot resample to 0.5 Hz .*from 1.001 to 9990 Hz"):
         seq.resampled(0.5)
+    # The rate as given, not rounded onto the bound it misses.
+    with pytest.raises(ValueError, match=r"cannot resample to 1.0009 Hz"):
+        seq.resampled(1.0009)
     for gap in (0.0, -1.0, float("nan")):
         with pytest.raises(ValueError, match=r"the gap limit a number above 0"):
             seq.resampled(100.0, max_gap_s=gap)

@@ -194,6 +194,8 @@ def test_live_tracker_refuses_bad_samples_and_stays_usable(seq, recorded_model):
     # What numbers would read but a sample cannot hold: bools, a float32 time.
     with pytest.raises(TypeError, match=r"`gyro` holds bools"):
         live.push(seq.time[2], [True, False, True], seq.acce[2], **recorded)
+    with pytest.raises(TypeError, match=r"`gyro` holds bools"):
+        live.push(seq.time[2], np.array([True, 0.0, 0.0], dtype=object), seq.acce[2], **recorded)
     with pytest.raises(TypeError, match=r"`time` holds bools"):
         live.push(True, seq.gyro[2], seq.acce[2], **recorded)
     with pytest.raises(TypeError, match=r"`time` is a float32: its bits have rounded"):

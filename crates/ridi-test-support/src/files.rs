@@ -48,3 +48,13 @@ pub fn file_names(dir: &Path) -> Vec<String> {
 pub fn stderr(output: &Output) -> String {
     String::from_utf8_lossy(&output.stderr).into_owned()
 }
+
+/// Makes a named pipe at `path` (`mkfifo`): what a test gives where a regular file is expected
+/// (an output the atomic rename would replace; a device such as `/dev/null` would be replaced
+/// for good, were the check to fail in a test run as root).
+#[cfg(unix)]
+#[track_caller]
+pub fn make_fifo(path: &Path) {
+    let made = std::process::Command::new("mkfifo").arg(path).status();
+    assert!(made.is_ok_and(|s| s.success()), "mkfifo {}", path.display());
+}

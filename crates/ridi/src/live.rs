@@ -320,7 +320,10 @@ impl<'m> LiveTracker<'m> {
     /// # Errors
     /// A refused sample ([`TrackError`], [`ridi_frames::EstimateError`]), or a recorded model
     /// given a sample without its recorded orientation; the tracking is unchanged (the
-    /// sample still counts towards the stream's last second, as the type's docs say).
+    /// sample still counts towards the stream's last second, as the type's docs say). A
+    /// sample whose time falls inside the pause before the last one (a clock that jumped
+    /// ahead, taken for a pause) is [`PipelineError::Live`], naming the jump, rather than
+    /// [`TrackError::TimeNotIncreasing`].
     pub fn push(&mut self, sample: &SensorReading, out: &mut Vec<Update>) -> Result<()> {
         match self.push_checked(sample, out) {
             Ok(()) => {
@@ -334,9 +337,14 @@ impl<'m> LiveTracker<'m> {
             // After a clock that jumped ahead (a glitch taken for a pause), every sample
             // would go back: say why, and what to do.
             Err(PipelineError::Track(TrackError::TimeNotIncreasing { time, previous })) => {
-                let Some((_, Some(pause))) = self.last else {
+                // Only a sample landing inside the pause before the last one says the pause
+                // was a clock's jump (a repeated timestamp says nothing of it).
+                let Some((_, Some(pause))) = self.last.filter(|_| time < previous) else {
                     return Err(TrackError::TimeNotIncreasing { time, previous }.into());
                 };
+                if time <= previous - pause {
+                    return Err(TrackError::TimeNotIncreasing { time, previous }.into());
+                }
                 Err(PipelineError::Live(format!(
                     "sample time {time} is not after the previous sample's {previous}, which \
                      came {} s after the one before it (taken for a pause, where a new segment \

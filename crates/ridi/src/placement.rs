@@ -45,7 +45,8 @@ impl PlacementMap {
     }
 
     /// Reads `label,class` lines (`#` comments and blank lines skipped). A label given two
-    /// different classes, and a file without any entry, are errors.
+    /// different classes, a class that is also a label mapped on (a chain), a file without any
+    /// entry, and a list file (every label a path beside it) are errors.
     pub fn read(path: impl AsRef<Path>) -> Result<Self> {
         let path = path.as_ref();
         // At the file and line, as every reader's error is.
@@ -79,6 +80,29 @@ impl PlacementMap {
             return Err(error(
                 None,
                 "no `label,class` entry in the placement map".into(),
+            ));
+        }
+        // Applied once, a chain maps `a` to `b` but `b` to `c`: what was meant is unclear.
+        for (label, (class, at)) in &map {
+            if let Some((next, next_at)) = map.get(class).filter(|(next, _)| next != class) {
+                return Err(error(
+                    Some(*next_at),
+                    format!(
+                        "`{class}` is a class (of `{label}`, line {at}) and a label mapped to \
+                         `{next}` here: a map is applied once, so `{label}` would become \
+                         `{class}` and `{class}` `{next}`; map each label to its final class"
+                    ),
+                ));
+            }
+        }
+        // A list file given for a map: its labels are the recordings' paths.
+        let folder = path.parent().unwrap_or(Path::new(""));
+        if map.keys().all(|label| folder.join(label).exists()) {
+            return Err(error(
+                None,
+                "every label names a file or folder beside it: a list file (`path,placement` \
+                 lines, for `--list`), not a placement map (`label,class` lines)"
+                    .into(),
             ));
         }
         Ok(Self {
@@ -227,6 +251,16 @@ mod tests {
             ),
             ("", "bad.txt: no `label,class` entry"),
             ("# nothing\n\n", "bad.txt: no `label,class` entry"),
+            (
+                "AR,hand\nhand,swing\n",
+                "bad.txt:2: `hand` is a class (of `AR`, line 1) and a label mapped to `swing` \
+                 here: a map is applied once",
+            ),
+            // A list file given for a map: its labels are paths beside it.
+            (
+                "map.txt,hand\nbad.txt,swing\n",
+                "bad.txt: every label names a file or folder beside it: a list file",
+            ),
         ] {
             std::fs::write(&bad, text).unwrap();
             let err = PlacementMap::read(&bad).unwrap_err().to_string();

@@ -361,11 +361,28 @@ fn recover(out: &Path) -> Result<(), DataError> {
 }
 
 /// Refuses a staged file `rel` that could not be moved into `out`: its path there is a folder,
-/// or runs through a file.
+/// or runs through a file; or that must not be: a symbolic link, a device, a pipe or a socket
+/// there, which the move would replace with a regular file (an output folder holds regular
+/// files, and its commit moves the file it replaces aside, not the one a link leads to).
 fn check_destination(out: &Path, rel: &Path) -> Result<(), DataError> {
     let dest = out.join(rel);
     if dest.is_dir() {
         return Err(DataError::io(&dest, io::ErrorKind::IsADirectory.into()));
+    }
+    if let Ok(meta) = std::fs::symlink_metadata(&dest)
+        && !meta.is_file()
+    {
+        let what = match meta.file_type().is_symlink() {
+            true => "is a symbolic link",
+            false => "is a device, a pipe or a socket",
+        };
+        return Err(DataError::io(
+            &dest,
+            io::Error::other(format!(
+                "{what}, which the output folder's commit would replace with a regular file: \
+                 remove it, or write to another --out"
+            )),
+        ));
     }
     let mut dir = out.to_path_buf();
     for part in rel.parent().into_iter().flat_map(Path::components) {
@@ -548,6 +565,49 @@ mod tests {
         assert_eq!(
             std::fs::read_to_string(out.join("x/data.txt")).unwrap(),
             "new"
+        );
+    }
+
+    /// A symbolic link or a pipe where a staged file goes is refused at the commit, and
+    /// nothing moves: the move would replace it with a regular file.
+    #[cfg(unix)]
+    #[test]
+    fn links_and_pipes_in_the_output_folder_are_refused() {
+        let dir = tempfile::tempdir().unwrap();
+        let out = dir.path().join("out");
+        std::fs::create_dir_all(&out).unwrap();
+        std::fs::write(dir.path().join("keep.txt"), "kept").unwrap();
+        std::os::unix::fs::symlink("../keep.txt", out.join("list.txt")).unwrap();
+        let fifo = out.join("report.json");
+        ridi_test_support::make_fifo(&fifo);
+        for (name, what) in [
+            ("list.txt", "is a symbolic link"),
+            ("report.json", "is a device, a pipe or a socket"),
+        ] {
+            let staging = Staging::new(&out).unwrap();
+            std::fs::write(staging.file(Path::new(name)).unwrap(), "new").unwrap();
+            let e = staging.commit().unwrap_err().to_string();
+            assert!(
+                e.contains(what) && e.contains("remove it, or write to another --out"),
+                "{e}"
+            );
+        }
+        assert!(
+            std::fs::symlink_metadata(out.join("list.txt"))
+                .unwrap()
+                .file_type()
+                .is_symlink()
+        );
+        assert_eq!(
+            std::fs::read_to_string(dir.path().join("keep.txt")).unwrap(),
+            "kept"
+        );
+        use std::os::unix::fs::FileTypeExt as _;
+        assert!(
+            std::fs::symlink_metadata(&fifo)
+                .unwrap()
+                .file_type()
+                .is_fifo()
         );
     }
 
