@@ -40,10 +40,10 @@ pub(crate) fn evaluate<'py>(
     model: &Bound<'py, Model>,
     methods: Option<&Bound<'py, PyAny>>,
     placement_map: Option<PathBuf>,
-    placement_window: f64,
+    #[pyo3(from_py_with = crate::options::real)] placement_window: f64,
     align: Option<&Bound<'py, PyAny>>,
     heading: &str,
-    jobs: Option<i64>,
+    #[pyo3(from_py_with = crate::options::opt_whole)] jobs: Option<i64>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let inputs = Inputs::extract(data)?;
     let methods = match methods {

@@ -151,10 +151,10 @@ impl LiveTracker {
     ))]
     fn new(
         model: &Bound<'_, Model>,
-        regress_every: i64,
-        lambda_: f64,
+        #[pyo3(from_py_with = crate::options::whole)] regress_every: i64,
+        #[pyo3(from_py_with = crate::options::real)] lambda_: f64,
         estimate_initial_velocity: bool,
-        placement_window: f64,
+        #[pyo3(from_py_with = crate::options::real)] placement_window: f64,
         heading: &str,
     ) -> PyResult<Self> {
         let opts = options::track_options(

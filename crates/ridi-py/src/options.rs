@@ -84,6 +84,44 @@ pub(crate) fn recorded_heading(heading: &str) -> PyResult<Option<ridi::frames::H
     )
 }
 
+/// A number argument (`from_py_with`): what Python and numpy read as one, but not a bool,
+/// which would read as 0 or 1 (`align=True`: an alignment on 1 s) where a number was meant.
+pub(crate) fn real(obj: &Bound<'_, PyAny>) -> PyResult<f64> {
+    not_bool(obj)?;
+    obj.extract()
+}
+
+/// A whole-number argument, as [`real`].
+pub(crate) fn whole(obj: &Bound<'_, PyAny>) -> PyResult<i64> {
+    not_bool(obj)?;
+    obj.extract()
+}
+
+/// An optional [`real`]: `None` stays `None`.
+pub(crate) fn opt_real(obj: &Bound<'_, PyAny>) -> PyResult<Option<f64>> {
+    (!obj.is_none()).then(|| real(obj)).transpose()
+}
+
+/// An optional [`whole`]: `None` stays `None`.
+pub(crate) fn opt_whole(obj: &Bound<'_, PyAny>) -> PyResult<Option<i64>> {
+    (!obj.is_none()).then(|| whole(obj)).transpose()
+}
+
+fn not_bool(obj: &Bound<'_, PyAny>) -> PyResult<()> {
+    let numpy_bool = obj
+        .get_type()
+        .name()
+        .is_ok_and(|n| n == "bool_" || n == "bool");
+    if obj.is_instance_of::<pyo3::types::PyBool>() || numpy_bool {
+        return Err(PyTypeError::new_err(format!(
+            "expected a number, not a bool ({})",
+            obj.repr()
+                .map_or_else(|_| "?".to_owned(), |r| r.to_string())
+        )));
+    }
+    Ok(())
+}
+
 /// `align`: seconds, or `"all"` for the whole run, as `ridi eval --align`.
 pub(crate) fn align(value: &Bound<'_, PyAny>) -> PyResult<AlignWindow> {
     if let Ok(text) = value.extract::<String>() {
@@ -94,7 +132,9 @@ pub(crate) fn align(value: &Bound<'_, PyAny>) -> PyResult<AlignWindow> {
             "`align` is '{text}'; expected seconds above 0 or 'all'"
         )));
     }
-    let seconds: f64 = value.extract().map_err(|_| {
+    // `True` would read as 1 s, and change every figure.
+    let bool_ = value.is_instance_of::<pyo3::types::PyBool>();
+    let seconds: f64 = value.extract().ok().filter(|_| !bool_).ok_or_else(|| {
         PyTypeError::new_err("`align` must be a number of seconds or 'all'".to_string())
     })?;
     Ok(AlignWindow::Seconds(positive("align", seconds)?))

@@ -99,7 +99,7 @@ impl Sequence {
         steps: Option<&Bound<'_, PyAny>>,
         orientation_source: Option<&str>,
         device: Option<&str>,
-        device_imu_rate_hz: Option<f64>,
+        #[pyo3(from_py_with = crate::options::opt_real)] device_imu_rate_hz: Option<f64>,
     ) -> PyResult<Self> {
         let time = vector(time, "time", None)?;
         let n = time.as_array().len();
@@ -349,7 +349,11 @@ impl Sequence {
     /// plain name when one is left). Without such a gap, a list of the sequence itself (empty
     /// when it is shorter than ``min_duration_s``).
     #[pyo3(signature = (max_gap_s, min_duration_s=0.0))]
-    fn split_at_gaps(&self, max_gap_s: f64, min_duration_s: f64) -> PyResult<Vec<Self>> {
+    fn split_at_gaps(
+        &self,
+        #[pyo3(from_py_with = crate::options::real)] max_gap_s: f64,
+        #[pyo3(from_py_with = crate::options::real)] min_duration_s: f64,
+    ) -> PyResult<Vec<Self>> {
         let split = self
             .inner
             .clone()
@@ -371,7 +375,11 @@ impl Sequence {
     /// >>> seq50 = ridi.Sequence(t, gyro, acce, gravity, orientation)  # doctest: +SKIP
     /// >>> seq = seq50.resampled(ridi.RATE_HZ)                          # doctest: +SKIP
     #[pyo3(signature = (rate_hz, max_gap_s=None))]
-    fn resampled(&self, rate_hz: f64, max_gap_s: Option<f64>) -> PyResult<Self> {
+    fn resampled(
+        &self,
+        #[pyo3(from_py_with = crate::options::real)] rate_hz: f64,
+        #[pyo3(from_py_with = crate::options::opt_real)] max_gap_s: Option<f64>,
+    ) -> PyResult<Self> {
         let max_gap = max_gap_s.unwrap_or_else(|| ridi::resample_max_gap(&self.inner));
         let median_step = 1.0 / self.inner.median_rate_hz();
         // Not a gap limit of no sequence (0, NaN): the resampler names those.
@@ -559,7 +567,7 @@ pub(crate) fn read(
     py: Python<'_>,
     path: PathBuf,
     format: Option<&str>,
-    split_at_gaps: Option<f64>,
+    #[pyo3(from_py_with = crate::options::opt_real)] split_at_gaps: Option<f64>,
 ) -> PyResult<Sequence> {
     let mut seqs = read_sequences(py, &path, format, split_at_gaps)?;
     if seqs.is_empty() {
@@ -592,7 +600,7 @@ pub(crate) fn read_any(
     py: Python<'_>,
     path: PathBuf,
     format: Option<&str>,
-    split_at_gaps: Option<f64>,
+    #[pyo3(from_py_with = crate::options::opt_real)] split_at_gaps: Option<f64>,
 ) -> PyResult<Vec<Sequence>> {
     read_sequences(py, &path, format, split_at_gaps)
 }

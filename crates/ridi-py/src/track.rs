@@ -289,10 +289,10 @@ pub(crate) fn track(
     sequence: &Bound<'_, Sequence>,
     model: &Bound<'_, Model>,
     online: bool,
-    regress_every: i64,
-    lambda_: f64,
+    #[pyo3(from_py_with = crate::options::whole)] regress_every: i64,
+    #[pyo3(from_py_with = crate::options::real)] lambda_: f64,
     estimate_initial_velocity: bool,
-    placement_window: f64,
+    #[pyo3(from_py_with = crate::options::real)] placement_window: f64,
     heading: &str,
 ) -> PyResult<Track> {
     let opts = options::track_options(
@@ -320,8 +320,8 @@ pub(crate) fn regress(
     py: Python<'_>,
     sequence: &Bound<'_, Sequence>,
     model: &Bound<'_, Model>,
-    regress_every: i64,
-    placement_window: f64,
+    #[pyo3(from_py_with = crate::options::whole)] regress_every: i64,
+    #[pyo3(from_py_with = crate::options::real)] placement_window: f64,
 ) -> PyResult<Regressions> {
     let opts = ridi::TrackOptions {
         regress_every: options::count("regress_every", regress_every, 1, MAX_FRAMES_APART)?,

@@ -335,3 +335,21 @@ def test_tracks_pickle_bit_for_bit(seq, model):
     assert back.placement_names == track.placement_names
     with pytest.raises(ValueError, match="not the state of a pickled ridi.Track"):
         ridi.Track._from_state(b"\0" * 12, [])
+
+
+@pytest.mark.parametrize(
+    "call",
+    [
+        lambda s, m: s.resampled(True),
+        lambda s, m: s.split_at_gaps(np.bool_(True), 0.0),
+        lambda s, m: ridi.track(s, m, regress_every=True),
+        lambda s, m: ridi.track(s, m, placement_window=False),
+        lambda s, m: ridi.LiveTracker(m, lambda_=True),
+    ],
+)
+def test_a_bool_is_no_number(seq, model, call):
+    # `True` would read as 1 (an alignment on 1 s, a regression every frame): refused, the
+    # argument named in the exception's notes.
+    with pytest.raises(TypeError, match=r"expected a number, not a bool") as caught:
+        call(seq, model)
+    assert any("while processing" in n for n in getattr(caught.value, "__notes__", []))
