@@ -389,7 +389,7 @@ impl Validation {
             // while the phone turns, or a slow turn reads in deg/s. An orientation that turns
             // in the steps left out as jumps (one held between updates at a lower rate) does
             // not stay put.
-            let held = fit.left_out as f64 >= HELD_ORIENTATION_SHARE * (n + fit.left_out) as f64;
+            let held = fit.left_out >= HELD_ORIENTATION_MIN_JUMPS;
             if gyro_rms < ORIENTATION_STILL_GYRO_RATE || held {
                 return Ok(());
             }
@@ -583,11 +583,11 @@ pub const MIN_GYRO_AXIS_SCALE: f64 = 0.15;
 /// with 3 decimals read 0.2 rad/s of it at 200 Hz).
 pub const GYRO_AXIS_MIN_SHARE: f64 = 0.1;
 
-/// Least share of a recording's steps left out as orientation jumps for
-/// [`Validation::check_gyro_scale`] to take a still orientation under a turning gyro for one
-/// held between updates at a lower rate (a 2 Hz orientation in a 200 Hz recording jumps at 1 %
-/// of the steps), rather than for one that stays put with a glitch or two.
-const HELD_ORIENTATION_SHARE: f64 = 0.01;
+/// Fewest steps left out as orientation jumps for [`Validation::check_gyro_scale`] to take a
+/// still orientation under a turning gyro for one held between updates at a lower rate (under
+/// a gyro turning at 0.3 rad/s, one updated at 12 Hz or less jumps at most updates), rather
+/// than for one that stays put with a glitch (which jumps out and back: 2 steps).
+const HELD_ORIENTATION_MIN_JUMPS: usize = 4;
 
 /// Scales of the gyro against the orientation's rotation rate that read as a gyroscope in
 /// deg/s (57.3) where the orientation turns too little to judge the scale otherwise.
@@ -1039,6 +1039,18 @@ mod tests {
         let held: Vec<WorldFromDevice> =
             (0..time.len()).map(|k| turning(time[k - k % 20])).collect();
         v.check_gyro_scale(&time, &gyro(1.0), &held).unwrap();
+        // At 2 Hz, over 10 s: 19 updates, each a jump. (Over these 2 s its 3 would be refused:
+        // as few as a glitch's in and out, the bound.)
+        let long: Vec<f64> = (0..2000).map(|i| i as f64 * 0.005).collect();
+        let slow: Vec<WorldFromDevice> = (0..long.len())
+            .map(|k| turning(long[k - k % 100]))
+            .collect();
+        let turning_gyro = vec![DeviceVec::new(0.0, 0.0, 1.0); long.len()];
+        v.check_gyro_scale(&long, &turning_gyro, &slow).unwrap();
+        let short: Vec<WorldFromDevice> = (0..time.len())
+            .map(|k| turning(time[k - k % 100]))
+            .collect();
+        v.check_gyro_scale(&time, &gyro(1.0), &short).unwrap_err();
         // One glitch in an orientation that stays put does not pass for that.
         let mut glitch = still.clone();
         glitch[200] = turning(1.0);

@@ -269,7 +269,7 @@ pub(crate) fn train(
     storage: &str,
     solver: &str,
     #[pyo3(from_py_with = crate::options::whole)] landmarks: i64,
-    seed: i128,
+    #[pyo3(from_py_with = crate::options::whole_wide)] seed: i128,
     #[pyo3(from_py_with = crate::options::whole)] turned_copies: i64,
     #[pyo3(from_py_with = crate::options::opt_whole)] step: Option<i64>,
     #[pyo3(from_py_with = crate::options::opt_whole)] window: Option<i64>,

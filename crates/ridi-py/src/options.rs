@@ -97,6 +97,13 @@ pub(crate) fn whole(obj: &Bound<'_, PyAny>) -> PyResult<i64> {
     obj.extract()
 }
 
+/// A whole-number argument of any size, as [`whole`] (`seed`: a value past `u64` is named by
+/// its own check).
+pub(crate) fn whole_wide(obj: &Bound<'_, PyAny>) -> PyResult<i128> {
+    not_bool(obj)?;
+    obj.extract()
+}
+
 /// An optional [`real`]: `None` stays `None`.
 pub(crate) fn opt_real(obj: &Bound<'_, PyAny>) -> PyResult<Option<f64>> {
     (!obj.is_none()).then(|| real(obj)).transpose()
@@ -107,11 +114,12 @@ pub(crate) fn opt_whole(obj: &Bound<'_, PyAny>) -> PyResult<Option<i64>> {
     (!obj.is_none()).then(|| whole(obj)).transpose()
 }
 
-fn not_bool(obj: &Bound<'_, PyAny>) -> PyResult<()> {
+/// Refuses a Python bool, a numpy bool and a 0-d bool array (`np.array(True)`).
+pub(crate) fn not_bool(obj: &Bound<'_, PyAny>) -> PyResult<()> {
     let numpy_bool = obj
-        .get_type()
-        .name()
-        .is_ok_and(|n| n == "bool_" || n == "bool");
+        .getattr("dtype")
+        .and_then(|d| d.getattr("kind"))
+        .is_ok_and(|k| k.extract::<String>().is_ok_and(|k| k == "b"));
     if obj.is_instance_of::<pyo3::types::PyBool>() || numpy_bool {
         return Err(PyTypeError::new_err(format!(
             "expected a number, not a bool ({})",
@@ -133,7 +141,7 @@ pub(crate) fn align(value: &Bound<'_, PyAny>) -> PyResult<AlignWindow> {
         )));
     }
     // `True` would read as 1 s, and change every figure.
-    let bool_ = value.is_instance_of::<pyo3::types::PyBool>();
+    let bool_ = not_bool(value).is_err();
     let seconds: f64 = value.extract().ok().filter(|_| !bool_).ok_or_else(|| {
         PyTypeError::new_err("`align` must be a number of seconds or 'all'".to_string())
     })?;

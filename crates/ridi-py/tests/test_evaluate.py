@@ -90,8 +90,9 @@ def test_bad_evaluations_are_refused(model, test_list, tmp_path):
     with pytest.raises(ValueError, match=r"`align` is -1"):
         ridi.evaluate(test_list, model, align=-1.0)
     # A bool is no number of seconds (True would align on 1 s).
-    with pytest.raises(TypeError, match=r"`align` must be a number of seconds or 'all'"):
-        ridi.evaluate(test_list, model, align=True)
+    for true in (True, np.True_, np.array(True)):
+        with pytest.raises(TypeError, match=r"`align` must be a number of seconds or 'all'"):
+            ridi.evaluate(test_list, model, align=true)
     twice = tmp_path / "twice.txt"
     twice.write_text(test_list.read_text() + f"{SAMPLE / RUNS[0]},Texting\n")
     with pytest.raises(ValueError, match=r"twice.txt:3"):

@@ -100,10 +100,13 @@ def test_progress_reports_each_stage_and_can_cancel():
         (dict(seed=-1), r"`seed` is -1; expected a whole number from 0 to 18446744073709551615"),
         (dict(seed=2**64), r"`seed` is 18446744073709551616"),
         (dict(placement_map="no-such-map.txt"), r"no-such-map.txt"),
+        (dict(seed=True), r"expected a number, not a bool"),
+        (dict(landmarks=True), r"expected a number, not a bool"),
     ],
 )
 def test_bad_training_options_are_refused(options, message):
-    error = OSError if "placement_map" in options else ValueError
+    error = (OSError if "placement_map" in options
+             else TypeError if any(v is True for v in options.values()) else ValueError)
     with pytest.raises(error, match=message):
         ridi.train(GUILLAUME, **options)
 

@@ -342,6 +342,7 @@ def test_tracks_pickle_bit_for_bit(seq, model):
     [
         lambda s, m: s.resampled(True),
         lambda s, m: s.split_at_gaps(np.bool_(True), 0.0),
+        lambda s, m: s.resampled(np.array(True)),
         lambda s, m: ridi.track(s, m, regress_every=True),
         lambda s, m: ridi.track(s, m, placement_window=False),
         lambda s, m: ridi.LiveTracker(m, lambda_=True),

@@ -46,7 +46,8 @@ impl PlacementMap {
 
     /// Reads `label,class` lines (`#` comments and blank lines skipped). A label given two
     /// different classes, a class that is also a label mapped on (a chain), a file without any
-    /// entry, and a list file (every label a path beside it) are errors.
+    /// entry, and a list file (every label a path beside it, with a separator or an extension)
+    /// are errors.
     pub fn read(path: impl AsRef<Path>) -> Result<Self> {
         let path = path.as_ref();
         // At the file and line, as every reader's error is.
@@ -95,13 +96,19 @@ impl PlacementMap {
                 ));
             }
         }
-        // A list file given for a map: its labels are the recordings' paths.
+        // A list file given for a map: its labels are the recordings' paths (a path is told
+        // by a separator or an extension: a map's labels may name folders beside it, `AR/`).
         let folder = path.parent().unwrap_or(Path::new(""));
-        if map.keys().all(|label| folder.join(label).exists()) {
+        let a_path = |label: &String| {
+            (label.contains(std::path::is_separator) || Path::new(label).extension().is_some())
+                && folder.join(label).exists()
+        };
+        if map.keys().all(a_path) {
             return Err(error(
                 None,
-                "every label names a file or folder beside it: a list file (`path,placement` \
-                 lines, for `--list`), not a placement map (`label,class` lines)"
+                "every label is the path of a file or folder beside it: a list file \
+                 (`path,placement` lines, for `--list`), not a placement map (`label,class` \
+                 lines)"
                     .into(),
             ));
         }
@@ -259,7 +266,7 @@ mod tests {
             // A list file given for a map: its labels are paths beside it.
             (
                 "map.txt,hand\nbad.txt,swing\n",
-                "bad.txt: every label names a file or folder beside it: a list file",
+                "bad.txt: every label is the path of a file or folder beside it: a list file",
             ),
         ] {
             std::fs::write(&bad, text).unwrap();

@@ -380,7 +380,7 @@ fn check_destination(out: &Path, rel: &Path) -> Result<(), DataError> {
             &dest,
             io::Error::other(format!(
                 "{what}, which the output folder's commit would replace with a regular file: \
-                 remove it, or write to another --out"
+                 remove it, or write to another folder"
             )),
         ));
     }
@@ -588,7 +588,7 @@ mod tests {
             std::fs::write(staging.file(Path::new(name)).unwrap(), "new").unwrap();
             let e = staging.commit().unwrap_err().to_string();
             assert!(
-                e.contains(what) && e.contains("remove it, or write to another --out"),
+                e.contains(what) && e.contains("remove it, or write to another folder"),
                 "{e}"
             );
         }
