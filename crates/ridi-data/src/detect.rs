@@ -110,6 +110,12 @@ pub(crate) fn locate(path: &Path) -> Result<(Format, PathBuf)> {
                 return Ok((Format::Ronin, folder.to_path_buf()));
             }
         }
+        if crate::text::is_model_file(path) {
+            return Err(DataError::format(
+                Location::file(path),
+                "is a model file of `ridi train` (load it with `--model`, in Python `ridi.load`), not a recording",
+            ));
+        }
         return Err(DataError::format(
             Location::file(path),
             "unknown file type: expected a RIDI `.csv` or `data_plain.txt`, an Indoor \

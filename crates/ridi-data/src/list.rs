@@ -14,7 +14,7 @@ use std::path::{Path, PathBuf};
 use crate::detect::{read_sequence, source_files};
 use crate::error::{DataError, Location, Result, shown};
 use crate::options::ReadOptions;
-use crate::text;
+use crate::text::{self, is_model_file};
 use crate::{FileId, Sequence};
 
 /// Largest list file read, bytes: a million entries of 64-byte paths; a list larger than that
@@ -86,7 +86,7 @@ impl ListEntry {
             if is_model_file(path) {
                 return Err(DataError::format(
                     Location::file(path),
-                    "is a model file of `ridi train` (it goes to `--model`), not a list file \
+                    "is a model file of `ridi train` (load it with `--model`, in Python `ridi.load`), not a list file \
                      (one `path,placement` line per sequence)",
                 ));
             }
@@ -303,25 +303,11 @@ impl Listed {
     }
 }
 
-/// How a model file of `ridi train` starts (`ridi_regress::MODEL_MAGIC`, a crate above this
-/// one): a list or an entry that is one gets an error that says so.
-const MODEL_MAGIC: &[u8] = b"RIDIREG\0";
-
-/// Whether `path` is a regular file that starts as a model file does (whatever its size; only
-/// a regular file is opened: a pipe would wait for a writer).
-fn is_model_file(path: &Path) -> bool {
-    use std::io::Read as _;
-    let mut head = [0u8; 8];
-    path.is_file()
-        && std::fs::File::open(path).is_ok_and(|mut f| f.read_exact(&mut head).is_ok())
-        && head == MODEL_MAGIC
-}
-
 /// The error for an entry that names no recording but a list file (lists do not nest) or a
 /// model file, at the entry's line; `None` for anything else (its reader's error stands).
 fn misplaced(e: &ListEntry) -> Option<DataError> {
     let what = if is_model_file(&e.path) {
-        "a model file of `ridi train` (it goes to `--model`)"
+        "a model file of `ridi train` (load it with `--model`, in Python `ridi.load`)"
     } else if e.path.is_file()
         && text::read_file_bounded(&e.path, MAX_LIST_BYTES).is_ok_and(|bytes| {
             parse_list(&bytes, &e.path)
@@ -455,7 +441,7 @@ mod tests {
         let e = ListEntry::read(&[&model]).unwrap_err().to_string();
         assert!(
             e.ends_with(
-                "m.ridi: is a model file of `ridi train` (it goes to `--model`), not \
+                "m.ridi: is a model file of `ridi train` (load it with `--model`, in Python `ridi.load`), not \
              a list file (one `path,placement` line per sequence)"
             ),
             "{e}"
@@ -466,6 +452,17 @@ mod tests {
             .unwrap_err()
             .to_string();
         assert!(e.contains("m.ridi` is a model file of `ridi train`"), "{e}");
+        // Given as a recording itself.
+        let e = crate::read_sequence(&model, &ReadOptions::default())
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.ends_with(
+                "m.ridi: is a model file of `ridi train` (load it with `--model`, \
+             in Python `ridi.load`), not a recording"
+            ),
+            "{e}"
+        );
         // Its records would parse as a list of paths that do not exist.
         let ilc = dir.path().join("5dd9e7abc5b77e0006b1732d.txt");
         let records = "#\tstartTime:1574559495000\n1574559495000\tTYPE_ACCELEROMETER\t0\t0\t9.8\n";

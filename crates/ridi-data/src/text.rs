@@ -41,6 +41,20 @@ pub fn read_text(path: impl AsRef<Path>, max: u64) -> Result<String> {
     as_text(&bytes, path).map(str::to_owned)
 }
 
+/// How a model file of `ridi train` starts (`ridi_regress::MODEL_MAGIC`, a crate above this
+/// one): a list, a list entry or a recording that is one gets an error that says so.
+const MODEL_MAGIC: &[u8] = b"RIDIREG\0";
+
+/// Whether `path` is a regular file that starts as a model file does (whatever its size; only
+/// a regular file is opened: a pipe would wait for a writer).
+pub(crate) fn is_model_file(path: &Path) -> bool {
+    use std::io::Read as _;
+    let mut head = [0u8; 8];
+    path.is_file()
+        && std::fs::File::open(path).is_ok_and(|mut f| f.read_exact(&mut head).is_ok())
+        && head == MODEL_MAGIC
+}
+
 /// Whether there is a directory entry `path`: a folder, a device or a symbolic link that leads
 /// to no file counts, so that an optional file of that name is read (and the read says what
 /// it is) rather than taken as absent.
