@@ -26,7 +26,7 @@ pub(crate) fn run(
     let after = ridi::Report::read(&second)?;
     let comparison = ridi::compare_reports(&before, &after)?;
     crate::print_result(&if json {
-        crate::inspect::escaped(serde_json::to_string_pretty(&comparison)?) + "\n"
+        crate::inspect::json_text(&comparison)?
     } else {
         comparison.to_markdown()
     })

@@ -169,11 +169,7 @@ fn print_summary(report: &Report) {
             .map_or("-".into(), |a| format!("{a:.3}"))
     );
     let c = &report.config;
-    let bounded = report
-        .intervals
-        .values()
-        .flat_map(|m| m.values())
-        .any(ridi::eval::Interval::is_bounded);
+    let bounded = report.has_intervals();
     outln!(
         "{:<10} {:>26} {:>9} {:>10} {:>9} {:>17}",
         "method",

@@ -25,7 +25,7 @@ pub(crate) fn run(Args { sequence, json }: Args) -> Result<()> {
         let model = crate::load_model(&sequence)?;
         let report = ridi::inspect_model(&model);
         return crate::print_result(&if json {
-            escaped(serde_json::to_string_pretty(&report)?) + "\n"
+            json_text(&report)?
         } else {
             report.to_string()
         });
@@ -43,7 +43,7 @@ pub(crate) fn run(Args { sequence, json }: Args) -> Result<()> {
         let rows = ridi::data::RowReader::open(&sequence, &opts)?;
         let report = ridi::inspect_stream(rows)?;
         return crate::print_result(&if json {
-            escaped(serde_json::to_string_pretty(&report)?) + "\n"
+            json_text(&report)?
         } else {
             report.to_string()
         });
@@ -62,11 +62,10 @@ pub(crate) fn run(Args { sequence, json }: Args) -> Result<()> {
     }
     if json {
         // One object, or an array of the parts of a recording split at its gaps.
-        let text = match &reports[..] {
-            [one] => serde_json::to_string_pretty(one)?,
-            parts => serde_json::to_string_pretty(parts)?,
-        };
-        crate::print_result(&(escaped(text) + "\n"))
+        crate::print_result(&match &reports[..] {
+            [one] => json_text(one)?,
+            parts => json_text(&parts)?,
+        })
     } else {
         let mut text = String::new();
         for (i, report) in reports.iter().enumerate() {
@@ -115,6 +114,11 @@ fn is_model_file(path: &Path) -> bool {
 /// it escapes U+0000-U+001F: they are valid JSON raw, but a terminal may obey them (U+009B
 /// starts an escape sequence on some). They can only be inside strings (JSON's own syntax is
 /// ASCII), where the escape stands for the same character.
+/// `value` as the JSON `--json` prints: pretty, [`escaped`], a line of its own.
+pub(crate) fn json_text(value: &impl serde::Serialize) -> Result<String> {
+    Ok(escaped(serde_json::to_string_pretty(value)?) + "\n")
+}
+
 pub(crate) fn escaped(json: String) -> String {
     let raw = |c: char| ('\u{7f}'..='\u{9f}').contains(&c);
     if !json.contains(raw) {

@@ -843,13 +843,7 @@ fn convert_train_track_and_eval() {
             "{}",
             stderr(&out)
         );
-        use std::os::unix::fs::FileTypeExt as _;
-        assert!(
-            std::fs::symlink_metadata(&fifo)
-                .unwrap()
-                .file_type()
-                .is_fifo()
-        );
+        assert!(ridi_test_support::is_fifo(&fifo));
     }
     // The model at a name the evaluation writes inside --out: refused before anything moves.
     let inside = dir.path().join("eval-into-model");

@@ -447,10 +447,7 @@ struct Sums {
     gravity_norms: f64,
     acce_norms: f64,
     /// Gyro scale sums of every step and of the steps that are no orientation jump.
-    rates: usize,
-    jumps: usize,
-    all: crate::GyroFit,
-    kept: crate::GyroFit,
+    gyro_steps: crate::validation::GyroSteps,
     /// Linear acceleration scale sums.
     linacce: (f64, f64, f64, usize),
     magnet_seen: bool,
@@ -794,10 +791,7 @@ impl RowReader {
         let s = &self.sums;
         let checks = limits
             .check_acce_scale(s.acce_norms / n, mean)
-            .and_then(|()| {
-                let leave_out = s.jumps as f64 <= crate::MAX_JUMP_SHARE * s.rates as f64;
-                limits.gyro_verdict(if leave_out { &s.kept } else { &s.all })
-            })
+            .and_then(|()| limits.gyro_verdict(s.gyro_steps.fit()))
             .and_then(|()| {
                 let (dl, ll, dd, k) = s.linacce;
                 limits.linacce_scale_verdict(dl, ll, dd, k)
@@ -903,14 +897,7 @@ impl RowReader {
             let (time, gyro) = ([p.time, row.time], [p.gyro, row.gyro]);
             let orientation = [p.orientation, row.orientation];
             for step in crate::validation::step_rates(&time, &gyro, &orientation) {
-                s.rates += 1;
-                s.all.add(&step);
-                if step.is_jump() {
-                    s.jumps += 1;
-                    s.kept.left_out += 1;
-                } else {
-                    s.kept.add(&step);
-                }
+                s.gyro_steps.add(&step);
             }
             if let (Some((pp, _)), Some((rp, _))) = (p.ground_truth, row.ground_truth) {
                 let speed = Validation::step_speed(rp - pp, dt);

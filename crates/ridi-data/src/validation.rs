@@ -364,22 +364,17 @@ impl Validation {
         gyro: &[DeviceVec],
         orientation: &[WorldFromDevice],
     ) -> Result<(), SequenceError> {
-        let rates: Vec<StepRate> = step_rates(time, gyro, orientation).collect();
-        let jumps = rates.iter().filter(|r| r.is_jump()).count();
-        let leave_out = jumps as f64 <= MAX_JUMP_SHARE * rates.len() as f64;
-        let mut fit = GyroFit::default();
-        for step in &rates {
-            match leave_out && step.is_jump() {
-                true => fit.left_out += 1,
-                false => fit.add(step),
-            }
+        let mut steps = GyroSteps::default();
+        for step in step_rates(time, gyro, orientation) {
+            steps.add(&step);
         }
-        self.gyro_verdict(&fit)
+        self.gyro_verdict(steps.fit())
     }
 
     /// [`Self::check_gyro_scale`] of the sums of its steps.
     pub(crate) fn gyro_verdict(&self, fit: &GyroFit) -> Result<(), SequenceError> {
-        let GyroFit { gw, ww, gg, n, .. } = *fit;
+        let GyroFit { gw, gg, n, .. } = *fit;
+        let ww = fit.ww();
         if n == 0 {
             return Ok(());
         }
@@ -500,17 +495,17 @@ impl Validation {
 pub struct GyroFit {
     /// Gyro rate times orientation rate (magnitudes), summed.
     pub(crate) gw: f64,
-    /// Orientation rate squared, summed.
-    pub(crate) ww: f64,
     /// Gyro rate squared, summed.
     pub(crate) gg: f64,
     /// Per device axis: gyro rate times orientation rate, summed.
     pub(crate) axis_gw: [f64; 3],
-    /// Per device axis: orientation rate squared, summed.
+    /// Per device axis: orientation rate squared, summed (the orientation rate squared is
+    /// their sum over the axes).
     pub(crate) axis_ww: [f64; 3],
     /// Steps left out as orientation jumps.
     pub(crate) left_out: usize,
-    /// Dot product of the two rate vectors, summed.
+    /// Dot product of the two rate vectors, summed (step by step: summed over the axes
+    /// instead, opposite rates read an agreement a rounding below -1).
     pub(crate) dot: f64,
     /// Steps.
     pub(crate) n: usize,
@@ -519,10 +514,8 @@ pub struct GyroFit {
 impl GyroFit {
     /// Adds a step.
     pub(crate) fn add(&mut self, step: &StepRate) {
-        let (w, g) = (step.w(), step.g());
-        self.gw += g * w;
-        self.ww += w * w;
-        self.gg += g * g;
+        self.gw += step.g * step.w;
+        self.gg += step.g * step.g;
         self.dot += step.gyro.dot(&step.rate);
         for k in 0..3 {
             self.axis_gw[k] += step.gyro[k] * step.rate[k];
@@ -549,8 +542,13 @@ impl GyroFit {
     /// ([`MIN_GYRO_AGREEMENT`]). `None` while the orientation turns too little to judge
     /// ([`GYRO_SCALE_MIN_RATE`] RMS) or the gyro reads nothing.
     pub fn agreement(&self) -> Option<f64> {
-        let turns = self.n > 0 && (self.ww / self.n as f64).sqrt() >= GYRO_SCALE_MIN_RATE;
+        let turns = self.n > 0 && (self.ww() / self.n as f64).sqrt() >= GYRO_SCALE_MIN_RATE;
         (turns && self.gw > 0.0).then(|| self.dot / self.gw)
+    }
+
+    /// The orientation rate squared, summed over the steps.
+    fn ww(&self) -> f64 {
+        self.axis_ww.iter().sum()
     }
 }
 
@@ -642,23 +640,42 @@ pub(crate) struct StepRate {
     pub(crate) dt: f64,
     pub(crate) rate: Vector3<f64>,
     pub(crate) gyro: Vector3<f64>,
+    /// `rate`'s and `gyro`'s norms: the rates' magnitudes.
+    pub(crate) w: f64,
+    pub(crate) g: f64,
 }
 
 impl StepRate {
-    /// The orientation's rotation rate, rad/s.
-    pub(crate) fn w(&self) -> f64 {
-        self.rate.norm()
-    }
-
-    /// The gyro's rotation rate, rad/s.
-    pub(crate) fn g(&self) -> f64 {
-        self.gyro.norm()
-    }
-
     /// Whether the orientation turns so much faster than the gyro that the step belongs to an
     /// orientation jump ([`ORIENTATION_JUMP_RATE`]).
     pub(crate) fn is_jump(&self) -> bool {
-        self.w() - self.g() > ORIENTATION_JUMP_RATE
+        self.w - self.g > ORIENTATION_JUMP_RATE
+    }
+}
+
+/// A recording's steps as [`Validation::check_gyro_scale`] sums them, as they come (a stream's
+/// too): the fit of every step and the fit without the orientation jumps; [`Self::fit`] is
+/// the one judged.
+#[derive(Debug, Clone, Copy, Default)]
+pub(crate) struct GyroSteps {
+    all: GyroFit,
+    kept: GyroFit,
+}
+
+impl GyroSteps {
+    pub(crate) fn add(&mut self, step: &StepRate) {
+        self.all.add(step);
+        match step.is_jump() {
+            true => self.kept.left_out += 1,
+            false => self.kept.add(step),
+        }
+    }
+
+    /// Without the jumps while they are at most [`MAX_JUMP_SHARE`] of the steps; beyond, they
+    /// are no glitches but a gyro that disagrees, and every step counts.
+    pub(crate) fn fit(&self) -> &GyroFit {
+        let leave_out = self.kept.left_out as f64 <= MAX_JUMP_SHARE * self.all.n as f64;
+        if leave_out { &self.kept } else { &self.all }
     }
 }
 
@@ -675,11 +692,15 @@ pub(crate) fn step_rates<'a>(
             // The step's rotation in the device frame (world-from-device q_k = q_{k-1} * step),
             // as a rotation vector: the rate the gyro should read, direction included.
             let step = orientation[k - 1].inverse() * orientation[k];
+            let rate = step.quaternion().scaled_axis() / dt;
+            let gyro = (*gyro[k - 1].vector() + *gyro[k].vector()) * 0.5;
             StepRate {
                 k,
                 dt,
-                rate: step.quaternion().scaled_axis() / dt,
-                gyro: (*gyro[k - 1].vector() + *gyro[k].vector()) * 0.5,
+                w: rate.norm(),
+                g: gyro.norm(),
+                rate,
+                gyro,
             }
         })
     })
@@ -699,7 +720,7 @@ pub fn orientation_jumps(
         if !step.is_jump() {
             continue;
         }
-        let (k, dt, w, g) = (step.k, step.dt, step.w(), step.g());
+        let StepRate { k, dt, w, g, .. } = step;
         let excess = (w - g) * dt;
         match out.last_mut() {
             Some(j) if time[k - 1] - j.time.1 <= JUMP_JOIN_S => {

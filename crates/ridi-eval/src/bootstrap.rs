@@ -40,11 +40,6 @@ pub struct Interval {
     pub high: f64,
 }
 
-/// NaN: serde's default of a figure left out ([`nan_if_null`] reads `null` as the same).
-pub(crate) fn nan() -> f64 {
-    f64::NAN
-}
-
 /// A float that JSON holds as `null` where it is NaN (serde_json writes a NaN as `null`).
 pub(crate) fn nan_if_null<'de, D: serde::Deserializer<'de>>(d: D) -> Result<f64, D::Error> {
     Ok(Option::<f64>::deserialize(d)?.unwrap_or(f64::NAN))

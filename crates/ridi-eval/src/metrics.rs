@@ -41,51 +41,48 @@ use crate::error::{
 /// [`evaluate_trajectory`] checks. A figure written as `null` (a NaN), or left out of a
 /// hand-edited file, reads back as NaN (`None` for the optional ones).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-// A misspelled figure in a hand-edited report is an error, not a missing figure.
-#[serde(deny_unknown_fields)]
+// A misspelled figure in a hand-edited report is an error, not a missing figure; a figure
+// left out is missing (`TrajectoryMetrics::missing`'s).
+#[serde(deny_unknown_fields, default = "TrajectoryMetrics::missing")]
 pub struct TrajectoryMetrics {
     /// Mean positional error, metres.
-    #[serde(
-        deserialize_with = "crate::bootstrap::nan_if_null",
-        default = "crate::bootstrap::nan"
-    )]
+    #[serde(deserialize_with = "crate::bootstrap::nan_if_null")]
     pub mpe_m: f64,
     /// Mean positional error, % of the ground-truth path length.
-    #[serde(default)]
     pub mpe_pct: Option<f64>,
     /// Absolute trajectory error, Euclidean RMS, metres.
-    #[serde(
-        deserialize_with = "crate::bootstrap::nan_if_null",
-        default = "crate::bootstrap::nan"
-    )]
+    #[serde(deserialize_with = "crate::bootstrap::nan_if_null")]
     pub ate_m: f64,
     /// Relative trajectory error (long window), Euclidean RMS, metres.
-    #[serde(
-        deserialize_with = "crate::bootstrap::nan_if_null",
-        default = "crate::bootstrap::nan"
-    )]
+    #[serde(deserialize_with = "crate::bootstrap::nan_if_null")]
     pub rte_m: f64,
     /// Absolute trajectory error, RoNIN per-coordinate RMS, metres.
-    #[serde(
-        deserialize_with = "crate::bootstrap::nan_if_null",
-        default = "crate::bootstrap::nan"
-    )]
+    #[serde(deserialize_with = "crate::bootstrap::nan_if_null")]
     pub ate_ronin_m: f64,
     /// Relative trajectory error (long window), RoNIN per-coordinate RMS, metres.
-    #[serde(
-        deserialize_with = "crate::bootstrap::nan_if_null",
-        default = "crate::bootstrap::nan"
-    )]
+    #[serde(deserialize_with = "crate::bootstrap::nan_if_null")]
     pub rte_ronin_m: f64,
     /// Relative trajectory error (short window), Euclidean RMS, metres.
-    #[serde(
-        deserialize_with = "crate::bootstrap::nan_if_null",
-        default = "crate::bootstrap::nan"
-    )]
+    #[serde(deserialize_with = "crate::bootstrap::nan_if_null")]
     pub rte_5s_m: f64,
     /// Estimated over ground-truth horizontal path length.
-    #[serde(default)]
     pub path_length_ratio: Option<f64>,
+}
+
+impl TrajectoryMetrics {
+    /// Every figure missing: NaN, or `None` for the optional ones.
+    fn missing() -> Self {
+        Self {
+            mpe_m: f64::NAN,
+            mpe_pct: None,
+            ate_m: f64::NAN,
+            rte_m: f64::NAN,
+            ate_ronin_m: f64::NAN,
+            rte_ronin_m: f64::NAN,
+            rte_5s_m: f64::NAN,
+            path_length_ratio: None,
+        }
+    }
 }
 
 /// Mean positional error (MPE), metres: `(1/N) Σᵢ ‖estᵢ − gtᵢ‖`.

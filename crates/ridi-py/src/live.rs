@@ -305,9 +305,6 @@ impl LiveTracker {
 /// minutes at Unix times).
 fn refuse_unreadable(obj: &Bound<'_, PyAny>, name: &str) -> PyResult<()> {
     let kind = |o: &Bound<'_, PyAny>| -> Option<(u8, usize)> {
-        if o.is_instance_of::<pyo3::types::PyBool>() {
-            return Some((b'b', 1));
-        }
         let dtype = o.getattr("dtype").ok()?;
         let kind = dtype.getattr("kind").ok()?.extract::<String>().ok()?;
         let size = dtype.getattr("itemsize").ok()?.extract::<usize>().ok()?;
@@ -319,12 +316,12 @@ fn refuse_unreadable(obj: &Bound<'_, PyAny>, name: &str) -> PyResult<()> {
         _ => vec![obj.clone()],
     };
     for item in items.iter().chain(std::iter::once(obj)) {
+        if crate::options::not_bool(item).is_err() {
+            return Err(PyTypeError::new_err(format!(
+                "`{name}` holds bools; a sample's readings are numbers"
+            )));
+        }
         match kind(item) {
-            Some((b'b', _)) => {
-                return Err(PyTypeError::new_err(format!(
-                    "`{name}` holds bools; a sample's readings are numbers"
-                )));
-            }
             Some((b'f', size)) if name == "time" && size < 8 => {
                 return Err(PyTypeError::new_err(format!(
                     "`time` is a float{}: its bits have rounded the timestamp already (to 0.24 \

@@ -43,9 +43,9 @@ mod text;
 mod tyrex;
 
 pub use errors::{Blame, assert_err, assert_names_file};
-#[cfg(unix)]
-pub use files::make_fifo;
 pub use files::{edit_file, file_names, stderr, write_files};
+#[cfg(unix)]
+pub use files::{is_fifo, make_fifo};
 pub use mat::{MatArray, MatWriter, qtm_take};
 pub use naive::{naive_features, naive_kernel, naive_mirror, naive_smooth};
 pub use paths::{sample_dataset, shared_dataset, workspace_root};

@@ -123,7 +123,12 @@ pub fn compare_reports(first: &Report, second: &Report) -> Result<Comparison> {
     let mut figures = Vec::new();
     // Figures one report has for a sequence and the other lacks: compared over fewer sequences.
     let mut one_sided = Vec::new();
-    for method in first.methods.iter().filter(|m| second.methods.contains(m)) {
+    let shared: Vec<&String> = first
+        .methods
+        .iter()
+        .filter(|m| second.methods.contains(m))
+        .collect();
+    for &method in &shared {
         for metric in Metric::ALL {
             let mut rows: Vec<(f64, f64, &str)> = Vec::new();
             let mut lacking = 0;
@@ -165,7 +170,7 @@ pub fn compare_reports(first: &Report, second: &Report) -> Result<Comparison> {
             });
         }
     }
-    if !first.methods.iter().any(|m| second.methods.contains(m)) {
+    if shared.is_empty() {
         warnings.push(format!(
             "the two reports share no method ({} against {}): no figure to compare",
             first.methods.join(", "),

@@ -809,11 +809,7 @@ impl Report {
         for w in &self.warnings {
             let _ = writeln!(out, "**Warning**: {w}.\n");
         }
-        let has_intervals = self
-            .intervals
-            .values()
-            .flat_map(BTreeMap::values)
-            .any(ridi_eval::Interval::is_bounded);
+        let has_intervals = self.has_intervals();
         if has_intervals {
             let _ = writeln!(
                 out,
@@ -968,6 +964,15 @@ impl Report {
             .map_err(|e| file(format!("not a report.json of `ridi eval`: {e}")))?;
         report.check_read().map_err(file)?;
         Ok(report)
+    }
+
+    /// Whether any mean has a 95 % interval (there are none from fewer than
+    /// [`ridi_eval::MIN_INTERVAL_RUNS`] runs).
+    pub fn has_intervals(&self) -> bool {
+        self.intervals
+            .values()
+            .flat_map(BTreeMap::values)
+            .any(ridi_eval::Interval::is_bounded)
     }
 
     /// Refuses what no evaluation writes (a hand-edited report): a negative figure, RTE

@@ -602,13 +602,7 @@ mod tests {
             std::fs::read_to_string(dir.path().join("keep.txt")).unwrap(),
             "kept"
         );
-        use std::os::unix::fs::FileTypeExt as _;
-        assert!(
-            std::fs::symlink_metadata(&fifo)
-                .unwrap()
-                .file_type()
-                .is_fifo()
-        );
+        assert!(ridi_test_support::is_fifo(&fifo));
     }
 
     #[test]
