@@ -144,12 +144,14 @@ pub fn world_acceleration(imu: &ImuFrames<'_>) -> Result<Vec<WorldVec>, CorrectE
 /// past its last knot take the last knot's value).
 ///
 /// # Errors
-/// Refuses frames a correction refuses (any time step is accepted).
+/// Refuses frames a correction refuses (any time step is accepted), and a curve whose knots'
+/// times do not increase strictly.
 pub fn corrected_acceleration(
     imu: &ImuFrames<'_>,
     bias: &BiasCurve,
 ) -> Result<Vec<WorldVec>, CorrectError> {
     validate_imu(imu, f64::INFINITY)?;
+    bias.knots().check_times()?;
     Ok(corrected_acceleration_unchecked(imu, bias))
 }
 
@@ -228,5 +230,14 @@ mod tests {
         });
         assert_eq!(world_acceleration(&imu), short);
         assert_eq!(corrected_acceleration(&imu, &bias), short);
+        // Knots at one time (built from another timeline) would weigh 0 / 0: refused.
+        imu.orientation = &orientation;
+        let stuck = BiasCurve::zero(Knots::new(&[0.0; 20], 5));
+        assert_eq!(
+            corrected_acceleration(&imu, &stuck),
+            Err(CorrectError::InvalidKnots(
+                "times must be finite and increasing"
+            ))
+        );
     }
 }

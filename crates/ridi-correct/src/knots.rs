@@ -50,14 +50,13 @@ impl TryFrom<KnotParts> for Knots {
         {
             return Err(bad("frames are not every `spacing` frames from 0"));
         }
-        if p.times.iter().any(|t| !t.is_finite()) || p.times.windows(2).any(|w| w[1] <= w[0]) {
-            return Err(bad("times must be finite and increasing"));
-        }
-        Ok(Self {
+        let knots = Self {
             spacing: p.spacing,
             frames: p.frames,
             times: p.times,
-        })
+        };
+        knots.check_times()?;
+        Ok(knots)
     }
 }
 
@@ -79,6 +78,18 @@ impl Knots {
             frames,
             times,
         }
+    }
+
+    /// Checks that the knots' times are finite and increase strictly: [`Knots::new`] takes
+    /// them from any `time`, and the weight between two knots at one time is 0 / 0.
+    pub(crate) fn check_times(&self) -> Result<(), CorrectError> {
+        let t = &self.times;
+        if t.iter().any(|t| !t.is_finite()) || t.windows(2).any(|w| w[1] <= w[0]) {
+            return Err(CorrectError::InvalidKnots(
+                "times must be finite and increasing",
+            ));
+        }
+        Ok(())
     }
 
     /// Number of knots.

@@ -10,6 +10,8 @@ use std::collections::VecDeque;
 
 use serde::{Deserialize, Serialize};
 
+use crate::CorrectError;
+
 /// Parameters of the placement-change filter.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 pub struct PlacementFilter {
@@ -81,6 +83,28 @@ impl Default for PlacementSmoother {
 }
 
 impl PlacementSmoother {
+    /// A smoother voting over `window_s` seconds.
+    ///
+    /// # Errors
+    /// A `window_s` that is not finite and positive.
+    pub fn new(window_s: f64) -> Result<Self, CorrectError> {
+        let s = Self { window_s };
+        s.validate()?;
+        Ok(s)
+    }
+
+    /// Checks the window (its field is public): finite and positive. A window of another
+    /// value smooths nothing, or not as asked, but never panics.
+    pub fn validate(&self) -> Result<(), CorrectError> {
+        if self.window_s.is_finite() && self.window_s > 0.0 {
+            Ok(())
+        } else {
+            Err(CorrectError::InvalidConfig(
+                "placement smoothing window_s must be finite and positive",
+            ))
+        }
+    }
+
     /// The smoothed label of each entry of `labels` (indices below `classes`) observed at
     /// `times` (seconds, non-decreasing). A tie keeps the label itself when it is among the
     /// most frequent, else the lowest tied label: the result does not depend on anything but
@@ -100,7 +124,8 @@ impl PlacementSmoother {
                 counts[labels[hi]] += 1;
                 hi += 1;
             }
-            while times[lo] < t - half {
+            // `lo < hi`: a negative window (unvalidated) would run past what was counted.
+            while lo < hi && times[lo] < t - half {
                 counts[labels[lo]] -= 1;
                 lo += 1;
             }
@@ -171,6 +196,22 @@ mod tests {
         };
         assert_eq!(wide.flags(&[Some(0), Some(1)]), [true, true]);
         assert_eq!(wide.flags(&[Some(0), None, Some(0)]), [false; 3]);
+    }
+
+    #[test]
+    fn a_window_that_is_not_positive_is_refused_and_does_not_panic_unchecked() {
+        for window_s in [0.0, -1.0, f64::NAN, f64::INFINITY] {
+            assert!(PlacementSmoother::new(window_s).is_err(), "{window_s}");
+            // Built through the public field, unchecked: labels come back, no panic.
+            let s = PlacementSmoother { window_s };
+            assert_eq!(s.smooth(&[0.0, 1.0, 2.0], &[0, 1, 0], 2).len(), 3);
+            let mut live = s.trailing(2);
+            assert!(live.push(0.0, 1) < 2);
+        }
+        assert_eq!(
+            PlacementSmoother::new(10.0).unwrap(),
+            PlacementSmoother::default()
+        );
     }
 
     #[test]

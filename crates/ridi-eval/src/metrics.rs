@@ -371,15 +371,13 @@ impl ConfusionMatrix {
 
     /// Total number of samples, `Σ counts`.
     pub fn total(&self) -> usize {
-        self.counts.iter().flatten().sum()
+        count_sum(self.counts.iter().flatten())
     }
 
     /// Overall accuracy, `Σ_c counts[c][c] / total`; `None` for an empty matrix.
     pub fn accuracy(&self) -> Option<f64> {
         let total = self.total();
-        let diag: usize = (0..self.counts.len())
-            .map(|c| self.counts[c].get(c).copied().unwrap_or(0))
-            .sum();
+        let diag = count_sum((0..self.counts.len()).filter_map(|c| self.counts[c].get(c)));
         (total > 0).then(|| diag as f64 / total as f64)
     }
 
@@ -387,7 +385,7 @@ impl ConfusionMatrix {
     /// in the truth or `c` is out of range.
     pub fn recall(&self, c: usize) -> Option<f64> {
         let row = self.counts.get(c)?;
-        let n: usize = row.iter().sum();
+        let n = count_sum(row);
         (n > 0).then(|| row.get(c).copied().unwrap_or(0) as f64 / n as f64)
     }
 
@@ -395,9 +393,15 @@ impl ConfusionMatrix {
     /// predicted or `c` is out of range.
     pub fn precision(&self, c: usize) -> Option<f64> {
         let hit = *self.counts.get(c)?.get(c)?;
-        let n: usize = self.counts.iter().filter_map(|row| row.get(c)).sum();
+        let n = count_sum(self.counts.iter().filter_map(|row| row.get(c)));
         (n > 0).then(|| hit as f64 / n as f64)
     }
+}
+
+/// A sum of confusion counts, saturating: the fields are public (and read from reports), and
+/// counts no recording reaches must not overflow.
+fn count_sum<'a>(counts: impl IntoIterator<Item = &'a usize>) -> usize {
+    counts.into_iter().fold(0, |a, &c| a.saturating_add(c))
 }
 
 /// How far the mean rate of a timeline ([`estimate_rate_hz`]) may be from
@@ -684,6 +688,15 @@ mod tests {
             ConfusionMatrix::from_indices(&[0, 0, 1, 2, 3, 3], &[0, 1, 1, 2, 3, 2], &classes)
                 .unwrap();
         assert_eq!(by_index, cm);
+        // Counts no recording reaches (a report edited by hand) saturate, not overflow.
+        let huge = ConfusionMatrix {
+            classes: vec!["a".into(), "b".into()],
+            counts: vec![vec![usize::MAX, 1], vec![1, usize::MAX]],
+        };
+        assert_eq!(huge.total(), usize::MAX);
+        assert!(huge.accuracy().is_some_and(f64::is_finite));
+        assert!(huge.recall(0).is_some_and(f64::is_finite));
+        assert!(huge.precision(1).is_some_and(f64::is_finite));
     }
 
     #[test]

@@ -185,7 +185,9 @@ fn subtract_moving_average(x: &[f64], half: usize) -> Vec<f64> {
     (0..x.len())
         .map(|i| {
             let lo = i.saturating_sub(half);
-            let hi = (i + half + 1).min(x.len());
+            // Saturating: a window longer than any recording (half near usize::MAX) is the
+            // whole recording, not an overflow.
+            let hi = i.saturating_add(half).saturating_add(1).min(x.len());
             x[i] - (prefix[hi] - prefix[lo]) / (hi - lo) as f64
         })
         .collect()
@@ -342,6 +344,13 @@ mod tests {
             let off = phase.min(0.5 - phase);
             assert!(off < 0.03, "step at {} s is {off} s off a crest", times[s]);
         }
+        // A baseline window longer than the recording is its mean: the same walk, no overflow.
+        let whole = StepDetectorConfig {
+            baseline_window_s: 1e18,
+            ..StepDetectorConfig::default()
+        };
+        let steps = detect_steps_in_magnitude(&times, &magnitude, &whole).unwrap();
+        assert!(steps.len().abs_diff(60) <= 1, "{} steps", steps.len());
     }
 
     #[test]

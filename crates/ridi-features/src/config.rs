@@ -179,8 +179,14 @@ impl Standardization {
     }
 
     /// Standardizes one feature row in place.
+    ///
+    /// # Errors
+    /// A row of another length, and a standardization that is not one (its fields are
+    /// public): lengths that differ, a non-finite mean, a standard deviation that is not
+    /// positive and finite.
     pub fn apply_row(&self, row: &mut [f32]) -> Result<(), FeatureError> {
-        if row.len() != self.dim() || self.std.len() != self.dim() {
+        self.validate(self.dim())?;
+        if row.len() != self.dim() {
             return Err(FeatureError::LengthMismatch {
                 what: "feature row",
                 expected: self.dim(),
@@ -192,9 +198,13 @@ impl Standardization {
     }
 
     /// Standardizes every row of `m` in place (in parallel).
+    ///
+    /// # Errors
+    /// As [`Standardization::apply_row`].
     pub fn apply(&self, m: &mut FeatureMatrix) -> Result<(), FeatureError> {
         use rayon::prelude::*;
-        if m.cols() != self.dim() || self.std.len() != self.dim() {
+        self.validate(self.dim())?;
+        if m.cols() != self.dim() {
             return Err(FeatureError::LengthMismatch {
                 what: "feature matrix row",
                 expected: self.dim(),

@@ -59,7 +59,17 @@ pub(crate) fn half_kernel(sigma: f64, truncate: f64) -> Result<Vec<f64>, Feature
         return Ok(vec![1.0]);
     }
     let a = -0.5 / (sigma * sigma);
-    let half: Vec<f64> = (0..=r).map(|x| (a * (x * x) as f64).exp()).collect();
+    // The centre tap is 1 whatever `a` is: for a sigma whose square underflows, `a` is -inf
+    // and `-inf * 0` would be NaN.
+    let half: Vec<f64> = (0..=r)
+        .map(|x| {
+            if x == 0 {
+                1.0
+            } else {
+                (a * (x * x) as f64).exp()
+            }
+        })
+        .collect();
     // Sum in scipy's order (from -r to r) so the normalization matches to the last bit as
     // closely as a different summation engine allows.
     let sum: f64 = (0..=2 * r).map(|i| half[i.abs_diff(r)]).sum();
@@ -265,6 +275,13 @@ mod tests {
         let k = gaussian_kernel(2.0, 4.0).unwrap();
         assert_eq!(half_kernel(2.0, 4.0).unwrap()[..], k[8..]);
         assert_eq!(kernel_radius(30.0, 4.0), 120);
+    }
+
+    #[test]
+    fn a_sigma_whose_square_underflows_is_the_identity_not_nan() {
+        // Radius 1 (truncate * sigma + 0.5 rounds down), sigma^2 = 0: the centre tap alone.
+        let out = gaussian_filter1d(&[1.0, 2.0, 3.0], 1e-300, 1e300).unwrap();
+        assert_eq!(out, [1.0, 2.0, 3.0]);
     }
 
     #[test]

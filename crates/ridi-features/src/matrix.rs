@@ -15,11 +15,18 @@ pub struct FeatureMatrix {
 
 impl FeatureMatrix {
     /// A zero-filled matrix.
+    ///
+    /// # Panics
+    /// If `rows * cols` overflows `usize` (no allocation could hold it; unchecked, it would
+    /// wrap into a matrix smaller than its shape).
     pub fn zeros(rows: usize, cols: usize) -> Self {
+        let len = rows
+            .checked_mul(cols)
+            .expect("FeatureMatrix::zeros: rows * cols overflows usize");
         Self {
             rows,
             cols,
-            data: vec![0.0; rows * cols],
+            data: vec![0.0; len],
         }
     }
 

@@ -95,11 +95,24 @@ pub fn turned_copies(
     // Checked once here, so that the rows below cannot fail half-way.
     YawTurn::new(0.0).row(&mut vec![0.0; features.cols()])?;
     // Appended rather than zero-filled and overwritten: the matrix is the whole training set.
-    let mut data = Vec::with_capacity(total * features.cols());
+    // Reserved fallibly: a count of copies no memory holds is an error, not an abort.
+    let too_many = || {
+        FeatureError::InvalidConfig(format!(
+            "{copies} turned copies of {n} rows of {} features do not fit in memory",
+            features.cols()
+        ))
+    };
+    let values = total.checked_mul(features.cols()).ok_or_else(too_many)?;
+    let mut data = Vec::new();
+    data.try_reserve_exact(values).map_err(|_| too_many())?;
     data.extend_from_slice(features.as_slice());
-    let mut targets_out = Vec::with_capacity(total);
+    let mut targets_out = Vec::new();
+    targets_out
+        .try_reserve_exact(total)
+        .map_err(|_| too_many())?;
     targets_out.extend_from_slice(targets);
-    let mut source = Vec::with_capacity(total);
+    let mut source = Vec::new();
+    source.try_reserve_exact(total).map_err(|_| too_many())?;
     source.extend(0..n);
     const PHI: f64 = 0.618_033_988_749_894_9;
     for j in 0..copies {
@@ -214,5 +227,10 @@ mod tests {
         // The two copies of one row are half a turn apart.
         assert!((ty[3] + ty[6]).norm() < 1e-5);
         assert!(turned_copies(&x, &y[..2], 1).is_err());
+        // More copies than memory holds: an error, not an abort or an overflow.
+        for copies in [1 << 40, usize::MAX] {
+            let e = turned_copies(&x, &y, copies).unwrap_err().to_string();
+            assert!(e.contains("turned copies of 3 rows"), "{e}");
+        }
     }
 }

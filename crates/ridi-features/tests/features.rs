@@ -487,6 +487,20 @@ fn standardization_fit_apply_and_fused_extraction() {
             std: vec![1.0, 1.0]
         }
     );
+    // Built through its public fields, a zero or missing deviation is refused, not divided by.
+    for bad in [
+        Standardization {
+            mean: vec![2.0, 5.0],
+            std: vec![1.0, 0.0],
+        },
+        Standardization {
+            mean: vec![2.0, 5.0],
+            std: vec![1.0],
+        },
+    ] {
+        assert!(bad.apply_row(&mut [1.0, 2.0]).is_err());
+        assert!(bad.apply(&mut FeatureMatrix::zeros(3, 2)).is_err());
+    }
 }
 
 #[test]

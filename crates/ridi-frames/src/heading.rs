@@ -173,7 +173,12 @@ impl HeadingCorrector {
             },
             Some(s) => {
                 let dt = time - s.time;
-                let limit = self.config.max_rate * dt;
+                // Not `0 * inf` = NaN (a clamp to NaN panics) for times of extreme range.
+                let limit = if self.config.max_rate == 0.0 {
+                    0.0
+                } else {
+                    self.config.max_rate * dt
+                };
                 let drift = s.drift + wrap_angle(h - s.raw).clamp(-limit, limit);
                 let gain = 1.0 - (-dt / self.config.time_constant).exp();
                 State {
@@ -432,5 +437,13 @@ mod tests {
             with_reference_heading(&[], &[], &[], &HeadingConfig::default()),
             Ok(Vec::new())
         );
+        // No clamp at all across the widest finite step (0 rad/s times an infinite step).
+        let mut still = HeadingCorrector::new(HeadingConfig {
+            max_rate: 0.0,
+            ..HeadingConfig::default()
+        })
+        .unwrap();
+        still.correct(-1.5e308, q, q).unwrap();
+        assert_eq!(still.correct(1.5e308, q, turned), Ok(q));
     }
 }

@@ -15,14 +15,45 @@ const QUERY_BLOCK: usize = 512;
 
 /// Support vectors with `k` coefficient columns.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(try_from = "ExpansionParts")]
 pub(crate) struct Expansion {
     #[serde(with = "crate::matrix::stored")]
     pub sv: FeatureMatrix,
+    /// Squared norms of the support vectors: recomputed when read, not stored.
+    #[serde(skip)]
     pub norms: Vec<f32>,
     /// Row-major `n_sv × k`.
     pub coef: Vec<f64>,
     pub k: usize,
     pub gamma: f32,
+}
+
+/// [`Expansion`] as stored (the public serde form of [`Svr`](crate::Svr) and
+/// [`Svc`](crate::Svc)), checked on the way in: evaluation indexes by its sizes.
+#[derive(Deserialize)]
+struct ExpansionParts {
+    #[serde(with = "crate::matrix::stored")]
+    sv: FeatureMatrix,
+    coef: Vec<f64>,
+    k: usize,
+    gamma: f32,
+}
+
+impl TryFrom<ExpansionParts> for Expansion {
+    type Error = RegressError;
+    fn try_from(p: ExpansionParts) -> Result<Self, RegressError> {
+        let bad = |m: &str| Err(RegressError::Decode(format!("support vectors: {m}")));
+        if p.k == 0 || p.sv.rows().checked_mul(p.k) != Some(p.coef.len()) {
+            return bad("one coefficient per support vector and column is needed");
+        }
+        if !p.sv.as_slice().iter().all(|v| v.is_finite()) || !p.coef.iter().all(|c| c.is_finite()) {
+            return bad("non-finite value");
+        }
+        if !(p.gamma.is_finite() && p.gamma > 0.0) {
+            return bad("the kernel width must be finite and positive");
+        }
+        Ok(Self::new(p.sv, p.coef, p.k, p.gamma))
+    }
 }
 
 impl Expansion {

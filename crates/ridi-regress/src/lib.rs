@@ -109,8 +109,12 @@
 //!
 //! [`Cascade::save`] and [`Cascade::load`] (or [`Cascade::to_bytes`] and
 //! [`Cascade::from_bytes`]): the magic number [`MODEL_MAGIC`], the format version (7 for an
-//! exact model, 8 = [`MODEL_FORMAT_VERSION`] for a Nyström one), a CRC32, and a bincode 2 payload including the
-//! [`ridi_features::FeatureConfig`]; atomic writes, deterministic bytes. That configuration is
+//! exact model, 8 = [`MODEL_FORMAT_VERSION`] for a Nyström one), a CRC32, and a bincode 2
+//! payload including the [`ridi_features::FeatureConfig`]; atomic writes (a path that is not a
+//! regular file, such as a link or a pipe, is refused), deterministic bytes; reading checks
+//! every size and value a prediction uses. `Cascade`'s serde impls are that payload's codec,
+//! not a format of their own: a model deserialized by serde alone is refused by prediction
+//! (the [`Svr`] and [`Svc`] machines' serde forms are checked when read). That configuration is
 //! how a model is used: its features must be computed with it, and its velocities are in the S
 //! its `up_axis` defines (give the same `up_axis` to a correction of them, ridi-correct's
 //! `CorrectionConfig::up_axis`).

@@ -83,7 +83,11 @@ impl Cascade {
     /// (`.<name>.tmp<pid>-<n>`), `fsync`, rename. An error removes the temporary file; a process
     /// killed while saving leaves it, since this crate keeps no record of other processes'
     /// files. `ridi::save_model` writes through `ridi_data::write_atomically` instead, which
-    /// removes what killed runs left.
+    /// removes what killed runs left and writes through a symbolic link.
+    ///
+    /// # Errors
+    /// Encoding or I/O failures, and a `path` that exists and is not a regular file (a
+    /// symbolic link, a device, a pipe: the rename would replace it).
     pub fn save(&self, path: impl AsRef<Path>) -> Result<(), RegressError> {
         save(self, path.as_ref())
     }
@@ -300,6 +304,16 @@ fn io_err(path: &Path) -> impl FnOnce(std::io::Error) -> RegressError + '_ {
 }
 
 fn save(model: &Cascade, path: &Path) -> Result<(), RegressError> {
+    // The rename would replace a link, a device, a pipe or a socket with a regular file.
+    if let Ok(m) = std::fs::symlink_metadata(path)
+        && !m.is_file()
+    {
+        return Err(io_err(path)(std::io::Error::other(
+            "not a regular file (a folder, a symbolic link, a device, a pipe or a socket), which \
+             saving would replace: save to a regular file, or through `ridi::save_model`, which \
+             writes through links",
+        )));
+    }
     let bytes = encode(model)?;
     let dir = match path.parent() {
         Some(d) if !d.as_os_str().is_empty() => d.to_path_buf(),

@@ -115,6 +115,13 @@ pub(crate) fn fit_ovo(
     params: &SvcParams,
     on_pair: &mut dyn FnMut(usize, usize) -> bool,
 ) -> Result<Vec<PairDual>, RegressError> {
+    if k > Svc::MAX_CLASSES {
+        return Err(RegressError::InvalidParam(format!(
+            "{k} classes: a one-vs-one classifier fits a machine per pair of them, at most {} \
+             classes",
+            Svc::MAX_CLASSES
+        )));
+    }
     let mut members: Vec<Vec<usize>> = vec![Vec::new(); k];
     for (i, &c) in class_of.iter().enumerate() {
         members[c].push(i);
@@ -182,8 +189,10 @@ pub(crate) fn vote(dec: &[f64], pairs: &[(u32, u32)], k: usize, votes: &mut [u32
     best
 }
 
-/// Trained multi-class (or binary) C-SVC over integer labels.
+/// Trained multi-class (or binary) C-SVC over integer labels. Its serde form is checked when
+/// read (labels, pairs, sizes, finite values), so a deserialized one predicts or was refused.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(try_from = "SvcParts")]
 pub struct Svc {
     /// Sorted distinct labels; class index `c` stands for `labels[c]`.
     pub(crate) labels: Vec<usize>,
@@ -195,8 +204,51 @@ pub struct Svc {
     pub(crate) info: Vec<FitInfo>,
 }
 
+/// [`Svc`] as stored, checked on the way in: voting indexes by its pairs.
+#[derive(Deserialize)]
+struct SvcParts {
+    labels: Vec<usize>,
+    pairs: Vec<(u32, u32)>,
+    exp: Expansion,
+    rho: Vec<f64>,
+    params: SvcParams,
+    info: Vec<FitInfo>,
+}
+
+impl TryFrom<SvcParts> for Svc {
+    type Error = RegressError;
+    fn try_from(p: SvcParts) -> Result<Self, RegressError> {
+        let k = p.labels.len();
+        let consistent = (2..=Svc::MAX_CLASSES).contains(&k)
+            && p.labels.windows(2).all(|w| w[0] < w[1])
+            && p.pairs.len() == k * (k - 1) / 2
+            && p.pairs.iter().all(|&(a, b)| a < b && (b as usize) < k)
+            && p.rho.len() == p.pairs.len()
+            && p.rho.iter().all(|r| r.is_finite())
+            && p.exp.k == p.pairs.len();
+        if !consistent {
+            return Err(RegressError::Decode(
+                "SVC: labels, class pairs, offsets and coefficient columns disagree".into(),
+            ));
+        }
+        Ok(Self {
+            labels: p.labels,
+            pairs: p.pairs,
+            exp: p.exp,
+            rho: p.rho,
+            params: p.params,
+            info: p.info,
+        })
+    }
+}
+
 impl Svc {
-    /// Trains on rows of `x` with labels `y` (at least two distinct labels).
+    /// Most distinct labels a classifier is trained for: one-vs-one fits `k (k - 1) / 2`
+    /// machines, 499,500 at this bound (a placement classifier has a handful).
+    pub const MAX_CLASSES: usize = 1000;
+
+    /// Trains on rows of `x` with labels `y` (at least two distinct labels, at most
+    /// [`Svc::MAX_CLASSES`]).
     pub fn fit(
         x: FeatureMatrixRef<'_>,
         y: &[usize],

@@ -151,13 +151,41 @@ pub(crate) fn solve_svr(
     }
 }
 
-/// Trained epsilon-SVR: `f(x) = Σ_s coef_s K(sv_s, x) - rho`.
+/// Trained epsilon-SVR: `f(x) = Σ_s coef_s K(sv_s, x) - rho`. Its serde form is checked when
+/// read (sizes, finite values), so a deserialized one predicts or was refused.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(try_from = "SvrParts")]
 pub struct Svr {
     pub(crate) exp: Expansion,
     pub(crate) rho: f64,
     pub(crate) params: SvrParams,
     pub(crate) info: FitInfo,
+}
+
+/// [`Svr`] as stored, checked on the way in.
+#[derive(Deserialize)]
+struct SvrParts {
+    exp: Expansion,
+    rho: f64,
+    params: SvrParams,
+    info: FitInfo,
+}
+
+impl TryFrom<SvrParts> for Svr {
+    type Error = RegressError;
+    fn try_from(p: SvrParts) -> Result<Self, RegressError> {
+        if p.exp.k != 1 || !p.rho.is_finite() {
+            return Err(RegressError::Decode(
+                "SVR: one coefficient column and a finite offset are needed".into(),
+            ));
+        }
+        Ok(Self {
+            exp: p.exp,
+            rho: p.rho,
+            params: p.params,
+            info: p.info,
+        })
+    }
 }
 
 pub(crate) fn check_xy(x: FeatureMatrixRef<'_>, n_targets: usize) -> Result<(), RegressError> {

@@ -237,6 +237,59 @@ fn speed_regressor_scales_velocities_to_the_regressed_speed() {
     assert_eq!(back.predict(xt).unwrap(), scaled);
 }
 
+/// An exact model of two placements with fixed hyper-parameters, and its data.
+fn small_exact_model() -> (Data, Cascade) {
+    let data = make(2, 3, 8, 11);
+    let params = fixed(CascadeParams::default().storage, Solver::Exact);
+    let model = Cascade::train(&data.set(), &params, &mut NoProgress).unwrap();
+    (data, model)
+}
+
+#[test]
+fn a_nan_anywhere_in_an_exact_model_file_is_refused_or_harmless() {
+    // Every 8 bytes of the payload made a NaN f64, the checksum fixed: the file is refused,
+    // or (the bytes of no f64, such as counts) the model still predicts finite velocities.
+    let (data, model) = small_exact_model();
+    let bytes = model.to_bytes().unwrap();
+    let x = data.set().features;
+    let mut refused = 0;
+    for at in 24..bytes.len() - 8 {
+        let mut b = bytes.clone();
+        b[at..at + 8].copy_from_slice(&f64::NAN.to_le_bytes());
+        let crc = crc32fast::hash(&b[24..]);
+        b[20..24].copy_from_slice(&crc.to_le_bytes());
+        match Cascade::from_bytes(&b) {
+            Err(_) => refused += 1,
+            Ok(m) => {
+                for p in m.predict(x).unwrap() {
+                    assert!(p.velocity.is_finite(), "a NaN at byte {at} predicts {p:?}");
+                }
+            }
+        }
+    }
+    assert!(refused > 0);
+}
+
+#[test]
+fn a_cascade_deserialized_by_serde_alone_predicts_nothing() {
+    // Its serde form is the model file's payload, without what the file adds and checks.
+    let (data, model) = small_exact_model();
+    let cfg = bincode::config::standard();
+    let bytes = bincode::serde::encode_to_vec(&model, cfg).unwrap();
+    let (back, _): (Cascade, _) = bincode::serde::decode_from_slice(&bytes, cfg).unwrap();
+    let x = data.set().features;
+    for e in [
+        back.predict(x).unwrap_err(),
+        back.predict_one(x.row(0)).unwrap_err(),
+        back.predict_with_placement(x, 0).unwrap_err(),
+    ] {
+        assert!(e.to_string().contains("Cascade::from_bytes"), "{e}");
+    }
+    // The model file's codec gives it back whole.
+    let whole = Cascade::from_bytes(&model.to_bytes().unwrap()).unwrap();
+    assert_eq!(whole.predict(x).unwrap(), model.predict(x).unwrap());
+}
+
 #[test]
 fn training_is_deterministic_and_model_files_round_trip() {
     let data = make(2, 3, 12, 5);
@@ -273,6 +326,21 @@ fn training_is_deterministic_and_model_files_round_trip() {
         1,
         "temporary file left behind"
     );
+    // What the rename would replace is refused and left as it was: a link, a pipe, a folder.
+    #[cfg(unix)]
+    {
+        let link = dir.join("link.ridi");
+        std::os::unix::fs::symlink(&path, &link).unwrap();
+        let fifo = dir.join("fifo.ridi");
+        ridi_test_support::make_fifo(&fifo);
+        for kept in [&link, &fifo, &dir] {
+            let e = a.save(kept).unwrap_err().to_string();
+            assert!(e.contains("not a regular file"), "{e}");
+        }
+        assert!(std::fs::symlink_metadata(&link).unwrap().is_symlink());
+        assert!(ridi_test_support::is_fifo(&fifo));
+        assert_eq!(std::fs::read_dir(&dir).unwrap().count(), 3);
+    }
     std::fs::remove_dir_all(&dir).unwrap();
 
     let mut corrupt = bytes.clone();
@@ -447,6 +515,13 @@ fn small_or_degenerate_placements_give_clear_errors_or_documented_fallbacks() {
     assert!(matches!(
         Cascade::train(&set, &fixed, &mut NoProgress),
         Err(RegressError::LengthMismatch { expected: 30, .. })
+    ));
+    // A feature configuration a model file would not load with is refused before training.
+    let mut stepless = make(2, 3, 10, 3);
+    stepless.config.step = 0;
+    assert!(matches!(
+        Cascade::train(&stepless.set(), &fixed, &mut NoProgress),
+        Err(RegressError::Features(FeatureError::InvalidConfig(_)))
     ));
 }
 

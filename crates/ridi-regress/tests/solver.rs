@@ -53,6 +53,63 @@ fn two_point_classifier_matches_closed_form() {
 }
 
 #[test]
+fn machines_read_back_by_serde_are_checked() {
+    let cfg = bincode::config::standard();
+    fn round<T: serde::de::DeserializeOwned>(bytes: &[u8]) -> Option<T> {
+        let cfg = bincode::config::standard();
+        bincode::serde::decode_from_slice(bytes, cfg)
+            .ok()
+            .map(|(m, _)| m)
+    }
+    let x = [0.0f32, 0.5, 1.0, 1.0, 0.0, 0.2, 0.3, 0.3, 0.9];
+    let xm = FeatureMatrixRef::new(&x, 3).unwrap();
+    let svr = Svr::fit(xm, &[0.5, -0.5, 0.1], &SvrParams::new(1.0, 0.01, 0.4)).unwrap();
+    let svc = Svc::fit(xm, &[7, 3, 9], &SvcParams::new(1.0, 0.4)).unwrap();
+    let svr_bytes = bincode::serde::encode_to_vec(&svr, cfg).unwrap();
+    let svc_bytes = bincode::serde::encode_to_vec(&svc, cfg).unwrap();
+    let svr_back: Svr = round(&svr_bytes).unwrap();
+    let svc_back: Svc = round(&svc_bytes).unwrap();
+    assert_eq!(svr_back, svr);
+    assert_eq!(svc_back, svc);
+    assert_eq!(svc_back.predict(xm).unwrap(), svc.predict(xm).unwrap());
+    // Any one byte changed is refused or still predicts: never a panic, never a NaN.
+    for (bytes, is_svr) in [(&svr_bytes, true), (&svc_bytes, false)] {
+        for at in 0..bytes.len() {
+            for v in [0u8, 1, 0x7f, 0xff] {
+                let mut b = bytes.clone();
+                b[at] = v;
+                if is_svr {
+                    if let Some(m) = round::<Svr>(&b) {
+                        assert!(m.predict(xm).is_ok_and(|p| p.iter().all(|v| v.is_finite())));
+                    }
+                } else if let Some(m) = round::<Svc>(&b) {
+                    m.predict(xm).unwrap();
+                }
+            }
+        }
+    }
+}
+
+#[test]
+fn a_label_per_row_beyond_the_class_bound_is_refused_before_any_fit() {
+    // 100,000 distinct labels would be 5e9 one-vs-one machines: refused, not an abort.
+    let n = 100_000;
+    let x = vec![0.0f32; n];
+    let y: Vec<usize> = (0..n).collect();
+    let e = Svc::fit(
+        FeatureMatrixRef::new(&x, 1).unwrap(),
+        &y,
+        &SvcParams::new(1.0, 1.0),
+    )
+    .unwrap_err()
+    .to_string();
+    assert!(
+        e.contains("100000 classes") && e.contains("at most 1000"),
+        "{e}"
+    );
+}
+
+#[test]
 fn two_point_regressor_matches_closed_form() {
     // Targets ±t: coefficients ±beta with beta = min(C, (t - eps) / (1 - k)), rho = 0, and the
     // fit reaches the tube edge t - eps when beta is not clipped.

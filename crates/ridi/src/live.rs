@@ -52,6 +52,9 @@ impl<'m> CascadeRegressor<'m> {
     /// A regressor over `model`; with `smoothing`, each placement becomes the majority label of
     /// the window's length of regressions before it (the streaming form of the batch vote).
     pub fn new(model: &'m Cascade, smoothing: Option<PlacementSmoother>) -> Result<Self> {
+        if let Some(s) = smoothing {
+            s.validate()?;
+        }
         let extractor = FeatureExtractor::new(model.feature_config().clone())?;
         let row = vec![0.0; extractor.dim()];
         Ok(Self {

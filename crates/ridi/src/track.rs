@@ -57,6 +57,26 @@ impl Track {
 
     /// The rows of [`Track::write_csv`], header first.
     pub(crate) fn csv(&self, w: &mut dyn std::io::Write) -> std::io::Result<()> {
+        // The fields are public: lengths that do not match are refused before a row is written.
+        let frames = self.time.len();
+        for (what, len, of, want) in [
+            ("positions", self.position.len(), "timestamps", frames),
+            ("velocities", self.velocity.len(), "timestamps", frames),
+            ("biases", self.bias.len(), "timestamps", frames),
+            (
+                "placements",
+                self.placements.len(),
+                "regressions",
+                self.regressions.len(),
+            ),
+        ] {
+            if len != want {
+                return Err(std::io::Error::new(
+                    std::io::ErrorKind::InvalidInput,
+                    format!("the track has {len} {what} for {want} {of}"),
+                ));
+            }
+        }
         let mut next = 0;
         let mut current: Option<&str> = None;
         csv_header(w)?;
@@ -264,6 +284,10 @@ pub(crate) fn regressed(
     model: &Cascade,
     opts: &TrackOptions,
 ) -> Result<(Vec<FrameVelocity>, Vec<usize>)> {
+    // Its field is public: checked before the work.
+    if let Some(s) = opts.placement_smoothing {
+        s.validate()?;
+    }
     let seq = oriented(
         seq,
         model.feature_config().orientation,

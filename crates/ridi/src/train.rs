@@ -125,6 +125,22 @@ impl TrainingData {
         if copies == 0 {
             return Ok(self);
         }
+        // The fields are public: rows whose placements or groups do not match are refused.
+        let rows = self.features.rows();
+        for (what, found) in [
+            ("placements", self.placements.len()),
+            ("groups", self.groups.len()),
+        ] {
+            if found != rows {
+                return Err(PipelineError::Features(
+                    ridi_features::FeatureError::LengthMismatch {
+                        what,
+                        expected: rows,
+                        found,
+                    },
+                ));
+            }
+        }
         let turned = ridi_features::turned_copies(&self.features, &self.targets, copies)?;
         Ok(Self {
             placements: turned.source.iter().map(|&i| self.placements[i]).collect(),
@@ -323,4 +339,34 @@ pub fn train(
         }
         e => e.into(),
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn turned_copies_of_rows_without_their_labels_are_refused() {
+        let data = TrainingData {
+            features: FeatureMatrix::zeros(10, 1200),
+            targets: vec![StabHorizontal::new(1.0, 0.0); 10],
+            placements: vec![0; 5],
+            placement_names: vec!["hand".into()],
+            groups: vec![0; 10],
+        };
+        let e = data.clone().with_turned_copies(1).unwrap_err().to_string();
+        assert!(e.contains("placements") && e.contains("10"), "{e}");
+        let data = TrainingData {
+            placements: vec![0; 10],
+            groups: vec![0; 3],
+            ..data
+        };
+        let e = data.clone().with_turned_copies(1).unwrap_err().to_string();
+        assert!(e.contains("groups"), "{e}");
+        let data = TrainingData {
+            groups: vec![0; 10],
+            ..data
+        };
+        assert_eq!(data.with_turned_copies(1).unwrap().placements.len(), 20);
+    }
 }

@@ -1,7 +1,7 @@
 //! End to end on the bundled sample: train, track (batch and online), evaluate.
 
 use ridi::CascadeRegressor;
-use ridi::correct::{Tracker, TrackerConfig};
+use ridi::correct::{PlacementSmoother, Tracker, TrackerConfig};
 use ridi::data::{Listed, ReadOptions, Sequence};
 use ridi::features::Orientation;
 use ridi::frames::nalgebra::Vector3;
@@ -272,6 +272,16 @@ fn placement_smoothing_takes_the_window_majority_and_its_regressors() {
     }
     // A model of one person mislabels some windows of another: the test must exercise that.
     assert!(changed > 0);
+    // A window set through the public field is checked, batch and streaming, before the work.
+    for online in [false, true] {
+        let bad = TrackOptions {
+            online,
+            placement_smoothing: Some(PlacementSmoother { window_s: -1.0 }),
+            ..TrackOptions::default()
+        };
+        let e = ridi::track(&test[0], &model, &bad).unwrap_err().to_string();
+        assert!(e.contains("window_s must be finite and positive"), "{e}");
+    }
 }
 
 #[test]
@@ -345,6 +355,18 @@ fn online_tracking_stays_close_to_batch_tracking() {
     assert!(first.ends_with(",1.28e-300,-5e-20,0"), "{first}");
     let longest = text.split([',', '\n']).map(str::len).max().unwrap();
     assert!(longest < 30, "a field of {longest} characters");
+    // A track put together with lengths that do not match is refused; the file is kept.
+    let mut short = batch.clone();
+    short.position.pop();
+    let e = format!("{:#}", short.write_csv(&csv).unwrap_err());
+    assert!(
+        e.contains(&format!("positions for {} timestamps", seq.len())),
+        "{e}"
+    );
+    let mut unlabelled = batch.clone();
+    unlabelled.placements.clear();
+    assert!(unlabelled.write_csv(&csv).is_err());
+    assert_eq!(std::fs::read_to_string(&csv).unwrap(), text);
 }
 
 #[test]

@@ -177,6 +177,7 @@ impl Cascade {
                 norms,
                 clf_weights,
             })),
+            checked: true,
         })
     }
 }

@@ -40,6 +40,11 @@ pub use self::rounding::RoundingEffect;
 pub use self::train::TrainingSet;
 
 /// A trained cascade (what the model file holds).
+///
+/// Its serde impls are the model file's payload codec, not a storage format of their own: a
+/// `Cascade` deserialized by serde alone lacks what [`Cascade::from_bytes`] recomputes, adds
+/// and checks (the Nyström part, the samples' norms, the consistency checks), and its
+/// predictions are refused. Store a model with [`Cascade::to_bytes`] or [`Cascade::save`].
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Cascade {
     feature_config: FeatureConfig,
@@ -56,6 +61,10 @@ pub struct Cascade {
     /// 7): the model file writes it after the cascade, as format 8.
     #[serde(skip)]
     nystrom: Option<Box<NystromParts>>,
+    /// Trained, or decoded and checked ([`Cascade::finish_decode`]): `false` only for one
+    /// deserialized by serde alone, which prediction refuses.
+    #[serde(skip)]
+    checked: bool,
 }
 
 /// What a Nyström model adds to the cascade: the classifier's landmarks, drawn from all

@@ -77,6 +77,7 @@ thread_local! {
 impl Cascade {
     /// Classifies and regresses one query (the online path).
     pub fn predict_one(&self, q: &[f32]) -> Result<Prediction, RegressError> {
+        self.check_decoded()?;
         if q.len() != self.dim {
             return Err(RegressError::LengthMismatch {
                 what: "query row",
@@ -262,6 +263,7 @@ impl Cascade {
     }
 
     pub(super) fn check_dim(&self, x: FeatureMatrixRef<'_>) -> Result<(), RegressError> {
+        self.check_decoded()?;
         if x.cols() != self.dim {
             return Err(RegressError::LengthMismatch {
                 what: "query row",

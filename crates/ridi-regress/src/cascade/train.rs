@@ -110,6 +110,8 @@ fn check_training_set(
     if data.placement_names.is_empty() {
         return Err(RegressError::NotEnoughData("no placements".into()));
     }
+    // As a model file's is checked when read: a model is never saved that cannot be loaded.
+    data.feature_config.validate()?;
     let fd = data.feature_config.feature_dim();
     if fd != data.features.cols() {
         return Err(RegressError::LengthMismatch {
@@ -313,6 +315,7 @@ impl Cascade {
             grid: grid_rows,
             projection,
             nystrom: None,
+            checked: true,
         })
     }
 }

@@ -15,7 +15,22 @@ impl Cascade {
             n.norms = n.landmarks.norms();
         }
         self.check()?;
-        self.check_nystrom()
+        self.check_nystrom()?;
+        self.checked = true;
+        Ok(())
+    }
+
+    /// Refuses a model deserialized by serde alone (see [`Cascade`]).
+    pub(crate) fn check_decoded(&self) -> Result<(), RegressError> {
+        if self.checked {
+            Ok(())
+        } else {
+            Err(RegressError::Decode(
+                "a model deserialized by serde alone, unchecked and incomplete: read model \
+                 files with Cascade::from_bytes or Cascade::load"
+                    .into(),
+            ))
+        }
     }
 
     /// The Nyström part: the classifier's landmarks in the model's storage (some exactly when
@@ -50,24 +65,8 @@ impl Cascade {
         {
             return bad("placement sizes");
         }
-        // Every number a query multiplies or adds: a non-finite one would give NaN velocities.
-        let offsets = self.classes.iter().flat_map(|c| {
-            c.reg_rho
-                .iter()
-                .copied()
-                .chain(c.speed.as_ref().map(|s| s.rho))
-        });
-        let head = self.classifier.iter().flat_map(|h| h.rho.iter().copied());
-        let coef = self.classes.iter().flat_map(|c| c.reg_coef.iter().copied());
-        if !n
-            .clf_weights
-            .iter()
-            .copied()
-            .chain(coef)
-            .chain(offsets)
-            .chain(head)
-            .all(f64::is_finite)
-        {
+        // The weights of its classifier; the rest is checked as any model's ([`Self::check`]).
+        if !n.clf_weights.iter().all(|w| w.is_finite()) {
             return bad("non-finite weight or offset");
         }
         Ok(())
@@ -130,6 +129,21 @@ impl Cascade {
             {
                 return bad("class sample store sizes");
             }
+        }
+        // Every number a query multiplies or adds: a non-finite one would give NaN velocities.
+        let offsets = self.classes.iter().flat_map(|c| {
+            c.reg_rho
+                .iter()
+                .copied()
+                .chain(c.speed.as_ref().map(|s| s.rho))
+        });
+        let head = self.classifier.iter().flat_map(|h| h.rho.iter().copied());
+        let coef = self
+            .classes
+            .iter()
+            .flat_map(|c| c.reg_coef.iter().chain(&c.clf_coef).copied());
+        if !coef.chain(offsets).chain(head).all(f64::is_finite) {
+            return bad("non-finite weight or offset");
         }
         Ok(())
     }
