@@ -71,18 +71,18 @@
 //!
 //! # Errors
 //! Every error names the file, and the line and field when one is to blame: a non-numeric or
-//! non-finite value, too few values (a truncated line), too many (two records run together
-//! without a line break), a record line that is not `unix_ms<TAB>TYPE_...`, timestamps of one
-//! type that go back or leave a gap longer than the validation's `max_gap_s` (repeated
-//! timestamps keep their first record; with that limit raised, as `ridi convert
+//! non-finite value, too few values (a truncated line), too many (named as two records run together
+//! when the next record's type is among them), a record line that is not `unix_ms<TAB>TYPE_...`,
+//! timestamps of one type that go back or leave a gap longer than the validation's `max_gap_s`
+//! (repeated timestamps keep their first record; with that limit raised, as `ridi convert
 //! --split-at-gaps` reads, a pause stays a gap of the timeline and a magnetometer dropout over
-//! [`MAX_MAGNET_FILL_S`] leaves the magnetometer out), a rotation vector longer than 1, a missing accelerometer,
-//! gyroscope or rotation vector, a single waypoint, waypoints that do not overlap the IMU
-//! data, a last record without a line break after it (a file cut off while being written;
-//! complete files end with the `#<TAB>endTime` line), a value beyond its channel's physical
-//! bound (accelerometer, gyroscope, magnetic field, waypoint) and a record type in the wrong unit
-//! (an IMU type whose timestamps step by less than 0.1 ms, a gyroscope in deg/s, an accelerometer
-//! in g): the [`Validation`] limits, applied to each record type before resampling.
+//! [`MAX_MAGNET_FILL_S`] leaves the magnetometer out), a rotation vector longer than 1, a missing
+//! accelerometer, gyroscope or rotation vector, a single waypoint, waypoints that do not overlap
+//! the IMU data, a last record without a line break after it (a file cut off while being written;
+//! complete files end with the `#<TAB>endTime` line), a value beyond its channel's physical bound
+//! (accelerometer, gyroscope, magnetic field, waypoint) and a record type in the wrong unit (an IMU
+//! type whose timestamps step by less than 0.1 ms, a gyroscope in deg/s, an accelerometer in g):
+//! the [`Validation`] limits, applied to each record type before resampling.
 //!
 //! # Example
 //! ```no_run
@@ -554,10 +554,13 @@ fn parse_records(content: &str, path: &Path) -> Result<([Stream; 5], Header)> {
         let t_ms = text::number(stamp, path, line, "unix_ms", Nan::Reject)?;
         let mut v = [0.0; 3];
         let mut n = 0;
+        // The next record's type among the values: its line break is missing.
+        let mut run_together = false;
         for cell in cells {
             if n < want {
                 v[n] = text::number(cell, path, line, kind.fields[n], Nan::Reject)?;
             }
+            run_together |= cell.trim_start().starts_with("TYPE_");
             n += 1;
         }
         let expected = || {
@@ -582,9 +585,13 @@ fn parse_records(content: &str, path: &Path) -> Result<([Stream; 5], Header)> {
             return Err(DataError::format(
                 Location::line(path, line).with_field(ty),
                 format!(
-                    "{n} values for {ty}, expected {}: two records run together (a missing \
-                     line break)?",
-                    expected()
+                    "{n} values for {ty}, expected {}: {}",
+                    expected(),
+                    if run_together {
+                        "two records run together (a missing line break)"
+                    } else {
+                        "a recorder that writes more values than the competition's files do"
+                    }
                 ),
             ));
         }
@@ -1067,7 +1074,14 @@ mod tests {
                 "1574559496000\tTYPE_WAYPOINT\t1\t5",
                 "1574559496000\tTYPE_WAYPOINT\t1\t5\t0",
                 "p/abc.txt:263: field `TYPE_WAYPOINT`: 3 values for TYPE_WAYPOINT, expected \
-                 `x y`: two records run together",
+                 `x y`: a recorder that writes more values than the competition's files do",
+            ),
+            (
+                // Android's rotation vector has a fifth value, w, before the accuracy.
+                "1574559495020\tTYPE_ROTATION_VECTOR\t0\t0\t0.0009999998333333417\t3",
+                "1574559495020\tTYPE_ROTATION_VECTOR\t0\t0\t0.0009999998333333417\t1\t3",
+                "p/abc.txt:14: field `TYPE_ROTATION_VECTOR`: 5 values for TYPE_ROTATION_VECTOR, \
+                 expected `x y z [accuracy]`: a recorder that writes more values",
             ),
         ];
         for (from, to, want) in cases {

@@ -226,9 +226,6 @@ impl Callback {
     }
 }
 
-// A literal, so that `inspect.signature` shows the value (a path shows as `...`).
-const _: () = assert!(Nystrom::DEFAULT_LANDMARKS == 2048);
-
 /// Trains a model, as ``ridi train`` does, with its options and defaults.
 ///
 /// ``data`` is a list file (``path,placement`` per line), several, or a list of
@@ -237,7 +234,7 @@ const _: () = assert!(Nystrom::DEFAULT_LANDMARKS == 2048);
 /// (``"tyrex4"`` or a ``label,class`` file), ``orientation`` (``"recorded"``,
 /// ``"estimated"``), ``storage`` (``"projected"``: 99.99 % of the variance, 90 % with the
 /// Nyström solver; ``"half"``), ``solver`` (``"exact"``,
-/// ``"nystrom"``), ``landmarks``, ``seed`` (of the grid's folds and the Nyström draws),
+/// ``"nystrom"``), ``landmarks`` (with ``"nystrom"`` only, default 2048), ``seed`` (of the grid's folds and the Nyström draws),
 /// ``turned_copies``, ``step`` (default ``10 * (turned_copies +
 /// 1)``), ``window`` (default 200), ``speed`` (``False`` for ``--no-speed``), ``up_axis``
 /// (``"plus-or-minus-y"``, ``"plus-y"``), ``standardize`` (``False`` for
@@ -255,7 +252,7 @@ const _: () = assert!(Nystrom::DEFAULT_LANDMARKS == 2048);
 #[pyfunction]
 #[pyo3(signature = (
     data, *, grid="paper", placement_map=None, orientation="estimated", storage="projected",
-    solver="exact", landmarks=2048, seed=0, turned_copies=1, step=None,
+    solver="exact", landmarks=None, seed=0, turned_copies=1, step=None,
     window=None, speed=true, up_axis="plus-or-minus-y", standardize=true, classifier_c=10.0,
     jobs=None, progress=None,
 ))]
@@ -268,7 +265,7 @@ pub(crate) fn train(
     orientation: &str,
     storage: &str,
     solver: &str,
-    #[pyo3(from_py_with = crate::options::whole)] landmarks: i64,
+    #[pyo3(from_py_with = crate::options::opt_whole)] landmarks: Option<i64>,
     #[pyo3(from_py_with = crate::options::whole_wide)] seed: i128,
     #[pyo3(from_py_with = crate::options::whole)] turned_copies: i64,
     #[pyo3(from_py_with = crate::options::opt_whole)] step: Option<i64>,
@@ -313,13 +310,22 @@ pub(crate) fn train(
     opts.cascade.classifier_c = options::positive("classifier_c", classifier_c)?;
     opts.cascade.regressors = grid.regressors();
     opts.cascade.speed = speed;
-    // Checked whatever the solver, so that a wrong value is never passed over unsaid.
-    let landmarks = options::count("landmarks", landmarks, 2, Nystrom::MAX_LANDMARKS)?;
+    let landmarks = landmarks
+        .map(|l| options::count("landmarks", l, 2, Nystrom::MAX_LANDMARKS))
+        .transpose()?;
     opts.cascade.method = match choice("solver", solver, &[("exact", false), ("nystrom", true)])? {
-        false => Solver::Exact,
-        true => {
-            Solver::Nystrom(Nystrom::new(landmarks, 0).map_err(|e| errors::value(e.to_string()))?)
+        // As `ridi train --landmarks` with the exact solver: a value that would be ignored.
+        false if landmarks.is_some() => {
+            return Err(errors::value(
+                "`landmarks` is for solver=\"nystrom\": the exact solver keeps every training \
+                 window",
+            ));
         }
+        false => Solver::Exact,
+        true => Solver::Nystrom(
+            Nystrom::new(landmarks.unwrap_or(Nystrom::DEFAULT_LANDMARKS), 0)
+                .map_err(|e| errors::value(e.to_string()))?,
+        ),
     };
     opts.cascade.set_seed(u64::try_from(seed).map_err(|_| {
         errors::value(format!(

@@ -91,6 +91,8 @@ def test_progress_reports_each_stage_and_can_cancel():
         (dict(step=0), r"`step` is 0"),
         (dict(classifier_c=0.0), r"`classifier_c` is 0"),
         (dict(solver="nystrom", landmarks=1), r"`landmarks` is 1"),
+        (dict(landmarks=64), r"`landmarks` is for solver=\"nystrom\""),
+        (dict(landmarks=1), r"`landmarks` is 1"),
         (dict(storage="full"), r"`storage` is 'full'"),
         (dict(orientation="magnetic"), r"`orientation` is 'magnetic'"),
         (dict(up_axis="z"), r"`up_axis` is 'z'"),

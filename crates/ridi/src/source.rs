@@ -82,12 +82,23 @@ pub fn source_format(path: &Path, from: Option<Format>) -> Result<Format, DataEr
 /// Reads the sequence(s) at `path`: a RIDI `data.csv`, `data_plain.txt`, RIDI raw folder,
 /// Tyrex sequence folder, Indoor Location Competition path file or RoNIN sequence folder. `from` forces a format
 /// instead of detecting it: a source that is not one is an error saying what it is and what
-/// the format looks like; a folder read as a RIDI raw folder names the raw files it lacks.
+/// the format looks like; a folder read as a RIDI raw folder names the raw files it lacks, and
+/// one with both a `data.csv` and a `data_plain.txt` is read from the one `from` names.
 pub fn read_any(
     path: &Path,
     from: Option<Format>,
     opts: &ReadOptions,
 ) -> Result<Loaded, DataError> {
+    // Detection prefers a folder's data.csv; forced, its data_plain.txt is what is read.
+    let plain = (from == Some(Format::RidiPlain) && path.is_dir())
+        .then(|| {
+            ["processed/data_plain.txt", "data_plain.txt"]
+                .map(|rel| path.join(rel))
+                .into_iter()
+                .find(|file| std::fs::symlink_metadata(file).is_ok())
+        })
+        .flatten();
+    let path = plain.as_deref().unwrap_or(path);
     let format = source_format(path, from)?;
     match format {
         Format::Tyrex => {

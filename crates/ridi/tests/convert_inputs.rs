@@ -202,6 +202,18 @@ fn a_source_of_another_format_than_given_says_what_it_is_and_what_was_expected()
     let files = files_under(&out);
     assert_eq!(files.len(), 10, "{files:?}");
     assert!(!files.iter().any(|f| f.contains("staging")), "{files:?}");
+    // A folder with both processed files reads its data.csv unless data_plain.txt is asked for.
+    let both = dir.path().join("both");
+    std::fs::create_dir_all(both.join("processed")).unwrap();
+    write_ridi_csv(&s, both.join("processed/data.csv")).unwrap();
+    write_ridi_plain(&s.slice(0..1000), both.join("processed/data_plain.txt")).unwrap();
+    let frames = |from| {
+        let loaded = ridi::read_any(&both, from, &opts).unwrap();
+        (loaded.format, loaded.sequences[0].len())
+    };
+    assert_eq!(frames(None), (Format::RidiCsv, s.len()));
+    assert_eq!(frames(Some(Format::RidiCsv)), (Format::RidiCsv, s.len()));
+    assert_eq!(frames(Some(Format::RidiPlain)), (Format::RidiPlain, 1000));
 }
 
 #[test]

@@ -231,7 +231,7 @@ def train(
     orientation: Literal["recorded", "estimated"] = "estimated",
     storage: Literal["projected", "half"] = "projected",
     solver: Literal["exact", "nystrom"] = "exact",
-    landmarks: int = 2048,
+    landmarks: Optional[int] = None,
     seed: int = 0,
     turned_copies: int = 1,
     step: Optional[int] = None,
