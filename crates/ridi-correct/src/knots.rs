@@ -64,7 +64,7 @@ impl Knots {
     /// Knots for the frames of `time` every `spacing` frames. `spacing` is clamped to at
     /// least 1; an empty `time` gives no knot. `time` should increase strictly, as every
     /// correction input's does (checked there): knots at other times are refused when read
-    /// back (deserialized).
+    /// back (deserialized) and by [`corrected_acceleration`](crate::corrected_acceleration).
     pub fn new(time: &[f64], spacing: usize) -> Self {
         let spacing = spacing.max(1);
         let n = time.len();

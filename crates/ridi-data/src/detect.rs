@@ -86,6 +86,30 @@ impl Format {
     }
 }
 
+/// A folder's processed RIDI files, in the order detection takes them. A RIDI capture folder
+/// often holds the raw files and `processed/`: the processed file is what the published
+/// dataset ships, with the trimmed, synchronized timeline, so it wins.
+const PROCESSED_FILES: [(&str, Format); 6] = [
+    ("processed/data.csv", Format::RidiCsv),
+    ("processed/data.csv.gz", Format::RidiCsv),
+    ("data.csv", Format::RidiCsv),
+    ("data.csv.gz", Format::RidiCsv),
+    ("processed/data_plain.txt", Format::RidiPlain),
+    ("data_plain.txt", Format::RidiPlain),
+];
+
+/// The file in `folder` a processed recording of `format` is read from, when it holds one
+/// (present, even as a link that cannot be followed, whose reading then says so): for a
+/// folder holding both a `data.csv` and a `data_plain.txt`, which [`detect`] reads as its
+/// `data.csv`, the file a reader forced to `data_plain.txt` takes.
+pub fn processed_file(folder: &Path, format: Format) -> Option<PathBuf> {
+    PROCESSED_FILES
+        .iter()
+        .filter(|(_, f)| *f == format)
+        .map(|(rel, _)| folder.join(rel))
+        .find(|file| std::fs::symlink_metadata(file).is_ok())
+}
+
 /// What [`detect`] found: the format and the file or folder its reader takes.
 pub(crate) fn locate(path: &Path) -> Result<(Format, PathBuf)> {
     if path.is_file() {
@@ -137,16 +161,7 @@ pub(crate) fn locate(path: &Path) -> Result<(Format, PathBuf)> {
         ));
     }
     let has = |p: &str| crate::text::present_or_error(&path.join(p));
-    // A RIDI capture folder often holds the raw files and `processed/`: the processed file is
-    // what the published dataset ships, with the trimmed, synchronized timeline, so it wins.
-    for (rel, format) in [
-        ("processed/data.csv", Format::RidiCsv),
-        ("processed/data.csv.gz", Format::RidiCsv),
-        ("data.csv", Format::RidiCsv),
-        ("data.csv.gz", Format::RidiCsv),
-        ("processed/data_plain.txt", Format::RidiPlain),
-        ("data_plain.txt", Format::RidiPlain),
-    ] {
+    for (rel, format) in PROCESSED_FILES {
         if has(rel)? {
             return Ok((format, path.join(rel)));
         }

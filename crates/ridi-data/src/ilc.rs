@@ -376,11 +376,11 @@ fn name_of(path: &Path) -> String {
 
 /// Parses the content of a path file; `path` names it in errors and gives the sequence name.
 pub fn parse(bytes: &[u8], path: &Path, options: &IlcOptions) -> Result<IlcPath> {
-    if !(options.rate_hz.is_finite() && options.rate_hz > 0.0) {
-        return Err(DataError::format(
-            Location::file(path).with_field("rate_hz"),
-            format!("output rate must be positive, got {}", options.rate_hz),
-        ));
+    if let Some(e) = options
+        .validation
+        .output_rate_error(options.rate_hz, path, "rate_hz")
+    {
+        return Err(e);
     }
     let content = text::as_text(bytes, path)?;
     let (streams, header) = parse_records(content, path)?;
@@ -1324,16 +1324,19 @@ mod tests {
         assert!(seq.gyro().iter().all(|g| g.x() == 0.0));
         // Nothing at all.
         assert!(err("").contains("no TYPE_ACCELEROMETER records"));
-        let e = parse(
-            b"x",
-            Path::new("a.txt"),
-            &IlcOptions {
-                rate_hz: 0.0,
-                ..Default::default()
-            },
-        )
-        .unwrap_err();
-        assert!(e.to_string().contains("rate must be positive"), "{e}");
+        for rate_hz in [0.0, 1e12] {
+            let e = parse(
+                b"x",
+                Path::new("a.txt"),
+                &IlcOptions {
+                    rate_hz,
+                    ..Default::default()
+                },
+            )
+            .unwrap_err();
+            let want = format!("a.txt: field `rate_hz`: output rate {rate_hz} Hz: expected from");
+            assert!(e.to_string().starts_with(&want), "{e}");
+        }
     }
 
     /// A waypoint far off is named on its line, not on a frame of the resampled timeline.

@@ -111,7 +111,7 @@ pub mod tyrex;
 mod validation;
 mod write;
 
-pub use detect::{Format, detect, read_sequence, source_files};
+pub use detect::{Format, detect, processed_file, read_sequence, source_files};
 pub use device::{DeviceError, DeviceInfo};
 pub use error::{DataError, Location, Result, counted, first_few, one_line, shown, spans_text};
 pub use file_id::FileId;

@@ -546,6 +546,7 @@ fn required(folder: &Path, spec: &Spec, limits: &Validation) -> Result<Records> 
 /// every one it lacks.
 pub fn read(folder: impl AsRef<Path>, opts: &ReadOptions) -> Result<Sequence> {
     let folder = folder.as_ref();
+    check_rate(folder, opts)?;
     check_required(folder)?;
     let limits = &opts.validation;
     let gyro = required(folder, &GYRO, limits)?;
@@ -698,6 +699,19 @@ fn common_span(folder: &Path, spans: impl Iterator<Item = (f64, f64)>) -> Result
         ));
     }
     Ok((start, end))
+}
+
+/// Refuses a `rate_without_pose_hz` the validation's time steps exclude, whether or not the
+/// folder has a pose (an option is never passed over unsaid).
+pub(crate) fn check_rate(folder: &Path, opts: &ReadOptions) -> Result<()> {
+    let rate = opts.rate_without_pose_hz;
+    match opts
+        .validation
+        .output_rate_error(rate, folder, "rate_without_pose_hz")
+    {
+        Some(e) => Err(e),
+        None => Ok(()),
+    }
 }
 
 /// The error for a uniform timeline without a frame.

@@ -4,7 +4,7 @@ use std::fmt;
 use std::ops::Range;
 
 use ridi_frames::{
-    DeviceVec, FilterConfig, HeadingConfig, ImuFrames, WorldFromDevice, WorldVec,
+    DeviceVec, FilterConfig, Frame, HeadingConfig, ImuFrames, Rot, WorldFromDevice, WorldVec,
     estimate_orientation, gravity_and_linacce, with_reference_heading,
 };
 use serde::{Deserialize, Serialize};
@@ -285,7 +285,7 @@ pub fn part_name(name: &str, index: usize, parts: usize) -> String {
     if parts == 1 {
         name.to_owned()
     } else {
-        format!("{name}_part{}", index + 1)
+        format!("{name}_part{}", index.saturating_add(1))
     }
 }
 
@@ -363,6 +363,24 @@ fn check_vecs(field: &'static str, n: usize, v: &[DeviceVec]) -> Result<(), Sequ
     }
 }
 
+/// Checks that `field` has `n` rotations, each a finite unit quaternion: the constructors of
+/// `Rot` normalize, but an angle or axis that is NaN (a corrupt value) gives a NaN one.
+fn check_rots<A: Frame, B: Frame>(
+    field: &'static str,
+    n: usize,
+    r: &[Rot<A, B>],
+) -> Result<(), SequenceError> {
+    check_len(field, n, r.len())?;
+    let unit = |q: &Rot<A, B>| {
+        let w = q.to_wxyz();
+        w.iter().all(|c| c.is_finite()) && (w.iter().map(|c| c * c).sum::<f64>() - 1.0).abs() < 1e-6
+    };
+    match r.iter().position(|q| !unit(q)) {
+        Some(index) => Err(SequenceError::NonFinite { what: field, index }),
+        None => Ok(()),
+    }
+}
+
 impl Sequence {
     /// Validates `parts` with the default [`Validation`].
     pub fn new(parts: SequenceParts) -> Result<Self, SequenceError> {
@@ -387,10 +405,9 @@ impl Sequence {
         if let Some(m) = &parts.magnet {
             check_vecs("magnet", n, m)?;
         }
-        // Rot values are unit quaternions by construction; only the length can be wrong.
-        check_len("orientation", n, parts.orientation.len())?;
+        check_rots("orientation", n, &parts.orientation)?;
         if let Some(gt) = &parts.ground_truth {
-            check_len("ground_truth.orientation", n, gt.orientation.len())?;
+            check_rots("ground_truth.orientation", n, &gt.orientation)?;
             check_len("ground_truth.position", n, gt.position.len())?;
             if let Some(index) = gt.position.iter().position(|p| !p.is_finite()) {
                 return Err(SequenceError::NonFinite {
@@ -651,10 +668,11 @@ impl Sequence {
     /// [`SequenceError::InvalidRate`] for a `rate_hz` outside [`RESAMPLE_RATE_HZ`] or a `max_gap_s` that is not above 0 (infinity
     /// interpolates across every gap); a gap between two frames longer than `max_gap_s`
     /// (interpolating would invent the frames of a gap: split the recording there first); the
-    /// default validation of the result.
+    /// default validation of the result; gaps that would be most of the result
+    /// ([`SequenceError::ResampledAcrossGaps`]).
     pub fn resampled(&self, rate_hz: f64, max_gap_s: f64) -> Result<Sequence, SequenceError> {
         use crate::resample::{
-            interpolate_rot, interpolate_scalar, interpolate_vec3, uniform_timeline,
+            interpolate_rot, interpolate_scalar, interpolate_vec3, uniform_len, uniform_timeline,
         };
         // Checked before the frames are made: a rate the time-step check refuses could first
         // ask for billions of them. An infinite gap limit interpolates across every gap.
@@ -665,6 +683,14 @@ impl Sequence {
         let p = &self.parts;
         let t = &p.time;
         check_steps(t, max_gap_s)?;
+        // Before the frames are made: an infinite gap limit across a gap of years would fill it
+        // with billions of them.
+        let frames = uniform_len(t[0], t[t.len() - 1], rate_hz);
+        let covered = (t.len() as f64 * rate_hz / self.median_rate_hz().max(f64::MIN_POSITIVE))
+            .ceil() as usize;
+        if frames > covered.saturating_mul(2).saturating_add(2) {
+            return Err(SequenceError::ResampledAcrossGaps { frames, covered });
+        }
         let time = uniform_timeline(t[0], t[t.len() - 1], rate_hz);
         let vec3 = |v: &[DeviceVec]| interpolate_vec3(t, v, &time);
         Sequence::new(SequenceParts {

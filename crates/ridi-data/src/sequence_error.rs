@@ -85,6 +85,12 @@ pub(crate) fn time_step_message(median: f64, (min, max): (f64, f64), expected: &
 /// Axis names of the 3-vector channels.
 pub(crate) const AXES: [&str; 3] = ["x", "y", "z"];
 
+/// The name of `axis` (0..3) in an error's message; `?` for another (the errors' fields are
+/// public: a message never panics).
+pub(crate) fn axis_name(axis: usize) -> &'static str {
+    AXES.get(axis).copied().unwrap_or("?")
+}
+
 /// What is wrong with a value beyond its channel's bound, e.g. `1e308 m/s^2 is beyond any phone
 /// accelerometer (|value| <= 2000 m/s^2)`.
 pub(crate) fn beyond(channel: Channel, value: f64, limit: f64) -> String {
@@ -202,9 +208,21 @@ pub enum SequenceError {
         /// The longest gap to interpolate across, seconds.
         max_gap_s: f64,
     },
+    /// A resampling across gaps that would be most of the result
+    /// ([`Sequence::resampled`](crate::Sequence::resampled) with a large gap limit): more than
+    /// twice the frames the recording's own frames span at that rate, its median step each.
+    #[error(
+        "resampling would make {frames} frames, more than twice the {covered} its frames cover          at that rate: gaps would be most of the sequence (split it at its gaps first)"
+    )]
+    ResampledAcrossGaps {
+        /// Frames the uniform timeline would have.
+        frames: usize,
+        /// Frames the recording's frames cover at the rate asked for (each its median step).
+        covered: usize,
+    },
     /// A value beyond the hard physical bound of its channel ([`Validation::limit`](crate::Validation::limit)): a
     /// corrupt value or a wrong unit.
-    #[error("`{channel}.{}` at frame {index}: {}", AXES[*axis], beyond(*channel, *value, *limit))]
+    #[error("`{channel}.{}` at frame {index}: {}", axis_name(*axis), beyond(*channel, *value, *limit))]
     Implausible {
         /// The channel.
         channel: Channel,
@@ -285,7 +303,7 @@ pub enum SequenceError {
     #[error(
         "the gyro's {} axis reads {} times the orientation's rotation rate about it (least \
          squares over frames; at least {min} expected, where the other axes agree): {}?",
-        ["x", "y", "z"][*axis],
+        axis_name(*axis),
         short(*scale),
         if *scale < -0.5 { "a gyro axis with its sign reversed" } else { "a dead or stuck gyro axis" }
     )]
@@ -328,7 +346,7 @@ pub enum SequenceError {
     /// ([`Validation::max_speed`](crate::Validation::max_speed)): a corrupt position.
     #[error(
         "`ground_truth.position.{}` at frame {index}: {}",
-        AXES[*axis],
+        axis_name(*axis),
         jump(*distance, *dt, *max)
     )]
     GroundTruthJump {
@@ -431,5 +449,17 @@ mod tests {
             (short(f64::NAN), short(f64::NEG_INFINITY)),
             ("NaN".into(), "-inf".into())
         );
+    }
+
+    #[test]
+    fn an_axis_beyond_z_is_shown_not_indexed() {
+        let e = SequenceError::Implausible {
+            channel: Channel::Gyro,
+            axis: 3,
+            index: 0,
+            value: 1e9,
+            limit: 100.0,
+        };
+        assert!(e.to_string().starts_with("`gyro.?` at frame 0"), "{e}");
     }
 }

@@ -32,7 +32,7 @@ use crate::device::DeviceInfo;
 use crate::error::{DataError, Location, Result};
 use crate::text::{self, Nan};
 use crate::write::RoundTrip;
-use crate::{Sequence, write_atomically};
+use crate::{PendingFile, Sequence, write_pending};
 
 /// What a sidecar's name adds to its data file's.
 pub const SIDECAR_SUFFIX: &str = ".meta";
@@ -189,18 +189,19 @@ pub(crate) fn remove(data: &Path) -> Result<()> {
     }
 }
 
-/// Writes the sidecar of `data` for `seq` when it has metadata to keep (atomically): a device, or
-/// an orientation source other than the layout's game rotation vector. Without, writes nothing.
-pub(crate) fn write(seq: &Sequence, data: &Path) -> Result<()> {
+/// The sidecar of `data` for `seq`, written in full to a temporary file ([`write_pending`]) to
+/// be committed with the data file, when it has metadata to keep: a device, or an orientation
+/// source other than the layout's game rotation vector. Without, nothing.
+pub(crate) fn pending(seq: &Sequence, data: &Path) -> Result<Option<PendingFile>> {
     let device = seq.device();
     let source = seq
         .orientation_source()
         .filter(|&s| s != OrientationSource::GameRotationVector);
     if device.is_none() && source.is_none() {
-        return Ok(());
+        return Ok(None);
     }
     let name = data.file_name().unwrap_or_default().to_string_lossy();
-    write_atomically(&sidecar_path(data), |w| {
+    write_pending(&sidecar_path(data), |w| {
         writeln!(
             w,
             "# ridi-rs: what {name} has no column for (RIDI's own readers do not open this file)"
@@ -216,6 +217,7 @@ pub(crate) fn write(seq: &Sequence, data: &Path) -> Result<()> {
         }
         Ok(())
     })
+    .map(Some)
 }
 
 #[cfg(test)]

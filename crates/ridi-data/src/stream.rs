@@ -93,12 +93,12 @@ impl MedianTest {
     /// Uncounts one value counted before with these properties (for a sliding window of
     /// values).
     ///
-    /// # Panics
-    /// When no value with them is counted, as no caller that pushed it first can do.
+    /// Uncounting what was not counted leaves the counts at 0 (no caller that pushed it first
+    /// does; release builds do not check overflow, so this does).
     pub fn pop(&mut self, low: bool, high: bool) {
-        self.values -= 1;
-        self.low -= usize::from(low);
-        self.high -= usize::from(high);
+        self.values = self.values.saturating_sub(1);
+        self.low = self.low.saturating_sub(usize::from(low));
+        self.high = self.high.saturating_sub(usize::from(high));
     }
 
     /// Values counted.

@@ -4,7 +4,7 @@
 use std::path::Path;
 
 use crate::error::{DataError, Location, Result};
-use crate::sequence_error::{AXES, beyond, jump, short};
+use crate::sequence_error::{axis_name, beyond, jump, short};
 use crate::{Channel, SequenceError, Validation};
 
 /// Reads a whole file; the readers parse from memory because one pass over a byte slice is much
@@ -369,7 +369,7 @@ pub(crate) trait Fields {
 /// The name of `axis` among `axes`, or `first..last` for the whole channel (`None`).
 pub(crate) fn axis_field(axes: [&str; 3], axis: Option<usize>) -> String {
     match axis {
-        Some(a) => axes[a].to_owned(),
+        Some(a) => axes.get(a).copied().unwrap_or("?").to_owned(),
         None => format!("{}..{}", axes[0], axes[2]),
     }
 }
@@ -378,7 +378,7 @@ pub(crate) fn axis_field(axes: [&str; 3], axis: Option<usize>) -> String {
 /// channels a reader derives rather than reads.
 pub(crate) fn sequence_field(channel: Channel, axis: Option<usize>) -> String {
     match axis {
-        Some(a) => format!("{channel}.{}", AXES[a]),
+        Some(a) => format!("{channel}.{}", axis_name(a)),
         None => channel.name().to_owned(),
     }
 }

@@ -1147,11 +1147,50 @@ pub fn read(dir: impl AsRef<Path>, options: &TyrexOptions) -> Result<TyrexRead> 
             ),
         ));
     }
-    if !(options.rate_hz.is_finite() && options.rate_hz > 0.0) {
-        return Err(DataError::format(
-            Location::file(dir).with_field("rate_hz"),
-            format!("output rate must be positive, got {}", options.rate_hz),
-        ));
+    if let Some(e) = options
+        .validation
+        .output_rate_error(options.rate_hz, dir, "rate_hz")
+    {
+        return Err(e);
+    }
+    // NaN compares false: a NaN gap limit would split nothing and a NaN tilt trust both, unsaid;
+    // phone streams are never interpolated across an unbounded gap (that would invent them).
+    let o = options;
+    let positive = |v: f64| v.is_finite() && v > 0.0;
+    const POSITIVE: &str = "a finite number above 0";
+    for (field, value, ok, rule) in [
+        (
+            "max_mocap_gap_s",
+            o.max_mocap_gap_s,
+            o.max_mocap_gap_s > 0.0,
+            "above 0 (infinity interpolates across every loss)",
+        ),
+        (
+            "max_sensor_gap_s",
+            o.max_sensor_gap_s,
+            positive(o.max_sensor_gap_s),
+            POSITIVE,
+        ),
+        ("gravity", o.gravity, positive(o.gravity), POSITIVE),
+        (
+            "min_part_s",
+            o.min_part_s,
+            o.min_part_s.is_finite() && o.min_part_s >= 0.0,
+            "a finite number of at least 0",
+        ),
+        (
+            "max_mocap_tilt_deg",
+            o.max_mocap_tilt_deg,
+            o.max_mocap_tilt_deg > 0.0,
+            "above 0 (infinity trusts both)",
+        ),
+    ] {
+        if !ok {
+            return Err(DataError::format(
+                Location::file(dir).with_field(field),
+                format!("{value}: expected {rule}"),
+            ));
+        }
     }
     // `.` or `..` have no file name of their own: take the folder's real name.
     let name = dir

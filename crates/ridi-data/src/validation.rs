@@ -230,6 +230,31 @@ impl Validation {
         }
     }
 
+    /// The error for an output rate, `field` of the options a reader was given, whose time step
+    /// `1 / rate_hz` is outside [`Self::time_step_range`]: checked before the timeline is
+    /// built, which an absurd rate would make of billions of frames, refused only after.
+    pub(crate) fn output_rate_error(
+        &self,
+        rate_hz: f64,
+        at: &std::path::Path,
+        field: &str,
+    ) -> Option<crate::DataError> {
+        let (min, max) = self.time_step_range;
+        let accepted =
+            rate_hz.is_finite() && rate_hz > 0.0 && (min..=max).contains(&rate_hz.recip());
+        (!accepted).then(|| {
+            crate::DataError::format(
+                crate::Location::file(at).with_field(field),
+                format!(
+                    "output rate {rate_hz} Hz: expected from {} to {} Hz (time steps of {min} to \
+                     {max} s, the validation's range)",
+                    1.0 / max,
+                    1.0 / min
+                ),
+            )
+        })
+    }
+
     /// Checks the median interval of `time` (seconds, increasing) against
     /// [`Self::time_step_range`]; fewer than two times pass.
     pub fn check_time_step(&self, time: &[f64]) -> Result<(), SequenceError> {
@@ -762,9 +787,11 @@ pub fn bridge_orientation_jumps(
     // World-frame turn about z applied to the recorded orientation from the current frame on.
     let mut turn = WorldFromWorld::identity();
     let mut next = 0;
+    // Frames every slice has: a jump beyond a shorter time or gyro is skipped, not indexed.
+    let frames = orientation.len().min(time.len()).min(gyro.len());
     for jump in jumps {
         let (a, b) = jump.frames;
-        if a < next || b >= orientation.len() || b <= a {
+        if a < next || b >= frames || b <= a {
             continue; // overlapping or outside the slices: nothing sound to do
         }
         for k in next..=a {
@@ -940,6 +967,11 @@ mod tests {
         assert!(orientation_jumps(&time, &gyro, &bridged).is_empty());
         // Without jumps, the orientation as recorded.
         assert_eq!(bridge_orientation_jumps(&time, &gyro, &truth, &[]), truth);
+        // A jump beyond a shorter time or gyro is skipped, not indexed out of bounds.
+        assert_eq!(
+            bridge_orientation_jumps(&[], &[], &recorded, &jumps),
+            recorded
+        );
     }
 
     #[test]

@@ -28,7 +28,7 @@ use std::io::Write;
 use std::path::Path;
 
 use crate::Sequence;
-use crate::error::{DataError, Result};
+use crate::error::{DataError, Location, Result};
 use crate::processed::PROCESSED_COLUMNS;
 use crate::sidecar;
 use crate::temporaries::{
@@ -72,7 +72,8 @@ fn time_ns(seq: &Sequence, i: usize) -> i64 {
 /// output folder. [`write_pending`] is the same write in two steps, for a file that is to be
 /// renamed into place only once another is written too. (`ridi_regress::Cascade::save`, for
 /// users of that crate alone, which cannot depend on this one, writes its own temporary file,
-/// with the same mode.)
+/// with the same mode, and refuses a path that is not a regular file rather than write through
+/// a link.)
 ///
 /// # Permissions
 ///
@@ -242,30 +243,73 @@ fn push_value(line: &mut String, v: f64, precision: Precision) {
     };
 }
 
-/// Writes a processed data file of `seq` through [`write_text`], with its sidecar: the old
-/// sidecar removed before, the new one (when `seq` has a device) written after.
+/// Writes a processed data file of `seq` with its sidecar: both written in full first, then
+/// the sidecar committed (or the old one removed, when `seq` has no metadata to keep) and the
+/// data file. A failed write leaves the old pair as it was.
 fn write_data(
     seq: &Sequence,
     path: &Path,
     content: impl FnOnce(&mut dyn Write) -> std::io::Result<()>,
 ) -> Result<()> {
-    sidecar::remove(path)?;
-    write_text(path, content)?;
-    sidecar::write(seq, path)
+    check_writable(seq, path)?;
+    let data = pending_text(path, content)?;
+    match sidecar::pending(seq, path)? {
+        Some(side) => side.commit()?,
+        None => sidecar::remove(path)?,
+    }
+    data.commit()
 }
 
-/// Writes text through [`write_atomically`], gzip-compressed when `path` ends in `.gz`.
-fn write_text(
+/// Refuses what the data file could not hold as `seq`, before anything is written: a path
+/// without a file name (`.`, `..`: its sidecar would be another folder's), and times the
+/// nanosecond column cannot tell apart or hold (the file's own reader would refuse it).
+fn check_writable(seq: &Sequence, path: &Path) -> Result<()> {
+    if path.file_name().is_none() {
+        return Err(DataError::format(
+            Location::file(path),
+            "not a file name: give the data file's, such as `data.csv`",
+        ));
+    }
+    let at = || Location::file(path).with_field("time");
+    let mut previous = None;
+    for (i, &t) in seq.time().iter().enumerate() {
+        // i64 nanoseconds reach 9.2e9 s (the year 2262 as Unix time).
+        let fits = (t * 1e9).abs() < 9.2e18;
+        if !fits {
+            return Err(DataError::format(
+                at(),
+                format!("frame {i} at {t} s: beyond the nanoseconds the column holds"),
+            ));
+        }
+        let ns = time_ns(seq, i);
+        if previous.is_some_and(|p| ns <= p) {
+            return Err(DataError::format(
+                at(),
+                format!(
+                    "frames {} and {i} are less than a nanosecond apart: the column would give \
+                     them one timestamp",
+                    i - 1
+                ),
+            ));
+        }
+        previous = Some(ns);
+    }
+    Ok(())
+}
+
+/// Writes text through [`write_pending`], gzip-compressed when `path` ends in `.gz`; committed
+/// by the caller.
+fn pending_text(
     path: &Path,
     content: impl FnOnce(&mut dyn Write) -> std::io::Result<()>,
-) -> Result<()> {
+) -> Result<PendingFile> {
     let gz = path
         .file_name()
         .is_some_and(|n| n.to_string_lossy().to_lowercase().ends_with(".gz"));
     if !gz {
-        return write_atomically(path, content);
+        return write_pending(path, content);
     }
-    write_atomically(path, |w| {
+    write_pending(path, |w| {
         let mut enc = flate2::write::GzEncoder::new(w, flate2::Compression::new(9));
         content(&mut enc)?;
         enc.finish()?;

@@ -244,6 +244,20 @@ fn splits_at_gaps_and_resampling_keep_every_channel() {
             .is_ok()
     );
     assert!(split[1].resampled(100.0, f64::INFINITY).is_ok());
+    // Across a gap of 11 days, most of the result would be invented: refused before it is made.
+    let mut parts = split[1].parts().clone();
+    let mid = parts.time.len() / 2;
+    parts.time[mid..].iter_mut().for_each(|t| *t += 1e6);
+    let validation = ridi_data::Validation {
+        max_gap_s: f64::INFINITY,
+        ..ridi_data::Validation::default()
+    };
+    let paused = Sequence::with_validation(parts, &validation).unwrap();
+    let e = paused.resampled(100.0, f64::INFINITY).unwrap_err();
+    assert!(
+        matches!(e, SequenceError::ResampledAcrossGaps { frames, .. } if frames > 100_000_000),
+        "{e}"
+    );
 }
 
 #[test]

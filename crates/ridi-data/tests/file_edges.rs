@@ -334,3 +334,23 @@ fn outputs_write_through_links_and_refuse_pipes_and_devices() {
     std::os::unix::fs::symlink("loop.txt", &looped).unwrap();
     assert_err(write(&looped), &["links in a loop"]);
 }
+
+#[test]
+fn a_rotation_that_is_not_a_finite_unit_quaternion_is_named_on_its_frame() {
+    // Rot's constructors normalize, but a NaN angle (a corrupt value) gives a NaN rotation.
+    let nan = ridi_data::ridi_frames::WorldFromDevice::from_axis_angle(
+        &ridi_data::ridi_frames::nalgebra::Vector3::z_axis(),
+        f64::NAN,
+    );
+    let mut parts = sample_sequence("walk", 30, true, false).into_parts();
+    parts.orientation[7] = nan;
+    let e = Sequence::new(parts).unwrap_err().to_string();
+    assert!(e.contains("orientation") && e.contains("7"), "{e}");
+    let mut parts = sample_sequence("walk", 30, true, false).into_parts();
+    parts.ground_truth.as_mut().unwrap().orientation[9] = nan;
+    let e = Sequence::new(parts).unwrap_err().to_string();
+    assert!(
+        e.contains("ground_truth.orientation") && e.contains("9"),
+        "{e}"
+    );
+}

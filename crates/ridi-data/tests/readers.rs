@@ -812,6 +812,38 @@ fn writes_replace_atomically_and_leave_no_temporary_files() {
         write_ridi_csv(&seq, dir.path().join("no/such/dir/data.csv")),
         &["data.csv"],
     );
+    // What the nanosecond column cannot hold is refused before anything is written, and the
+    // old file and sidecar stay: two frames less than a nanosecond apart, a time past 2262.
+    let mut with_device = seq.clone();
+    with_device.set_device(Some(ridi_data::DeviceInfo::new("Nexus 5").unwrap()));
+    write_ridi_csv(&with_device, &path).unwrap();
+    let kept = std::fs::read(&path).unwrap();
+    let kept_side = std::fs::read(ridi_data::sidecar_path(&path)).unwrap();
+    let close = {
+        let mut p = seq.parts().clone();
+        p.time[1] = p.time[0] + 1e-10;
+        Sequence::new(p).unwrap()
+    };
+    let late = {
+        let mut p = seq.parts().clone();
+        p.time.iter_mut().for_each(|t| *t += 1e10);
+        Sequence::new(p).unwrap()
+    };
+    for (bad, words) in [
+        (&close, "frames 0 and 1 are less than a nanosecond apart"),
+        (&late, "frame 0 at"),
+    ] {
+        for e in [write_ridi_csv(bad, &path), write_ridi_plain(bad, &path)] {
+            assert_err(e, &["data.csv: field `time`", words]);
+        }
+    }
+    assert!(std::fs::read(&path).unwrap() == kept);
+    assert!(std::fs::read(ridi_data::sidecar_path(&path)).unwrap() == kept_side);
+    // A path without a file name would put its sidecar in another folder.
+    assert_err(
+        write_ridi_csv(&seq, dir.path().join("sub").join("..")),
+        &["not a file name"],
+    );
 }
 
 #[test]

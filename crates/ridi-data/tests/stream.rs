@@ -575,6 +575,7 @@ fn a_raw_folder_with_one_fault_gets_the_whole_readers_error() {
         (f64::INFINITY, 1.0),
         (f64::NAN, 1.0),
         (4.0, 0.1),
+        (1e12, 1.0),
     ] {
         let mut opts = ReadOptions {
             rate_without_pose_hz: rate,
@@ -584,6 +585,17 @@ fn a_raw_folder_with_one_fault_gets_the_whole_readers_error() {
         let e = raw_case(dir, &format!("rate{rate}"), &raw_files(60, false), &opts);
         assert!(e.is_err(), "{rate} Hz");
     }
+    // Refused with a pose too, before the work: the option is never passed over unsaid.
+    let opts = ReadOptions {
+        rate_without_pose_hz: 1e12,
+        ..raw_options()
+    };
+    let e = raw_case(dir, "rate with pose", &raw_files(60, true), &opts).unwrap_err();
+    assert!(
+        e.to_string()
+            .contains("field `rate_without_pose_hz`: output rate 1000000000000 Hz"),
+        "{e}"
+    );
 }
 
 /// Asserts that the rows of a raw folder of 6000 records a file (`raw_files`, after `edit`)

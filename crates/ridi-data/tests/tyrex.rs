@@ -775,6 +775,37 @@ fn bad_options_are_rejected() {
     )
     .unwrap_err();
     assert!(e.to_string().contains("rate_hz"), "{e}");
+    // A rate that would make a timeline of billions of frames is refused before it is built.
+    let e = tyrex::read(
+        &fx.dir,
+        &TyrexOptions {
+            rate_hz: 1e12,
+            ..TyrexOptions::default()
+        },
+    )
+    .unwrap_err();
+    assert!(e.to_string().contains("expected from 1 to 10000 Hz"), "{e}");
+    let with = |edit: fn(&mut TyrexOptions)| {
+        let mut o = TyrexOptions::default();
+        edit(&mut o);
+        tyrex::read(&fx.dir, &o).unwrap_err().to_string()
+    };
+    for (e, field) in [
+        (with(|o| o.max_sensor_gap_s = f64::NAN), "max_sensor_gap_s"),
+        (
+            with(|o| o.max_sensor_gap_s = f64::INFINITY),
+            "max_sensor_gap_s",
+        ),
+        (with(|o| o.max_mocap_gap_s = f64::NAN), "max_mocap_gap_s"),
+        (
+            with(|o| o.max_mocap_tilt_deg = f64::NAN),
+            "max_mocap_tilt_deg",
+        ),
+        (with(|o| o.min_part_s = -1.0), "min_part_s"),
+        (with(|o| o.gravity = 0.0), "gravity"),
+    ] {
+        assert!(e.contains(&format!("field `{field}`")), "{e}");
+    }
     for bad in [0.0, -1.0, f64::NAN] {
         let e = tyrex::read(
             &fx.dir,

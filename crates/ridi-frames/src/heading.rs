@@ -51,7 +51,9 @@ impl Default for HeadingConfig {
 }
 
 impl HeadingConfig {
-    fn validate(&self) -> Result<(), EstimateError> {
+    /// Checks every value's domain: a finite, positive time constant and a finite,
+    /// non-negative rate.
+    pub fn validate(&self) -> Result<(), EstimateError> {
         if !(self.time_constant.is_finite() && self.time_constant > 0.0) {
             return Err(EstimateError::InvalidConfig(
                 "heading time_constant must be finite and > 0",

@@ -226,6 +226,9 @@ impl Callback {
     }
 }
 
+// The docstring below and docs/python.md give the default number of landmarks.
+const _: () = assert!(Nystrom::DEFAULT_LANDMARKS == 2048);
+
 /// Trains a model, as ``ridi train`` does, with its options and defaults.
 ///
 /// ``data`` is a list file (``path,placement`` per line), several, or a list of

@@ -120,6 +120,13 @@ pub enum RegressError {
     /// The payload passed the checksum but does not decode into a consistent model.
     #[error("model file invalid: {0}")]
     Decode(String),
+    /// A [`Cascade`](crate::Cascade) deserialized by serde alone, without the checks and the
+    /// parts of [`Cascade::from_bytes`](crate::Cascade::from_bytes): refused by prediction.
+    #[error(
+        "the model was deserialized by serde alone, unchecked and incomplete: read model files \
+         with Cascade::from_bytes or Cascade::load"
+    )]
+    Unchecked,
     /// Encoding failure.
     #[error("model encoding failed: {0}")]
     Encode(String),

@@ -253,7 +253,7 @@ fn a_nan_anywhere_in_an_exact_model_file_is_refused_or_harmless() {
     let bytes = model.to_bytes().unwrap();
     let x = data.set().features;
     let mut refused = 0;
-    for at in 24..bytes.len() - 8 {
+    for at in 24..=bytes.len() - 8 {
         let mut b = bytes.clone();
         b[at..at + 8].copy_from_slice(&f64::NAN.to_le_bytes());
         let crc = crc32fast::hash(&b[24..]);

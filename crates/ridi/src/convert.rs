@@ -177,6 +177,7 @@ pub fn read_split(
             ),
         ));
     }
+    let path = &crate::source::forced_file(path, from);
     let format = source_format(path, from)?;
     let mut loaded = read_any(path, Some(format), &opts.reading_pauses(format))?;
     let sequences = std::mem::take(&mut loaded.sequences);

@@ -433,6 +433,7 @@ pub fn evaluate(
         return Err(PipelineError::NoSequences("evaluate"));
     }
     crate::check_distinct_recordings(seqs)?;
+    opts.track.validate()?;
     // Every sequence before any work: a bad one fails in a second, not after the others.
     for s in seqs {
         check_evaluable(s, model.feature_config(), opts)?;

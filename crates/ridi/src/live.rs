@@ -267,6 +267,7 @@ impl<'m> LiveTracker<'m> {
     /// # Errors
     /// A configuration the tracker refuses, or a model whose features cannot be extracted.
     pub fn new(model: &'m Cascade, opts: &TrackOptions) -> Result<Self> {
+        opts.validate()?;
         let config = TrackerConfig {
             correction: opts.correction_for(model),
             regress_every: opts.regress_every,

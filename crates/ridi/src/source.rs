@@ -79,6 +79,17 @@ pub fn source_format(path: &Path, from: Option<Format>) -> Result<Format, DataEr
     })
 }
 
+/// `path`, or for a folder read as [`Format::RidiPlain`] its `data_plain.txt`
+/// ([`ridi_data::processed_file`]): detection prefers the folder's `data.csv` when it has both.
+pub(crate) fn forced_file(path: &Path, from: Option<Format>) -> std::borrow::Cow<'_, Path> {
+    match from {
+        Some(Format::RidiPlain) if path.is_dir() => {
+            ridi_data::processed_file(path, Format::RidiPlain).map_or(path.into(), Into::into)
+        }
+        _ => path.into(),
+    }
+}
+
 /// Reads the sequence(s) at `path`: a RIDI `data.csv`, `data_plain.txt`, RIDI raw folder,
 /// Tyrex sequence folder, Indoor Location Competition path file or RoNIN sequence folder. `from` forces a format
 /// instead of detecting it: a source that is not one is an error saying what it is and what
@@ -89,16 +100,7 @@ pub fn read_any(
     from: Option<Format>,
     opts: &ReadOptions,
 ) -> Result<Loaded, DataError> {
-    // Detection prefers a folder's data.csv; forced, its data_plain.txt is what is read.
-    let plain = (from == Some(Format::RidiPlain) && path.is_dir())
-        .then(|| {
-            ["processed/data_plain.txt", "data_plain.txt"]
-                .map(|rel| path.join(rel))
-                .into_iter()
-                .find(|file| std::fs::symlink_metadata(file).is_ok())
-        })
-        .flatten();
-    let path = plain.as_deref().unwrap_or(path);
+    let path = &forced_file(path, from);
     let format = source_format(path, from)?;
     match format {
         Format::Tyrex => {

@@ -272,6 +272,7 @@ pub fn regress_sequence(
     model: &Cascade,
     opts: &TrackOptions,
 ) -> Result<(Vec<FrameVelocity>, Vec<usize>)> {
+    opts.validate()?;
     // A window across a gap, or counted at another rate, is no window the model knows.
     check_trackable(seq, model.feature_config(), opts.correction.max_dt)?;
     regressed(seq, model, opts)
@@ -284,10 +285,6 @@ pub(crate) fn regressed(
     model: &Cascade,
     opts: &TrackOptions,
 ) -> Result<(Vec<FrameVelocity>, Vec<usize>)> {
-    // Its field is public: checked before the work.
-    if let Some(s) = opts.placement_smoothing {
-        s.validate()?;
-    }
     let seq = oriented(
         seq,
         model.feature_config().orientation,
@@ -491,6 +488,7 @@ pub(crate) fn check_trackable(seq: &Sequence, config: &FeatureConfig, max_dt: f6
 /// Besides the stages' own: a sequence at another rate than [`TRACK_RATE_HZ`] (± [`TRACK_RATE_TOLERANCE`]),
 /// shorter than one feature window, or with a gap longer than the correction's `max_dt`.
 pub fn track(seq: &Sequence, model: &Cascade, opts: &TrackOptions) -> Result<Track> {
+    opts.validate()?;
     check_trackable(seq, model.feature_config(), opts.correction.max_dt)?;
     if opts.online {
         // The live tracker estimates an estimated orientation on the stream itself; a

@@ -49,6 +49,29 @@ impl Default for TrackOptions {
 }
 
 impl TrackOptions {
+    /// Checks every value's domain (the fields are public): tracking, evaluation and the live
+    /// tracker call it before any work.
+    ///
+    /// # Errors
+    /// `regress_every` 0, and what [`CorrectionConfig::validate`],
+    /// [`PlacementSmoother::validate`] and [`HeadingConfig::validate`] refuse.
+    pub fn validate(&self) -> crate::Result<()> {
+        use crate::PipelineError;
+        if self.regress_every == 0 {
+            return Err(PipelineError::Correct(
+                ridi_correct::CorrectError::InvalidConfig("regress_every must be at least 1"),
+            ));
+        }
+        self.correction.validate().map_err(PipelineError::Correct)?;
+        if let Some(s) = &self.placement_smoothing {
+            s.validate().map_err(PipelineError::Correct)?;
+        }
+        if let Some(h) = &self.recorded_heading {
+            h.validate().map_err(PipelineError::Orientation)?;
+        }
+        Ok(())
+    }
+
     /// The correction of `model`'s regressions: [`TrackOptions::correction`] with the S its
     /// velocities are expressed in (the model's [`FeatureConfig::up_axis`]).
     ///

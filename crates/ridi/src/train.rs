@@ -128,8 +128,8 @@ impl TrainingData {
         // The fields are public: rows whose placements or groups do not match are refused.
         let rows = self.features.rows();
         for (what, found) in [
-            ("placements", self.placements.len()),
-            ("groups", self.groups.len()),
+            ("placements (one per feature row)", self.placements.len()),
+            ("group ids (one per feature row)", self.groups.len()),
         ] {
             if found != rows {
                 return Err(PipelineError::Features(
@@ -362,7 +362,7 @@ mod tests {
             ..data
         };
         let e = data.clone().with_turned_copies(1).unwrap_err().to_string();
-        assert!(e.contains("groups"), "{e}");
+        assert!(e.contains("group ids"), "{e}");
         let data = TrainingData {
             groups: vec![0; 10],
             ..data

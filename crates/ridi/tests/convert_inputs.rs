@@ -214,6 +214,10 @@ fn a_source_of_another_format_than_given_says_what_it_is_and_what_was_expected()
     assert_eq!(frames(None), (Format::RidiCsv, s.len()));
     assert_eq!(frames(Some(Format::RidiCsv)), (Format::RidiCsv, s.len()));
     assert_eq!(frames(Some(Format::RidiPlain)), (Format::RidiPlain, 1000));
+    // Read to be split at its gaps too.
+    let split = ridi::read_split(&both, Some(Format::RidiPlain), &opts, 0.1).unwrap();
+    assert_eq!(split.format, Format::RidiPlain);
+    assert_eq!(split.sequences[0].len(), 1000);
 }
 
 #[test]

@@ -427,6 +427,7 @@ impl Rows {
     /// # Errors
     /// What [`read`](super::read) refuses before it builds the sequence, with its error.
     pub(crate) fn open(folder: &Path, opts: &ReadOptions) -> Result<Rows> {
+        super::check_rate(folder, opts)?;
         check_required(folder)?;
         let required = |spec: &'static Spec| {
             Scan::read(folder, spec, opts, None)?.ok_or_else(|| no_rows(&folder.join(spec.name)))

@@ -25,11 +25,7 @@ impl Cascade {
         if self.checked {
             Ok(())
         } else {
-            Err(RegressError::Decode(
-                "a model deserialized by serde alone, unchecked and incomplete: read model \
-                 files with Cascade::from_bytes or Cascade::load"
-                    .into(),
-            ))
+            Err(RegressError::Unchecked)
         }
     }
 
