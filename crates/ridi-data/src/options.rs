@@ -13,7 +13,9 @@ pub struct ReadOptions {
     /// Raw folders: pose records dropped at each end of `pose.txt` (Tango is unreliable while it
     /// starts and stops). The original drops 800 (about 4 s).
     pub pose_trim: usize,
-    /// Raw folders without `pose.txt`: rate of the uniform timeline, Hz.
+    /// Raw folders without `pose.txt`: rate of the uniform timeline, Hz (checked with a pose
+    /// too, within [`Validation::output_rate_range`]); the Tyrex and competition readers' rate
+    /// when their options are made from these.
     pub rate_without_pose_hz: f64,
 }
 

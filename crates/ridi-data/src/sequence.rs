@@ -300,7 +300,8 @@ pub fn heading_reference(source: Option<OrientationSource>) -> bool {
 }
 
 /// The rates [`Sequence::resampled`] (and `ridi convert --rate`) resamples to, Hz, both
-/// included: 1.001 to 9,990. The default [`Validation`] refuses frames 1 s apart or more
+/// included: 1.001 to 9,990, the default [`Validation`]'s
+/// [`output_rate_range`](Validation::output_rate_range). It refuses frames 1 s apart or more
 /// (`max_gap_s`) and a median step under 0.1 ms (`time_step_range`); a uniform timeline at
 /// exactly 1 Hz or 10 kHz lands on either side of those bounds once its times are added up in
 /// floating point (and written as whole nanoseconds), so the range keeps 0.1 % from each.
@@ -363,8 +364,12 @@ fn check_vecs(field: &'static str, n: usize, v: &[DeviceVec]) -> Result<(), Sequ
     }
 }
 
-/// Checks that `field` has `n` rotations, each a finite unit quaternion: the constructors of
-/// `Rot` normalize, but an angle or axis that is NaN (a corrupt value) gives a NaN one.
+/// How far a stored rotation's squared norm may be from 1: `Rot`'s constructors and slerp
+/// normalize, products of rotations drift by about 1e-13.
+const UNIT_TOLERANCE: f64 = 1e-6;
+
+/// Checks that `field` has `n` rotations, each a finite unit quaternion
+/// ([`SequenceError::NotRotation`]).
 fn check_rots<A: Frame, B: Frame>(
     field: &'static str,
     n: usize,
@@ -373,10 +378,11 @@ fn check_rots<A: Frame, B: Frame>(
     check_len(field, n, r.len())?;
     let unit = |q: &Rot<A, B>| {
         let w = q.to_wxyz();
-        w.iter().all(|c| c.is_finite()) && (w.iter().map(|c| c * c).sum::<f64>() - 1.0).abs() < 1e-6
+        let norm2: f64 = w.iter().map(|c| c * c).sum();
+        (norm2 - 1.0).abs() < UNIT_TOLERANCE
     };
     match r.iter().position(|q| !unit(q)) {
-        Some(index) => Err(SequenceError::NonFinite { what: field, index }),
+        Some(index) => Err(SequenceError::NotRotation { what: field, index }),
         None => Ok(()),
     }
 }
@@ -665,11 +671,11 @@ impl Sequence {
     /// count frames of a 200 Hz stream); `ridi convert --rate` applies it.
     ///
     /// # Errors
-    /// [`SequenceError::InvalidRate`] for a `rate_hz` outside [`RESAMPLE_RATE_HZ`] or a `max_gap_s` that is not above 0 (infinity
-    /// interpolates across every gap); a gap between two frames longer than `max_gap_s`
-    /// (interpolating would invent the frames of a gap: split the recording there first); the
-    /// default validation of the result; gaps that would be most of the result
-    /// ([`SequenceError::ResampledAcrossGaps`]).
+    /// [`SequenceError::InvalidRate`] for a `rate_hz` outside [`RESAMPLE_RATE_HZ`] or a
+    /// `max_gap_s` that is not above 0 (infinity interpolates across every gap, unless the
+    /// gaps over 1 s would be most of the result: [`SequenceError::ResampledAcrossGaps`]); a gap
+    /// between two frames longer than `max_gap_s` (interpolating would invent the frames of a
+    /// gap: split the recording there first); the default validation of the result.
     pub fn resampled(&self, rate_hz: f64, max_gap_s: f64) -> Result<Sequence, SequenceError> {
         use crate::resample::{
             interpolate_rot, interpolate_scalar, interpolate_vec3, uniform_len, uniform_timeline,
@@ -684,10 +690,11 @@ impl Sequence {
         let t = &p.time;
         check_steps(t, max_gap_s)?;
         // Before the frames are made: an infinite gap limit across a gap of years would fill it
-        // with billions of them.
+        // with billions of them. Steps up to the readers' longest gap count as recorded.
         let frames = uniform_len(t[0], t[t.len() - 1], rate_hz);
-        let covered = (t.len() as f64 * rate_hz / self.median_rate_hz().max(f64::MIN_POSITIVE))
-            .ceil() as usize;
+        let longest = Validation::default().max_gap_s;
+        let recorded_s: f64 = t.windows(2).map(|w| (w[1] - w[0]).min(longest)).sum();
+        let covered = (recorded_s * rate_hz).ceil() as usize + 1;
         if frames > covered.saturating_mul(2).saturating_add(2) {
             return Err(SequenceError::ResampledAcrossGaps { frames, covered });
         }

@@ -208,16 +208,27 @@ pub enum SequenceError {
         /// The longest gap to interpolate across, seconds.
         max_gap_s: f64,
     },
+    /// A rotation that is not a finite unit quaternion (a corrupt value; `Rot`'s constructors
+    /// normalize, but an angle or axis that is NaN gives a NaN one).
+    #[error("`{what}` at frame {index} is not a rotation (not a finite unit quaternion)")]
+    NotRotation {
+        /// Which rotations.
+        what: &'static str,
+        /// 0-based frame index.
+        index: usize,
+    },
     /// A resampling across gaps that would be most of the result
-    /// ([`Sequence::resampled`](crate::Sequence::resampled) with a large gap limit): more than
-    /// twice the frames the recording's own frames span at that rate, its median step each.
+    /// ([`Sequence::resampled`](crate::Sequence::resampled) with a gap limit above 1 s): more
+    /// than twice the frames of the recorded stretches (its steps of up to 1 s) at that rate.
     #[error(
-        "resampling would make {frames} frames, more than twice the {covered} its frames cover          at that rate: gaps would be most of the sequence (split it at its gaps first)"
+        "resampling would make {frames} frames, more than twice the {covered} of its recorded \
+         stretches at that rate: gaps over 1 s would be most of the sequence (split it at its \
+         gaps first)"
     )]
     ResampledAcrossGaps {
         /// Frames the uniform timeline would have.
         frames: usize,
-        /// Frames the recording's frames cover at the rate asked for (each its median step).
+        /// Frames of the recorded stretches at the rate asked for (steps of up to 1 s).
         covered: usize,
     },
     /// A value beyond the hard physical bound of its channel ([`Validation::limit`](crate::Validation::limit)): a

@@ -20,10 +20,10 @@
 //! key.
 //!
 //! The sidecar is optional: a data file without one (RIDI's own, one written by another tool)
-//! reads with no device. The writers replace it together with the data file: the old sidecar is
-//! removed first, then the data file and the new sidecar are each written atomically, so an
-//! interrupted write leaves at worst a data file without a sidecar (device unknown), never a data
-//! file beside the sidecar of another.
+//! reads with no device. The writers replace it together with the data file: both written in
+//! full first, then the old sidecar removed, the data file and the new sidecar renamed into
+//! place, so an interrupted write leaves at worst a data file without a sidecar (device
+//! unknown), never a data file beside the sidecar of another.
 
 use std::path::{Path, PathBuf};
 
@@ -179,8 +179,8 @@ fn parse(content: &str, path: &Path) -> Result<Sidecar> {
     })
 }
 
-/// Removes the sidecar of `data`, if there is one: before a data file is replaced, so that the
-/// new one is never read with the old one's metadata.
+/// Removes the sidecar of `data`, if there is one: before a data file is renamed into place,
+/// so that the new one is never read with the old one's metadata.
 pub(crate) fn remove(data: &Path) -> Result<()> {
     let path = sidecar_path(data);
     match std::fs::remove_file(&path) {

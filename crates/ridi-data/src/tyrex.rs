@@ -1131,32 +1131,14 @@ fn read_android(dir: &Path, name: &str, warnings: &mut Vec<String>) -> Result<Ph
     })
 }
 
-/// Reads one run folder, `datasets/android/<name>/` or `datasets/ios/<name>/` (see
-/// [`layout_of`]) and, when [`TyrexOptions::ground_truth`] is set and `datasets/qualisys/` holds
-/// its `.mat` (see [`mat_path`]), its ground truth. See the module documentation for the
-/// layouts, frames, time alignment and gap handling.
-pub fn read(dir: impl AsRef<Path>, options: &TyrexOptions) -> Result<TyrexRead> {
-    let dir = dir.as_ref();
-    if options.max_mocap_gyro_rad.is_nan() || options.max_mocap_gyro_rad <= 0.0 {
-        return Err(DataError::format(
-            Location::file(dir).with_field("max_mocap_gyro_rad"),
-            format!(
-                "the mocap's largest disagreement with the gyro must be positive (infinity \
-                 trusts the mocap), got {}",
-                options.max_mocap_gyro_rad
-            ),
-        ));
-    }
-    if let Some(e) = options
-        .validation
-        .output_rate_error(options.rate_hz, dir, "rate_hz")
-    {
+/// Refuses options no reading can follow, by field: NaN compares false, so a NaN gap limit
+/// would split nothing and a NaN tilt or gyro limit trust both, unsaid; phone streams are never
+/// interpolated across an unbounded gap (that would invent them).
+fn check_options(dir: &Path, o: &TyrexOptions) -> Result<()> {
+    if let Some(e) = o.validation.output_rate_error(o.rate_hz, dir, "rate_hz") {
         return Err(e);
     }
-    // NaN compares false: a NaN gap limit would split nothing and a NaN tilt trust both, unsaid;
-    // phone streams are never interpolated across an unbounded gap (that would invent them).
-    let o = options;
-    let positive = |v: f64| v.is_finite() && v > 0.0;
+    let finite_positive = |v: f64| v.is_finite() && v > 0.0;
     const POSITIVE: &str = "a finite number above 0";
     for (field, value, ok, rule) in [
         (
@@ -1168,10 +1150,10 @@ pub fn read(dir: impl AsRef<Path>, options: &TyrexOptions) -> Result<TyrexRead> 
         (
             "max_sensor_gap_s",
             o.max_sensor_gap_s,
-            positive(o.max_sensor_gap_s),
+            finite_positive(o.max_sensor_gap_s),
             POSITIVE,
         ),
-        ("gravity", o.gravity, positive(o.gravity), POSITIVE),
+        ("gravity", o.gravity, finite_positive(o.gravity), POSITIVE),
         (
             "min_part_s",
             o.min_part_s,
@@ -1184,6 +1166,18 @@ pub fn read(dir: impl AsRef<Path>, options: &TyrexOptions) -> Result<TyrexRead> 
             o.max_mocap_tilt_deg > 0.0,
             "above 0 (infinity trusts both)",
         ),
+        (
+            "max_mocap_gyro_rad",
+            o.max_mocap_gyro_rad,
+            o.max_mocap_gyro_rad > 0.0,
+            "above 0 (infinity trusts the mocap)",
+        ),
+        (
+            "extra_time_diff_s",
+            o.extra_time_diff_s,
+            o.extra_time_diff_s.is_finite(),
+            "a finite number",
+        ),
     ] {
         if !ok {
             return Err(DataError::format(
@@ -1192,6 +1186,16 @@ pub fn read(dir: impl AsRef<Path>, options: &TyrexOptions) -> Result<TyrexRead> 
             ));
         }
     }
+    Ok(())
+}
+
+/// Reads one run folder, `datasets/android/<name>/` or `datasets/ios/<name>/` (see
+/// [`layout_of`]) and, when [`TyrexOptions::ground_truth`] is set and `datasets/qualisys/` holds
+/// its `.mat` (see [`mat_path`]), its ground truth. See the module documentation for the
+/// layouts, frames, time alignment and gap handling.
+pub fn read(dir: impl AsRef<Path>, options: &TyrexOptions) -> Result<TyrexRead> {
+    let dir = dir.as_ref();
+    check_options(dir, options)?;
     // `.` or `..` have no file name of their own: take the folder's real name.
     let name = dir
         .file_name()

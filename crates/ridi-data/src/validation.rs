@@ -230,26 +230,33 @@ impl Validation {
         }
     }
 
-    /// The error for an output rate, `field` of the options a reader was given, whose time step
-    /// `1 / rate_hz` is outside [`Self::time_step_range`]: checked before the timeline is
-    /// built, which an absurd rate would make of billions of frames, refused only after.
+    /// The rates a uniform timeline may be built at, Hz, both included: one whose frames this
+    /// validation accepts, with 0.1 % to spare from its bounds (a timeline at exactly the
+    /// bound lands on either side of it once its times are added up in floating point and
+    /// written as whole nanoseconds). The default's is [`RESAMPLE_RATE_HZ`](crate::RESAMPLE_RATE_HZ).
+    pub fn output_rate_range(&self) -> (f64, f64) {
+        let (min_step, max_step) = self.time_step_range;
+        (1.001 / max_step.min(self.max_gap_s), 0.999 / min_step)
+    }
+
+    /// The error for an output rate, `field` of the options a reader was given, outside
+    /// [`Self::output_rate_range`]: checked before the timeline is built, which an absurd rate
+    /// would make of billions of frames, refused only after.
     pub(crate) fn output_rate_error(
         &self,
         rate_hz: f64,
         at: &std::path::Path,
         field: &str,
     ) -> Option<crate::DataError> {
-        let (min, max) = self.time_step_range;
-        let accepted =
-            rate_hz.is_finite() && rate_hz > 0.0 && (min..=max).contains(&rate_hz.recip());
-        (!accepted).then(|| {
+        let (min, max) = self.output_rate_range();
+        (!(min..=max).contains(&rate_hz)).then(|| {
             crate::DataError::format(
                 crate::Location::file(at).with_field(field),
                 format!(
-                    "output rate {rate_hz} Hz: expected from {} to {} Hz (time steps of {min} to \
-                     {max} s, the validation's range)",
-                    1.0 / max,
-                    1.0 / min
+                    "output rate {rate_hz} Hz: expected from {} to {} Hz (the validation's time \
+                     steps, with 0.1 % to spare)",
+                    crate::sequence_error::short(min),
+                    crate::sequence_error::short(max)
                 ),
             )
         })
@@ -947,6 +954,20 @@ mod tests {
             v.check_orientation_gravity(&[WorldFromDevice::identity()], &[DeviceVec::ZERO])
                 .is_ok()
         );
+    }
+
+    #[test]
+    fn the_default_output_rates_are_the_resampling_rates() {
+        assert_eq!(
+            Validation::default().output_rate_range(),
+            crate::RESAMPLE_RATE_HZ
+        );
+        // Reading pauses (an unbounded gap) keeps the lowest rate at the time steps' bound.
+        let pauses = Validation {
+            max_gap_s: f64::INFINITY,
+            ..Validation::default()
+        };
+        assert_eq!(pauses.output_rate_range(), crate::RESAMPLE_RATE_HZ);
     }
 
     #[test]

@@ -19,9 +19,10 @@
 //!
 //! Files are written atomically: to a temporary file in the target folder, then renamed, so a
 //! crash never leaves a half-written file under the final name. The sidecar goes with its data
-//! file: the old one is removed first, then the data file is written, then the new sidecar, so
-//! that an interrupted write leaves at worst a data file without its device, never one beside
-//! another file's sidecar.
+//! file: both are written in full first, then the old sidecar is removed, the data file renamed
+//! into place and the new sidecar after it, so that a failed write leaves the old pair (when it
+//! fails while writing) or at worst a data file without its device, never one beside another
+//! file's sidecar.
 
 use std::fmt::{self, Write as _};
 use std::io::Write;
@@ -243,9 +244,10 @@ fn push_value(line: &mut String, v: f64, precision: Precision) {
     };
 }
 
-/// Writes a processed data file of `seq` with its sidecar: both written in full first, then
-/// the sidecar committed (or the old one removed, when `seq` has no metadata to keep) and the
-/// data file. A failed write leaves the old pair as it was.
+/// Writes a processed data file of `seq` with its sidecar: both written in full first (a
+/// failure there, such as a full disk, leaves the old pair as it was), then the old sidecar
+/// removed, the data file committed and the new sidecar after it. A sidecar is so never beside
+/// another file's data; a failure between the renames leaves the data without its sidecar.
 fn write_data(
     seq: &Sequence,
     path: &Path,
@@ -253,21 +255,21 @@ fn write_data(
 ) -> Result<()> {
     check_writable(seq, path)?;
     let data = pending_text(path, content)?;
-    match sidecar::pending(seq, path)? {
-        Some(side) => side.commit()?,
-        None => sidecar::remove(path)?,
-    }
-    data.commit()
+    let side = sidecar::pending(seq, path)?;
+    sidecar::remove(path)?;
+    data.commit()?;
+    side.map_or(Ok(()), PendingFile::commit)
 }
 
-/// Refuses what the data file could not hold as `seq`, before anything is written: a path
-/// without a file name (`.`, `..`: its sidecar would be another folder's), and times the
+/// Refuses what the data file could not hold as `seq`, before anything is written: a folder,
+/// and times the
 /// nanosecond column cannot tell apart or hold (the file's own reader would refuse it).
+/// (A path without a file name, `.` or `..`, would also put its sidecar in another folder.)
 fn check_writable(seq: &Sequence, path: &Path) -> Result<()> {
-    if path.file_name().is_none() {
+    if path.file_name().is_none() || path.is_dir() {
         return Err(DataError::format(
             Location::file(path),
-            "not a file name: give the data file's, such as `data.csv`",
+            "a folder, not a file: give the data file's path, such as `walk/data.csv`",
         ));
     }
     let at = || Location::file(path).with_field("time");

@@ -839,11 +839,12 @@ fn writes_replace_atomically_and_leave_no_temporary_files() {
     }
     assert!(std::fs::read(&path).unwrap() == kept);
     assert!(std::fs::read(ridi_data::sidecar_path(&path)).unwrap() == kept_side);
-    // A path without a file name would put its sidecar in another folder.
-    assert_err(
-        write_ridi_csv(&seq, dir.path().join("sub").join("..")),
-        &["not a file name"],
-    );
+    // A folder, with a file name or without one (its sidecar would be another folder's).
+    std::fs::create_dir(dir.path().join("sub")).unwrap();
+    for folder in [dir.path().join("sub"), dir.path().join("sub").join("..")] {
+        assert_err(write_ridi_csv(&seq, &folder), &["a folder, not a file"]);
+    }
+    assert!(!dir.path().join("sub.meta").exists());
 }
 
 #[test]

@@ -784,7 +784,10 @@ fn bad_options_are_rejected() {
         },
     )
     .unwrap_err();
-    assert!(e.to_string().contains("expected from 1 to 10000 Hz"), "{e}");
+    assert!(
+        e.to_string().contains("expected from 1.001 to 9990 Hz"),
+        "{e}"
+    );
     let with = |edit: fn(&mut TyrexOptions)| {
         let mut o = TyrexOptions::default();
         edit(&mut o);
@@ -803,6 +806,10 @@ fn bad_options_are_rejected() {
         ),
         (with(|o| o.min_part_s = -1.0), "min_part_s"),
         (with(|o| o.gravity = 0.0), "gravity"),
+        (
+            with(|o| o.extra_time_diff_s = f64::NAN),
+            "extra_time_diff_s",
+        ),
     ] {
         assert!(e.contains(&format!("field `{field}`")), "{e}");
     }

@@ -53,15 +53,19 @@ impl TrackOptions {
     /// tracker call it before any work.
     ///
     /// # Errors
-    /// `regress_every` 0, and what [`CorrectionConfig::validate`],
+    /// A `regress_every` the streaming tracker refuses (0, or beyond its buffer), and what
+    /// [`CorrectionConfig::validate`],
     /// [`PlacementSmoother::validate`] and [`HeadingConfig::validate`] refuse.
     pub fn validate(&self) -> crate::Result<()> {
         use crate::PipelineError;
-        if self.regress_every == 0 {
-            return Err(PipelineError::Correct(
-                ridi_correct::CorrectError::InvalidConfig("regress_every must be at least 1"),
-            ));
+        // The streaming tracker's rule for `regress_every` (at least 1, a bounded buffer), so
+        // that batch and online tracking accept the same.
+        ridi_correct::TrackerConfig {
+            regress_every: self.regress_every,
+            ..ridi_correct::TrackerConfig::default()
         }
+        .validate()
+        .map_err(PipelineError::Track)?;
         self.correction.validate().map_err(PipelineError::Correct)?;
         if let Some(s) = &self.placement_smoothing {
             s.validate().map_err(PipelineError::Correct)?;
