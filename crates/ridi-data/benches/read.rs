@@ -49,8 +49,20 @@ fn sequence() -> Sequence {
     Sequence::new(SequenceParts {
         name: "bench".into(),
         placement: None,
-        // Scaled to about the rate the orientation turns at, as the readers check.
-        gyro: wave(0.071).into_iter().map(|g| g * 0.25).collect(),
+        // The orientation's own rotation rate (the readers check the gyro against it, per axis
+        // too), with a wave on top so that no two channels are alike.
+        gyro: (0..ROWS)
+            .map(|i| {
+                let (a, b) = if i + 1 < ROWS { (i, i + 1) } else { (i - 1, i) };
+                let rate = (orientation[a].inverse() * orientation[b])
+                    .quaternion()
+                    .scaled_axis()
+                    * 200.0;
+                let w = 0.071 * i as f64;
+                DeviceVec::new(rate.x, rate.y, rate.z)
+                    + DeviceVec::new(w.sin(), w.cos() * 0.5, (w * 0.3).sin() * 2.0) * 0.02
+            })
+            .collect(),
         acce: linacce.iter().zip(&gravity).map(|(a, g)| *a + *g).collect(),
         linacce,
         gravity,
