@@ -103,7 +103,7 @@ pub(crate) fn run(
     ridi::check_output_folder(&out)?;
     let summary = ridi::convert(&source, &out, &opts)?;
     for w in &summary.warnings {
-        eprintln!("warning: {}", shown(w));
+        errln!("warning: {}", shown(w));
     }
     for c in &summary.sequences {
         outln!(

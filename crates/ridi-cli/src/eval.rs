@@ -123,7 +123,7 @@ pub(crate) fn with_spinner<T>(n: usize, evaluate: impl FnOnce() -> T) -> T {
 /// files written on stdout.
 pub(crate) fn print_written(report: &Report, written: &EvalWritten, folder: &EvalFolder) {
     for w in &written.warnings {
-        eprintln!("warning: {}", shown(w));
+        errln!("warning: {}", shown(w));
     }
     print_summary(report);
     let stale = written.stale_plots;
@@ -155,7 +155,7 @@ pub(crate) fn print_written(report: &Report, written: &EvalWritten, folder: &Eva
 fn print_summary(report: &Report) {
     const RTE_5S: &str = ridi::eval::Metric::Rte5sM.key();
     for w in &report.warnings {
-        eprintln!("warning: {}", shown(w));
+        errln!("warning: {}", shown(w));
     }
     let mse = match report.velocity_mse {
         [x, z] if x.is_finite() && z.is_finite() => format!("S-x {x:.3} S-z {z:.3} (m/s)^2"),

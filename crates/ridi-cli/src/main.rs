@@ -23,6 +23,16 @@ macro_rules! outln {
     }};
 }
 
+/// `eprintln!` that ignores a closed or dead stderr (`ridi train ... 2>&1 | head`, a closed
+/// terminal): a warning that cannot be shown must not abort the run before its files are
+/// written, nor keep the signal handler from exiting.
+macro_rules! errln {
+    ($($arg:tt)*) => {{
+        use std::io::Write as _;
+        let _ = writeln!(std::io::stderr(), $($arg)*);
+    }};
+}
+
 /// `print!` that ignores a closed stdout, as [`outln!`].
 macro_rules! out {
     ($($arg:tt)*) => {{
@@ -268,7 +278,7 @@ fn model_or_bundled(path: Option<&Path>) -> Result<Cascade> {
     match path {
         Some(p) => load_model(p),
         None => {
-            eprintln!("no --model: using {}", ridi::BUNDLED_MODEL_SUMMARY);
+            errln!("no --model: using {}", ridi::BUNDLED_MODEL_SUMMARY);
             ridi::bundled_model().context("cannot decode the bundled model")
         }
     }
@@ -301,7 +311,7 @@ fn clean_up_on_signals() {
                     SIGTERM => "SIGTERM",
                     _ => "SIGHUP",
                 };
-                eprintln!("error: interrupted ({name}); the run's temporary files are removed");
+                errln!("error: interrupted ({name}); the run's temporary files are removed");
                 std::process::exit(128 + signal);
             }
         });
@@ -323,7 +333,7 @@ fn main() -> ExitCode {
     match result {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
-            eprintln!("error: {}", shown(one_line(&e)));
+            errln!("error: {}", shown(one_line(&e)));
             ExitCode::FAILURE
         }
     }

@@ -76,7 +76,7 @@ pub(crate) fn run(args: Args) -> Result<()> {
     }
     let mut loaded = ridi::read_any(&args.sequence, None, &ReadOptions::default())?;
     for w in &loaded.warnings {
-        eprintln!("warning: {}", shown(w));
+        errln!("warning: {}", shown(w));
     }
     // The model's orientation, once, so that the plot shows what was tracked.
     apply_orientation(

@@ -230,7 +230,7 @@ pub(crate) fn run(args: Args) -> Result<()> {
     if opts.cascade.method == Solver::Exact {
         let windows = ridi::training_windows(listed.sequences(), &opts)?;
         if let Some(note) = exact_solver_note(windows) {
-            eprintln!("{note}");
+            errln!("{note}");
         }
     }
     let model = with_progress(|progress| ridi::train(listed.sequences(), &opts, progress))

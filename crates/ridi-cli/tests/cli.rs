@@ -1306,6 +1306,17 @@ fn track_and_eval_without_a_model_use_the_bundled_one_and_say_so() {
     assert!(out.status.success(), "{}", stderr(&out));
     assert!(stderr(&out).contains("no --model: using the bundled model"));
     assert!(eval.join("report.json").is_file());
+    // A stderr nobody reads any more (`2>&1 | head -1`, a closed terminal) neither stops the
+    // run before its file is written nor changes its exit status.
+    let csv3 = dir.path().join("t3.csv");
+    let mut child = Command::new(env!("CARGO_BIN_EXE_ridi"))
+        .args(["track", s(&seq), "--out", s(&csv3)])
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    drop(child.stderr.take());
+    assert!(child.wait().unwrap().success());
+    assert!(std::fs::read(&csv3).unwrap() == std::fs::read(&csv).unwrap());
 }
 
 #[test]

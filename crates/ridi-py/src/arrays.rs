@@ -76,6 +76,14 @@ fn float64<'py>(obj: &Bound<'py, PyAny>, name: &str) -> PyResult<Bound<'py, PyUn
     };
     let found = array.dtype();
     if found.is_equiv_to(&dtype::<f64>(py)) {
+        // A view the element type cannot be read through as it lies (a field of a record
+        // array, bytes at an odd offset): rust-numpy divides strides by 8 and reads unaligned,
+        // so such a view is copied (a new array is aligned; `ascontiguousarray` would return a
+        // contiguous unaligned one as it is).
+        let aligned = array.getattr("flags")?.getattr("aligned")?.is_truthy()?;
+        if !aligned || array.strides().iter().any(|s| s % 8 != 0) {
+            return Ok(array.call_method0("copy")?.cast_into::<PyUntypedArray>()?);
+        }
         return Ok(array);
     }
     let kind = found.kind();

@@ -171,7 +171,8 @@ fn report_of(py: Python<'_>, obj: &Bound<'_, PyAny>, name: &str) -> PyResult<Rep
                 ))
             })?
             .extract()?;
-        return serde_json::from_str(&text).map_err(|e| {
+        // Checked as a report.json file is (a negative figure, a window that is not positive).
+        return Report::from_json(&text).map_err(|e| {
             errors::value(format!(
                 "`{name}` is not a report of `ridi.evaluate` (a dict of report.json's keys): {e}"
             ))

@@ -4,6 +4,7 @@ use std::sync::{Arc, Mutex, MutexGuard};
 
 use pyo3::exceptions::PyTypeError;
 use pyo3::prelude::*;
+use pyo3::types::{PyList, PyTuple};
 use ridi::correct::Update as RidiUpdate;
 use ridi::features::Orientation;
 use ridi::frames::{DeviceVec, WorldFromDevice};
@@ -310,10 +311,16 @@ fn refuse_unreadable(obj: &Bound<'_, PyAny>, name: &str) -> PyResult<()> {
         let size = dtype.getattr("itemsize").ok()?.extract::<usize>().ok()?;
         Some((*kind.as_bytes().first()?, size))
     };
-    // The items of a list, a tuple or an object array; an array of numbers says by its dtype.
-    let items: Vec<Bound<'_, PyAny>> = match obj.try_iter() {
-        Ok(iter) if kind(obj).is_none_or(|(k, _)| k == b'O') => iter.flatten().collect(),
-        _ => vec![obj.clone()],
+    // The items of a list, a tuple or an object array (at most 4: a reading has 3, and any
+    // other count is refused later); an array of numbers says by its dtype. Other iterables
+    // are not walked: an endless one would never end.
+    let listed = obj.is_instance_of::<PyList>()
+        || obj.is_instance_of::<PyTuple>()
+        || kind(obj).is_some_and(|(k, _)| k == b'O');
+    let items: Vec<Bound<'_, PyAny>> = if listed {
+        obj.try_iter()?.take(4).collect::<PyResult<_>>()?
+    } else {
+        vec![obj.clone()]
     };
     for item in items.iter().chain(std::iter::once(obj)) {
         if crate::options::not_bool(item).is_err() {

@@ -215,3 +215,8 @@ def test_compare_pairs_two_evaluations_as_the_command_does(model, model_file, ri
         ridi.compare(first, 5)
     with pytest.raises(ValueError, match=r"`first` is not a report of `ridi.evaluate`"):
         ridi.compare({"sequences": 3}, first)
+    # A dict is checked as a report.json file is: a window that is not positive is refused.
+    edited = json.loads((out / "report.json").read_text())
+    edited["config"]["rte_window_s"] = -5.0
+    with pytest.raises(ValueError, match=r"config.rte_window_s"):
+        ridi.compare(edited, first)

@@ -168,6 +168,25 @@ def test_any_layout_is_read_in_place(seq):
     np.testing.assert_array_equal(built.time, seq.time)
 
 
+def test_record_fields_and_unaligned_views_are_read_by_value(seq):
+    # A float64 field of a record array (strides of 9 bytes: not a multiple of 8) and a
+    # float64 view at an odd byte offset (unaligned) are read as the numbers they show.
+    n = len(seq)
+    args = arrays_of(seq)
+    rec = np.zeros(n, dtype=[("t", "f8"), ("ok", "?")])
+    rec["t"] = seq.time
+    assert rec["t"].strides == (9,)
+    args["time"] = rec["t"]
+    raw = np.zeros(n * 3 * 8 + 1, dtype=np.uint8)
+    raw[1:] = np.frombuffer(np.ascontiguousarray(seq.acce).tobytes(), dtype=np.uint8)
+    odd = np.frombuffer(raw.tobytes(), dtype="f8", offset=1).reshape(n, 3)
+    assert odd.ctypes.data % 8 != 0
+    args["acce"] = odd
+    built = ridi.Sequence(**args)
+    np.testing.assert_array_equal(built.time, seq.time)
+    np.testing.assert_array_equal(built.acce, seq.acce)
+
+
 def test_arrays_of_other_real_dtypes_and_array_likes_read_as_float64(seq):
     # float32 sensors, integer counts, lists, an object with __array__ (a pandas column):
     # each converted as np.asarray(x, dtype=np.float64) would, so the sequence is the one

@@ -961,9 +961,15 @@ impl Report {
         };
         // Bounded: a report holds figures per sequence, far below this for any dataset.
         let text = ridi_data::read_text(path, 1 << 30)?;
-        let report: Report = serde_json::from_str(&text)
-            .map_err(|e| file(format!("not a report.json of `ridi eval`: {e}")))?;
-        report.check_read().map_err(file)?;
+        Report::from_json(&text).map_err(file)
+    }
+
+    /// A report from the text of a `report.json`, checked as [`Report::read`] checks a file's
+    /// (what no evaluation writes is refused); the error says what is wrong.
+    pub fn from_json(text: &str) -> std::result::Result<Report, String> {
+        let report: Report = serde_json::from_str(text)
+            .map_err(|e| format!("not a report.json of `ridi eval`: {e}"))?;
+        report.check_read()?;
         Ok(report)
     }
 
