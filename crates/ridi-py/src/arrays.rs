@@ -2,7 +2,8 @@
 //!
 //! In: float64 arrays of any layout (C or Fortran order, strided slices, negative strides) are
 //! read in place through an ndarray view, without a contiguous copy first; the one copy made is
-//! into the `Sequence`'s own storage. Arrays of other real dtypes and array-likes (lists,
+//! into the `Sequence`'s own storage. A view that is unaligned or strided off whole elements (a
+//! field of a record array, bytes at an odd offset) is copied first. Arrays of other real dtypes and array-likes (lists,
 //! pandas) are converted to float64 by numpy first. A dtype that is not a real number is a
 //! `TypeError`, another shape a `ValueError`, both naming the argument; values (NaN, units) are checked by the facade's own
 //! validation, which names the array and the frame.
@@ -34,7 +35,8 @@ fn shape_text(shape: &[usize]) -> String {
 
 /// `obj` as a numpy array of float64, or a `TypeError` naming the argument `name`.
 ///
-/// A float64 array is taken as it is (read in place). Another array of real numbers (float32,
+/// A float64 array is taken as it is (read in place), unless it is unaligned, strided off
+/// whole elements or empty (copied: ndarray's view needs an aligned pointer). Another array of real numbers (float32,
 /// integers, objects that are numbers: a pandas nullable column) and what numpy reads as one
 /// (a list, a pandas column or frame, an `array.array`) are converted as `np.asarray(obj,
 /// dtype=np.float64)` would: a copy, exact for every float32 and for integers up to 2^53.
@@ -80,8 +82,9 @@ fn float64<'py>(obj: &Bound<'py, PyAny>, name: &str) -> PyResult<Bound<'py, PyUn
         // array, bytes at an odd offset): rust-numpy divides strides by 8 and reads unaligned,
         // so such a view is copied (a new array is aligned; `ascontiguousarray` would return a
         // contiguous unaligned one as it is).
+        // numpy calls every empty array aligned, whatever its pointer.
         let aligned = array.getattr("flags")?.getattr("aligned")?.is_truthy()?;
-        if !aligned || array.strides().iter().any(|s| s % 8 != 0) {
+        if !aligned || array.is_empty() || array.strides().iter().any(|s| s % 8 != 0) {
             return Ok(array.call_method0("copy")?.cast_into::<PyUntypedArray>()?);
         }
         return Ok(array);

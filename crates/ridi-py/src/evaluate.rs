@@ -171,12 +171,16 @@ fn report_of(py: Python<'_>, obj: &Bound<'_, PyAny>, name: &str) -> PyResult<Rep
                 ))
             })?
             .extract()?;
-        // Checked as a report.json file is (a negative figure, a window that is not positive).
-        return Report::from_json(&text).map_err(|e| {
+        let report: Report = serde_json::from_str(&text).map_err(|e| {
             errors::value(format!(
                 "`{name}` is not a report of `ridi.evaluate` (a dict of report.json's keys): {e}"
             ))
-        });
+        })?;
+        // Checked as a report.json file is (a negative figure, a window that is not positive).
+        report
+            .validate()
+            .map_err(|e| errors::value(format!("`{name}`: {e}")))?;
+        return Ok(report);
     }
     let path: PathBuf = obj.extract().map_err(|_| {
         pyo3::exceptions::PyTypeError::new_err(format!(

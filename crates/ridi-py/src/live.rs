@@ -4,7 +4,7 @@ use std::sync::{Arc, Mutex, MutexGuard};
 
 use pyo3::exceptions::PyTypeError;
 use pyo3::prelude::*;
-use pyo3::types::{PyList, PyTuple};
+use pyo3::types::{PyBytes, PySequence, PyString};
 use ridi::correct::Update as RidiUpdate;
 use ridi::features::Orientation;
 use ridi::frames::{DeviceVec, WorldFromDevice};
@@ -311,14 +311,21 @@ fn refuse_unreadable(obj: &Bound<'_, PyAny>, name: &str) -> PyResult<()> {
         let size = dtype.getattr("itemsize").ok()?.extract::<usize>().ok()?;
         Some((*kind.as_bytes().first()?, size))
     };
-    // The items of a list, a tuple or an object array (at most 4: a reading has 3, and any
-    // other count is refused later); an array of numbers says by its dtype. Other iterables
-    // are not walked: an endless one would never end.
-    let listed = obj.is_instance_of::<PyList>()
-        || obj.is_instance_of::<PyTuple>()
-        || kind(obj).is_some_and(|(k, _)| k == b'O');
-    let items: Vec<Bound<'_, PyAny>> = if listed {
+    // The items of what is read as a sequence of numbers (a list, a tuple, a deque, an object
+    // array; text is no reading), at most 4: a reading has 3, and any other count is refused
+    // later. An array of numbers says by its dtype. Other iterables are not walked: an endless
+    // one would never end; a 0-d object array is its one item.
+    let objects = kind(obj).is_some_and(|(k, _)| k == b'O');
+    let zero_d = objects && obj.getattr("ndim")?.extract::<usize>()? == 0;
+    let walk = (objects && !zero_d)
+        || (kind(obj).is_none()
+            && obj.cast::<PySequence>().is_ok()
+            && !obj.is_instance_of::<PyString>()
+            && !obj.is_instance_of::<PyBytes>());
+    let items: Vec<Bound<'_, PyAny>> = if walk {
         obj.try_iter()?.take(4).collect::<PyResult<_>>()?
+    } else if zero_d {
+        vec![obj.call_method0("item")?]
     } else {
         vec![obj.clone()]
     };

@@ -2,6 +2,7 @@
 online) within 1e-9, the live tracker's poses equal to online tracking, the GIL released, and
 refused inputs."""
 
+import collections
 import itertools
 import subprocess
 import threading
@@ -199,8 +200,10 @@ def test_live_tracker_refuses_bad_samples_and_stays_usable(seq, recorded_model):
         live.push(seq.time[2], np.array([True, 0.0, 0.0], dtype=object), seq.acce[2], **recorded)
     with pytest.raises(TypeError, match=r"`time` holds bools"):
         live.push(True, seq.gyro[2], seq.acce[2], **recorded)
-    # An endless iterable is refused, not walked for ever.
-    with pytest.raises((TypeError, ValueError)):
+    # Any sequence is looked into (a deque); an endless iterable is refused, not walked for ever.
+    with pytest.raises(TypeError, match=r"`gyro` holds bools"):
+        live.push(seq.time[2], collections.deque([True, 0.0, 0.0]), seq.acce[2], **recorded)
+    with pytest.raises(TypeError, match=r"`gyro` must be 3 numbers"):
         live.push(seq.time[2], itertools.repeat(0.0), seq.acce[2], **recorded)
     with pytest.raises(TypeError, match=r"`time` is a float32: its bits have rounded"):
         live.push(np.float32(seq.time[2]), seq.gyro[2], seq.acce[2], **recorded)

@@ -961,15 +961,9 @@ impl Report {
         };
         // Bounded: a report holds figures per sequence, far below this for any dataset.
         let text = ridi_data::read_text(path, 1 << 30)?;
-        Report::from_json(&text).map_err(file)
-    }
-
-    /// A report from the text of a `report.json`, checked as [`Report::read`] checks a file's
-    /// (what no evaluation writes is refused); the error says what is wrong.
-    pub fn from_json(text: &str) -> std::result::Result<Report, String> {
-        let report: Report = serde_json::from_str(text)
-            .map_err(|e| format!("not a report.json of `ridi eval`: {e}"))?;
-        report.check_read()?;
+        let report: Report = serde_json::from_str(&text)
+            .map_err(|e| file(format!("not a report.json of `ridi eval`: {e}")))?;
+        report.validate().map_err(file)?;
         Ok(report)
     }
 
@@ -983,8 +977,10 @@ impl Report {
     }
 
     /// Refuses what no evaluation writes (a hand-edited report): a negative figure, RTE
-    /// windows, an alignment or a rate that are not positive.
-    fn check_read(&self) -> std::result::Result<(), String> {
+    /// windows, an alignment or a rate that are not positive. [`Report::read`] checks every
+    /// file with it; a report deserialized otherwise (Python's `ridi.compare` of a dict) is
+    /// checked the same way.
+    pub fn validate(&self) -> std::result::Result<(), String> {
         let c = &self.config;
         let window = match c.align {
             ridi_eval::AlignWindow::Seconds(s) => s,

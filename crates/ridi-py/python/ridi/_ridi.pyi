@@ -11,7 +11,8 @@ __version__: str
 StrPath = Union[str, "os.PathLike[str]"]
 Array = npt.NDArray[np.float64]
 ArrayIn = npt.ArrayLike
-"""An input array: float64 is read in place, other real dtypes and array-likes converted."""
+"""An input array: float64 is read in place (copied when unaligned, as a record array's field),
+other real dtypes and array-likes converted."""
 Format = Literal["ridi-csv", "ridi-plain", "ridi-raw", "tyrex", "ilc", "ronin"]
 Inputs = Union[StrPath, Seq[StrPath], Seq["Sequence"]]
 
