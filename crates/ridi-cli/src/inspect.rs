@@ -110,16 +110,16 @@ fn is_model_file(path: &Path) -> bool {
         && magic.starts_with(&head)
 }
 
-/// serde_json's `json` with DEL and the C1 controls (U+007F-U+009F) escaped too (`\u009b`), as
-/// it escapes U+0000-U+001F: they are valid JSON raw, but a terminal may obey them (U+009B
-/// starts an escape sequence on some). They can only be inside strings (JSON's own syntax is
-/// ASCII), where the escape stands for the same character.
 /// `value` as the JSON `--json` prints: pretty, [`escaped`], a line of its own.
 pub(crate) fn json_text(value: &impl serde::Serialize) -> Result<String> {
     Ok(escaped(serde_json::to_string_pretty(value)?) + "\n")
 }
 
-pub(crate) fn escaped(json: String) -> String {
+/// serde_json's `json` with DEL and the C1 controls (U+007F-U+009F) escaped too (`\u009b`), as
+/// it escapes U+0000-U+001F: they are valid JSON raw, but a terminal may obey them (U+009B
+/// starts an escape sequence on some). They can only be inside strings (JSON's own syntax is
+/// ASCII), where the escape stands for the same character.
+fn escaped(json: String) -> String {
     let raw = |c: char| ('\u{7f}'..='\u{9f}').contains(&c);
     if !json.contains(raw) {
         return json;

@@ -107,7 +107,7 @@ pub fn processed_file(folder: &Path, format: Format) -> Option<PathBuf> {
         .iter()
         .filter(|(_, f)| *f == format)
         .map(|(rel, _)| folder.join(rel))
-        .find(|file| std::fs::symlink_metadata(file).is_ok())
+        .find(|file| crate::text::present(file))
 }
 
 /// What [`detect`] found: the format and the file or folder its reader takes.
@@ -137,7 +137,7 @@ pub(crate) fn locate(path: &Path) -> Result<(Format, PathBuf)> {
         if crate::text::is_model_file(path) {
             return Err(DataError::format(
                 Location::file(path),
-                "is a model file of `ridi train` (load it with `--model`, in Python `ridi.load`), not a recording",
+                format!("is {}, not a recording", crate::text::A_MODEL_FILE),
             ));
         }
         return Err(DataError::format(

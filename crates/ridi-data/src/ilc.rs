@@ -376,12 +376,10 @@ fn name_of(path: &Path) -> String {
 
 /// Parses the content of a path file; `path` names it in errors and gives the sequence name.
 pub fn parse(bytes: &[u8], path: &Path, options: &IlcOptions) -> Result<IlcPath> {
-    if let Some(e) = options
+    let rate = options.rate_hz;
+    options
         .validation
-        .output_rate_error(options.rate_hz, path, "rate_hz")
-    {
-        return Err(e);
-    }
+        .check_output_rate(rate, path, "rate_hz")?;
     let content = text::as_text(bytes, path)?;
     let (streams, header) = parse_records(content, path)?;
 

@@ -86,8 +86,10 @@ impl ListEntry {
             if is_model_file(path) {
                 return Err(DataError::format(
                     Location::file(path),
-                    "is a model file of `ridi train` (load it with `--model`, in Python `ridi.load`), not a list file \
-                     (one `path,placement` line per sequence)",
+                    format!(
+                        "is {}, not a list file (one `path,placement` line per sequence)",
+                        text::A_MODEL_FILE
+                    ),
                 ));
             }
             let bytes = text::read_file_bounded(path, MAX_LIST_BYTES)?;
@@ -307,7 +309,7 @@ impl Listed {
 /// model file, at the entry's line; `None` for anything else (its reader's error stands).
 fn misplaced(e: &ListEntry) -> Option<DataError> {
     let what = if is_model_file(&e.path) {
-        "a model file of `ridi train` (load it with `--model`, in Python `ridi.load`)"
+        text::A_MODEL_FILE
     } else if e.path.is_file()
         && text::read_file_bounded(&e.path, MAX_LIST_BYTES).is_ok_and(|bytes| {
             parse_list(&bytes, &e.path)

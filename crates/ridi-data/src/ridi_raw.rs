@@ -705,13 +705,8 @@ fn common_span(folder: &Path, spans: impl Iterator<Item = (f64, f64)>) -> Result
 /// folder has a pose (an option is never passed over unsaid).
 pub(crate) fn check_rate(folder: &Path, opts: &ReadOptions) -> Result<()> {
     let rate = opts.rate_without_pose_hz;
-    match opts
-        .validation
-        .output_rate_error(rate, folder, "rate_without_pose_hz")
-    {
-        Some(e) => Err(e),
-        None => Ok(()),
-    }
+    opts.validation
+        .check_output_rate(rate, folder, "rate_without_pose_hz")
 }
 
 /// The error for a uniform timeline without a frame.

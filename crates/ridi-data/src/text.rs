@@ -45,6 +45,11 @@ pub fn read_text(path: impl AsRef<Path>, max: u64) -> Result<String> {
 /// one): a list, a list entry or a recording that is one gets an error that says so.
 const MODEL_MAGIC: &[u8] = b"RIDIREG\0";
 
+/// What a model file given where data were expected is, and where it goes (the errors of
+/// detection and of list files).
+pub(crate) const A_MODEL_FILE: &str =
+    "a model file of `ridi train` (load it with `--model`, in Python `ridi.load`)";
+
 /// Whether `path` is a regular file that starts as a model file does (whatever its size; only
 /// a regular file is opened: a pipe would wait for a writer).
 pub(crate) fn is_model_file(path: &Path) -> bool {

@@ -1135,9 +1135,7 @@ fn read_android(dir: &Path, name: &str, warnings: &mut Vec<String>) -> Result<Ph
 /// would split nothing and a NaN tilt or gyro limit trust both, unsaid; phone streams are never
 /// interpolated across an unbounded gap (that would invent them).
 fn check_options(dir: &Path, o: &TyrexOptions) -> Result<()> {
-    if let Some(e) = o.validation.output_rate_error(o.rate_hz, dir, "rate_hz") {
-        return Err(e);
-    }
+    o.validation.check_output_rate(o.rate_hz, dir, "rate_hz")?;
     let finite_positive = |v: f64| v.is_finite() && v > 0.0;
     const POSITIVE: &str = "a finite number above 0";
     for (field, value, ok, rule) in [

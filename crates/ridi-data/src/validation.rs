@@ -239,27 +239,28 @@ impl Validation {
         (1.001 / max_step.min(self.max_gap_s), 0.999 / min_step)
     }
 
-    /// The error for an output rate, `field` of the options a reader was given, outside
+    /// Refuses an output rate, `field` of the options a reader was given, outside
     /// [`Self::output_rate_range`]: checked before the timeline is built, which an absurd rate
     /// would make of billions of frames, refused only after.
-    pub(crate) fn output_rate_error(
+    pub(crate) fn check_output_rate(
         &self,
         rate_hz: f64,
         at: &std::path::Path,
         field: &str,
-    ) -> Option<crate::DataError> {
+    ) -> crate::Result<()> {
         let (min, max) = self.output_rate_range();
-        (!(min..=max).contains(&rate_hz)).then(|| {
-            crate::DataError::format(
-                crate::Location::file(at).with_field(field),
-                format!(
-                    "output rate {rate_hz} Hz: expected from {} to {} Hz (the validation's time \
+        if (min..=max).contains(&rate_hz) {
+            return Ok(());
+        }
+        Err(crate::DataError::format(
+            crate::Location::file(at).with_field(field),
+            format!(
+                "output rate {rate_hz} Hz: expected from {} to {} Hz (the validation's time \
                      steps, with 0.1 % to spare)",
-                    crate::sequence_error::short(min),
-                    crate::sequence_error::short(max)
-                ),
-            )
-        })
+                crate::sequence_error::short(min),
+                crate::sequence_error::short(max)
+            ),
+        ))
     }
 
     /// Checks the median interval of `time` (seconds, increasing) against

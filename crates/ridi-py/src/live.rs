@@ -4,7 +4,7 @@ use std::sync::{Arc, Mutex, MutexGuard};
 
 use pyo3::exceptions::PyTypeError;
 use pyo3::prelude::*;
-use pyo3::types::{PyBytes, PySequence, PyString};
+use pyo3::types::{PyBytes, PyFloat, PySequence, PyString};
 use ridi::correct::Update as RidiUpdate;
 use ridi::features::Orientation;
 use ridi::frames::{DeviceVec, WorldFromDevice};
@@ -299,12 +299,14 @@ impl LiveTracker {
     }
 }
 
-/// `N` numbers of one sample for argument `name`, or a `TypeError` that says so (pyo3's own
-/// names neither the argument nor what it wants).
 /// Refuses a pushed value numpy or Python would read as numbers but a sample cannot hold:
 /// bools (`True` read as 1), and for `time` a float16/float32 scalar (rounded already: to
 /// minutes at Unix times).
 fn refuse_unreadable(obj: &Bound<'_, PyAny>, name: &str) -> PyResult<()> {
+    // The common case, a Python float (a `time`), needs no look at a dtype: pushed per sample.
+    if obj.is_exact_instance_of::<PyFloat>() {
+        return Ok(());
+    }
     let kind = |o: &Bound<'_, PyAny>| -> Option<(u8, usize)> {
         let dtype = o.getattr("dtype").ok()?;
         let kind = dtype.getattr("kind").ok()?.extract::<String>().ok()?;
@@ -315,10 +317,11 @@ fn refuse_unreadable(obj: &Bound<'_, PyAny>, name: &str) -> PyResult<()> {
     // array; text is no reading), at most 4: a reading has 3, and any other count is refused
     // later. An array of numbers says by its dtype. Other iterables are not walked: an endless
     // one would never end; a 0-d object array is its one item.
-    let objects = kind(obj).is_some_and(|(k, _)| k == b'O');
+    let own = kind(obj);
+    let objects = own.is_some_and(|(k, _)| k == b'O');
     let zero_d = objects && obj.getattr("ndim")?.extract::<usize>()? == 0;
     let walk = (objects && !zero_d)
-        || (kind(obj).is_none()
+        || (own.is_none()
             && obj.cast::<PySequence>().is_ok()
             && !obj.is_instance_of::<PyString>()
             && !obj.is_instance_of::<PyBytes>());
@@ -350,6 +353,8 @@ fn refuse_unreadable(obj: &Bound<'_, PyAny>, name: &str) -> PyResult<()> {
     Ok(())
 }
 
+/// `N` numbers of one sample for argument `name`, or a `TypeError` that says so (pyo3's own
+/// names neither the argument nor what it wants).
 fn values<const N: usize>(obj: &Bound<'_, PyAny>, name: &str) -> PyResult<[f64; N]> {
     obj.extract().map_err(|_| {
         let message = format!(

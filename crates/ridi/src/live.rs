@@ -339,23 +339,22 @@ impl<'m> LiveTracker<'m> {
                 Ok(())
             }
             // After a clock that jumped ahead (a glitch taken for a pause), every sample
-            // would go back: say why, and what to do.
+            // would go back: say why, and what to do. Only a sample landing inside the pause
+            // before the last one says the pause was a clock's jump (a repeated timestamp says
+            // nothing of it).
             Err(PipelineError::Track(TrackError::TimeNotIncreasing { time, previous })) => {
-                // Only a sample landing inside the pause before the last one says the pause
-                // was a clock's jump (a repeated timestamp says nothing of it).
-                let Some((_, Some(pause))) = self.last.filter(|_| time < previous) else {
-                    return Err(TrackError::TimeNotIncreasing { time, previous }.into());
-                };
-                if time <= previous - pause {
-                    return Err(TrackError::TimeNotIncreasing { time, previous }.into());
+                match self.last {
+                    Some((_, Some(pause))) if time < previous && time > previous - pause => {
+                        Err(PipelineError::Live(format!(
+                            "sample time {time} is not after the previous sample's {previous}, \
+                             which came {} s after the one before it (taken for a pause, where a \
+                             new segment started): a stream cannot go back in time; if that \
+                             timestamp was a glitch, start a new tracker",
+                            ridi_data::short(pause)
+                        )))
+                    }
+                    _ => Err(TrackError::TimeNotIncreasing { time, previous }.into()),
                 }
-                Err(PipelineError::Live(format!(
-                    "sample time {time} is not after the previous sample's {previous}, which \
-                     came {} s after the one before it (taken for a pause, where a new segment \
-                     started): a stream cannot go back in time; if that timestamp was a glitch, \
-                     start a new tracker",
-                    ridi_data::short(pause)
-                )))
             }
             Err(e) => Err(e),
         }
