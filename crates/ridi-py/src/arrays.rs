@@ -10,12 +10,12 @@
 //!
 //! Out: each array is built once in Rust and handed to numpy without a further copy.
 
-use numpy::ndarray::{Array2, ArrayView2};
+use numpy::ndarray::{Array2, ArrayView1, ArrayView2};
 use numpy::{
     IntoPyArray, PyArray1, PyArray2, PyArrayDescrMethods, PyArrayMethods, PyReadonlyArray1,
     PyReadonlyArray2, PyUntypedArray, PyUntypedArrayMethods, dtype,
 };
-use pyo3::exceptions::PyTypeError;
+use pyo3::exceptions::{PyMemoryError, PyTypeError};
 use pyo3::prelude::*;
 use pyo3::types::{PyBytes, PyString};
 use ridi::frames::{Frame, Vec3, WorldFromDevice};
@@ -218,27 +218,46 @@ pub(crate) fn vector<'py>(
     Ok(array.cast::<PyArray1<f64>>()?.readonly())
 }
 
-/// The rows of `(N, 3)` `view` as vectors of frame `F`.
-pub(crate) fn vecs<F: Frame>(view: ArrayView2<'_, f64>) -> Vec<Vec3<F>> {
-    view.rows()
-        .into_iter()
-        .map(|r| Vec3::new(r[0], r[1], r[2]))
-        .collect()
+/// Room for `n` values of argument `name`, or `MemoryError`: a numpy view (a broadcast, a
+/// stride trick) can describe more frames than memory holds, and a failed allocation would
+/// abort the interpreter.
+fn room<T>(n: usize, name: &str) -> PyResult<Vec<T>> {
+    let mut v = Vec::new();
+    v.try_reserve_exact(n).map_err(|_| {
+        PyMemoryError::new_err(format!(
+            "`{name}` has {n} frames, more than memory holds a copy of"
+        ))
+    })?;
+    Ok(v)
+}
+
+/// The values of 1-D `view`, argument `name`.
+pub(crate) fn values(view: ArrayView1<'_, f64>, name: &str) -> PyResult<Vec<f64>> {
+    let mut out = room(view.len(), name)?;
+    out.extend(view.iter().copied());
+    Ok(out)
+}
+
+/// The rows of `(N, 3)` `view`, argument `name`, as vectors of frame `F`.
+pub(crate) fn vecs<F: Frame>(view: ArrayView2<'_, f64>, name: &str) -> PyResult<Vec<Vec3<F>>> {
+    let mut out = room(view.nrows(), name)?;
+    out.extend(view.rows().into_iter().map(|r| Vec3::new(r[0], r[1], r[2])));
+    Ok(out)
 }
 
 /// The rows of `(N, 4)` `view` as orientations, `[w, x, y, z]` (the order of RIDI's files);
 /// a row that is not a unit quaternion is an error naming `name` and the frame.
 pub(crate) fn rotations(view: ArrayView2<'_, f64>, name: &str) -> PyResult<Vec<WorldFromDevice>> {
-    view.rows()
-        .into_iter()
-        .enumerate()
-        .map(|(i, r)| {
-            // As given when unit to round-off, so that a sequence rebuilt from another's
-            // arrays (or unpickled) tracks exactly as the original.
+    let mut out = room(view.nrows(), name)?;
+    for (i, r) in view.rows().into_iter().enumerate() {
+        // As given when unit to round-off, so that a sequence rebuilt from another's
+        // arrays (or unpickled) tracks exactly as the original.
+        out.push(
             WorldFromDevice::from_wxyz_as_given([r[0], r[1], r[2], r[3]])
-                .map_err(|e| errors::value(format!("`{name}` at frame {i}: {e}")))
-        })
-        .collect()
+                .map_err(|e| errors::value(format!("`{name}` at frame {i}: {e}")))?,
+        );
+    }
+    Ok(out)
 }
 
 /// `rows` as a `(N, C)` float64 array.

@@ -22,7 +22,8 @@ use crate::options::{self, Inputs};
 /// ``methods`` are keys of ``ridi.METHODS``, one or a list (default: all, in that order); ``placement_map``,
 /// ``placement_window`` (seconds, 0 for the paper's per-window labels), ``align`` (seconds,
 /// or ``"all"``), ``heading`` (``"corrected"`` or ``"gyro"``, as ``ridi.track``'s) and
-/// ``jobs`` are ``ridi eval``'s options with its defaults.
+/// ``jobs`` are ``ridi eval``'s options with its defaults. Ctrl-C stops the evaluation once the
+/// sequences under way are done (``KeyboardInterrupt``).
 ///
 /// >>> report = ridi.evaluate("datasets/sample/list_test.txt", model,
 /// ...                        placement_map="tyrex4")           # doctest: +SKIP
@@ -92,34 +93,30 @@ pub(crate) fn evaluate<'py>(
     let map_name = placement_map.as_ref().map(|p| p.display().to_string());
     let map = options::placement_map(placement_map)?;
     let model = &model.get().inner;
-    let mut report = py
-        .detach(|| {
-            options::with_jobs(jobs, || -> ridi::Result<Report> {
-                match inputs {
-                    Inputs::Lists(lists) => {
-                        let entries =
-                            ridi::data::ListEntry::read(&lists).map_err(PipelineError::from)?;
-                        let listed = load_listed(
-                            entries,
-                            map.as_ref(),
-                            Purpose::Evaluation,
-                            &options::read_options(),
-                        )?;
-                        ridi::evaluate(listed.sequences(), model, &opts)
-                            .map(|(report, _)| report)
-                            .map_err(|e| e.locate_in(&listed))
-                    }
-                    Inputs::Sequences(mut seqs) => {
-                        if let Some(map) = &map {
-                            map.check(&seqs)?;
-                            map.apply(&mut seqs);
-                        }
-                        ridi::evaluate(&seqs, model, &opts).map(|(report, _)| report)
-                    }
+    let mut report = options::interruptible(py, jobs, |cancel| -> ridi::Result<Report> {
+        match inputs {
+            Inputs::Lists(lists) => {
+                let entries = ridi::data::ListEntry::read(&lists).map_err(PipelineError::from)?;
+                let listed = load_listed(
+                    entries,
+                    map.as_ref(),
+                    Purpose::Evaluation,
+                    &options::read_options(),
+                )?;
+                ridi::evaluate_cancellable(listed.sequences(), model, &opts, cancel)
+                    .map(|(report, _)| report)
+                    .map_err(|e| e.locate_in(&listed))
+            }
+            Inputs::Sequences(mut seqs) => {
+                if let Some(map) = &map {
+                    map.check(&seqs)?;
+                    map.apply(&mut seqs);
                 }
-            })
-        })?
-        .map_err(errors::pipeline)?;
+                ridi::evaluate_cancellable(&seqs, model, &opts, cancel).map(|(report, _)| report)
+            }
+        }
+    })?
+    .map_err(errors::pipeline)?;
     // Also in the report's `warnings`, but a caller reading one figure would not see them.
     crate::sequence::warn(py, &report.warnings)?;
     if let Some(p) = &mut report.provenance {

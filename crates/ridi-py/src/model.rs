@@ -1,6 +1,7 @@
 //! `ridi.Model`, `ridi.load` and `ridi.train`.
 
 use std::path::PathBuf;
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Arc, Mutex};
 
 use pyo3::exceptions::PyRuntimeError;
@@ -157,47 +158,50 @@ pub(crate) fn bundled_model(py: Python<'_>) -> PyResult<Model> {
         .map_err(|e| errors::value(format!("cannot decode the bundled model: {e}")))
 }
 
-/// A progress callback, and what it did: the first exception it raised (or a
-/// `KeyboardInterrupt` caught between its calls), or whether it asked to stop.
-struct Callback {
+/// A progress callback, and what it did: the first exception it raised, or whether it asked
+/// to stop.
+struct Callback<'a> {
     callback: Option<Py<PyAny>>,
+    /// Set on Ctrl-C ([`options::interruptible`]): the training stops at its next report.
+    cancel: &'a AtomicBool,
     raised: Mutex<Option<PyErr>>,
     stopped: Mutex<bool>,
 }
 
-impl Callback {
-    /// Called by the training, from any thread, with the GIL released: attaches to Python,
-    /// checks for Ctrl-C and calls the callback with `(stage, done, total)`.
+impl Callback<'_> {
+    /// Called by the training, from any thread, with the GIL released: calls the callback
+    /// with `(stage, done, total)`; `false` stops the training.
     fn report(&self, e: &ProgressEvent<'_>) -> bool {
-        Python::attach(|py| {
+        let Some(f) = &self.callback else {
+            return !self.cancel.load(Ordering::Relaxed);
+        };
+        let outcome = Python::attach(|py| {
             let stage = match e.stage {
                 Stage::Classifier => "placement classifier".to_string(),
                 Stage::Grid { placement } => format!("grid {placement}"),
                 Stage::Regressors { placement } => format!("regressors {placement}"),
             };
-            let outcome = py.check_signals().and_then(|()| match &self.callback {
-                Some(f) => f.call1(py, (stage, e.done, e.total)).map(|r| {
-                    // Only an explicit `False` stops; `None` (no return) goes on.
-                    !r.bind(py).is_instance_of::<pyo3::types::PyBool>()
-                        || r.extract::<bool>(py).unwrap_or(true)
-                }),
-                None => Ok(true),
-            });
-            match outcome {
-                Ok(true) => true,
-                Ok(false) => {
-                    *self.stopped.lock().unwrap_or_else(|p| p.into_inner()) = true;
-                    false
-                }
-                Err(err) => {
-                    self.raised
-                        .lock()
-                        .unwrap_or_else(|p| p.into_inner())
-                        .get_or_insert(err);
-                    false
-                }
+            f.call1(py, (stage, e.done, e.total)).map(|r| {
+                // Only an explicit `False` stops; `None` (no return) goes on.
+                !r.bind(py).is_instance_of::<pyo3::types::PyBool>()
+                    || r.extract::<bool>(py).unwrap_or(true)
+            })
+        });
+        match outcome {
+            // Ctrl-C may have come while the callback ran.
+            Ok(true) => !self.cancel.load(Ordering::Relaxed),
+            Ok(false) => {
+                *self.stopped.lock().unwrap_or_else(|p| p.into_inner()) = true;
+                false
             }
-        })
+            Err(err) => {
+                self.raised
+                    .lock()
+                    .unwrap_or_else(|p| p.into_inner())
+                    .get_or_insert(err);
+                false
+            }
+        }
     }
 
     /// The Python exception for a training that ended with `e`.
@@ -246,8 +250,8 @@ const _: () = assert!(Nystrom::DEFAULT_LANDMARKS == 2048);
 /// ``progress``, when given, is called as ``progress(stage, done, total)`` at the start of each
 /// stage and after each step (``stage`` is ``"placement classifier"``, ``"grid <placement>"``
 /// or ``"regressors <placement>"``); returning ``False`` cancels the training
-/// (``RuntimeError``), and an exception it raises, or Ctrl-C, ends the training with that
-/// exception.
+/// (``RuntimeError``), and an exception it raises ends the training with that exception.
+/// Ctrl-C stops the training at its next step (``KeyboardInterrupt``).
 ///
 /// >>> model = ridi.train("datasets/sample/list_Guillaume.txt", grid="none",
 /// ...                    placement_map="tyrex4")                     # doctest: +SKIP
@@ -343,13 +347,14 @@ pub(crate) fn train(
         &[("projected", projected), ("half", Storage::Half)],
     )?;
     let map = options::placement_map(placement_map)?;
-    let callback = Callback {
-        callback: progress,
-        raised: Mutex::new(None),
-        stopped: Mutex::new(false),
-    };
-    let trained = py.detach(|| {
-        options::with_jobs(jobs, || {
+    let trained = options::interruptible(py, jobs, |cancel| {
+        let callback = Callback {
+            callback: progress,
+            cancel,
+            raised: Mutex::new(None),
+            stopped: Mutex::new(false),
+        };
+        let trained = (|| -> ridi::Result<Cascade> {
             let mut report = |e: &ProgressEvent<'_>| callback.report(e);
             match inputs {
                 Inputs::Lists(lists) => {
@@ -374,9 +379,10 @@ pub(crate) fn train(
                     ridi::train(&seqs, &opts, &mut report)
                 }
             }
-        })
-    })?;
-    trained.map(Model::of).map_err(|e| callback.error(e))
+        })();
+        trained.map_err(|e| callback.error(e))
+    })??;
+    Ok(Model::of(trained))
 }
 
 /// A dict from the JSON text `json` (what `report.json` holds).

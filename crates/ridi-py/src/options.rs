@@ -3,8 +3,11 @@
 //! the same facade options the commands build.
 
 use std::path::PathBuf;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::mpsc;
+use std::time::Duration;
 
-use pyo3::exceptions::PyTypeError;
+use pyo3::exceptions::{PyRuntimeError, PyTypeError};
 use pyo3::prelude::*;
 use ridi::PlacementMap;
 use ridi::correct::{InitialVelocity, PlacementSmoother};
@@ -270,6 +273,51 @@ pub(crate) fn with_jobs<T: Send>(jobs: Option<i64>, f: impl FnOnce() -> T + Send
         .map_err(|e| errors::value(format!("cannot set up the worker threads: {e}")))?;
     Ok(pool.install(f))
 }
+
+/// Runs `f(cancel)` without the GIL on a thread of its own, with [`with_jobs`]'s workers, while
+/// the calling thread watches for Ctrl-C: Python runs signal handlers on the main thread only,
+/// and the work's own threads never are it. On a signal, `cancel` is set for `f` to stop at its
+/// next check, and the handler's exception (`KeyboardInterrupt`) is raised once `f` returns.
+pub(crate) fn interruptible<T: Send>(
+    py: Python<'_>,
+    jobs: Option<i64>,
+    f: impl FnOnce(&AtomicBool) -> T + Send,
+) -> PyResult<T> {
+    let cancel = AtomicBool::new(false);
+    let mut caught = None;
+    let done = py.detach(|| {
+        std::thread::scope(|scope| {
+            let (tx, rx) = mpsc::channel();
+            let cancel = &cancel;
+            scope.spawn(move || tx.send(with_jobs(jobs, || f(cancel))));
+            loop {
+                match rx.recv_timeout(SIGNAL_POLL) {
+                    Ok(done) => return Some(done),
+                    // `f` panicked: the scope passes the panic on as it ends.
+                    Err(mpsc::RecvTimeoutError::Disconnected) => return None,
+                    Err(mpsc::RecvTimeoutError::Timeout) if caught.is_none() => {
+                        if let Err(e) = Python::attach(|py| py.check_signals()) {
+                            caught = Some(e);
+                            cancel.store(true, Ordering::Relaxed);
+                        }
+                    }
+                    Err(mpsc::RecvTimeoutError::Timeout) => {}
+                }
+            }
+        })
+    });
+    match (caught, done) {
+        (Some(e), _) => Err(e),
+        (None, Some(done)) => done,
+        (None, None) => Err(PyRuntimeError::new_err(
+            "the work's thread ended without a result",
+        )),
+    }
+}
+
+/// How often [`interruptible`] looks for a signal: well under a person's patience, and a wake-up
+/// that costs nothing beside the work.
+const SIGNAL_POLL: Duration = Duration::from_millis(50);
 
 /// Runs `f` without the GIL, on the worker threads [`with_jobs`] gives by default.
 pub(crate) fn detached<T: Send>(py: Python<'_>, f: impl FnOnce() -> T + Send) -> PyResult<T> {

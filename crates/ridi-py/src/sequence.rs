@@ -13,7 +13,7 @@ use ridi::data::{
 use ridi::frames::{FilterConfig, Frame, STANDARD_GRAVITY, Vec3, gravity_in_device};
 use ridi::{Purpose, load_listed};
 
-use crate::arrays::{matrix, rotations, rotations_out, vecs, vecs_out, vector, vector_out};
+use crate::arrays::{matrix, rotations, rotations_out, values, vecs, vecs_out, vector, vector_out};
 use crate::errors;
 use crate::options::{self, choice};
 
@@ -104,13 +104,13 @@ impl Sequence {
         let time = vector(time, "time", None)?;
         let n = time.as_array().len();
         fn three<F: Frame>(obj: &Bound<'_, PyAny>, name: &str, n: usize) -> PyResult<Vec<Vec3<F>>> {
-            matrix(obj, name, 3, Some(n)).map(|a| vecs(a.as_array()))
+            matrix(obj, name, 3, Some(n)).and_then(|a| vecs(a.as_array(), name))
         }
         let four = |obj: &Bound<'_, PyAny>, name: &str| {
             matrix(obj, name, 4, Some(n)).and_then(|a| rotations(a.as_array(), name))
         };
         let (gyro, acce) = (three(gyro, "gyro", n)?, three(acce, "acce", n)?);
-        let time = time.as_array().to_vec();
+        let time = values(time.as_array(), "time")?;
         let (orientation, gravity, estimated) = match (orientation, gravity) {
             (Some(q), Some(g)) => (four(q, "orientation")?, three(g, "gravity", n)?, false),
             // Gravity as Android's gravity sensor gives it: the orientation's up axis.
@@ -191,7 +191,7 @@ impl Sequence {
             orientation_source,
             ground_truth,
             steps: steps
-                .map(|s| vector(s, "steps", Some(n)).map(|s| s.as_array().to_vec()))
+                .map(|s| vector(s, "steps", Some(n)).and_then(|s| values(s.as_array(), "steps")))
                 .transpose()?,
             device,
             placement,

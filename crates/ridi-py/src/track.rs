@@ -219,7 +219,12 @@ impl Track {
             let from = 2 + n + 3 * n * k;
             ArrayView2::from_shape((n, 3), &v[from..from + 3 * n]).map_err(|_| corrupt())
         };
-        let (position, velocity, bias) = (vecs(rows(0)?), vecs(rows(1)?), vecs(rows(2)?));
+        let state = "the pickled track";
+        let (position, velocity, bias) = (
+            vecs(rows(0)?, state)?,
+            vecs(rows(1)?, state)?,
+            vecs(rows(2)?, state)?,
+        );
         let mut regressions = Vec::with_capacity(m);
         let mut placements = Vec::with_capacity(m);
         for r in v[2 + 10 * n..].chunks_exact(4) {

@@ -1,10 +1,13 @@
 """ridi.evaluate: the dict of `ridi eval`'s report.json, from list files or sequences, and its
 options and refusals."""
 
+import _thread
 import json
 import math
 import subprocess
 import sys
+import threading
+import time
 
 import numpy as np
 import pytest
@@ -220,3 +223,21 @@ def test_compare_pairs_two_evaluations_as_the_command_does(model, model_file, ri
     edited["config"]["rte_window_s"] = -5.0
     with pytest.raises(ValueError, match=r"config.rte_window_s"):
         ridi.compare(edited, first)
+
+
+@pytest.mark.filterwarnings("ignore::UserWarning")
+def test_ctrl_c_stops_an_evaluation(model):
+    # The evaluation runs on threads of its own while the main thread, where Python runs signal
+    # handlers, waits for it: Ctrl-C stops it after the sequences under way, not at its end.
+    seqs = ridi.read_list(SAMPLE / "list_all.txt", placement_map="tyrex4")
+    start = time.perf_counter()
+    ridi.evaluate(seqs, model, jobs=1)
+    whole = time.perf_counter() - start
+    threading.Timer(0.02, _thread.interrupt_main).start()  # as Ctrl-C
+    start = time.perf_counter()
+    with pytest.raises(KeyboardInterrupt):
+        ridi.evaluate(seqs, model, jobs=1)
+        time.sleep(10)  # where an evaluation that ignored the signal takes it
+    stopped = time.perf_counter() - start
+    # One sequence at a time: stopped after the first or second of the sample's 26.
+    assert stopped < whole / 2, f"stopped after {stopped:.2f} s; a whole evaluation takes {whole:.2f} s"

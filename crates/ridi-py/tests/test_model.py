@@ -1,8 +1,10 @@
 """ridi.train, ridi.load, Model.save and the model's description: the same model file as
 `ridi train` with the same options, progress, cancellation, and bad options and inputs."""
 
+import _thread
 import json
 import pickle
+import time
 
 import pytest
 
@@ -80,6 +82,25 @@ def test_progress_reports_each_stage_and_can_cancel():
 
     with pytest.raises(KeyError, match="stop here"):
         ridi.train(seqs, grid="none", progress=fail)
+
+
+def test_ctrl_c_stops_a_training_on_worker_threads():
+    # Python runs signal handlers on its main thread only, and the callback here runs on one
+    # of the training's own: Ctrl-C must stop the training at its next report, not after it.
+    seqs = ridi.read_list(GUILLAUME, placement_map="tyrex4")[:4]
+    events = []
+
+    def progress(*event):
+        events.append(event)
+        if len(events) == 1:
+            _thread.interrupt_main()  # as Ctrl-C
+            time.sleep(1)  # the main thread notices meanwhile
+
+    with pytest.raises(KeyboardInterrupt):
+        ridi.train(seqs, grid="none", progress=progress, jobs=2)
+    # The first report is the classifier's start, before any parallel work; the test above
+    # shows a whole training reports many more.
+    assert events == [("placement classifier", 0, events[0][2])]
 
 
 @pytest.mark.parametrize(

@@ -187,6 +187,16 @@ def test_record_fields_and_unaligned_views_are_read_by_value(seq):
     np.testing.assert_array_equal(built.acce, seq.acce)
 
 
+def test_views_of_more_frames_than_memory_holds_are_a_memory_error():
+    # A broadcast costs numpy nothing; its copy would be 24 PB, beyond any address space: a
+    # MemoryError, not an aborted interpreter.
+    huge = 10**15
+    time = np.broadcast_to(0.0, (huge,))
+    rows = np.broadcast_to(np.zeros(3), (huge, 3))
+    with pytest.raises(MemoryError, match=r"`gyro` has 1000000000000000 frames, more than memory"):
+        ridi.Sequence(time, rows, rows)
+
+
 def test_arrays_of_other_real_dtypes_and_array_likes_read_as_float64(seq):
     # float32 sensors, integer counts, lists, an object with __array__ (a pandas column):
     # each converted as np.asarray(x, dtype=np.float64) would, so the sequence is the one

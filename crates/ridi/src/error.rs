@@ -55,6 +55,9 @@ pub enum PipelineError {
     /// A stage was given no sequence at all.
     #[error("no sequences to {0}")]
     NoSequences(&'static str),
+    /// The caller cancelled a stage (its flag was set, [`crate::evaluate_cancellable`]).
+    #[error("{0} cancelled")]
+    Cancelled(&'static str),
     /// An output that cannot be written, or would replace an input ([`crate::OutputError`]).
     #[error(transparent)]
     Output(#[from] crate::output::OutputError),

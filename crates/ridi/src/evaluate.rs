@@ -13,6 +13,7 @@
 use std::collections::{BTreeMap, BTreeSet};
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicBool, Ordering};
 
 use rayon::prelude::*;
 use ridi_data::{Sequence, write_atomically};
@@ -429,6 +430,18 @@ pub fn evaluate(
     model: &Cascade,
     opts: &EvalOptions,
 ) -> Result<(Report, Vec<Traces>)> {
+    evaluate_cancellable(seqs, model, opts, &AtomicBool::new(false))
+}
+
+/// [`evaluate`], which another thread cancels by setting `cancel`: the sequences being
+/// evaluated then finish, no other starts, and the result is [`PipelineError::Cancelled`].
+/// (Python's `ridi.evaluate` sets it on Ctrl-C; the command line exits instead.)
+pub fn evaluate_cancellable(
+    seqs: &[Sequence],
+    model: &Cascade,
+    opts: &EvalOptions,
+    cancel: &AtomicBool,
+) -> Result<(Report, Vec<Traces>)> {
     if seqs.is_empty() {
         return Err(PipelineError::NoSequences("evaluate"));
     }
@@ -440,7 +453,13 @@ pub fn evaluate(
     }
     let done: Vec<Evaluated> = seqs
         .par_iter()
-        .map(|s| evaluate_one(s, model, opts))
+        .map(|s| {
+            // Relaxed: the flag carries no data, and a sequence more or less is no matter.
+            if cancel.load(Ordering::Relaxed) {
+                return Err(PipelineError::Cancelled("evaluation"));
+            }
+            evaluate_one(s, model, opts)
+        })
         // The first error in the sequences' order, whatever the threads met first.
         .collect::<Vec<Result<_>>>()
         .into_iter()

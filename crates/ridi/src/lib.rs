@@ -116,7 +116,7 @@ pub use demo::Demo;
 pub use error::{PipelineError, Result};
 pub use evaluate::{
     EvalOptions, GroupSummary, Provenance, Report, SequenceResult, Traces, check_evaluable,
-    evaluate, placement_warnings,
+    evaluate, evaluate_cancellable, placement_warnings,
 };
 pub use inspect::{
     Inspection, ModelInspection, PlacementModel, RegressorSummary, SeriesStats, inspect,

@@ -92,6 +92,15 @@ fn train_track_and_evaluate_on_the_sample_dataset() {
     let reversed: Vec<Sequence> = test.iter().rev().cloned().collect();
     let (again, _) = ridi::evaluate(&reversed, &model, &EvalOptions::default()).unwrap();
     assert_eq!(again.summary, report.summary);
+    // Cancelled before it starts: no sequence is evaluated, and the error says so.
+    let cancel = std::sync::atomic::AtomicBool::new(true);
+    let err =
+        ridi::evaluate_cancellable(&test, &model, &EvalOptions::default(), &cancel).unwrap_err();
+    assert!(
+        matches!(err, ridi::PipelineError::Cancelled("evaluation")),
+        "{err:?}"
+    );
+    assert_eq!(err.to_string(), "evaluation cancelled");
     assert_eq!(
         (&again.intervals, &again.ridi_minus),
         (&report.intervals, &report.ridi_minus)
