@@ -797,6 +797,15 @@ fn convert_train_track_and_eval() {
             stderr(&out)
         );
     }
+    // An input that does not exist is that error, not the output's, and nothing is written.
+    let missing = dir.path().join("missing.csv");
+    let out = track_to(&missing, &missing, &[]);
+    let err = stderr(&out);
+    assert!(
+        !out.status.success() && err.contains("missing.csv") && !err.contains("reads it"),
+        "{err}"
+    );
+    assert!(!missing.exists());
     let out = ridi(&[
         "train",
         "--list",

@@ -681,8 +681,23 @@ fn lists_load_every_format_and_set_placements() {
     std::fs::write(&list, "csv_seq,body\n\nmissing_seq,bag\n").unwrap();
     assert_err(
         load_list(&list),
-        &["list.txt:3: field `path`", "missing_seq", "does not exist"],
+        &[
+            "list.txt:3: field `path`",
+            "missing_seq",
+            "does not exist (a relative path in a list is read from the list's folder, ",
+        ],
     );
+    // A tab or a semicolon for the comma: the whole line is read as the path.
+    for separator in ["\t", ";"] {
+        std::fs::write(&list, format!("csv_seq{separator}body\n")).unwrap();
+        assert_err(
+            load_list(&list),
+            &[
+                "list.txt:1: field `path`",
+                "does not exist (a list line is `path,placement`, separated by a comma)",
+            ],
+        );
+    }
     std::fs::write(&list, "nothing\n").unwrap();
     assert_err(load_list(&list), &["nothing", "not a known dataset folder"]);
 }

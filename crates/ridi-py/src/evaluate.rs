@@ -38,7 +38,7 @@ use crate::options::{self, Inputs};
 pub(crate) fn evaluate<'py>(
     py: Python<'py>,
     data: &Bound<'py, PyAny>,
-    model: &Bound<'py, Model>,
+    #[pyo3(from_py_with = crate::options::model)] model: Bound<'py, Model>,
     methods: Option<&Bound<'py, PyAny>>,
     placement_map: Option<PathBuf>,
     #[pyo3(from_py_with = crate::options::real)] placement_window: f64,

@@ -4,10 +4,12 @@
 //! command's defaults, so that a notebook and the command line give the same numbers:
 //! `read` is `ridi::read_any`, `read_list` is `ridi::load_listed`, `train` is
 //! `ridi::train` with `ridi train`'s options, `track` is `ridi::track`, `LiveTracker` is
-//! `ridi::LiveTracker`, `evaluate` is `ridi::evaluate` and its dict is `report.json`.
+//! `ridi::LiveTracker`, `evaluate` is `ridi::evaluate_cancellable` and its dict is
+//! `report.json`.
 //!
 //! The GIL is released while Rust reads, trains, tracks and evaluates (`Python::detach`), so
-//! other Python threads run meanwhile.
+//! other Python threads run meanwhile; training and evaluation run on a thread of their own
+//! while the caller's watches for Ctrl-C (`options::interruptible`).
 
 use pyo3::prelude::*;
 

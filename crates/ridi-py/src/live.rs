@@ -151,7 +151,7 @@ impl LiveTracker {
         placement_window=10.0, heading="corrected",
     ))]
     fn new(
-        model: &Bound<'_, Model>,
+        #[pyo3(from_py_with = crate::options::model)] model: Bound<'_, Model>,
         #[pyo3(from_py_with = crate::options::whole)] regress_every: i64,
         #[pyo3(from_py_with = crate::options::real)] lambda_: f64,
         estimate_initial_velocity: bool,
@@ -364,10 +364,43 @@ fn values<const N: usize>(obj: &Bound<'_, PyAny>, name: &str) -> PyResult<[f64; 
         );
         // Numbers of another count (or a chunk's rows) are a wrong value, as a wrong shape is
         // for `Sequence`; anything else is a wrong type.
-        let numbers = obj.extract::<Vec<f64>>().is_ok() || obj.extract::<Vec<Vec<f64>>>().is_ok();
-        match numbers {
+        match reads_as_numbers(obj, 0) {
             true => errors::value(message),
             false => PyTypeError::new_err(message),
         }
     })
+}
+
+/// Whether `obj` is numbers (`depth` 0), or rows of them: a numeric array, or a sequence whose
+/// first items (at most 4) are numbers, or at `depth` 0 such rows. Judged by a look, not a
+/// copy: a chunk pushed by mistake may hold more rows than memory holds a copy of.
+fn reads_as_numbers(obj: &Bound<'_, PyAny>, depth: u8) -> bool {
+    let numeric = obj
+        .getattr("dtype")
+        .and_then(|d| d.getattr("kind"))
+        .is_ok_and(|k| {
+            k.extract::<String>()
+                .is_ok_and(|k| matches!(&*k, "f" | "i" | "u"))
+        });
+    if numeric {
+        return true;
+    }
+    if depth > 0 && obj.extract::<f64>().is_ok() {
+        return true;
+    }
+    let walkable = depth < 2
+        && obj.cast::<PySequence>().is_ok()
+        && !obj.is_instance_of::<PyString>()
+        && !obj.is_instance_of::<PyBytes>();
+    let first = walkable
+        .then(|| {
+            obj.try_iter()
+                .ok()?
+                .take(4)
+                .collect::<PyResult<Vec<_>>>()
+                .ok()
+        })
+        .flatten()
+        .unwrap_or_default();
+    !first.is_empty() && first.iter().all(|item| reads_as_numbers(item, depth + 1))
 }

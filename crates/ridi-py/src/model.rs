@@ -251,7 +251,8 @@ const _: () = assert!(Nystrom::DEFAULT_LANDMARKS == 2048);
 /// stage and after each step (``stage`` is ``"placement classifier"``, ``"grid <placement>"``
 /// or ``"regressors <placement>"``); returning ``False`` cancels the training
 /// (``RuntimeError``), and an exception it raises ends the training with that exception.
-/// Ctrl-C stops the training at its next step (``KeyboardInterrupt``).
+/// Ctrl-C stops the training at its next progress step (``KeyboardInterrupt``): seconds
+/// between steps, but the last fit of each placement's regressors reports only as it ends.
 ///
 /// >>> model = ridi.train("datasets/sample/list_Guillaume.txt", grid="none",
 /// ...                    placement_map="tyrex4")                     # doctest: +SKIP
@@ -368,6 +369,10 @@ pub(crate) fn train(
                                 &options::read_options(),
                             )
                         })?;
+                    // Reading a long list can take a while before training's first report.
+                    if cancel.load(Ordering::Relaxed) {
+                        return Err(PipelineError::Cancelled("training"));
+                    }
                     ridi::train(listed.sequences(), &opts, &mut report)
                         .map_err(|e| e.locate_in(&listed))
                 }

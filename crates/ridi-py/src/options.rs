@@ -7,7 +7,7 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::mpsc;
 use std::time::Duration;
 
-use pyo3::exceptions::{PyRuntimeError, PyTypeError};
+use pyo3::exceptions::PyTypeError;
 use pyo3::prelude::*;
 use ridi::PlacementMap;
 use ridi::correct::{InitialVelocity, PlacementSmoother};
@@ -85,6 +85,48 @@ pub(crate) fn recorded_heading(heading: &str) -> PyResult<Option<ridi::frames::H
             ("gyro", None),
         ],
     )
+}
+
+/// A `model` argument (`from_py_with`): a `ridi.Model`, or a `TypeError` saying how to get
+/// one from what was given (a path is loaded, not taken as a model).
+pub(crate) fn model<'py>(obj: &Bound<'py, PyAny>) -> PyResult<Bound<'py, crate::model::Model>> {
+    instance(
+        obj,
+        "model",
+        "load a model file with ridi.load(path)",
+        "train one (ridi.train), load a model file (ridi.load) or take the bundled one \
+         (ridi.bundled_model())",
+    )
+}
+
+/// A `sequence` argument (`from_py_with`), as [`model`].
+pub(crate) fn sequence<'py>(obj: &Bound<'py, PyAny>) -> PyResult<Bound<'py, Sequence>> {
+    instance(
+        obj,
+        "sequence",
+        "read a recording with ridi.read(path)",
+        "read a recording (ridi.read) or build one from arrays (ridi.Sequence)",
+    )
+}
+
+/// `obj` as a `T` for argument `name`, or a `TypeError` with `for_path` (given a str or a
+/// path-like) or `otherwise` as its remedy.
+fn instance<'py, T: pyo3::PyClass + pyo3::type_object::PyTypeInfo>(
+    obj: &Bound<'py, PyAny>,
+    name: &str,
+    for_path: &str,
+    otherwise: &str,
+) -> PyResult<Bound<'py, T>> {
+    if let Ok(it) = obj.cast::<T>() {
+        return Ok(it.clone());
+    }
+    let path = obj.is_instance_of::<pyo3::types::PyString>() || obj.hasattr("__fspath__")?;
+    Err(PyTypeError::new_err(format!(
+        "`{name}` is {}, not a ridi.{}: {}",
+        crate::arrays::described(obj),
+        T::NAME,
+        if path { for_path } else { otherwise }
+    )))
 }
 
 /// A number argument (`from_py_with`): what Python and numpy read as one, but not a bool,
@@ -289,29 +331,34 @@ pub(crate) fn interruptible<T: Send>(
         std::thread::scope(|scope| {
             let (tx, rx) = mpsc::channel();
             let cancel = &cancel;
-            scope.spawn(move || tx.send(with_jobs(jobs, || f(cancel))));
+            let work = std::thread::Builder::new()
+                .spawn_scoped(scope, move || tx.send(with_jobs(jobs, || f(cancel))))
+                .map_err(|e| errors::value(format!("cannot start the work's thread: {e}")))?;
             loop {
                 match rx.recv_timeout(SIGNAL_POLL) {
-                    Ok(done) => return Some(done),
-                    // `f` panicked: the scope passes the panic on as it ends.
-                    Err(mpsc::RecvTimeoutError::Disconnected) => return None,
+                    Ok(done) => return done,
+                    // `f` panicked: passed on with its own message.
+                    Err(mpsc::RecvTimeoutError::Disconnected) => match work.join() {
+                        Err(panic) => std::panic::resume_unwind(panic),
+                        Ok(_) => unreachable!("the thread ends after sending"),
+                    },
                     Err(mpsc::RecvTimeoutError::Timeout) if caught.is_none() => {
-                        if let Err(e) = Python::attach(|py| py.check_signals()) {
-                            caught = Some(e);
-                            cancel.store(true, Ordering::Relaxed);
-                        }
+                        // The flag is set while the GIL is held, before a callback the handler
+                        // woke can look at it.
+                        caught = Python::attach(|py| {
+                            py.check_signals()
+                                .inspect_err(|_| cancel.store(true, Ordering::Relaxed))
+                                .err()
+                        });
                     }
                     Err(mpsc::RecvTimeoutError::Timeout) => {}
                 }
             }
         })
     });
-    match (caught, done) {
-        (Some(e), _) => Err(e),
-        (None, Some(done)) => done,
-        (None, None) => Err(PyRuntimeError::new_err(
-            "the work's thread ended without a result",
-        )),
+    match caught {
+        Some(e) => Err(e),
+        None => done,
     }
 }
 

@@ -219,11 +219,10 @@ impl Track {
             let from = 2 + n + 3 * n * k;
             ArrayView2::from_shape((n, 3), &v[from..from + 3 * n]).map_err(|_| corrupt())
         };
-        let state = "the pickled track";
         let (position, velocity, bias) = (
-            vecs(rows(0)?, state)?,
-            vecs(rows(1)?, state)?,
-            vecs(rows(2)?, state)?,
+            vecs(rows(0)?, "position")?,
+            vecs(rows(1)?, "velocity")?,
+            vecs(rows(2)?, "bias")?,
         );
         let mut regressions = Vec::with_capacity(m);
         let mut placements = Vec::with_capacity(m);
@@ -291,8 +290,8 @@ impl Track {
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn track(
     py: Python<'_>,
-    sequence: &Bound<'_, Sequence>,
-    model: &Bound<'_, Model>,
+    #[pyo3(from_py_with = crate::options::sequence)] sequence: Bound<'_, Sequence>,
+    #[pyo3(from_py_with = crate::options::model)] model: Bound<'_, Model>,
     online: bool,
     #[pyo3(from_py_with = crate::options::whole)] regress_every: i64,
     #[pyo3(from_py_with = crate::options::real)] lambda_: f64,
@@ -323,8 +322,8 @@ pub(crate) fn track(
 #[pyo3(signature = (sequence, model, *, regress_every=50, placement_window=10.0))]
 pub(crate) fn regress(
     py: Python<'_>,
-    sequence: &Bound<'_, Sequence>,
-    model: &Bound<'_, Model>,
+    #[pyo3(from_py_with = crate::options::sequence)] sequence: Bound<'_, Sequence>,
+    #[pyo3(from_py_with = crate::options::model)] model: Bound<'_, Model>,
     #[pyo3(from_py_with = crate::options::whole)] regress_every: i64,
     #[pyo3(from_py_with = crate::options::real)] placement_window: f64,
 ) -> PyResult<Regressions> {

@@ -193,6 +193,9 @@ def test_live_tracker_refuses_bad_samples_and_stays_usable(seq, recorded_model):
                   gravity=[0.0, 9.8], linacce=seq.linacce[2])
     with pytest.raises(ValueError, match=r"`gyro` must be 3 numbers .* of shape \(5, 3\)"):
         live.push(seq.time[2], seq.gyro[2:7], seq.acce[2], **recorded)
+    # Judged by a look, not a copy (a copy of this view would be 8 PB).
+    with pytest.raises(ValueError, match=r"`gyro` must be 3 numbers .* \(1000000000000000,\)"):
+        live.push(seq.time[2], np.broadcast_to(0.0, (10**15,)), seq.acce[2], **recorded)
     # What numbers would read but a sample cannot hold: bools, a float32 time.
     with pytest.raises(TypeError, match=r"`gyro` holds bools"):
         live.push(seq.time[2], [True, False, True], seq.acce[2], **recorded)
@@ -361,3 +364,18 @@ def test_a_bool_is_no_number(seq, model, call):
     with pytest.raises(TypeError, match=r"expected a number, not a bool") as caught:
         call(seq, model)
     assert any("while processing" in n for n in getattr(caught.value, "__notes__", []))
+
+
+def test_a_path_or_another_object_for_a_model_or_sequence_says_how_to_get_one(
+        seq, model, model_file):
+    with pytest.raises(TypeError, match=r"`model` is str of length \d+, not a ridi.Model: load a "
+                                        r"model file with ridi.load\(path\)"):
+        ridi.track(seq, str(model_file))
+    with pytest.raises(TypeError, match=r"`model` is PosixPath, not a ridi.Model: .*ridi.load"):
+        ridi.evaluate([seq], model_file)
+    with pytest.raises(TypeError, match=r"`model` is NoneType, not a ridi.Model: train one "
+                                        r"\(ridi.train\), .*ridi.bundled_model"):
+        ridi.LiveTracker(None)
+    with pytest.raises(TypeError, match=r"`sequence` is str of length 8, not a ridi.Sequence: "
+                                        r"read a recording with ridi.read\(path\)"):
+        ridi.regress("walk.csv", model)

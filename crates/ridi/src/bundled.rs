@@ -19,6 +19,26 @@ const BYTES: &[u8] = include_bytes!("../model/ridi-tyrex.ridi");
 pub const BUNDLED_MODEL_SUMMARY: &str = "the bundled model (Nyström, trained on 66 Tyrex runs \
      of a Nexus 5 and an iPhone 4S, three people; its card: docs/model-card.md)";
 
+/// The names of the runs the bundled model was trained on, one per line after `#` comments.
+const TRAINING_RUNS: &str = include_str!("../model/training-runs.txt");
+
+/// The names of the runs the bundled model was trained on (`Thibaud_Nexus5_NoDist_AR`, ...):
+/// its figures on them, or on a part of one (`<run>_part2`), are not those of a person or phone
+/// it never saw.
+pub fn bundled_training_runs() -> impl Iterator<Item = &'static str> {
+    TRAINING_RUNS
+        .lines()
+        .map(str::trim)
+        .filter(|l| !l.is_empty() && !l.starts_with('#'))
+}
+
+/// Whether a model whose bytes have `fingerprint` ([`crate::Provenance::model_fingerprint`]) is
+/// the bundled model.
+pub(crate) fn is_bundled(fingerprint: &str) -> bool {
+    static BUNDLED: std::sync::OnceLock<String> = std::sync::OnceLock::new();
+    BUNDLED.get_or_init(|| crate::evaluate::fingerprint(BYTES)) == fingerprint
+}
+
 /// The bundled model, decoded (a few milliseconds; decode once and keep it).
 ///
 /// # Errors

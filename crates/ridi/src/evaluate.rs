@@ -180,10 +180,6 @@ impl Provenance {
     /// The provenance of an evaluation of `model` with `opts`.
     pub fn of(model: &Cascade, opts: &EvalOptions) -> Result<Self> {
         let bytes = model.to_bytes()?;
-        // FNV-1a: a stable, dependency-free fingerprint (not a cryptographic one).
-        let hash = bytes.iter().fold(0xcbf2_9ce4_8422_2325_u64, |h, &b| {
-            (h ^ u64::from(b)).wrapping_mul(0x0100_0000_01b3)
-        });
         let config = model.feature_config();
         let orientation = match config.orientation {
             ridi_features::Orientation::Recorded => "the recorded orientation",
@@ -192,7 +188,7 @@ impl Provenance {
         Ok(Self {
             ridi_version: env!("CARGO_PKG_VERSION").to_string(),
             model_source: None,
-            model_fingerprint: format!("{hash:016x}"),
+            model_fingerprint: fingerprint(&bytes),
             model: format!(
                 "{} solver; placements {}; a feature window of {} frames; {}",
                 match model.solver() {
@@ -434,8 +430,10 @@ pub fn evaluate(
 }
 
 /// [`evaluate`], which another thread cancels by setting `cancel`: the sequences being
-/// evaluated then finish, no other starts, and the result is [`PipelineError::Cancelled`].
-/// (Python's `ridi.evaluate` sets it on Ctrl-C; the command line exits instead.)
+/// evaluated then finish and no other starts; the result is [`PipelineError::Cancelled`] when
+/// one was left out (an error of a sequence evaluated comes first), the whole report when the
+/// flag came after the last had started. (Python's `ridi.evaluate` sets it on Ctrl-C; the
+/// command line exits instead.)
 pub fn evaluate_cancellable(
     seqs: &[Sequence],
     model: &Cascade,
@@ -451,7 +449,7 @@ pub fn evaluate_cancellable(
     for s in seqs {
         check_evaluable(s, model.feature_config(), opts)?;
     }
-    let done: Vec<Evaluated> = seqs
+    let results: Vec<Result<Evaluated>> = seqs
         .par_iter()
         .map(|s| {
             // Relaxed: the flag carries no data, and a sequence more or less is no matter.
@@ -460,10 +458,23 @@ pub fn evaluate_cancellable(
             }
             evaluate_one(s, model, opts)
         })
-        // The first error in the sequences' order, whatever the threads met first.
-        .collect::<Vec<Result<_>>>()
-        .into_iter()
-        .collect::<Result<_>>()?;
+        .collect();
+    // The first error in the sequences' order, whatever the threads met first; a sequence
+    // left out by a cancel is no fault of its own, so another's error comes before it.
+    let mut done = Vec::with_capacity(results.len());
+    let mut cancelled = None;
+    for r in results {
+        match r {
+            Ok(e) => done.push(e),
+            Err(e @ PipelineError::Cancelled(_)) => {
+                cancelled.get_or_insert(e);
+            }
+            Err(e) => return Err(e),
+        }
+    }
+    if let Some(e) = cancelled {
+        return Err(e);
+    }
     let order: Vec<String> = opts.methods.iter().map(|m| m.key().to_string()).collect();
     let reports = sequence_reports(done.iter().map(|e| &e.result), &order);
     let summary = summarize(&reports)
@@ -520,6 +531,9 @@ pub fn evaluate_cancellable(
     warnings.extend(still_ahead(&summary));
     warnings.extend(pdr_without_steps(&results));
     warnings.extend(too_few_runs(&results));
+    let provenance = Provenance::of(model, opts)?;
+    #[cfg(feature = "bundled-model")]
+    warnings.extend(trained_on_by_bundled(seqs, &provenance));
     Ok((
         Report {
             sequences: results,
@@ -533,7 +547,7 @@ pub fn evaluate_cancellable(
             recorded_heading: opts.track.recorded_heading,
             methods: order,
             warnings,
-            provenance: Some(Provenance::of(model, opts)?),
+            provenance: Some(provenance),
         },
         traces,
     ))
@@ -624,7 +638,7 @@ fn weak_alignment(sequences: &[SequenceResult], align: ridi_eval::AlignWindow) -
             // Aligned on the whole trajectory already, there is no larger window to offer.
             match align {
                 ridi_eval::AlignWindow::All => "",
-                _ => " (`ridi eval --align all` shows them without it)",
+                _ => " (`ridi eval --align all`, in Python `align=\"all\"`, shows them without it)",
             }
         )
     })
@@ -1123,6 +1137,45 @@ impl Traces {
     }
 }
 
+/// FNV-1a 64 of `bytes` in hex ([`Provenance::model_fingerprint`]): a stable,
+/// dependency-free fingerprint (not a cryptographic one).
+pub(crate) fn fingerprint(bytes: &[u8]) -> String {
+    let hash = bytes.iter().fold(0xcbf2_9ce4_8422_2325_u64, |h, &b| {
+        (h ^ u64::from(b)).wrapping_mul(0x0100_0000_01b3)
+    });
+    format!("{hash:016x}")
+}
+
+/// A warning when the model is the bundled one and some of `seqs` are runs it was trained on
+/// (or parts of them): its figures there are not a new person's or phone's.
+#[cfg(feature = "bundled-model")]
+fn trained_on_by_bundled(seqs: &[Sequence], provenance: &Provenance) -> Option<String> {
+    if !crate::bundled::is_bundled(&provenance.model_fingerprint) {
+        return None;
+    }
+    let runs: BTreeSet<&str> = crate::bundled_training_runs().collect();
+    let seen: Vec<&str> = seqs
+        .iter()
+        .map(Sequence::name)
+        .filter(|name| {
+            let run = name
+                .rsplit_once("_part")
+                .filter(|(_, k)| !k.is_empty() && k.bytes().all(|b| b.is_ascii_digit()))
+                .map_or(*name, |(run, _)| run);
+            runs.contains(run)
+        })
+        .collect();
+    (!seen.is_empty()).then(|| {
+        format!(
+            "{} of {} ({}) {} of the runs the bundled model was trained on: its figures there              are not those of a person or phone it never saw (docs/model-card.md has those,              each person left out); to measure that on your data, evaluate a model trained              without them (`ridi train`, then `--model`)",
+            seen.len(),
+            ridi_data::counted(seqs.len(), "sequence"),
+            ridi_data::first_few(seen.iter(), 3),
+            if seen.len() == 1 { "is one" } else { "are" },
+        )
+    })
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -1274,7 +1327,7 @@ mod tests {
         let w = weak_alignment(&sequences, ridi_eval::AlignWindow::default()).unwrap();
         assert!(
             w.starts_with("weakly determined alignment in 1 of 2 sequences")
-                && w.ends_with("still (0.40 m) (`ridi eval --align all` shows them without it)"),
+                && w.ends_with("still (0.40 m) (`ridi eval --align all`, in Python `align=\"all\"`, shows them without it)"),
             "{w}"
         );
         let w = weak_alignment(&sequences, ridi_eval::AlignWindow::All).unwrap();

@@ -106,7 +106,7 @@ mod train;
 
 pub use baselines::{Method, baseline_trajectory, device_heading};
 #[cfg(feature = "bundled-model")]
-pub use bundled::{BUNDLED_MODEL_SUMMARY, bundled_model};
+pub use bundled::{BUNDLED_MODEL_SUMMARY, bundled_model, bundled_training_runs};
 pub use compare::{ComparedFigure, Comparison, compare_reports};
 pub use convert::{
     ConvertOptions, ConvertSummary, Converted, SPLIT_MIN_PART_S, WARNINGS_FILE, convert,

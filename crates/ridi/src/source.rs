@@ -158,12 +158,14 @@ impl ReadFiles {
 
     /// The input `out` would replace, if any: by path (links, `..`) or, when `out` exists, by
     /// file identity (also through hard links and bind mounts, which paths do not show). Files
-    /// beside a recording that its reader does not take (a trajectory, notes) are not inputs.
+    /// beside a recording that its reader does not take (a trajectory, notes) are not inputs,
+    /// nor is an input that does not exist: its read fails, and that is the error to see.
     pub fn overwritten_by(&self, out: &Path) -> Option<&Path> {
         let target = resolved(out)?;
         let id = FileId::of(out).ok();
         self.files
             .iter()
+            .filter(|(_, _, i)| i.is_some())
             .find(|(_, r, i)| *r == target || (id.is_some() && *i == id))
             .map(|(given, _, _)| given.as_path())
     }

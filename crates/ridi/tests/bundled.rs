@@ -63,4 +63,46 @@ fn the_bundled_model_tracks_the_sample_far_better_than_double_integration() {
         report.velocity_mse
     );
     assert!(report.placement_accuracy.unwrap() > 0.8);
+    // And the report says so: every one of them is a run the model was trained on.
+    let trained_on: Vec<&String> = report
+        .warnings
+        .iter()
+        .filter(|w| w.contains("the bundled model was trained on"))
+        .collect();
+    assert_eq!(trained_on.len(), 1, "{:?}", report.warnings);
+    assert!(
+        trained_on[0].starts_with("10 of 10 sequences (Thibaud_Nexus5_NoDist_AR, "),
+        "{}",
+        trained_on[0]
+    );
+    // A part of such a run counts; another name does not.
+    let mut part = seqs[0].clone();
+    part.set_name(format!("{}_part2", seqs[0].name()));
+    let mut other = seqs[1].clone();
+    other.set_name("my_walk_part2");
+    let (report, _) = ridi::evaluate(&[part, other], &model, &EvalOptions::default()).unwrap();
+    assert!(
+        report
+            .warnings
+            .iter()
+            .any(|w| w.starts_with("1 of 2 sequences (Thibaud_Nexus5_NoDist_AR_part2) is one of")),
+        "{:?}",
+        report.warnings
+    );
+}
+
+#[test]
+fn the_bundled_models_training_runs_are_the_committed_run_list() {
+    let list = std::fs::read_to_string(
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("../../datasets/protocols/tyrex-runs.txt"),
+    )
+    .unwrap();
+    let committed: Vec<&str> = list
+        .lines()
+        .filter(|l| !l.starts_with('#') && !l.trim().is_empty())
+        .map(|l| l.trim().rsplit('/').next().unwrap())
+        .collect();
+    assert_eq!(committed.len(), 66);
+    assert_eq!(ridi::bundled_training_runs().collect::<Vec<_>>(), committed);
 }

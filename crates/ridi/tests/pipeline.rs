@@ -92,6 +92,15 @@ fn train_track_and_evaluate_on_the_sample_dataset() {
     let reversed: Vec<Sequence> = test.iter().rev().cloned().collect();
     let (again, _) = ridi::evaluate(&reversed, &model, &EvalOptions::default()).unwrap();
     assert_eq!(again.summary, report.summary);
+    // A model of its own: no warning about the bundled model's training runs.
+    assert!(
+        !report
+            .warnings
+            .iter()
+            .any(|w| w.contains("the bundled model was trained on")),
+        "{:?}",
+        report.warnings
+    );
     // Cancelled before it starts: no sequence is evaluated, and the error says so.
     let cancel = std::sync::atomic::AtomicBool::new(true);
     let err =
