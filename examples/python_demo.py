@@ -28,15 +28,31 @@ def print_table(report):
         f"\n{len(report['sequences'])} sequences; velocity MSE S-x {mse[0]:.3f} S-z {mse[1]:.3f}"
         f" (m/s)^2; placement accuracy {'-' if accuracy is None else f'{accuracy:.3f}'}"
     )
-    print(f"{'method':<10} {'RTE 5 s m':>9} {'ATE m':>9} {'RTE 60 s m':>10} {'MPE m':>9}"
-          f" {'path length ratio':>17}")
+    def interval(figures):
+        """`(low, high)` of a report's interval, or None where the runs were too few for one
+        (its bounds are null, NaN in Rust)."""
+        low, high = (figures or {}).get("low"), (figures or {}).get("high")
+        return None if low is None or high is None else (low, high)
+
+    bounded = any(interval(i.get("rte_5s_m")) for i in report["intervals"].values())
+    print(f"{'method':<10} {'RTE 5 s m' + (' [95 %]' if bounded else ''):>26} {'ATE m':>9}"
+          f" {'RTE 60 s m':>10} {'MPE m':>9} {'path length ratio':>17}")
     for key in report["methods"]:
         m = report["summary"][key]
         ratio = "-" if m["path_length_ratio"] is None else f"{m['path_length_ratio']:.3f}"
+        bounds = interval(report["intervals"].get(key, {}).get("rte_5s_m"))
+        rte = f"{m['rte_5s_m']:.3f}" + ("" if bounds is None else " [{:.3f}, {:.3f}]".format(*bounds))
         print(
-            f"{key:<10} {m['rte_5s_m']:>9.3f} {m['ate_m']:>9.3f} {m['rte_m']:>10.3f}"
+            f"{key:<10} {rte:>26} {m['ate_m']:>9.3f} {m['rte_m']:>10.3f}"
             f" {m['mpe_m']:>9.3f} {ratio:>17}"
         )
+    # RIDI's difference from PDR, paired over the sequences, as `ridi demo` prints it.
+    difference = report["ridi_minus"].get("pdr", {}).get("rte_5s_m")
+    if difference is not None:
+        bounds = interval(difference)
+        text = ("(too few runs for an interval)" if bounds is None
+                else "[{:+.3f}, {:+.3f}]".format(*bounds))
+        print(f"ridi - pdr, RTE 5 s: {difference['mean']:+.3f} m {text} (paired over sequences)")
     # Each device's mean RTE 5 s when the sequences span phones (`ridi::Report::per_device`).
     devices = sorted({s["device"] for s in report["sequences"] if s.get("device")})
     if len(devices) > 1:

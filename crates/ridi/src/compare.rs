@@ -57,6 +57,14 @@ pub struct Comparison {
 /// The two reports hold no sequence of the same name.
 pub fn compare_reports(first: &Report, second: &Report) -> Result<Comparison> {
     let mut warnings = Vec::new();
+    // The same report twice (one folder given for both, say): every difference is 0. As JSON,
+    // where a NaN equals itself.
+    if serde_json::to_value(first).ok() == serde_json::to_value(second).ok() {
+        warnings.push(
+            "the two reports are identical (the same folder twice?): every difference is 0"
+                .to_string(),
+        );
+    }
     let (a, b) = (
         by_name(first, "first", &mut warnings),
         by_name(second, "second", &mut warnings),
@@ -404,6 +412,13 @@ mod tests {
         ] {
             assert!(warnings.contains(expected), "{expected}: {warnings}");
         }
+        assert!(!warnings.contains("identical"), "{warnings}");
+        let same = compare_reports(&first, &first).unwrap();
+        assert!(
+            same.warnings[0].starts_with("the two reports are identical"),
+            "{:?}",
+            same.warnings
+        );
         // Nothing recorded but what both reports hold: no claim about the model.
         assert!(c.settings.is_empty(), "{:?}", c.settings);
         assert!(

@@ -439,6 +439,9 @@ impl std::fmt::Display for Inspection {
 pub struct ModelInspection {
     /// Model file format version ([`Cascade::format_version`]: 7 exact, 8 Nyström).
     pub format_version: u32,
+    /// The model file's fingerprint, as an evaluation report records it
+    /// ([`crate::Provenance::model_fingerprint`]): which model a report was made with.
+    pub fingerprint: String,
     /// Most landmarks one machine of a Nyström model holds (`None`: exact kernel machines,
     /// [`ridi_regress::Solver`]): the classifier's are drawn from all rows, each placement's
     /// regressors' from its own (its samples).
@@ -536,6 +539,10 @@ pub fn inspect_model(model: &Cascade) -> ModelInspection {
         })
         .collect();
     ModelInspection {
+        // A model that cannot be encoded (one serde built alone) has no file to name.
+        fingerprint: model
+            .to_bytes()
+            .map_or_else(|_| "-".to_string(), |b| crate::evaluate::fingerprint(&b)),
         format_version: model.format_version(),
         landmarks: match model.solver() {
             Solver::Exact => None,
@@ -590,6 +597,11 @@ impl std::fmt::Display for ModelInspection {
         writeln!(
             f,
             "orientation: {orientation} (track and eval use the same)"
+        )?;
+        writeln!(
+            f,
+            "fingerprint: {} (an evaluation report's model_fingerprint)",
+            self.fingerprint
         )?;
         if let Some(m) = self.landmarks {
             let seed = self.landmark_seed.unwrap_or_default();

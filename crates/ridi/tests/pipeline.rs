@@ -92,6 +92,11 @@ fn train_track_and_evaluate_on_the_sample_dataset() {
     let reversed: Vec<Sequence> = test.iter().rev().cloned().collect();
     let (again, _) = ridi::evaluate(&reversed, &model, &EvalOptions::default()).unwrap();
     assert_eq!(again.summary, report.summary);
+    // `ridi inspect` names the model as the report records it.
+    assert_eq!(
+        ridi::inspect_model(&model).fingerprint,
+        report.provenance.as_ref().unwrap().model_fingerprint
+    );
     // A model of its own: no warning about the bundled model's training runs.
     assert!(
         !report
