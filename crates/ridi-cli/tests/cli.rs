@@ -802,7 +802,10 @@ fn convert_train_track_and_eval() {
     let out = track_to(&missing, &missing, &[]);
     let err = stderr(&out);
     assert!(
-        !out.status.success() && err.contains("missing.csv") && !err.contains("reads it"),
+        !out.status.success()
+            && err.contains("missing.csv")
+            && err.contains("no such file or folder")
+            && !err.contains("reads it"),
         "{err}"
     );
     assert!(!missing.exists());

@@ -372,8 +372,9 @@ fn values<const N: usize>(obj: &Bound<'_, PyAny>, name: &str) -> PyResult<[f64; 
 }
 
 /// Whether `obj` is numbers (`depth` 0), or rows of them: a numeric array, or a sequence whose
-/// first items (at most 4) are numbers, or at `depth` 0 such rows. Judged by a look, not a
-/// copy: a chunk pushed by mistake may hold more rows than memory holds a copy of.
+/// first items (at most 4) are numbers, or at `depth` 0 such rows; a single number is not.
+/// Judged by a look, not a copy: a chunk pushed by mistake may hold more rows than memory
+/// holds a copy of.
 fn reads_as_numbers(obj: &Bound<'_, PyAny>, depth: u8) -> bool {
     let numeric = obj
         .getattr("dtype")
@@ -382,7 +383,11 @@ fn reads_as_numbers(obj: &Bound<'_, PyAny>, depth: u8) -> bool {
             k.extract::<String>()
                 .is_ok_and(|k| matches!(&*k, "f" | "i" | "u"))
         });
-    if numeric {
+    // A numpy scalar (0-d) at the top is one number, as a Python float is.
+    let array = obj
+        .getattr("ndim")
+        .is_ok_and(|n| n.extract::<usize>().is_ok_and(|n| n > 0));
+    if numeric && (depth > 0 || array) {
         return true;
     }
     if depth > 0 && obj.extract::<f64>().is_ok() {

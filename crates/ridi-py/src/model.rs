@@ -93,7 +93,8 @@ impl Model {
     }
 
     /// What ``ridi inspect --json`` says of the model: placements, window, S, orientation,
-    /// regressors, stored samples, cross-validation table.
+    /// fingerprint (a report's ``model_fingerprint``), regressors, stored samples,
+    /// cross-validation table.
     fn describe<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
         let json = serde_json::to_string(&ridi::inspect_model(&self.inner))
             .map_err(|e| errors::value(e.to_string()))?;

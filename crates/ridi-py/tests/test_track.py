@@ -193,6 +193,9 @@ def test_live_tracker_refuses_bad_samples_and_stays_usable(seq, recorded_model):
                   gravity=[0.0, 9.8], linacce=seq.linacce[2])
     with pytest.raises(ValueError, match=r"`gyro` must be 3 numbers .* of shape \(5, 3\)"):
         live.push(seq.time[2], seq.gyro[2:7], seq.acce[2], **recorded)
+    # One number is a wrong type, whether a Python float or a numpy scalar.
+    with pytest.raises(TypeError, match=r"`gyro` must be 3 numbers .* not float64"):
+        live.push(seq.time[2], np.float64(1.0), seq.acce[2], **recorded)
     # Judged by a look, not a copy (a copy of this view would be 8 PB).
     with pytest.raises(ValueError, match=r"`gyro` must be 3 numbers .* \(1000000000000000,\)"):
         live.push(seq.time[2], np.broadcast_to(0.0, (10**15,)), seq.acce[2], **recorded)

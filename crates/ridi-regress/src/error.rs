@@ -85,7 +85,7 @@ pub enum RegressError {
     #[error("training cancelled")]
     Cancelled,
     /// The file does not start with the model magic number.
-    #[error("not a ridi model file: it does not begin as one (`ridi train` writes them)")]
+    #[error("not a ridi model file: its first bytes are not a model file's")]
     BadMagic,
     /// The file was written by another format version: an older one (retrain the model) or a
     /// newer or unknown one.

@@ -59,7 +59,9 @@ pub fn compare_reports(first: &Report, second: &Report) -> Result<Comparison> {
     let mut warnings = Vec::new();
     // The same report twice (one folder given for both, say): every difference is 0. As JSON,
     // where a NaN equals itself.
-    if serde_json::to_value(first).ok() == serde_json::to_value(second).ok() {
+    if let (Ok(a), Ok(b)) = (serde_json::to_value(first), serde_json::to_value(second))
+        && a == b
+    {
         warnings.push(
             "the two reports are identical (the same folder twice?): every difference is 0"
                 .to_string(),

@@ -1157,21 +1157,22 @@ fn trained_on_by_bundled(seqs: &[Sequence], provenance: &Provenance) -> Option<S
     let seen: Vec<&str> = seqs
         .iter()
         .map(Sequence::name)
-        .filter(|name| {
-            let run = name
-                .rsplit_once("_part")
-                .filter(|(_, k)| !k.is_empty() && k.bytes().all(|b| b.is_ascii_digit()))
-                .map_or(*name, |(run, _)| run);
-            runs.contains(run)
-        })
+        .filter(|name| runs.contains(ridi_eval::run_of(name)))
         .collect();
     (!seen.is_empty()).then(|| {
         format!(
-            "{} of {} ({}) {} of the runs the bundled model was trained on: its figures there              are not those of a person or phone it never saw (docs/model-card.md has those,              each person left out); to measure that on your data, evaluate a model trained              without them (`ridi train`, then `--model`)",
+            "{} of {} ({}) {} the runs the bundled model was trained on: its figures there are \
+             not those of a person or phone it never saw (docs/model-card.md has those, each \
+             person left out); to measure that on your data, evaluate a model trained without \
+             them (`ridi train`, then `--model`; in Python `ridi.train`)",
             seen.len(),
             ridi_data::counted(seqs.len(), "sequence"),
             ridi_data::first_few(seen.iter(), 3),
-            if seen.len() == 1 { "is one" } else { "are" },
+            if seen.len() == 1 {
+                "is one of"
+            } else {
+                "are among"
+            },
         )
     })
 }
