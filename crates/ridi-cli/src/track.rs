@@ -85,10 +85,14 @@ pub(crate) fn run(args: Args) -> Result<()> {
         &mut loaded.sequences,
     )?;
     let [seq] = &loaded.sequences[..] else {
+        let names = loaded.sequences.iter().map(|s| shown(s.name()));
         bail!(
-            "{} holds {} sequences; convert it with `ridi convert` and track each",
+            "{} holds {} ({}, cut at gaps in the recording): `ridi convert {} --out <folder>` \
+             writes each as a recording of its own, to track one by one",
             shown(&args.sequence),
-            loaded.sequences.len()
+            ridi::data::counted(loaded.sequences.len(), "sequence"),
+            ridi::data::first_few(names, 3),
+            shown(&args.sequence),
         );
     };
     let track = ridi::track(seq, &model, &opts)

@@ -105,6 +105,18 @@ fn inspect_prints_text_and_json() {
         1,
         "{text}"
     );
+    // Tracked, it names its parts and the command that writes each as a recording.
+    let out = ridi(&["track", s(&split), "--out", s(&dir.path().join("t.csv"))]);
+    let err = stderr(&out);
+    assert!(
+        !out.status.success()
+            && err.contains(
+                "holds 2 sequences (Ann_Nexus5_NoDist_Texting_part1, \
+                 Ann_Nexus5_NoDist_Texting_part2, cut at gaps in the recording): `ridi convert "
+            )
+            && err.contains("--out <folder>` writes each as a recording of its own"),
+        "{err}"
+    );
 
     // One frame: no rate to speak of, and nothing to do with it.
     let one = dir.path().join("one.csv");
