@@ -202,6 +202,9 @@ pub(crate) fn run(args: Args) -> Result<()> {
     read.extend(args.placement_map.iter().map(PathBuf::from));
     check_not_input(out, &ReadFiles::of(&read), &[])?;
     let listed = crate::load_listed(entries, args.placement_map.as_deref(), Purpose::Training)?;
+    for w in ridi::training_warnings(listed.sequences()) {
+        errln!("warning: {}", shown(&w));
+    }
     let defaults = TrainOptions::default();
     let mut opts = TrainOptions {
         standardize: !args.no_standardize,

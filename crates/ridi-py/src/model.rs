@@ -349,14 +349,15 @@ pub(crate) fn train(
         &[("projected", projected), ("half", Storage::Half)],
     )?;
     let map = options::placement_map(placement_map)?;
-    let trained = options::interruptible(py, jobs, |cancel| {
+    let (trained, warnings) = options::interruptible(py, jobs, |cancel| {
         let callback = Callback {
             callback: progress,
             cancel,
             raised: Mutex::new(None),
             stopped: Mutex::new(false),
         };
-        let trained = (|| -> ridi::Result<Cascade> {
+        // The model and the training set's warnings (`ridi::training_warnings`).
+        let trained = (|| -> ridi::Result<(Cascade, Vec<String>)> {
             let mut report = |e: &ProgressEvent<'_>| callback.report(e);
             match inputs {
                 Inputs::Lists(lists) => {
@@ -374,7 +375,9 @@ pub(crate) fn train(
                     if cancel.load(Ordering::Relaxed) {
                         return Err(PipelineError::Cancelled("training"));
                     }
+                    let warnings = ridi::training_warnings(listed.sequences());
                     ridi::train(listed.sequences(), &opts, &mut report)
+                        .map(|model| (model, warnings))
                         .map_err(|e| e.locate_in(&listed))
                 }
                 Inputs::Sequences(mut seqs) => {
@@ -382,12 +385,14 @@ pub(crate) fn train(
                         map.check(&seqs)?;
                         map.apply(&mut seqs);
                     }
-                    ridi::train(&seqs, &opts, &mut report)
+                    let warnings = ridi::training_warnings(&seqs);
+                    ridi::train(&seqs, &opts, &mut report).map(|model| (model, warnings))
                 }
             }
         })();
         trained.map_err(|e| callback.error(e))
     })??;
+    crate::sequence::warn(py, &warnings)?;
     Ok(Model::of(trained))
 }
 

@@ -195,3 +195,22 @@ def test_a_training_error_names_the_first_bad_sequence_whatever_the_threads():
     for jobs in (1, 2, 4, 4, 4):
         with pytest.raises(ValueError, match=rf"sequence `{bare[0].name}`: has no ground truth"):
             ridi.train(bare, grid="none", jobs=jobs)
+
+
+def test_training_on_waypoint_ground_truth_warns(tmp_path):
+    # A run whose ground truth is straight lines between a point every 5 s (the competition's
+    # waypoints, interpolated): its targets are the lines' speeds, which the warning says.
+    seqs = ridi.read_list(GUILLAUME, placement_map="tyrex4")[:4]
+    s = seqs[0]
+    t, p = s.time, s.ground_truth_position.copy()
+    marks = list(range(0, len(t), 1000)) + [len(t) - 1]
+    for a, b in zip(marks, marks[1:]):
+        f = ((t[a:b + 1] - t[a]) / (t[b] - t[a]))[:, None]
+        p[a:b + 1] = p[a] + (p[b] - p[a]) * f
+    straight = ridi.Sequence(s.time, s.gyro, s.acce, s.gravity, s.orientation,
+                             linacce=s.linacce, name="straight", placement=s.placement,
+                             ground_truth_position=p,
+                             ground_truth_orientation=s.ground_truth_orientation)
+    with pytest.warns(UserWarning, match=r"1 of 4 training sequences \(straight\) has a ground "
+                                         r"truth that moves in straight lines"):
+        ridi.train([straight, *seqs[1:]], grid="none")

@@ -302,6 +302,64 @@ pub fn training_windows(seqs: &[Sequence], opts: &TrainOptions) -> Result<usize>
         })
 }
 
+/// Below this share of frames where the ground truth's horizontal velocity changes, it moves
+/// in straight lines at constant speed between a few points: waypoints, interpolated (the 12
+/// Indoor Location Competition paths of `../shared`, converted: 0.09-0.18 % of the frames;
+/// the motion capture of every shared Tyrex run, each part of one: 41 % and more).
+pub const MIN_TURNING_SHARE: f64 = 0.1;
+
+/// A change of velocity between two frames (m/s) that counts as one ([`MIN_TURNING_SHARE`]):
+/// 0.2 m/s² at 200 Hz, ten times what a straight line's timestamps rounded to the nanosecond
+/// make of a brisk walk's velocity.
+const TURN_M_S: f64 = 1e-3;
+
+/// What a training set holds that is no error but makes a poorer model, one warning per
+/// kind, for the caller to show (`ridi train` prints them; Python warns): sequences whose ground
+/// truth moves in straight lines at constant speed between a few points (waypoints,
+/// [`MIN_TURNING_SHARE`]), whose velocity targets are those lines' average speeds, not the
+/// walk's.
+pub fn training_warnings(seqs: &[Sequence]) -> Vec<String> {
+    let straight: Vec<&str> = seqs
+        .iter()
+        .filter(|s| {
+            let Some(gt) = s.ground_truth() else {
+                return false;
+            };
+            let (t, p) = (s.time(), &gt.position);
+            let velocity = |i: usize| {
+                let dt = t[i + 1] - t[i];
+                [
+                    (p[i + 1].x() - p[i].x()) / dt,
+                    (p[i + 1].y() - p[i].y()) / dt,
+                ]
+            };
+            let turns = (1..t.len().saturating_sub(1))
+                .filter(|&i| {
+                    let (a, b) = (velocity(i - 1), velocity(i));
+                    (b[0] - a[0]).hypot(b[1] - a[1]) > TURN_M_S
+                })
+                .count();
+            let steps = t.len().saturating_sub(2);
+            steps > 0 && (turns as f64) < MIN_TURNING_SHARE * steps as f64
+        })
+        .map(Sequence::name)
+        .collect();
+    if straight.is_empty() {
+        return Vec::new();
+    }
+    vec![format!(
+        "{} of {} ({}) {} a ground truth that moves in straight lines at constant speed between \
+         a few points (waypoints, as the Indoor Location Competition's): the velocity targets \
+         are those lines' average speeds, not the walk's, and a model learns them; train on \
+         motion capture or a visual-inertial track (docs/datasets.md), and keep waypoints to \
+         evaluate positions",
+        straight.len(),
+        ridi_data::counted(seqs.len(), "training sequence"),
+        ridi_data::first_few(straight.iter(), 3),
+        if straight.len() == 1 { "has" } else { "have" },
+    )]
+}
+
 /// Trains the cascade on labelled sequences (placement and ground truth required).
 pub fn train(
     seqs: &[Sequence],

@@ -133,4 +133,10 @@ fn indoor_location_competition_paths_convert_with_the_hand_placement() {
         assert!(s.ground_truth().is_some() && s.magnet().is_some());
         assert!((s.rate_hz() - 200.0).abs() < 0.01, "{}", s.rate_hz());
     }
+    // Their waypoints, interpolated, are no ground truth to train on: all 12 are named.
+    let warnings = ridi::training_warnings(&seqs);
+    assert!(
+        warnings.len() == 1 && warnings[0].starts_with("12 of 12 training sequences ("),
+        "{warnings:?}"
+    );
 }
