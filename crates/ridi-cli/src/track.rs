@@ -87,7 +87,7 @@ pub(crate) fn run(args: Args) -> Result<()> {
     let [seq] = &loaded.sequences[..] else {
         let names = loaded.sequences.iter().map(|s| shown(s.name()));
         bail!(
-            "{} holds {} ({}, cut at gaps in the recording): `ridi convert {} --out <folder>` \
+            "{} holds {} (cut at gaps in the recording: {}): `ridi convert {} --out <folder>` \
              writes each as a recording of its own, to track one by one",
             shown(&args.sequence),
             ridi::data::counted(loaded.sequences.len(), "sequence"),

@@ -111,8 +111,9 @@ fn inspect_prints_text_and_json() {
     assert!(
         !out.status.success()
             && err.contains(
-                "holds 2 sequences (Ann_Nexus5_NoDist_Texting_part1, \
-                 Ann_Nexus5_NoDist_Texting_part2, cut at gaps in the recording): `ridi convert "
+                "holds 2 sequences (cut at gaps in the recording: \
+                 Ann_Nexus5_NoDist_Texting_part1, Ann_Nexus5_NoDist_Texting_part2): \
+                 `ridi convert "
             )
             && err.contains("--out <folder>` writes each as a recording of its own"),
         "{err}"
@@ -144,6 +145,51 @@ fn inspect_prints_text_and_json() {
         out.status.success()
             && text.contains("150 frames: no whole feature window of the default 200 frames"),
         "{text}"
+    );
+}
+
+#[test]
+fn training_on_ground_truth_between_waypoints_is_warned_about_first() {
+    // A run whose ground truth is straight lines between points 5 s apart (the competition's
+    // waypoints, interpolated) beside one with motion capture.
+    let dir = tempfile::tempdir().unwrap();
+    let read = |name: &str| {
+        ridi::data::read_sequence(
+            sample_dataset().join(name),
+            &ridi::data::ReadOptions::default(),
+        )
+        .unwrap()
+    };
+    let mut parts = read("Jakob_Nexus5_NoDist_Texting").into_parts();
+    let gt = parts.ground_truth.as_mut().unwrap();
+    ridi_test_support::straight_between_points(&parts.time, &mut gt.position, 1000);
+    parts.name = "straight".into();
+    let straight = ridi::data::Sequence::new(parts).unwrap();
+    ridi::data::write_ridi_csv(&straight, dir.path().join("straight.csv")).unwrap();
+    let pocket = read("Jakob_Nexus5_NoDist_FrontPocket");
+    ridi::data::write_ridi_csv(&pocket, dir.path().join("pocket.csv")).unwrap();
+    let list = dir.path().join("list.txt");
+    std::fs::write(&list, "straight.csv,Texting\npocket.csv,FrontPocket\n").unwrap();
+    let model = dir.path().join("m.ridi");
+    let out = ridi(&[
+        "train",
+        "--list",
+        s(&list),
+        "--out",
+        s(&model),
+        "--grid",
+        "none",
+        "--placement-map",
+        "tyrex4",
+    ]);
+    let err = stderr(&out);
+    assert!(out.status.success(), "{err}");
+    assert!(
+        err.starts_with(
+            "warning: 1 of 2 training sequences (straight (0.2 a second)) has a ground truth \
+             that moves in straight lines at constant speed between a few points"
+        ),
+        "{err}"
     );
 }
 

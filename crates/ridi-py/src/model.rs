@@ -349,15 +349,30 @@ pub(crate) fn train(
         &[("projected", projected), ("half", Storage::Half)],
     )?;
     let map = options::placement_map(placement_map)?;
-    let (trained, warnings) = options::interruptible(py, jobs, |cancel| {
+    let trained = options::interruptible(py, jobs, |cancel| {
         let callback = Callback {
             callback: progress,
             cancel,
             raised: Mutex::new(None),
             stopped: Mutex::new(false),
         };
-        // The model and the training set's warnings (`ridi::training_warnings`).
-        let trained = (|| -> ridi::Result<(Cascade, Vec<String>)> {
+        // The training set's warnings (`ridi::training_warnings`), before training, as `ridi
+        // train` prints them; one that raises (`-W error`) stops it.
+        let warned = |seqs: &[ridi::data::Sequence]| {
+            let warnings = ridi::training_warnings(seqs);
+            match Python::attach(|py| crate::sequence::warn(py, &warnings)) {
+                Ok(()) => Ok(()),
+                Err(e) => {
+                    callback
+                        .raised
+                        .lock()
+                        .unwrap_or_else(|p| p.into_inner())
+                        .get_or_insert(e);
+                    Err(PipelineError::Cancelled("training"))
+                }
+            }
+        };
+        let trained = (|| -> ridi::Result<Cascade> {
             let mut report = |e: &ProgressEvent<'_>| callback.report(e);
             match inputs {
                 Inputs::Lists(lists) => {
@@ -375,9 +390,8 @@ pub(crate) fn train(
                     if cancel.load(Ordering::Relaxed) {
                         return Err(PipelineError::Cancelled("training"));
                     }
-                    let warnings = ridi::training_warnings(listed.sequences());
+                    warned(listed.sequences())?;
                     ridi::train(listed.sequences(), &opts, &mut report)
-                        .map(|model| (model, warnings))
                         .map_err(|e| e.locate_in(&listed))
                 }
                 Inputs::Sequences(mut seqs) => {
@@ -385,14 +399,13 @@ pub(crate) fn train(
                         map.check(&seqs)?;
                         map.apply(&mut seqs);
                     }
-                    let warnings = ridi::training_warnings(&seqs);
-                    ridi::train(&seqs, &opts, &mut report).map(|model| (model, warnings))
+                    warned(&seqs)?;
+                    ridi::train(&seqs, &opts, &mut report)
                 }
             }
         })();
         trained.map_err(|e| callback.error(e))
     })??;
-    crate::sequence::warn(py, &warnings)?;
     Ok(Model::of(trained))
 }
 

@@ -5,6 +5,7 @@ import _thread
 import json
 import pickle
 import time
+import warnings
 
 import pytest
 
@@ -211,6 +212,13 @@ def test_training_on_waypoint_ground_truth_warns(tmp_path):
                              linacce=s.linacce, name="straight", placement=s.placement,
                              ground_truth_position=p,
                              ground_truth_orientation=s.ground_truth_orientation)
-    with pytest.warns(UserWarning, match=r"1 of 4 training sequences \(straight\) has a ground "
-                                         r"truth that moves in straight lines"):
+    events = []
+    with pytest.warns(UserWarning, match=r"1 of 4 training sequences \(straight \(0\.\d a second\)\) "
+                                         r"has a ground truth that moves in straight lines"):
         ridi.train([straight, *seqs[1:]], grid="none")
+    # Before training, as `ridi train` prints it: a warning made an error stops it there.
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        with pytest.raises(UserWarning, match="straight lines"):
+            ridi.train([straight, *seqs[1:]], grid="none", progress=lambda *e: events.append(e))
+    assert events == []

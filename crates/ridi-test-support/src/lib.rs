@@ -49,6 +49,6 @@ pub use files::{is_fifo, make_fifo};
 pub use mat::{MatArray, MatWriter, qtm_take};
 pub use naive::{naive_features, naive_kernel, naive_mirror, naive_smooth};
 pub use paths::{sample_dataset, shared_dataset, workspace_root};
-pub use synthetic::{SplitMix64, blob_data, regression_data};
+pub use synthetic::{SplitMix64, blob_data, regression_data, straight_between_points};
 pub use text::{edit_cells, edit_rows, with_cell};
 pub use tyrex::{TYREX_OMEGA, TYREX_TIME_DIFF, tyrex_mocap, tyrex_phone_rows, yaw};

@@ -66,3 +66,25 @@ pub fn blob_data(
     }
     (x, y)
 }
+
+/// `positions` (one per frame of `time`) made straight lines at constant speed between the
+/// points every `every` frames and the last, as waypoints interpolated are (the Indoor
+/// Location Competition's ground truth).
+pub fn straight_between_points<F: ridi_frames::Frame>(
+    time: &[f64],
+    positions: &mut [ridi_frames::Vec3<F>],
+    every: usize,
+) {
+    let marks: Vec<usize> = (0..time.len())
+        .step_by(every)
+        .chain([time.len() - 1])
+        .collect();
+    let truth = positions.to_vec();
+    for w in marks.windows(2) {
+        let (a, b) = (w[0], w[1]);
+        for i in a..=b {
+            let share = (time[i] - time[a]) / (time[b] - time[a]);
+            positions[i] = truth[a] + (truth[b] - truth[a]) * share;
+        }
+    }
+}

@@ -140,7 +140,7 @@ pub use track::{
 };
 pub use track_options::TrackOptions;
 pub use train::{
-    GridChoice, MIN_TURNING_SHARE, TrainOptions, TrainingData, default_step, ground_truth_view,
+    GridChoice, MIN_TURNS_PER_S, TrainOptions, TrainingData, default_step, ground_truth_view,
     train, training_data, training_warnings, training_windows,
 };
 

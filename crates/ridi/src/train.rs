@@ -302,30 +302,31 @@ pub fn training_windows(seqs: &[Sequence], opts: &TrainOptions) -> Result<usize>
         })
 }
 
-/// Below this share of frames where the ground truth's horizontal velocity changes, it moves
-/// in straight lines at constant speed between a few points: waypoints, interpolated (the 12
-/// Indoor Location Competition paths of `../shared`, converted: 0.09-0.18 % of the frames;
-/// the motion capture of every shared Tyrex run, each part of one: 41 % and more).
-pub const MIN_TURNING_SHARE: f64 = 0.1;
+/// Fewer changes of velocity a second than this, and the ground truth moves in straight lines
+/// at constant speed between a few points: waypoints, interpolated. Counted per second, not per
+/// frame, so that the frame rate does not matter (a change: an acceleration over 0.2 m/s²
+/// between two frames' velocities). Measured: the 12 Indoor Location Competition paths of
+/// `../shared`, converted, 0.1-0.35 a second (a waypoint every 2-10 s, each a change over one
+/// or two frames); the motion capture of every part of every shared Tyrex run, 82 a second and
+/// more.
+pub const MIN_TURNS_PER_S: f64 = 2.0;
 
-/// A change of velocity between two frames (m/s) that counts as one ([`MIN_TURNING_SHARE`]):
-/// 0.2 m/s² at 200 Hz, ten times what a straight line's timestamps rounded to the nanosecond
-/// make of a brisk walk's velocity.
-const TURN_M_S: f64 = 1e-3;
+/// An acceleration (m/s²) between two frames' velocities that counts as a change of
+/// velocity ([`MIN_TURNS_PER_S`]): far above what timestamps' round-off (f64 seconds since
+/// 1970, about 0.2 µs) makes of a straight line walked briskly, far below a step's.
+const TURN_M_S2: f64 = 0.2;
 
-/// What a training set holds that is no error but makes a poorer model, one warning per
-/// kind, for the caller to show (`ridi train` prints them; Python warns): sequences whose ground
+/// What a training set holds that is no error but makes a poorer model, one warning per kind,
+/// for the caller to show (`ridi train` prints them; Python warns): sequences whose ground
 /// truth moves in straight lines at constant speed between a few points (waypoints,
-/// [`MIN_TURNING_SHARE`]), whose velocity targets are those lines' average speeds, not the
-/// walk's.
+/// [`MIN_TURNS_PER_S`]), whose velocity targets are those lines' average speeds, not the
+/// walk's. A ground truth that never changes velocity (a still or synthetic recording) is not
+/// named: nothing tells it from a walk in one straight line.
 pub fn training_warnings(seqs: &[Sequence]) -> Vec<String> {
-    let straight: Vec<&str> = seqs
+    let straight: Vec<String> = seqs
         .iter()
-        .filter(|s| {
-            let Some(gt) = s.ground_truth() else {
-                return false;
-            };
-            let (t, p) = (s.time(), &gt.position);
+        .filter_map(|s| {
+            let (t, p) = (s.time(), &s.ground_truth()?.position);
             let velocity = |i: usize| {
                 let dt = t[i + 1] - t[i];
                 [
@@ -336,23 +337,25 @@ pub fn training_warnings(seqs: &[Sequence]) -> Vec<String> {
             let turns = (1..t.len().saturating_sub(1))
                 .filter(|&i| {
                     let (a, b) = (velocity(i - 1), velocity(i));
-                    (b[0] - a[0]).hypot(b[1] - a[1]) > TURN_M_S
+                    let dt = 0.5 * (t[i + 1] - t[i - 1]);
+                    (b[0] - a[0]).hypot(b[1] - a[1]) > TURN_M_S2 * dt
                 })
                 .count();
-            let steps = t.len().saturating_sub(2);
-            steps > 0 && (turns as f64) < MIN_TURNING_SHARE * steps as f64
+            let per_s = turns as f64 / s.duration();
+            (turns > 0 && per_s < MIN_TURNS_PER_S)
+                .then(|| format!("{} ({per_s:.1} a second)", ridi_data::shown(s.name())))
         })
-        .map(Sequence::name)
         .collect();
     if straight.is_empty() {
         return Vec::new();
     }
     vec![format!(
         "{} of {} ({}) {} a ground truth that moves in straight lines at constant speed between \
-         a few points (waypoints, as the Indoor Location Competition's): the velocity targets \
-         are those lines' average speeds, not the walk's, and a model learns them; train on \
-         motion capture or a visual-inertial track (docs/datasets.md), and keep waypoints to \
-         evaluate positions",
+         a few points, its velocity changing under {MIN_TURNS_PER_S} times a second (waypoints, \
+         as the Indoor Location Competition's; motion capture's changes at every frame): the \
+         velocity targets are those lines' average speeds, not the walk's, and a model learns \
+         them; train on motion capture or a visual-inertial track (docs/datasets.md), and keep \
+         waypoints to evaluate positions",
         straight.len(),
         ridi_data::counted(seqs.len(), "training sequence"),
         ridi_data::first_few(straight.iter(), 3),

@@ -1184,24 +1184,25 @@ fn ground_truth_in_straight_lines_between_waypoints_is_warned_about_at_training(
     assert!(ridi::training_warnings(&seqs).is_empty());
     // One run's ground truth as the competition's: straight lines between a point every 5 s.
     let mut parts = seqs[0].clone().into_parts();
-    let (t, gt) = (&parts.time, parts.ground_truth.as_mut().unwrap());
-    let marks: Vec<usize> = (0..t.len()).step_by(1000).chain([t.len() - 1]).collect();
-    let truth = gt.position.clone();
-    for w in marks.windows(2) {
-        let (a, b) = (w[0], w[1]);
-        for i in a..=b {
-            gt.position[i] = truth[a] + (truth[b] - truth[a]) * ((t[i] - t[a]) / (t[b] - t[a]));
-        }
-    }
+    let gt = parts.ground_truth.as_mut().unwrap();
+    ridi_test_support::straight_between_points(&parts.time, &mut gt.position, 1000);
     let straight = Sequence::new(parts).unwrap();
+    // One line from start to end never changes velocity: nothing tells it from a walk in one
+    // straight line, and it is not named.
+    let mut parts = seqs[1].clone().into_parts();
+    let gt = parts.ground_truth.as_mut().unwrap();
+    ridi_test_support::straight_between_points(&parts.time, &mut gt.position, usize::MAX);
+    assert!(ridi::training_warnings(&[Sequence::new(parts).unwrap()]).is_empty());
     let warnings = ridi::training_warnings(&[straight, seqs[1].clone()]);
     assert_eq!(warnings.len(), 1, "{warnings:?}");
     assert!(
         warnings[0].starts_with(&format!(
-            "1 of 2 training sequences ({}) has a ground truth that moves in straight lines at \
-             constant speed between a few points",
+            "1 of 2 training sequences ({} (0.",
             seqs[0].name()
-        )),
+        )) && warnings[0].contains(
+            " a second)) has a ground truth that moves in straight lines at constant speed \
+                 between a few points, its velocity changing under 2 times a second"
+        ),
         "{}",
         warnings[0]
     );
