@@ -568,9 +568,9 @@ pub fn run(opts: Options) -> Result<PathBuf> {
         runs.len()
     );
     apply_orientation(opts.orientation, opts.recorded_heading.as_ref(), &mut seqs)?;
-    PlacementMap::tyrex_groups().apply(&mut seqs);
+    PlacementMap::tyrex4().apply(&mut seqs);
     for s in bridged.iter_mut().flatten() {
-        PlacementMap::tyrex_groups().apply(std::slice::from_mut(s));
+        PlacementMap::tyrex4().apply(std::slice::from_mut(s));
     }
 
     let train_opts = train_options(

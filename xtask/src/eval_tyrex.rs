@@ -372,7 +372,7 @@ fn prepare(all: &[Sequence], v: &Variant) -> Result<Vec<Sequence>> {
     let heading = EvalOptions::default().track.recorded_heading;
     apply_orientation(v.orientation, heading.as_ref(), &mut seqs)?;
     if v.groups {
-        PlacementMap::tyrex_groups().apply(&mut seqs);
+        PlacementMap::tyrex4().apply(&mut seqs);
     }
     Ok(seqs)
 }

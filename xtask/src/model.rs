@@ -33,7 +33,7 @@ pub fn run(data: Option<PathBuf>, out: Option<PathBuf>) -> Result<PathBuf> {
     let orientation = Orientation::Estimated;
     // Training does not see the heading (features and targets live in S).
     apply_orientation(orientation, None, &mut seqs)?;
-    PlacementMap::tyrex_groups().apply(&mut seqs);
+    PlacementMap::tyrex4().apply(&mut seqs);
     eprintln!(
         "{} sequences read in {:.0} s",
         seqs.len(),

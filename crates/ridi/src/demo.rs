@@ -34,13 +34,13 @@ const MODEL_FILE: &str = "model.ridi";
 
 impl Demo {
     /// Reads the demo in `data` (`list_train.txt` and `list_test.txt`, labels grouped as the
-    /// four Tyrex groups, [`PlacementMap::tyrex_groups`]) to write into `out`, with the
+    /// four Tyrex groups, [`PlacementMap::tyrex4`]) to write into `out`, with the
     /// regressor search `grid` and `plots`. Refused: an output folder that cannot be written,
     /// list errors, a recording on both lists or in both as copies, and each sequence's
     /// problems as [`load_listed`] finds them.
     pub fn prepare(data: &Path, out: &Path, grid: GridChoice, plots: EvalPlots) -> Result<Self> {
         let folder = EvalFolder::new(out, plots)?;
-        let map = PlacementMap::tyrex_groups();
+        let map = PlacementMap::tyrex4();
         let read = ReadOptions::default();
         let load = |list: &str, purpose| {
             let entries = ListEntry::read(&[data.join(list)])?;

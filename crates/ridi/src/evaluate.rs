@@ -363,7 +363,7 @@ pub fn placement_warnings(seqs: &[Sequence], model: &Cascade) -> Vec<String> {
             unknown.entry(label).or_default().push(s.name());
         }
     }
-    let tyrex = crate::PlacementMap::tyrex_groups();
+    let tyrex = crate::PlacementMap::tyrex4();
     unknown
         .into_iter()
         .map(|(label, names)| {

@@ -25,10 +25,10 @@
 //! # Design decisions
 //!
 //! - **The model decides what a sequence must look like.** A trained [`regress::Cascade`]
-//!   carries its feature configuration (window, S definition, orientation source); training,
-//!   tracking and evaluation all pass a sequence through [`oriented`] and derive the
-//!   correction's S from the model ([`TrackOptions::correction_for`]), so a model cannot be
-//!   applied to features it was not trained on.
+//!   carries its feature configuration (window, S definition, orientation recorded or
+//!   estimated); training, tracking and evaluation all pass a sequence through [`oriented`]
+//!   and derive the correction's S from the model ([`TrackOptions::correction_for`]), so a
+//!   model cannot be applied to features it was not trained on.
 //! - **Online and live tracking are one code path.** `ridi track --online` and [`track()`] with
 //!   [`TrackOptions::online`] feed a recording through [`LiveTracker`] sample by sample, so the
 //!   streaming poses a program gets are the ones the command line tests. A recording whose
@@ -60,13 +60,13 @@
 //! let sample = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../datasets/sample");
 //! let read = |list: &str| Listed::read(&[sample.join(list)], &ReadOptions::default());
 //! let mut train = read("list_Guillaume.txt")?.into_sequences();
-//! PlacementMap::tyrex_groups().apply(&mut train);
+//! PlacementMap::tyrex4().apply(&mut train);
 //! let mut opts = TrainOptions::default();
 //! opts.cascade.regressors = GridChoice::None.regressors(); // fixed C and epsilon: fast
 //! let model = ridi::train(&train, &opts, &mut NoProgress)?;
 //!
 //! let mut test = read("list_Jakob.txt")?.into_sequences();
-//! PlacementMap::tyrex_groups().apply(&mut test);
+//! PlacementMap::tyrex4().apply(&mut test);
 //! let track = ridi::track(&test[0], &model, &TrackOptions::default())?;
 //! assert_eq!(track.position.len(), test[0].len());
 //!

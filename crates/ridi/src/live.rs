@@ -216,7 +216,7 @@ impl SensorReading {
 /// let sample = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../datasets/sample");
 /// let read = |list: &str| Listed::read(&[sample.join(list)], &ReadOptions::default());
 /// let mut train = read("list_Guillaume.txt")?.into_sequences();
-/// PlacementMap::tyrex_groups().apply(&mut train);
+/// PlacementMap::tyrex4().apply(&mut train);
 /// let mut opts = TrainOptions::default();
 /// opts.cascade.regressors = ridi::GridChoice::None.regressors();
 /// let model = ridi::train(&train, &opts, &mut NoProgress)?;

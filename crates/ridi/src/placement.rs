@@ -21,10 +21,11 @@ pub struct PlacementMap {
 }
 
 impl PlacementMap {
-    /// The four groups of the Tyrex benchmark used by the accuracy protocol: `hand` (Texting,
-    /// Phoning, AR), `swing` (Swinging), `pocket` (FrontPocket, BackPocket) and `running`
-    /// (RunningHand, RunningPocket).
-    pub fn tyrex_groups() -> Self {
+    /// The four groups of the Tyrex benchmark used by the accuracy protocol, `--placement-map
+    /// tyrex4` (Python `placement_map="tyrex4"`): `hand` (Texting, Phoning, AR), `swing`
+    /// (Swinging), `pocket` (FrontPocket, BackPocket) and `running` (RunningHand,
+    /// RunningPocket).
+    pub fn tyrex4() -> Self {
         let pairs = [
             ("Texting", "hand"),
             ("Phoning", "hand"),
@@ -118,12 +119,12 @@ impl PlacementMap {
         })
     }
 
-    /// `tyrex4` for [`Self::tyrex_groups`], otherwise a file for [`Self::read`] (a missing
+    /// `tyrex4` for [`Self::tyrex4`], otherwise a file for [`Self::read`] (a missing
     /// one is named with the `tyrex4` alternative: a mistyped group name reads as a path).
     pub fn from_arg(arg: impl AsRef<Path>) -> Result<Self> {
         let arg = arg.as_ref();
         if arg.as_os_str() == "tyrex4" {
-            return Ok(Self::tyrex_groups());
+            return Ok(Self::tyrex4());
         }
         Self::read(arg).map_err(|e| match e {
             PipelineError::Data(DataError::Io { path, error })
@@ -208,8 +209,8 @@ mod tests {
     use super::*;
 
     #[test]
-    fn tyrex_groups_cover_every_motion() {
-        let m = PlacementMap::tyrex_groups();
+    fn tyrex4_covers_every_motion() {
+        let m = PlacementMap::tyrex4();
         for motion in ridi_data::tyrex::MOTIONS {
             assert!(m.class_of(motion).is_some(), "{motion} has no group");
         }
@@ -295,7 +296,7 @@ mod tests {
         assert!(err.ends_with("tyrex5: no such file or folder"), "{err}");
         assert_eq!(
             PlacementMap::from_arg("tyrex4").unwrap(),
-            PlacementMap::tyrex_groups()
+            PlacementMap::tyrex4()
         );
     }
 }

@@ -47,7 +47,7 @@ fn the_bundled_model_tracks_the_sample_far_better_than_double_integration() {
     )
     .unwrap()
     .into_sequences();
-    PlacementMap::tyrex_groups().apply(&mut seqs);
+    PlacementMap::tyrex4().apply(&mut seqs);
     let model = ridi::bundled_model().unwrap();
     let (report, _) = ridi::evaluate(&seqs, &model, &EvalOptions::default()).unwrap();
     let (ridi, raw) = (report.summary["ridi"], report.summary["raw"]);

@@ -41,7 +41,7 @@ fn err<T: std::fmt::Debug>(r: ridi::Result<T>) -> String {
 #[test]
 fn unknown_placement_labels_name_the_list_line_and_the_known_labels() {
     let dir = tempfile::tempdir().unwrap();
-    let tyrex4 = PlacementMap::tyrex_groups();
+    let tyrex4 = PlacementMap::tyrex4();
     for label in ["Hovering", "Swingin"] {
         let l = list(
             dir.path(),
@@ -237,7 +237,7 @@ fn labels_the_model_does_not_know_are_a_warning_in_the_report() {
             line("Jakob_Nexus5_NoDist_BackPocket", "BackPocket"),
         ],
     );
-    let tyrex4 = PlacementMap::tyrex_groups();
+    let tyrex4 = PlacementMap::tyrex4();
     let train = load(&[&l], Some(&tyrex4), Purpose::Training).unwrap();
     let mut opts = TrainOptions::default();
     opts.cascade.regressors = GridChoice::None.regressors();

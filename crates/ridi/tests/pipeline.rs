@@ -17,7 +17,7 @@ fn load(list: &str) -> Vec<Sequence> {
     let mut seqs = Listed::read(&[sample_dataset().join(list)], &ReadOptions::default())
         .unwrap()
         .into_sequences();
-    PlacementMap::tyrex_groups().apply(&mut seqs);
+    PlacementMap::tyrex4().apply(&mut seqs);
     seqs
 }
 
