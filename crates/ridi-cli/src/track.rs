@@ -92,7 +92,7 @@ pub(crate) fn run(args: Args) -> Result<()> {
             shown(&args.sequence),
             ridi::data::counted(loaded.sequences.len(), "sequence"),
             ridi::data::first_few(names, 3),
-            shown(&args.sequence),
+            shell_word(&shown(&args.sequence)),
         );
     };
     let track = ridi::track(seq, &model, &opts)
@@ -130,4 +130,28 @@ fn track_options(args: &Args) -> TrackOptions {
         opts.correction.initial_velocity = ridi::correct::InitialVelocity::Estimate;
     }
     opts
+}
+
+/// `text` as one shell word, to copy into a command line: as it is when no shell treats any of
+/// its characters specially, else in single quotes.
+fn shell_word(text: &str) -> String {
+    let plain = |c: char| c.is_ascii_alphanumeric() || "/._-+,:@%=".contains(c);
+    if !text.is_empty() && text.chars().all(plain) {
+        text.to_string()
+    } else {
+        format!("'{}'", text.replace('\'', r"'\''"))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::shell_word;
+
+    #[test]
+    fn a_path_is_one_shell_word() {
+        assert_eq!(shell_word("runs/a_b-1.csv"), "runs/a_b-1.csv");
+        assert_eq!(shell_word("my runs/x"), "'my runs/x'");
+        assert_eq!(shell_word("it's"), r"'it'\''s'");
+        assert_eq!(shell_word(""), "''");
+    }
 }

@@ -368,7 +368,7 @@ pub(crate) fn train(
                         .lock()
                         .unwrap_or_else(|p| p.into_inner())
                         .get_or_insert(e);
-                    Err(PipelineError::Cancelled("training"))
+                    Err(PipelineError::Regress(RegressError::Cancelled))
                 }
             }
         };
@@ -388,7 +388,7 @@ pub(crate) fn train(
                         })?;
                     // Reading a long list can take a while before training's first report.
                     if cancel.load(Ordering::Relaxed) {
-                        return Err(PipelineError::Cancelled("training"));
+                        return Err(PipelineError::Regress(RegressError::Cancelled));
                     }
                     warned(listed.sequences())?;
                     ridi::train(listed.sequences(), &opts, &mut report)

@@ -55,7 +55,9 @@ pub enum PipelineError {
     /// A stage was given no sequence at all.
     #[error("no sequences to {0}")]
     NoSequences(&'static str),
-    /// The caller cancelled a stage (its flag was set, [`crate::evaluate_cancellable`]).
+    /// The caller cancelled an evaluation (its flag was set, [`crate::evaluate_cancellable`]);
+    /// a training cancelled by its progress callback is
+    /// `Regress(ridi_regress::RegressError::Cancelled)`.
     #[error("{0} cancelled")]
     Cancelled(&'static str),
     /// An output that cannot be written, or would replace an input ([`crate::OutputError`]).

@@ -140,8 +140,8 @@ pub use track::{
 };
 pub use track_options::TrackOptions;
 pub use train::{
-    GridChoice, MIN_TURNS_PER_S, TrainOptions, TrainingData, default_step, ground_truth_view,
-    train, training_data, training_warnings, training_windows,
+    GridChoice, MIN_VELOCITY_CHANGES_PER_S, TrainOptions, TrainingData, default_step,
+    ground_truth_view, train, training_data, training_warnings, training_windows,
 };
 
 /// The README's Rust example, compiled by `cargo test --doc` so that it cannot drift from the API.

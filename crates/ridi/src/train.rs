@@ -309,17 +309,17 @@ pub fn training_windows(seqs: &[Sequence], opts: &TrainOptions) -> Result<usize>
 /// `../shared`, converted, 0.1-0.35 a second (a waypoint every 2-10 s, each a change over one
 /// or two frames); the motion capture of every part of every shared Tyrex run, 82 a second and
 /// more.
-pub const MIN_TURNS_PER_S: f64 = 2.0;
+pub const MIN_VELOCITY_CHANGES_PER_S: f64 = 2.0;
 
 /// An acceleration (m/s²) between two frames' velocities that counts as a change of
-/// velocity ([`MIN_TURNS_PER_S`]): far above what timestamps' round-off (f64 seconds since
+/// velocity ([`MIN_VELOCITY_CHANGES_PER_S`]): far above what timestamps' round-off (f64 seconds since
 /// 1970, about 0.2 µs) makes of a straight line walked briskly, far below a step's.
-const TURN_M_S2: f64 = 0.2;
+const VELOCITY_CHANGE_M_S2: f64 = 0.2;
 
 /// What a training set holds that is no error but makes a poorer model, one warning per kind,
 /// for the caller to show (`ridi train` prints them; Python warns): sequences whose ground
 /// truth moves in straight lines at constant speed between a few points (waypoints,
-/// [`MIN_TURNS_PER_S`]), whose velocity targets are those lines' average speeds, not the
+/// [`MIN_VELOCITY_CHANGES_PER_S`]), whose velocity targets are those lines' average speeds, not the
 /// walk's. A ground truth that never changes velocity (a still or synthetic recording) is not
 /// named: nothing tells it from a walk in one straight line.
 pub fn training_warnings(seqs: &[Sequence]) -> Vec<String> {
@@ -334,15 +334,15 @@ pub fn training_warnings(seqs: &[Sequence]) -> Vec<String> {
                     (p[i + 1].y() - p[i].y()) / dt,
                 ]
             };
-            let turns = (1..t.len().saturating_sub(1))
+            let changes = (1..t.len().saturating_sub(1))
                 .filter(|&i| {
                     let (a, b) = (velocity(i - 1), velocity(i));
                     let dt = 0.5 * (t[i + 1] - t[i - 1]);
-                    (b[0] - a[0]).hypot(b[1] - a[1]) > TURN_M_S2 * dt
+                    (b[0] - a[0]).hypot(b[1] - a[1]) > VELOCITY_CHANGE_M_S2 * dt
                 })
                 .count();
-            let per_s = turns as f64 / s.duration();
-            (turns > 0 && per_s < MIN_TURNS_PER_S)
+            let per_s = changes as f64 / s.duration();
+            (changes > 0 && per_s < MIN_VELOCITY_CHANGES_PER_S)
                 .then(|| format!("{} ({per_s:.1} a second)", ridi_data::shown(s.name())))
         })
         .collect();
@@ -351,7 +351,7 @@ pub fn training_warnings(seqs: &[Sequence]) -> Vec<String> {
     }
     vec![format!(
         "{} of {} ({}) {} a ground truth that moves in straight lines at constant speed between \
-         a few points, its velocity changing under {MIN_TURNS_PER_S} times a second (waypoints, \
+         a few points, its velocity changing under {MIN_VELOCITY_CHANGES_PER_S} times a second (waypoints, \
          as the Indoor Location Competition's; motion capture's changes at every frame): the \
          velocity targets are those lines' average speeds, not the walk's, and a model learns \
          them; train on motion capture or a visual-inertial track (docs/datasets.md), and keep \
