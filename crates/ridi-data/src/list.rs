@@ -231,16 +231,17 @@ impl Listed {
         for e in &entries {
             if !text::present(&e.path) {
                 let name = e.path.file_name().map(|n| n.to_string_lossy());
-                let hint = match e.list.parent().filter(|d| !d.as_os_str().is_empty()) {
-                    // A tab or a semicolon where the comma goes: the placement read as a path.
-                    _ if name.is_some_and(|n| n.contains(['\t', ';'])) => {
-                        " (a list line is `path,placement`, separated by a comma)".to_string()
-                    }
-                    Some(dir) if e.path.starts_with(dir) => format!(
+                let folder = e.list.parent().filter(|d| !d.as_os_str().is_empty());
+                // A tab or a semicolon where the comma goes: the placement read as a path.
+                let hint = if name.is_some_and(|n| n.contains(['\t', ';'])) {
+                    " (a list line is `path,placement`, separated by a comma)".to_string()
+                } else if let Some(dir) = folder.filter(|d| e.path.starts_with(d)) {
+                    format!(
                         " (a relative path in a list is read from the list's folder, {})",
                         shown(dir)
-                    ),
-                    _ => String::new(),
+                    )
+                } else {
+                    String::new()
                 };
                 return Err(DataError::format(
                     e.location().with_field("path"),

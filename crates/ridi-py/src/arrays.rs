@@ -161,6 +161,15 @@ fn object_elements(array: &Bound<'_, PyUntypedArray>, name: &str) -> PyResult<()
     Ok(())
 }
 
+/// The kind (`b'f'`, `b'i'`, `b'b'`, `b'O'`, ...) and item size of `obj`'s numpy dtype, when it
+/// has one (an array or a numpy scalar).
+pub(crate) fn dtype_kind(obj: &Bound<'_, PyAny>) -> Option<(u8, usize)> {
+    let dtype = obj.getattr("dtype").ok()?;
+    let kind = dtype.getattr("kind").ok()?.extract::<String>().ok()?;
+    let size = dtype.getattr("itemsize").ok()?.extract::<usize>().ok()?;
+    Some((*kind.as_bytes().first()?, size))
+}
+
 /// What `obj` is, for a message: its type, and its shape when it has one.
 pub(crate) fn described(obj: &Bound<'_, PyAny>) -> String {
     let kind = obj

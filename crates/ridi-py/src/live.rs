@@ -11,7 +11,7 @@ use ridi::frames::{DeviceVec, WorldFromDevice};
 use ridi::regress::Cascade;
 use ridi::{Recorded, SensorReading};
 
-use crate::arrays::described;
+use crate::arrays::{described, dtype_kind};
 use crate::errors;
 use crate::model::Model;
 use crate::options;
@@ -307,17 +307,11 @@ fn refuse_unreadable(obj: &Bound<'_, PyAny>, name: &str) -> PyResult<()> {
     if obj.is_exact_instance_of::<PyFloat>() {
         return Ok(());
     }
-    let kind = |o: &Bound<'_, PyAny>| -> Option<(u8, usize)> {
-        let dtype = o.getattr("dtype").ok()?;
-        let kind = dtype.getattr("kind").ok()?.extract::<String>().ok()?;
-        let size = dtype.getattr("itemsize").ok()?.extract::<usize>().ok()?;
-        Some((*kind.as_bytes().first()?, size))
-    };
     // The items of what is read as a sequence of numbers (a list, a tuple, a deque, an object
     // array; text is no reading), at most 4: a reading has 3, and any other count is refused
     // later. An array of numbers says by its dtype. Other iterables are not walked: an endless
     // one would never end; a 0-d object array is its one item.
-    let own = kind(obj);
+    let own = dtype_kind(obj);
     let objects = own.is_some_and(|(k, _)| k == b'O');
     let zero_d = objects && obj.getattr("ndim")?.extract::<usize>()? == 0;
     let walk = (objects && !zero_d)
@@ -338,7 +332,7 @@ fn refuse_unreadable(obj: &Bound<'_, PyAny>, name: &str) -> PyResult<()> {
                 "`{name}` holds bools; a sample's readings are numbers"
             )));
         }
-        match kind(item) {
+        match dtype_kind(item) {
             Some((b'f', size)) if name == "time" && size < 8 => {
                 return Err(PyTypeError::new_err(format!(
                     "`time` is a float{}: its bits have rounded the timestamp already (to 0.24 \
@@ -376,13 +370,7 @@ fn values<const N: usize>(obj: &Bound<'_, PyAny>, name: &str) -> PyResult<[f64; 
 /// Judged by a look, not a copy: a chunk pushed by mistake may hold more rows than memory
 /// holds a copy of.
 fn reads_as_numbers(obj: &Bound<'_, PyAny>, depth: u8) -> bool {
-    let numeric = obj
-        .getattr("dtype")
-        .and_then(|d| d.getattr("kind"))
-        .is_ok_and(|k| {
-            k.extract::<String>()
-                .is_ok_and(|k| matches!(&*k, "f" | "i" | "u"))
-        });
+    let numeric = dtype_kind(obj).is_some_and(|(k, _)| matches!(k, b'f' | b'i' | b'u'));
     // A numpy scalar (0-d) at the top is one number, as a Python float is.
     let array = obj
         .getattr("ndim")

@@ -196,13 +196,18 @@ impl Callback<'_> {
                 false
             }
             Err(err) => {
-                self.raised
-                    .lock()
-                    .unwrap_or_else(|p| p.into_inner())
-                    .get_or_insert(err);
+                self.raise(err);
                 false
             }
         }
+    }
+
+    /// Keeps `err` as the exception the training ends with, unless one came first.
+    fn raise(&self, err: PyErr) {
+        self.raised
+            .lock()
+            .unwrap_or_else(|p| p.into_inner())
+            .get_or_insert(err);
     }
 
     /// The Python exception for a training that ended with `e`.
@@ -360,17 +365,10 @@ pub(crate) fn train(
         // train` prints them; one that raises (`-W error`) stops it.
         let warned = |seqs: &[ridi::data::Sequence]| {
             let warnings = ridi::training_warnings(seqs);
-            match Python::attach(|py| crate::sequence::warn(py, &warnings)) {
-                Ok(()) => Ok(()),
-                Err(e) => {
-                    callback
-                        .raised
-                        .lock()
-                        .unwrap_or_else(|p| p.into_inner())
-                        .get_or_insert(e);
-                    Err(PipelineError::Regress(RegressError::Cancelled))
-                }
-            }
+            Python::attach(|py| crate::sequence::warn(py, &warnings)).map_err(|e| {
+                callback.raise(e);
+                PipelineError::Regress(RegressError::Cancelled)
+            })
         };
         let trained = (|| -> ridi::Result<Cascade> {
             let mut report = |e: &ProgressEvent<'_>| callback.report(e);

@@ -161,10 +161,7 @@ pub(crate) fn opt_whole(obj: &Bound<'_, PyAny>) -> PyResult<Option<i64>> {
 
 /// Refuses a Python bool, a numpy bool and a 0-d bool array (`np.array(True)`).
 pub(crate) fn not_bool(obj: &Bound<'_, PyAny>) -> PyResult<()> {
-    let numpy_bool = obj
-        .getattr("dtype")
-        .and_then(|d| d.getattr("kind"))
-        .is_ok_and(|k| k.extract::<String>().is_ok_and(|k| k == "b"));
+    let numpy_bool = crate::arrays::dtype_kind(obj).is_some_and(|(k, _)| k == b'b');
     if obj.is_instance_of::<pyo3::types::PyBool>() || numpy_bool {
         return Err(PyTypeError::new_err(format!(
             "expected a number, not a bool ({})",

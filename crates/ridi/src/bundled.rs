@@ -10,6 +10,9 @@
 //! it cannot be expected to do. `cargo xtask model` rebuilds it; the Tyrex data are CeCILL
 //! v2.1 (`model/PROVENANCE.md` and the licence beside the file).
 
+use std::collections::BTreeSet;
+
+use ridi_data::Sequence;
 use ridi_regress::{Cascade, RegressError};
 
 /// The model file's bytes.
@@ -34,9 +37,40 @@ pub fn bundled_training_runs() -> impl Iterator<Item = &'static str> {
 
 /// Whether a model whose bytes have `fingerprint` ([`crate::Provenance::model_fingerprint`]) is
 /// the bundled model.
-pub(crate) fn is_bundled(fingerprint: &str) -> bool {
+fn is_bundled(fingerprint: &str) -> bool {
     static BUNDLED: std::sync::OnceLock<String> = std::sync::OnceLock::new();
     BUNDLED.get_or_init(|| crate::evaluate::fingerprint(BYTES)) == fingerprint
+}
+
+/// A warning when the model of `fingerprint` is the bundled one and some of `seqs` are runs it
+/// was trained on
+/// (or parts of them): its figures there are not a new person's or phone's.
+pub(crate) fn trained_on_warning(seqs: &[Sequence], fingerprint: &str) -> Option<String> {
+    if !is_bundled(fingerprint) {
+        return None;
+    }
+    let runs: BTreeSet<&str> = bundled_training_runs().collect();
+    let seen: Vec<&str> = seqs
+        .iter()
+        .map(Sequence::name)
+        .filter(|name| runs.contains(ridi_eval::run_of(name)))
+        .collect();
+    (!seen.is_empty()).then(|| {
+        format!(
+            "{} of {} ({}) {} the runs the bundled model was trained on: its figures there are \
+             not those of a person or phone it never saw (docs/model-card.md has those, each \
+             person left out); to measure that on your data, evaluate a model trained without \
+             them (`ridi train`, then `--model`; in Python `ridi.train`)",
+            seen.len(),
+            ridi_data::counted(seqs.len(), "sequence"),
+            ridi_data::first_few(seen.iter(), 3),
+            if seen.len() == 1 {
+                "is one of"
+            } else {
+                "are among"
+            },
+        )
+    })
 }
 
 /// The bundled model, decoded (a few milliseconds; decode once and keep it).

@@ -179,7 +179,6 @@ pub struct Provenance {
 impl Provenance {
     /// The provenance of an evaluation of `model` with `opts`.
     pub fn of(model: &Cascade, opts: &EvalOptions) -> Result<Self> {
-        let bytes = model.to_bytes()?;
         let config = model.feature_config();
         let orientation = match config.orientation {
             ridi_features::Orientation::Recorded => "the recorded orientation",
@@ -188,7 +187,7 @@ impl Provenance {
         Ok(Self {
             ridi_version: env!("CARGO_PKG_VERSION").to_string(),
             model_source: None,
-            model_fingerprint: fingerprint(&bytes),
+            model_fingerprint: model_fingerprint(model)?,
             model: format!(
                 "{} solver; placements {}; a feature window of {} frames; {}",
                 match model.solver() {
@@ -533,7 +532,10 @@ pub fn evaluate_cancellable(
     warnings.extend(too_few_runs(&results));
     let provenance = Provenance::of(model, opts)?;
     #[cfg(feature = "bundled-model")]
-    warnings.extend(trained_on_by_bundled(seqs, &provenance));
+    warnings.extend(crate::bundled::trained_on_warning(
+        seqs,
+        &provenance.model_fingerprint,
+    ));
     Ok((
         Report {
             sequences: results,
@@ -1137,6 +1139,11 @@ impl Traces {
     }
 }
 
+/// The fingerprint of `model`'s file ([`Provenance::model_fingerprint`]).
+pub(crate) fn model_fingerprint(model: &Cascade) -> Result<String> {
+    Ok(fingerprint(&model.to_bytes()?))
+}
+
 /// FNV-1a 64 of `bytes` in hex ([`Provenance::model_fingerprint`]): a stable,
 /// dependency-free fingerprint (not a cryptographic one).
 pub(crate) fn fingerprint(bytes: &[u8]) -> String {
@@ -1144,37 +1151,6 @@ pub(crate) fn fingerprint(bytes: &[u8]) -> String {
         (h ^ u64::from(b)).wrapping_mul(0x0100_0000_01b3)
     });
     format!("{hash:016x}")
-}
-
-/// A warning when the model is the bundled one and some of `seqs` are runs it was trained on
-/// (or parts of them): its figures there are not a new person's or phone's.
-#[cfg(feature = "bundled-model")]
-fn trained_on_by_bundled(seqs: &[Sequence], provenance: &Provenance) -> Option<String> {
-    if !crate::bundled::is_bundled(&provenance.model_fingerprint) {
-        return None;
-    }
-    let runs: BTreeSet<&str> = crate::bundled_training_runs().collect();
-    let seen: Vec<&str> = seqs
-        .iter()
-        .map(Sequence::name)
-        .filter(|name| runs.contains(ridi_eval::run_of(name)))
-        .collect();
-    (!seen.is_empty()).then(|| {
-        format!(
-            "{} of {} ({}) {} the runs the bundled model was trained on: its figures there are \
-             not those of a person or phone it never saw (docs/model-card.md has those, each \
-             person left out); to measure that on your data, evaluate a model trained without \
-             them (`ridi train`, then `--model`; in Python `ridi.train`)",
-            seen.len(),
-            ridi_data::counted(seqs.len(), "sequence"),
-            ridi_data::first_few(seen.iter(), 3),
-            if seen.len() == 1 {
-                "is one of"
-            } else {
-                "are among"
-            },
-        )
-    })
 }
 
 #[cfg(test)]

@@ -540,9 +540,7 @@ pub fn inspect_model(model: &Cascade) -> ModelInspection {
         .collect();
     ModelInspection {
         // A model that cannot be encoded (one serde built alone) has no file to name.
-        fingerprint: model
-            .to_bytes()
-            .map_or_else(|_| "-".to_string(), |b| crate::evaluate::fingerprint(&b)),
+        fingerprint: crate::evaluate::model_fingerprint(model).unwrap_or_else(|_| "-".into()),
         format_version: model.format_version(),
         landmarks: match model.solver() {
             Solver::Exact => None,

@@ -311,8 +311,8 @@ pub fn training_windows(seqs: &[Sequence], opts: &TrainOptions) -> Result<usize>
 /// more.
 pub const MIN_VELOCITY_CHANGES_PER_S: f64 = 2.0;
 
-/// An acceleration (m/s²) between two frames' velocities that counts as a change of
-/// velocity ([`MIN_VELOCITY_CHANGES_PER_S`]): far above what timestamps' round-off (f64 seconds since
+/// An acceleration (m/s²) between two frames' velocities that counts as a change of velocity
+/// ([`MIN_VELOCITY_CHANGES_PER_S`]): far above what timestamps' round-off (f64 seconds since
 /// 1970, about 0.2 µs) makes of a straight line walked briskly, far below a step's.
 const VELOCITY_CHANGE_M_S2: f64 = 0.2;
 
