@@ -36,8 +36,10 @@ pub(crate) struct Args {
 enum FromFormat {
     /// RIDI raw recorder folder (gyro.txt, acce.txt, ..., pose.txt).
     RidiRaw,
-    /// RIDI processed data.csv (or data_plain.txt).
+    /// RIDI processed data.csv (or data_plain.txt where a folder has no data.csv).
     RidiCsv,
+    /// RIDI processed data_plain.txt (of a folder that has a data.csv too).
+    RidiPlain,
     /// Tyrex smartphone benchmark (a sequence folder or the dataset root).
     Tyrex,
     /// Indoor Location Competition 2.0 path files (a file, or a folder searched recursively).
@@ -51,6 +53,7 @@ impl From<FromFormat> for Format {
         match f {
             FromFormat::RidiRaw => Format::RidiRaw,
             FromFormat::RidiCsv => Format::RidiCsv,
+            FromFormat::RidiPlain => Format::RidiPlain,
             FromFormat::Tyrex => Format::Tyrex,
             FromFormat::Ilc => Format::Ilc,
             FromFormat::Ronin => Format::Ronin,

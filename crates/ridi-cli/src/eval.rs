@@ -41,8 +41,8 @@ pub(crate) struct Args {
     #[arg(long, value_enum, default_value = "png")]
     plots: Plots,
     /// Worker threads (default: all cores).
-    #[arg(long, value_parser = |s: &str| count(s, 1, 4096))]
-    jobs: Option<usize>,
+    #[arg(long, value_parser = |s: &str| count(s, 1, ridi::MAX_JOBS))]
+    pub(crate) jobs: Option<usize>,
     /// Placement majority window, seconds: each regression takes the most frequent placement
     /// label within it, centred on it; 0 keeps each window's own label, as in the paper.
     #[arg(long, value_name = "SECONDS", default_value_t = 10.0, value_parser = non_negative)]
@@ -61,7 +61,6 @@ pub(crate) struct Args {
 }
 
 pub(crate) fn run(args: Args) -> Result<()> {
-    crate::set_jobs(args.jobs)?;
     let folder = EvalFolder::new(&args.out, args.plots.into())?;
     let mut methods: Vec<Method> = Vec::new();
     for &m in &args.methods {

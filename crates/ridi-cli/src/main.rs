@@ -243,13 +243,11 @@ fn placement_smoothing(window_s: f64) -> Option<PlacementSmoother> {
     (window_s > 0.0).then_some(PlacementSmoother { window_s })
 }
 
-/// `--jobs`: the worker threads of the whole run.
-fn set_jobs(jobs: Option<usize>) -> Result<()> {
-    if let Some(n) = jobs {
-        rayon::ThreadPoolBuilder::new()
-            .num_threads(n.max(1))
-            .build_global()
-            .context("cannot set up the worker threads")?;
+/// The worker threads of the whole run, started before any work ([`ridi::start_workers`]):
+/// `--jobs` (train, eval), else `RAYON_NUM_THREADS` when set.
+fn start_workers(jobs: Option<usize>) -> Result<()> {
+    if let Some(warning) = ridi::start_workers(jobs)? {
+        errln!("warning: {}", shown(warning));
     }
     Ok(())
 }
@@ -321,6 +319,15 @@ fn clean_up_on_signals() {
 fn main() -> ExitCode {
     let cli = Cli::parse();
     clean_up_on_signals();
+    let jobs = match &cli.command {
+        Command::Train(args) => args.jobs,
+        Command::Eval(args) => args.jobs,
+        _ => None,
+    };
+    if let Err(e) = start_workers(jobs) {
+        errln!("error: {}", shown(one_line(&e)));
+        return ExitCode::FAILURE;
+    }
     let result = match cli.command {
         Command::Inspect(args) => inspect::run(args),
         Command::Convert(args) => convert::run(args),

@@ -90,8 +90,8 @@ pub(crate) struct Args {
     #[arg(long, value_enum, default_value = "plus-or-minus-y")]
     up_axis: UpAxisArg,
     /// Worker threads (default: all cores).
-    #[arg(long, value_parser = |s: &str| count(s, 1, 4096))]
-    jobs: Option<usize>,
+    #[arg(long, value_parser = |s: &str| count(s, 1, ridi::MAX_JOBS))]
+    pub(crate) jobs: Option<usize>,
 }
 
 /// Largest `--turned-copies`: copy `j` of a window is turned by `j / N` of a full turn, so a few
@@ -192,7 +192,6 @@ pub(crate) fn run(args: Args) -> Result<()> {
             "--landmarks is for --solver nystrom: the exact solver keeps every training window"
         );
     }
-    crate::set_jobs(args.jobs)?;
     let out = &args.out;
     check_output_file(out)?;
     let entries = ListEntry::read(&args.list)?;

@@ -1187,6 +1187,91 @@ fn convert_writes_all_or_nothing() {
 }
 
 #[test]
+fn from_ridi_plain_converts_the_data_plain_txt_of_a_folder_with_both() {
+    // Detection and `--from ridi-csv` prefer a folder's data.csv; `--from ridi-plain` (the
+    // Python package's name too) takes its data_plain.txt.
+    let corpus = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/corpus");
+    let dir = tempfile::tempdir().unwrap();
+    let both = dir.path().join("both/processed");
+    std::fs::create_dir_all(&both).unwrap();
+    std::fs::copy(corpus.join("ok/processed/data.csv"), both.join("data.csv")).unwrap();
+    std::fs::copy(
+        corpus.join("plain/ok/data_plain.txt"),
+        both.join("data_plain.txt"),
+    )
+    .unwrap();
+    let source = dir.path().join("both");
+    for (from, frames) in [
+        (None, 240),
+        (Some("ridi-csv"), 240),
+        (Some("ridi-plain"), 24),
+    ] {
+        let out_dir = dir
+            .path()
+            .join(format!("out-{}", from.unwrap_or("detected")));
+        let mut args = vec!["convert", s(&source), "--out", s(&out_dir)];
+        args.extend(from.iter().flat_map(|f| ["--from", f]));
+        let out = ridi(&args);
+        assert!(out.status.success(), "{from:?}: {}", stderr(&out));
+        let out = ridi(&["inspect", s(&out_dir.join("both")), "--json"]);
+        let json: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+        assert_eq!(json["frames"], frames, "{from:?}");
+    }
+}
+
+#[test]
+fn rayon_num_threads_out_of_range_is_a_warning_and_jobs_outranks_it() {
+    // rayon would start what RAYON_NUM_THREADS asks for at its first parallel call, without a
+    // bound, and panic if the system refused: the command starts them first, checked.
+    let seq = sample_dataset().join("Jakob_Nexus5_NoDist_Texting");
+    let dir = tempfile::tempdir().unwrap();
+    let with_env = |value: &str, args: &[&str]| {
+        Command::new(env!("CARGO_BIN_EXE_ridi"))
+            .args(args)
+            .env("RAYON_NUM_THREADS", value)
+            .output()
+            .unwrap()
+    };
+    let csv = dir.path().join("t.csv");
+    let track = ["track", s(&seq), "--out", s(&csv)];
+    let out = with_env("100000", &track);
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert!(
+        stderr(&out).starts_with(
+            "warning: RAYON_NUM_THREADS=100000 is over 4096 threads: using one worker thread \
+             per core ("
+        ),
+        "{}",
+        stderr(&out)
+    );
+    let out = with_env("2", &track);
+    let err = stderr(&out);
+    assert!(
+        out.status.success() && !err.contains("RAYON_NUM_THREADS"),
+        "{err}"
+    );
+    // --jobs outranks it: no warning before the missing list's error.
+    let (missing, model) = (dir.path().join("missing.txt"), dir.path().join("m.ridi"));
+    let out = with_env(
+        "100000",
+        &[
+            "train",
+            "--list",
+            s(&missing),
+            "--out",
+            s(&model),
+            "--jobs",
+            "1",
+        ],
+    );
+    let err = stderr(&out);
+    assert!(
+        !err.contains("RAYON_NUM_THREADS") && err.contains("missing.txt"),
+        "{err}"
+    );
+}
+
+#[test]
 fn empty_lists_are_errors() {
     let dir = tempfile::tempdir().unwrap();
     let list = dir.path().join("empty.txt");

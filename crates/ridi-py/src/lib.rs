@@ -25,7 +25,7 @@ mod track;
 /// The native module; `python/ridi/__init__.py` re-exports it as `ridi`.
 #[pymodule]
 fn _ridi(m: &Bound<'_, PyModule>) -> PyResult<()> {
-    options::note_process();
+    options::note_process(m.py())?;
     m.add_class::<sequence::Sequence>()?;
     m.add_class::<model::Model>()?;
     m.add_class::<track::Track>()?;

@@ -24,8 +24,6 @@ pub(crate) const MAX_FRAMES_APART: usize = 12_000;
 pub(crate) const MAX_TURNED_COPIES: usize = 32;
 /// Smallest and largest training `window` (`ridi train --window`).
 pub(crate) const WINDOW_RANGE: (usize, usize) = (20, 600);
-/// Largest `jobs` (`--jobs`).
-pub(crate) const MAX_JOBS: usize = 4096;
 
 /// `value` of the option `name`, one of `choices` (`(name, value)` pairs), or a `ValueError`
 /// listing them.
@@ -283,9 +281,18 @@ impl Inputs {
 /// The process the module was loaded in.
 static LOADED_IN: std::sync::OnceLock<u32> = std::sync::OnceLock::new();
 
-/// Notes the process the module is loaded in (at import).
-pub(crate) fn note_process() {
+/// Notes the process the module is loaded in, and starts the worker threads
+/// `RAYON_NUM_THREADS` asks for (at import): rayon would start them at the first parallel
+/// call, without a bound, and panic there if the system refused them
+/// ([`ridi::start_workers`]). A pool that cannot be started is a warning, not an import error:
+/// the global pool may be another extension's, already running.
+pub(crate) fn note_process(py: Python<'_>) -> PyResult<()> {
     LOADED_IN.get_or_init(std::process::id);
+    let warning = match ridi::start_workers(None) {
+        Ok(warning) => warning,
+        Err(e) => Some(e.to_string()),
+    };
+    crate::sequence::warn(py, warning.as_slice())
 }
 
 /// Whether this is a child forked from the process the module was loaded in (`multiprocessing`'s
@@ -302,9 +309,9 @@ fn forked() -> bool {
 pub(crate) fn with_jobs<T: Send>(jobs: Option<i64>, f: impl FnOnce() -> T + Send) -> PyResult<T> {
     let threads = match jobs {
         None if !forked() => return Ok(f()),
-        // rayon's default: as many as the cores.
-        None => 0,
-        Some(n) => count("jobs", n, 1, MAX_JOBS)?,
+        // The global pool's count (one per core, or `RAYON_NUM_THREADS`'s as checked at import).
+        None => rayon::current_num_threads(),
+        Some(n) => count("jobs", n, 1, ridi::MAX_JOBS)?,
     };
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(threads)

@@ -3,7 +3,10 @@
 
 import _thread
 import json
+import os
 import pickle
+import subprocess
+import sys
 import time
 import warnings
 
@@ -222,3 +225,25 @@ def test_training_on_waypoint_ground_truth_warns(tmp_path):
         with pytest.raises(UserWarning, match="straight lines"):
             ridi.train([straight, *seqs[1:]], grid="none", progress=lambda *e: events.append(e))
     assert events == []
+
+
+@pytest.mark.parametrize("value, warning", [
+    ("100000", "RAYON_NUM_THREADS=100000 is over 4096 threads: using one worker thread per core"),
+    ("2x", "RAYON_NUM_THREADS=2x is not a whole number: using one worker thread per core"),
+    ("1", None),
+])
+def test_rayon_num_threads_is_checked_at_import(value, warning):
+    # rayon would start what RAYON_NUM_THREADS asks for at its first parallel call, without a
+    # bound, and panic if the system refused: import starts the pool, and a count out of range
+    # is a warning there; tracking runs on whatever was started.
+    script = ("import warnings, sys; warnings.simplefilter('always'); import ridi;"
+              "ridi.track(ridi.read(sys.argv[1]), ridi.bundled_model())")
+    run = SAMPLE / "Jakob_Nexus5_NoDist_Texting"
+    done = subprocess.run([sys.executable, "-c", script, str(run)], capture_output=True,
+                          text=True, timeout=600, env={**os.environ, "RAYON_NUM_THREADS": value})
+    assert done.returncode == 0, done.stderr
+    if warning is None:
+        assert "RAYON_NUM_THREADS" not in done.stderr, done.stderr
+    else:
+        assert f"UserWarning: {warning} (" in done.stderr, done.stderr
+        assert done.stderr.count("RAYON_NUM_THREADS") == 1, done.stderr

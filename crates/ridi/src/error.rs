@@ -52,6 +52,14 @@ pub enum PipelineError {
         /// What is missing.
         message: String,
     },
+    /// The system refused the worker threads a run asked for ([`crate::start_workers`]).
+    #[error("cannot start {threads} worker threads: {reason}")]
+    Workers {
+        /// How many were asked for.
+        threads: usize,
+        /// The system's answer.
+        reason: String,
+    },
     /// A stage was given no sequence at all.
     #[error("no sequences to {0}")]
     NoSequences(&'static str),

@@ -103,6 +103,7 @@ mod staging;
 mod track;
 mod track_options;
 mod train;
+mod workers;
 
 pub use baselines::{Method, baseline_trajectory, device_heading};
 #[cfg(feature = "bundled-model")]
@@ -143,6 +144,8 @@ pub use train::{
     GridChoice, MIN_VELOCITY_CHANGES_PER_S, TrainOptions, TrainingData, default_step,
     ground_truth_view, train, training_data, training_warnings, training_windows,
 };
+
+pub use workers::{MAX_JOBS, start_workers};
 
 /// The README's Rust example, compiled by `cargo test --doc` so that it cannot drift from the API.
 #[cfg(doctest)]
