@@ -246,7 +246,7 @@ fn placement_smoothing(window_s: f64) -> Option<PlacementSmoother> {
 /// The worker threads of the whole run, started before any work ([`ridi::start_workers`]):
 /// `--jobs` (train, eval), else `RAYON_NUM_THREADS` when set.
 fn start_workers(jobs: Option<usize>) -> Result<()> {
-    if let Some(warning) = ridi::start_workers(jobs)? {
+    if let Some(warning) = ridi::start_workers(jobs)?.warning {
         errln!("warning: {}", shown(warning));
     }
     Ok(())

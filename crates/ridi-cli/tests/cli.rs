@@ -1225,13 +1225,16 @@ fn rayon_num_threads_out_of_range_is_a_warning_and_jobs_outranks_it() {
     // bound, and panic if the system refused: the command starts them first, checked.
     let seq = sample_dataset().join("Jakob_Nexus5_NoDist_Texting");
     let dir = tempfile::tempdir().unwrap();
-    let with_env = |value: &str, args: &[&str]| {
+    let with = |name: &str, value: &str, args: &[&str]| {
         Command::new(env!("CARGO_BIN_EXE_ridi"))
             .args(args)
-            .env("RAYON_NUM_THREADS", value)
+            .env_remove("RAYON_NUM_THREADS")
+            .env_remove("RAYON_RS_NUM_CPUS")
+            .env(name, value)
             .output()
             .unwrap()
     };
+    let with_env = |value: &str, args: &[&str]| with("RAYON_NUM_THREADS", value, args);
     let csv = dir.path().join("t.csv");
     let track = ["track", s(&seq), "--out", s(&csv)];
     let out = with_env("100000", &track);
@@ -1249,6 +1252,14 @@ fn rayon_num_threads_out_of_range_is_a_warning_and_jobs_outranks_it() {
     assert!(
         out.status.success() && !err.contains("RAYON_NUM_THREADS"),
         "{err}"
+    );
+    // rayon's older variable, read where the first is not set, is checked the same way.
+    let out = with("RAYON_RS_NUM_CPUS", "lots", &track);
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert!(
+        stderr(&out).starts_with("warning: RAYON_RS_NUM_CPUS=lots is not a whole number"),
+        "{}",
+        stderr(&out)
     );
     // --jobs outranks it: no warning before the missing list's error.
     let (missing, model) = (dir.path().join("missing.txt"), dir.path().join("m.ridi"));

@@ -90,6 +90,10 @@ pub(crate) fn pipeline_in(e: PipelineError, context: Option<String>) -> PyErr {
     };
     match file_kind(&e) {
         Some(kind) => os_error(kind, message),
+        // As Python's `threading` says "can't start new thread".
+        None if matches!(e, PipelineError::Workers { .. }) => {
+            pyo3::exceptions::PyRuntimeError::new_err(shown(message))
+        }
         None => value(message),
     }
 }

@@ -278,21 +278,19 @@ impl Inputs {
     }
 }
 
-/// The process the module was loaded in.
-static LOADED_IN: std::sync::OnceLock<u32> = std::sync::OnceLock::new();
+/// The process the module was loaded in, and the worker threads of its global pool (started
+/// then, or those rayon starts at its first parallel call).
+static LOADED_IN: std::sync::OnceLock<(u32, usize)> = std::sync::OnceLock::new();
 
 /// Notes the process the module is loaded in, and starts the worker threads
-/// `RAYON_NUM_THREADS` asks for (at import): rayon would start them at the first parallel
-/// call, without a bound, and panic there if the system refused them
-/// ([`ridi::start_workers`]). A pool that cannot be started is a warning, not an import error:
-/// the global pool may be another extension's, already running.
+/// `RAYON_NUM_THREADS` asks for (at import; [`ridi::start_workers`]): rayon would start them
+/// at the first parallel call, without a bound, and panic there and at every later call if the
+/// system refused them. A count out of range is a `UserWarning`, a refusal an `ImportError`.
 pub(crate) fn note_process(py: Python<'_>) -> PyResult<()> {
-    LOADED_IN.get_or_init(std::process::id);
-    let warning = match ridi::start_workers(None) {
-        Ok(warning) => warning,
-        Err(e) => Some(e.to_string()),
-    };
-    crate::sequence::warn(py, warning.as_slice())
+    let workers = ridi::start_workers(None)
+        .map_err(|e| pyo3::exceptions::PyImportError::new_err(ridi::data::shown(e.to_string())))?;
+    LOADED_IN.get_or_init(|| (std::process::id(), workers.threads));
+    crate::sequence::warn(py, workers.warning.as_slice())
 }
 
 /// Whether this is a child forked from the process the module was loaded in (`multiprocessing`'s
@@ -301,7 +299,7 @@ pub(crate) fn note_process(py: Python<'_>) -> PyResult<()> {
 fn forked() -> bool {
     LOADED_IN
         .get()
-        .is_some_and(|&pid| pid != std::process::id())
+        .is_some_and(|&(pid, _)| pid != std::process::id())
 }
 
 /// Runs `f` on `jobs` worker threads (all cores when `None`), as `--jobs` does for a command;
@@ -309,14 +307,20 @@ fn forked() -> bool {
 pub(crate) fn with_jobs<T: Send>(jobs: Option<i64>, f: impl FnOnce() -> T + Send) -> PyResult<T> {
     let threads = match jobs {
         None if !forked() => return Ok(f()),
-        // The global pool's count (one per core, or `RAYON_NUM_THREADS`'s as checked at import).
-        None => rayon::current_num_threads(),
+        // The parent's count (one per core, or `RAYON_NUM_THREADS`'s as checked at import).
+        None => LOADED_IN.get().map_or(0, |&(_, threads)| threads),
         Some(n) => count("jobs", n, 1, ridi::MAX_JOBS)?,
     };
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(threads)
         .build()
-        .map_err(|e| errors::value(format!("cannot set up the worker threads: {e}")))?;
+        .map_err(|e| {
+            errors::pipeline(ridi::PipelineError::Workers {
+                threads,
+                variable: None,
+                reason: e.to_string(),
+            })
+        })?;
     Ok(pool.install(f))
 }
 

@@ -17,7 +17,7 @@ use crate::arrays::{matrix, rotations, rotations_out, values, vecs, vecs_out, ve
 use crate::errors;
 use crate::options::{self, choice};
 
-/// The formats, by the names of `ridi convert --from` (and `ridi-plain` for `data_plain.txt`).
+/// The formats, by the names of `ridi convert --from`.
 const FORMATS: [(&str, Format); 6] = [
     ("ridi-csv", Format::RidiCsv),
     ("ridi-plain", Format::RidiPlain),

@@ -231,6 +231,7 @@ def test_training_on_waypoint_ground_truth_warns(tmp_path):
     ("100000", "RAYON_NUM_THREADS=100000 is over 4096 threads: using one worker thread per core"),
     ("2x", "RAYON_NUM_THREADS=2x is not a whole number: using one worker thread per core"),
     ("1", None),
+    ("", None),
 ])
 def test_rayon_num_threads_is_checked_at_import(value, warning):
     # rayon would start what RAYON_NUM_THREADS asks for at its first parallel call, without a

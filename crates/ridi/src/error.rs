@@ -52,12 +52,17 @@ pub enum PipelineError {
         /// What is missing.
         message: String,
     },
-    /// The system refused the worker threads a run asked for ([`crate::start_workers`]).
-    #[error("cannot start {threads} worker threads: {reason}")]
+    /// The worker threads a run asked for could not be started ([`crate::start_workers`]).
+    #[error(
+        "cannot start {threads} worker threads{}: {reason}",
+        variable.as_ref().map_or(String::new(), |v| format!(" ({v})"))
+    )]
     Workers {
         /// How many were asked for.
         threads: usize,
-        /// The system's answer.
+        /// The variable that asked, as `NAME=value` (none for a count the caller gave).
+        variable: Option<String>,
+        /// The system's answer, or rayon's (a pool already running).
         reason: String,
     },
     /// A stage was given no sequence at all.

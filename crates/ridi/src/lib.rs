@@ -145,7 +145,7 @@ pub use train::{
     ground_truth_view, train, training_data, training_warnings, training_windows,
 };
 
-pub use workers::{MAX_JOBS, start_workers};
+pub use workers::{MAX_JOBS, Workers, start_workers};
 
 /// The README's Rust example, compiled by `cargo test --doc` so that it cannot drift from the API.
 #[cfg(doctest)]
