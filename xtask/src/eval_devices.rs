@@ -471,8 +471,8 @@ pub fn train_options(
         train_opts.features.step = step;
     }
     if let Some(m) = landmarks {
-        train_opts.cascade.method = Solver::Nystrom(Nystrom::new(m, 0)?);
-        train_opts.cascade.storage = Storage::projected_for(&train_opts.cascade.method);
+        train_opts.cascade.solver = Solver::Nystrom(Nystrom::new(m, 0)?);
+        train_opts.cascade.storage = Storage::projected_for(&train_opts.cascade.solver);
     }
     train_opts.cascade.set_seed(seed);
     Ok(train_opts)

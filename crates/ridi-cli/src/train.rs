@@ -135,9 +135,9 @@ enum StorageArg {
 }
 
 impl StorageArg {
-    fn storage(self, method: &Solver) -> Storage {
+    fn storage(self, solver: &Solver) -> Storage {
         match self {
-            StorageArg::Projected => Storage::projected_for(method),
+            StorageArg::Projected => Storage::projected_for(solver),
             StorageArg::Half => Storage::Half,
         }
     }
@@ -220,7 +220,7 @@ pub(crate) fn run(args: Args) -> Result<()> {
     opts.cascade.classifier_c = args.classifier_c;
     opts.cascade.regressors = GridChoice::from(args.grid).regressors();
     opts.cascade.speed = !args.no_speed;
-    opts.cascade.method = match args.solver {
+    opts.cascade.solver = match args.solver {
         SolverArg::Exact => Solver::Exact,
         SolverArg::Nystrom => Solver::Nystrom(Nystrom::new(
             args.landmarks.unwrap_or(Nystrom::DEFAULT_LANDMARKS),
@@ -228,8 +228,8 @@ pub(crate) fn run(args: Args) -> Result<()> {
         )?),
     };
     opts.cascade.set_seed(args.seed);
-    opts.cascade.storage = args.storage.storage(&opts.cascade.method);
-    if opts.cascade.method == Solver::Exact {
+    opts.cascade.storage = args.storage.storage(&opts.cascade.solver);
+    if opts.cascade.solver == Solver::Exact {
         let windows = ridi::training_windows(listed.sequences(), &opts)?;
         if let Some(note) = exact_solver_note(windows) {
             errln!("{note}");

@@ -327,7 +327,7 @@ pub(crate) fn train(
     let landmarks = landmarks
         .map(|l| options::count("landmarks", l, 2, Nystrom::MAX_LANDMARKS))
         .transpose()?;
-    opts.cascade.method = match choice("solver", solver, &[("exact", false), ("nystrom", true)])? {
+    opts.cascade.solver = match choice("solver", solver, &[("exact", false), ("nystrom", true)])? {
         // As `ridi train --landmarks` with the exact solver: a value that would be ignored.
         false if landmarks.is_some() => {
             return Err(errors::value(
@@ -347,7 +347,7 @@ pub(crate) fn train(
             u64::MAX
         ))
     })?);
-    let projected = Storage::projected_for(&opts.cascade.method);
+    let projected = Storage::projected_for(&opts.cascade.solver);
     opts.cascade.storage = choice(
         "storage",
         storage,

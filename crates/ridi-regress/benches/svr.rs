@@ -83,10 +83,10 @@ fn benches(c: &mut Criterion) {
     // classifier, the ridge regressors) and one query, on up to 1024 landmarks per machine,
     // with the projection its users get (`Storage::projected_for`: its kernel's distances
     // from the principal coordinates).
-    let method = Solver::Nystrom(Nystrom::new(1024, 0).unwrap());
+    let solver = Solver::Nystrom(Nystrom::new(1024, 0).unwrap());
     let nystrom = CascadeParams {
-        storage: Storage::projected_for(&method),
-        method,
+        storage: Storage::projected_for(&solver),
+        solver,
         ..params.clone()
     };
     g.bench_function("cascade_train_nystrom_2000_1024", |b| {

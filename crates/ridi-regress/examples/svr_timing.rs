@@ -47,18 +47,18 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let eps: f64 = arg(&args, "--eps", 0.01);
     let k: usize = arg(&args, "--placements", 4);
     let mem_mb: u64 = arg(&args, "--mem-mb", 2048);
-    let mut solver = SolverConfig {
+    let mut solver_config = SolverConfig {
         kernel_memory: mem_mb << 20,
         ..SolverConfig::default()
     };
     if args.iter().any(|a| a == "--never-precompute") {
-        solver.regressor_kernel = Precompute::Never;
+        solver_config.regressor_kernel = Precompute::Never;
     }
     if args.iter().any(|a| a == "--precompute-classifier") {
-        solver.classifier_kernel = Precompute::Auto;
+        solver_config.classifier_kernel = Precompute::Auto;
     }
     if let Some(i) = args.iter().position(|a| a == "--max-iter") {
-        solver.smo.max_iter = args.get(i + 1).and_then(|v| v.parse().ok());
+        solver_config.smo.max_iter = args.get(i + 1).and_then(|v| v.parse().ok());
     }
     if task == "load-query" {
         return load_query(&args, n, k);
@@ -76,7 +76,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 c,
                 epsilon: eps,
                 gamma,
-                solver,
+                solver_config,
             };
             let t = Instant::now();
             let m = Svr::fit(x, &y, &p)?;
@@ -97,7 +97,11 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             );
         }
         "svc" => {
-            let p = SvcParams { c, gamma, solver };
+            let p = SvcParams {
+                c,
+                gamma,
+                solver_config,
+            };
             let t = Instant::now();
             let m = Svc::fit(x, &data.placement, &p)?;
             let fit = t.elapsed();
@@ -132,7 +136,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             } else {
                 RegressorChoice::Grid(GridSpec::default())
             };
-            let method = match args
+            let solver = match args
                 .iter()
                 .position(|a| a == "--solver")
                 .and_then(|i| args.get(i + 1))
@@ -151,15 +155,15 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 .and_then(|i| args.get(i + 1))
                 .map(String::as_str)
             {
-                None | Some("projected") => Storage::projected_for(&method),
+                None | Some("projected") => Storage::projected_for(&solver),
                 Some("half") => Storage::Half,
                 Some(other) => return Err(format!("unknown storage {other}").into()),
             };
             let params = CascadeParams {
                 regressors,
-                solver,
+                solver_config,
                 storage,
-                method,
+                solver,
                 ..CascadeParams::default()
             };
             let t = Instant::now();

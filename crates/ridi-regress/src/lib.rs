@@ -46,7 +46,7 @@
 //!
 //! # Nyström solver
 //!
-//! [`CascadeParams::method`] = [`Solver::Nystrom`] trains the same cascade approximately, in
+//! [`CascadeParams::solver`] = [`Solver::Nystrom`] trains the same cascade approximately, in
 //! time and memory linear in the rows, with a model whose size does not grow with them. Each
 //! machine keeps `m` landmarks (default 2048) drawn uniformly with a fixed seed: the
 //! classifier's from all training rows, each placement's regressors' from that placement's

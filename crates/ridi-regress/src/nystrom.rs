@@ -28,7 +28,7 @@ use crate::projection::Projection;
 use crate::store::SampleRows;
 use ridi_features::{FeatureMatrix, FeatureMatrixRef};
 
-/// How the cascade's kernel machines are trained ([`CascadeParams::method`](crate::CascadeParams::method)).
+/// How the cascade's kernel machines are trained ([`CascadeParams::solver`](crate::CascadeParams::solver)).
 #[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
 pub enum Solver {
     /// The exact kernel machines by SMO (the paper's; the default and the reference). Time

@@ -21,7 +21,7 @@ pub struct SvcParams {
     /// RBF width (paper: 1/1200).
     pub gamma: f32,
     /// Solver settings.
-    pub solver: SolverConfig,
+    pub solver_config: SolverConfig,
 }
 
 impl SvcParams {
@@ -30,13 +30,13 @@ impl SvcParams {
         Self {
             c,
             gamma,
-            solver: SolverConfig::default(),
+            solver_config: SolverConfig::default(),
         }
     }
 
     pub(crate) fn validate(&self) -> Result<(), RegressError> {
         check_c_gamma(self.c, self.gamma)?;
-        check_smo(&self.solver.smo)
+        check_smo(&self.solver_config.smo)
     }
 }
 
@@ -131,7 +131,7 @@ pub(crate) fn fit_ovo(
             "class {c} has no training samples"
         )));
     }
-    let cfg = &params.solver;
+    let cfg = &params.solver_config;
     // One kernel for all pairs when it fits; otherwise one per pair over the pair's samples.
     let shared: Option<FullKernel> = (cfg.classifier_kernel == Precompute::Auto
         && FullKernel::bytes_for(x.rows()) <= cfg.kernel_memory)

@@ -20,7 +20,7 @@ pub struct SvrParams {
     /// RBF width `gamma > 0`.
     pub gamma: f32,
     /// Solver settings.
-    pub solver: SolverConfig,
+    pub solver_config: SolverConfig,
 }
 
 impl SvrParams {
@@ -30,7 +30,7 @@ impl SvrParams {
             c,
             epsilon,
             gamma,
-            solver: SolverConfig::default(),
+            solver_config: SolverConfig::default(),
         }
     }
 
@@ -42,7 +42,7 @@ impl SvrParams {
                 self.epsilon
             )));
         }
-        check_smo(&self.solver.smo)
+        check_smo(&self.solver_config.smo)
     }
 }
 
@@ -220,8 +220,8 @@ impl Svr {
         let rows = config::kernel_rows(
             x,
             params.gamma,
-            params.solver.kernel_memory,
-            params.solver.regressor_kernel,
+            params.solver_config.kernel_memory,
+            params.solver_config.regressor_kernel,
         );
         let idx: Vec<usize> = (0..x.rows()).collect();
         let dual = solve_svr(
@@ -231,7 +231,7 @@ impl Svr {
             params.c,
             params.epsilon,
             None,
-            &params.solver.smo,
+            &params.solver_config.smo,
         );
         Ok(Self::from_dual(x, &idx, &dual, *params))
     }

@@ -718,14 +718,14 @@ impl Data {
 
 // ---- The Nyström solver ----
 
-fn fixed(storage: Storage, method: Solver) -> CascadeParams {
+fn fixed(storage: Storage, solver: Solver) -> CascadeParams {
     CascadeParams {
         regressors: RegressorChoice::Fixed {
             c: 10.0,
             epsilon: 0.01,
         },
         storage,
-        method,
+        solver,
         ..CascadeParams::default()
     }
 }
@@ -813,11 +813,11 @@ fn nystrom_with_every_row_a_landmark_is_the_exact_classifier_and_kernel_ridge() 
     let dim = 24;
     let xt = FeatureMatrixRef::new(&test.x, dim).unwrap();
     let mut exact = fixed(Storage::Half, Solver::Exact);
-    exact.solver.smo.tol = 1e-5;
+    exact.solver_config.smo.tol = 1e-5;
     let exact = Cascade::train(&data.set(), &exact, &mut NoProgress).unwrap();
     let cfg = Nystrom::new(480, 0).unwrap().with_tol(1e-4).unwrap();
     let mut params = fixed(Storage::Half, Solver::Nystrom(cfg));
-    params.solver.smo.max_iter = Some(20_000);
+    params.solver_config.smo.max_iter = Some(20_000);
     let nys = Cascade::train(&data.set(), &params, &mut NoProgress).unwrap();
     assert_eq!(nys.solver(), Solver::Nystrom(cfg));
     assert_eq!(nys.stored_samples(0), 160);
@@ -912,7 +912,7 @@ fn nystrom_classifier_separates_separable_placements_and_the_grid_runs() {
     let test = make(4, 1, 25, 12);
     let xt = FeatureMatrixRef::new(&test.x, 24).unwrap();
     let params = CascadeParams {
-        method: Solver::Nystrom(Nystrom::new(64, 5).unwrap()),
+        solver: Solver::Nystrom(Nystrom::new(64, 5).unwrap()),
         ..small_grid()
     };
     let mut events = Vec::new();
@@ -995,7 +995,7 @@ fn nystrom_models_are_deterministic_compact_and_round_trip() {
     assert_eq!(&bytes[8..12], &8u32.to_le_bytes());
     assert_eq!(a.format_version(), 8);
     let other = CascadeParams {
-        method: Solver::Nystrom(Nystrom::new(32, 10).unwrap()),
+        solver: Solver::Nystrom(Nystrom::new(32, 10).unwrap()),
         ..params.clone()
     };
     let c = Cascade::train(&data.set(), &other, &mut NoProgress).unwrap();

@@ -34,7 +34,7 @@ fn two_point_classifier_matches_closed_form() {
     let k = rbf(&x[..3], &x[3..], gamma);
     for c in [0.1, 1.0, 100.0] {
         let mut p = SvcParams::new(c, gamma);
-        p.solver = tight();
+        p.solver_config = tight();
         let m = Svc::fit(FeatureMatrixRef::new(&x, 3).unwrap(), &[7, 3], &p).unwrap();
         assert_eq!(m.labels(), &[3, 7]);
         let alpha = (1.0 / (1.0 - k)).min(c);
@@ -119,7 +119,7 @@ fn two_point_regressor_matches_closed_form() {
     let t = 1.0;
     for (c, eps) in [(100.0, 0.1), (0.5, 0.1), (10.0, 0.0)] {
         let mut p = SvrParams::new(c, eps, gamma);
-        p.solver = tight();
+        p.solver_config = tight();
         let m = Svr::fit(FeatureMatrixRef::new(&x, 2).unwrap(), &[t, -t], &p).unwrap();
         let beta = ((t - eps) / (1.0 - k)).min(c);
         let f = m.predict(FeatureMatrixRef::new(&x, 2).unwrap()).unwrap();
@@ -144,7 +144,7 @@ fn regressor_satisfies_kkt_conditions() {
     let xm = FeatureMatrixRef::new(&x, 10).unwrap();
     let (c, eps) = (3.0, 0.05);
     let mut p = SvrParams::new(c, eps, 0.2);
-    p.solver = tight();
+    p.solver_config = tight();
     let m = Svr::fit(xm, &y, &p).unwrap();
     assert!(m.info().converged);
     let coef = coef_by_row(m.support_vectors(), m.dual_coef());
@@ -190,7 +190,7 @@ fn classifier_satisfies_kkt_conditions() {
     let xm = FeatureMatrixRef::new(&x, 6).unwrap();
     let c = 2.0;
     let mut p = SvcParams::new(c, 0.3);
-    p.solver = tight();
+    p.solver_config = tight();
     let m = Svc::fit(xm, &y, &p).unwrap();
     let d = m.decision_function(xm).unwrap();
     let coef = coef_by_row(m.support_vectors(), m.dual_coef());
@@ -229,7 +229,7 @@ fn regressor_matches_linfa_svm() {
     let gamma = 0.25f32;
     for (c, eps) in [(1.0, 0.01), (10.0, 0.1), (0.1, 0.001)] {
         let mut p = SvrParams::new(c, eps, gamma);
-        p.solver = tight();
+        p.solver_config = tight();
         let ours = Svr::fit(xm, &y, &p).unwrap();
         let records = Array2::from_shape_fn((80, 8), |(i, j)| x[i * 8 + j] as f64);
         let targets = Array1::from_iter(y.iter().copied());
@@ -263,7 +263,7 @@ fn classifier_matches_linfa_svm() {
     let gamma = 0.5f32;
     for c in [0.5, 10.0] {
         let mut p = SvcParams::new(c, gamma);
-        p.solver = tight();
+        p.solver_config = tight();
         let ours = Svc::fit(xm, &y, &p).unwrap();
         let records = Array2::from_shape_fn((60, 5), |(i, j)| x[i * 5 + j] as f64);
         // Class index 0 is the positive side, as in libsvm's first label.
@@ -306,11 +306,11 @@ fn cached_rows_and_full_kernel_give_the_same_model() {
     let (x, y) = regression_data(150, 12, 8);
     let xm = FeatureMatrixRef::new(&x, 12).unwrap();
     let mut full = SvrParams::new(5.0, 0.01, 0.1);
-    full.solver = tight();
+    full.solver_config = tight();
     let mut cached = full;
-    cached.solver.regressor_kernel = Precompute::Never;
+    cached.solver_config.regressor_kernel = Precompute::Never;
     // A cache of 20 rows forces evictions and batched recomputation.
-    cached.solver.kernel_memory = 20 * 150 * 4;
+    cached.solver_config.kernel_memory = 20 * 150 * 4;
     let a = Svr::fit(xm, &y, &full).unwrap();
     let b = Svr::fit(xm, &y, &cached).unwrap();
     let (pa, pb) = (a.predict(xm).unwrap(), b.predict(xm).unwrap());
@@ -318,11 +318,11 @@ fn cached_rows_and_full_kernel_give_the_same_model() {
         assert!((u - v).abs() < 1e-4);
     }
     let mut p = SvcParams::new(1.0, 0.3);
-    p.solver = tight();
+    p.solver_config = tight();
     let (xc, yc) = blob_data(50, 6, &[1, 2, 3], 1.0, 2);
     let xcm = FeatureMatrixRef::new(&xc, 6).unwrap();
     let a = Svc::fit(xcm, &yc, &p).unwrap();
-    p.solver.classifier_kernel = Precompute::Auto;
+    p.solver_config.classifier_kernel = Precompute::Auto;
     let b = Svc::fit(xcm, &yc, &p).unwrap();
     let (da, db) = (
         a.decision_function(xcm).unwrap(),

@@ -1156,7 +1156,7 @@ fn the_order_sequences_are_given_in_does_not_change_the_model() {
     let mut opts = TrainOptions::default();
     opts.features.step = 60;
     // The Nyström landmark draw and the grid's folds are the order-sensitive parts.
-    opts.cascade.method = Solver::Nystrom(Nystrom::new(64, 0).unwrap());
+    opts.cascade.solver = Solver::Nystrom(Nystrom::new(64, 0).unwrap());
     opts.cascade.regressors = GridChoice::Small.regressors();
     let bytes = |seqs: &[Sequence]| {
         ridi::train(seqs, &opts, &mut NoProgress)

@@ -55,7 +55,7 @@ impl Cascade {
         } = r;
         let x = data.features;
         let k = members.len();
-        let stop = Stop::new(cfg.tol(), &params.solver.smo);
+        let stop = Stop::new(cfg.tol(), &params.solver_config.smo);
         // The classifier's landmarks, from all rows; none without a classifier.
         let picked = if k >= 2 {
             nystrom::pick(x.rows(), cfg.landmarks(), cfg.seed())

@@ -88,11 +88,11 @@ impl Storage {
     /// [`Storage::projected_for`].
     pub const NYSTROM_DEFAULT: Self = Self::Projected { energy: 0.9 };
 
-    /// The projected storage ridi uses with `method`: [`Storage::NYSTROM_DEFAULT`] for
+    /// The projected storage ridi uses with `solver`: [`Storage::NYSTROM_DEFAULT`] for
     /// [`Solver::Nystrom`], [`Storage::DEFAULT`] for the exact solver (whose machines see the
     /// features themselves; the projection only stores them).
-    pub fn projected_for(method: &Solver) -> Self {
-        match method {
+    pub fn projected_for(solver: &Solver) -> Self {
+        match solver {
             Solver::Exact => Self::DEFAULT,
             Solver::Nystrom(_) => Self::NYSTROM_DEFAULT,
         }
@@ -130,12 +130,14 @@ pub struct CascadeParams {
     pub regressor_gamma: Gamma,
     /// Regressor `C` / epsilon selection.
     pub regressors: RegressorChoice,
-    /// Solver, memory and kernel strategy.
-    pub solver: SolverConfig,
     /// Exact kernel machines (SMO, the default) or their Nyström approximation (linear
-    /// machines on features of shared landmarks; [`Solver::Nystrom`]). Both take the same
-    /// `C`, epsilon, RBF widths and grid.
-    pub method: Solver,
+    /// machines on features of shared landmarks; [`Solver::Nystrom`]): `ridi train --solver`.
+    /// Both take the same `C`, epsilon, RBF widths and grid.
+    pub solver: Solver,
+    /// How the solver runs: the SMO's stop and shrinking (the Nyström solver's linear machines
+    /// stop by its shrinking and iteration cap too), and the exact solver's kernel memory and
+    /// strategy.
+    pub solver_config: SolverConfig,
     /// Placements with fewer training samples are rejected with
     /// [`RegressError::NotEnoughData`] (default 10).
     pub min_class_samples: usize,
@@ -155,13 +157,13 @@ pub struct CascadeParams {
 impl CascadeParams {
     /// Seeds the random draws of training: the grid's sequence-to-fold shuffle
     /// ([`GridSpec::seed`]) and, with the Nyström solver ([`Nystrom::seed`](crate::Nystrom::seed)),
-    /// its landmarks and the order of its linear classifier's sweeps; 0 by default. Set it after [`Self::regressors`] and [`Self::method`]. Models trained
+    /// its landmarks and the order of its linear classifier's sweeps; 0 by default. Set it after [`Self::regressors`] and [`Self::solver`]. Models trained
     /// with other seeds show how much a figure owes to these draws.
     pub fn set_seed(&mut self, seed: u64) {
         if let RegressorChoice::Grid(g) = &mut self.regressors {
             g.seed = seed;
         }
-        if let Solver::Nystrom(n) = &mut self.method {
+        if let Solver::Nystrom(n) = &mut self.solver {
             n.reseed(seed);
         }
     }
@@ -174,8 +176,8 @@ impl Default for CascadeParams {
             classifier_gamma: Gamma::InverseDim,
             regressor_gamma: Gamma::InverseDim,
             regressors: RegressorChoice::Grid(GridSpec::default()),
-            solver: SolverConfig::default(),
-            method: Solver::Exact,
+            solver: Solver::Exact,
+            solver_config: SolverConfig::default(),
             min_class_samples: 10,
             storage: Storage::DEFAULT,
             speed: false,

@@ -149,7 +149,7 @@ fn check_training_set(
         }
     }
     svr::check_c_gamma(params.classifier_c, 1.0)?;
-    svr::check_smo(&params.solver.smo)?;
+    svr::check_smo(&params.solver_config.smo)?;
     match &params.regressors {
         RegressorChoice::Fixed { c, epsilon } => {
             svr::SvrParams::new(*c, *epsilon, 1.0).validate()?;
@@ -171,7 +171,7 @@ fn check_training_set(
             }
         }
     }
-    if let Solver::Nystrom(n) = params.method {
+    if let Solver::Nystrom(n) = params.solver {
         // A deserialized config is checked too (the type's constructor checks the others).
         Nystrom::new(n.landmarks(), n.seed())?.with_tol(n.tol())?;
     }
@@ -197,7 +197,7 @@ impl Cascade {
         if projection.is_none() {
             check_f16_range(x)?;
         }
-        if let Solver::Nystrom(cfg) = params.method {
+        if let Solver::Nystrom(cfg) = params.solver {
             let resolved = Resolved {
                 members,
                 gamma_c,
@@ -213,7 +213,7 @@ impl Cascade {
             let svc_params = SvcParams {
                 c: params.classifier_c,
                 gamma: gamma_c,
-                solver: params.solver,
+                solver_config: params.solver_config,
             };
             let mut on_pair = |done, total| {
                 progress.report(&ProgressEvent {
@@ -243,8 +243,8 @@ impl Cascade {
             let rows = config::kernel_rows(
                 xc.view(),
                 gamma_r,
-                params.solver.kernel_memory,
-                params.solver.regressor_kernel,
+                params.solver_config.kernel_memory,
+                params.solver_config.regressor_kernel,
             );
             let channels = 2 + usize::from(params.speed);
             let targets = channel_targets(data, idx, channels);
@@ -257,7 +257,7 @@ impl Cascade {
                         &targets,
                         &groups,
                         spec,
-                        &params.solver,
+                        &params.solver_config,
                         name,
                         progress,
                     )
@@ -269,7 +269,7 @@ impl Cascade {
             };
             report(progress, Stage::Regressors { placement: name }, 0, channels)?;
             let local: Vec<usize> = (0..idx.len()).collect();
-            let smo = &params.solver.smo;
+            let smo = &params.solver_config.smo;
             let rows_ref = rows.as_ref();
             let fit = |ch: usize| {
                 svr::solve_svr(
