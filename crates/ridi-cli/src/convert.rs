@@ -3,7 +3,6 @@
 use std::path::PathBuf;
 
 use anyhow::Result;
-use clap::ValueEnum;
 
 use ridi::data::{Format, ReadOptions, shown};
 
@@ -16,8 +15,8 @@ pub(crate) struct Args {
     #[arg(long)]
     out: PathBuf,
     /// Source format (detected when omitted).
-    #[arg(long, value_enum)]
-    from: Option<FromFormat>,
+    #[arg(long, value_name = "FORMAT", value_parser = from_format())]
+    from: Option<Format>,
     /// Resample every sequence to this rate, 1.001 to 9990 Hz (linear interpolation, slerp
     /// for rotations); a gap longer than 5 frame intervals is refused: split it first
     /// (--split-at-gaps).
@@ -32,33 +31,11 @@ pub(crate) struct Args {
     split_at_gaps: Option<f64>,
 }
 
-#[derive(Clone, Copy, ValueEnum)]
-enum FromFormat {
-    /// RIDI raw recorder folder (gyro.txt, acce.txt, ..., pose.txt).
-    RidiRaw,
-    /// RIDI processed data.csv (or data_plain.txt where a folder has no data.csv).
-    RidiCsv,
-    /// RIDI processed data_plain.txt (of a folder that has a data.csv too).
-    RidiPlain,
-    /// Tyrex smartphone benchmark (a sequence folder or the dataset root).
-    Tyrex,
-    /// Indoor Location Competition 2.0 path files (a file, or a folder searched recursively).
-    Ilc,
-    /// RoNIN sequence folders (data.hdf5 and info.json; one, or a folder of them).
-    Ronin,
-}
-
-impl From<FromFormat> for Format {
-    fn from(f: FromFormat) -> Format {
-        match f {
-            FromFormat::RidiRaw => Format::RidiRaw,
-            FromFormat::RidiCsv => Format::RidiCsv,
-            FromFormat::RidiPlain => Format::RidiPlain,
-            FromFormat::Tyrex => Format::Tyrex,
-            FromFormat::Ilc => Format::Ilc,
-            FromFormat::Ronin => Format::Ronin,
-        }
-    }
+/// `--from`: a [`Format`] by its key (`ridi-csv`, ...), each listed in `--help` in words.
+fn from_format() -> impl clap::builder::TypedValueParser<Value = Format> {
+    use clap::builder::{PossibleValue, PossibleValuesParser, TypedValueParser as _};
+    PossibleValuesParser::new(Format::ALL.map(|f| PossibleValue::new(f.key()).help(f.to_string())))
+        .try_map(|key| key.parse::<Format>())
 }
 
 /// `--rate`: within [`ridi::data::RESAMPLE_RATE_HZ`], the rates whose frames the readers accept
@@ -98,10 +75,10 @@ pub(crate) fn run(
     }: Args,
 ) -> Result<()> {
     let opts = ridi::ConvertOptions {
-        from: from.map(Format::from),
+        from,
         read: ReadOptions::default(),
         rate_hz: rate,
-        split_gaps_s: split_at_gaps,
+        split_at_gaps_s: split_at_gaps,
     };
     ridi::check_output_folder(&out)?;
     let summary = ridi::convert(&source, &out, &opts)?;

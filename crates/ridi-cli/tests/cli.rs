@@ -24,6 +24,9 @@ fn inspect_prints_text_and_json() {
     let out = ridi(&["inspect", s(&seq), "--json"]);
     let json: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
     assert_eq!(json["frames"], 4800);
+    // The format by the name `--from` and Python take; the longest gap between frames.
+    assert_eq!(json["format"], "ridi-csv");
+    assert!(json["longest_gap_s"].as_f64().unwrap() < 0.01, "{json}");
     assert_eq!(json["placement"], serde_json::Value::Null);
     assert!(json["path_length_m"].as_f64().unwrap() > 5.0);
     assert_eq!(json["upside_down_fraction"], 0.0);
@@ -370,7 +373,10 @@ fn the_nystrom_solver_keeps_its_own_share_of_the_variance() {
         assert!(out.status.success(), "{}", stderr(&out));
         let json: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
         // Two trainings differing in the draw alone are told apart.
-        assert_eq!(json["landmark_seed"], 7);
+        assert_eq!(
+            (&json["solver"], &json["landmark_seed"]),
+            (&"nystrom".into(), &7.into())
+        );
         let text = String::from_utf8(ridi(&["inspect", s(&model)]).stdout).unwrap();
         assert!(
             text.contains("landmarks per machine drawn with seed 7"),

@@ -66,7 +66,7 @@ fn convert_from_ronin_writes_the_ridi_layout() {
         assert!(out.status.success(), "{}", stderr(&out));
         let json: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
         assert_eq!(json["frames"], 280);
-        assert_eq!(json["format"], "RIDI processed csv");
+        assert_eq!(json["format"], "ridi-csv");
     }
     // One sequence folder converts too.
     let one = dir.path().join("one");

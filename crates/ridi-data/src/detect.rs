@@ -39,6 +39,30 @@ impl fmt::Display for Format {
 }
 
 impl Format {
+    /// Every format, in the order the command line and Python list them.
+    pub const ALL: [Format; 6] = [
+        Format::RidiCsv,
+        Format::RidiPlain,
+        Format::RidiRaw,
+        Format::Tyrex,
+        Format::Ilc,
+        Format::Ronin,
+    ];
+
+    /// The format's name wherever one is typed or read back: `ridi convert --from`, Python's
+    /// `format=` and `Sequence.format`, `ridi inspect --json` (`ridi-csv`, `ridi-plain`,
+    /// `ridi-raw`, `tyrex`, `ilc`, `ronin`). [`Display`](fmt::Display) is the format in words.
+    pub fn key(self) -> &'static str {
+        match self {
+            Format::RidiCsv => "ridi-csv",
+            Format::RidiPlain => "ridi-plain",
+            Format::RidiRaw => "ridi-raw",
+            Format::Tyrex => "tyrex",
+            Format::Ilc => "ilc",
+            Format::Ronin => "ronin",
+        }
+    }
+
     /// Whether a reader of this format given an unbounded
     /// [`Validation::max_gap_s`](crate::Validation::max_gap_s) keeps every pause of the recording
     /// as a gap between frames, where [`Sequence::split_at_gaps`](crate::Sequence::split_at_gaps)
@@ -83,6 +107,28 @@ impl Format {
                  RoNIN split folder (train_dataset_1, ...) holds the sequence folders"
             }
         }
+    }
+}
+
+/// A format by its [`Format::key`]; the error lists the keys.
+impl std::str::FromStr for Format {
+    type Err = String;
+
+    fn from_str(text: &str) -> std::result::Result<Self, String> {
+        Format::ALL
+            .into_iter()
+            .find(|f| f.key() == text)
+            .ok_or_else(|| {
+                let keys: Vec<&str> = Format::ALL.iter().map(|f| f.key()).collect();
+                format!("`{text}` is no format: one of {}", keys.join(", "))
+            })
+    }
+}
+
+/// As its [`Format::key`].
+impl serde::Serialize for Format {
+    fn serialize<S: serde::Serializer>(&self, s: S) -> std::result::Result<S::Ok, S::Error> {
+        s.serialize_str(self.key())
     }
 }
 
@@ -292,5 +338,22 @@ pub fn read_sequence(path: impl AsRef<Path>, opts: &ReadOptions) -> Result<Seque
                 )),
             }
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn every_format_parses_from_its_key_and_serializes_as_it() {
+        for f in Format::ALL {
+            assert_eq!(f.key().parse::<Format>(), Ok(f));
+            assert_eq!(serde_json::to_string(&f).unwrap(), format!("\"{}\"", f.key()));
+        }
+        assert_eq!(
+            "csv".parse::<Format>().unwrap_err(),
+            "`csv` is no format: one of ridi-csv, ridi-plain, ridi-raw, tyrex, ilc, ronin"
+        );
     }
 }

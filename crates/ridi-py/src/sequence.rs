@@ -17,25 +17,6 @@ use crate::arrays::{matrix, rotations, rotations_out, values, vecs, vecs_out, ve
 use crate::errors;
 use crate::options::{self, choice};
 
-/// The formats, by the names of `ridi convert --from`.
-const FORMATS: [(&str, Format); 6] = [
-    ("ridi-csv", Format::RidiCsv),
-    ("ridi-plain", Format::RidiPlain),
-    ("ridi-raw", Format::RidiRaw),
-    ("tyrex", Format::Tyrex),
-    ("ilc", Format::Ilc),
-    ("ronin", Format::Ronin),
-];
-
-/// The name of `format` in [`FORMATS`]; a format added to the readers since is named as they
-/// print it.
-fn format_name(format: Format) -> String {
-    FORMATS
-        .iter()
-        .find(|(_, f)| *f == format)
-        .map_or_else(|| format.to_string(), |(n, _)| n.to_string())
-}
-
 /// One recording on one timeline: IMU channels, device orientation and, where present, ground
 /// truth, as numpy arrays (each property returns a new float64 array).
 ///
@@ -229,8 +210,8 @@ impl Sequence {
     /// The format it was read from (`ridi-csv`, `ridi-plain`, `ridi-raw`, `tyrex`, `ilc`, `ronin`) by
     /// ``ridi.read``, or None (built from arrays, read from a list).
     #[getter]
-    fn format(&self) -> Option<String> {
-        self.format.map(format_name)
+    fn format(&self) -> Option<&'static str> {
+        self.format.map(Format::key)
     }
 
     /// Timestamps, seconds, shape (N,).
@@ -528,7 +509,8 @@ fn read_sequences(
     format: Option<&str>,
     split_at_gaps: Option<f64>,
 ) -> PyResult<Vec<Sequence>> {
-    let from = format.map(|f| choice("format", f, &FORMATS)).transpose()?;
+    let formats = Format::ALL.map(|f| (f.key(), f));
+    let from = format.map(|f| choice("format", f, &formats)).transpose()?;
     let read = options::read_options();
     let loaded = options::detached(py, || match split_at_gaps {
         Some(max_gap) => ridi::read_split(path, from, &read, max_gap),

@@ -60,6 +60,7 @@ def test_save_load_pickle_and_describe(model, model_file, ridi_bin):
     same = pickle.loads(pickle.dumps(model)).to_bytes() == model.to_bytes()
     assert same, "a pickled model differs"
     assert model.describe() == json.loads(ridi_bin("inspect", model_file, "--json"))
+    assert model.describe()["solver"] == "exact"
     assert str(model).strip() in ridi_bin("inspect", model_file)
     assert "hand" in repr(model)
 
@@ -182,8 +183,9 @@ def test_model_files(tmp_path, model):
 def test_the_bundled_model_is_the_one_ridi_track_uses_without_a_model(ridi_bin, tmp_path):
     model = ridi.bundled_model()
     assert model.placement_names == ["hand", "pocket", "running", "swing"]
-    assert model.describe()["landmarks"] is not None
-    assert model.describe()["landmark_seed"] == 0
+    description = model.describe()
+    assert description["solver"] == "nystrom" and description["landmarks"] is not None
+    assert description["landmark_seed"] == 0 and description["cross_validation"] == []
     seq = ridi.read(SAMPLE / "Thibaud_Nexus5_NoDist_Texting")
     out = tmp_path / "t.csv"
     ridi_bin("track", SAMPLE / "Thibaud_Nexus5_NoDist_Texting", "--out", out)

@@ -71,10 +71,10 @@ pub struct ConvertOptions {
     /// conversion left without any sequence is an error. `None` keeps sequences whole. What
     /// `ridi track` (a gap over 0.1 s) and `rate_hz` (over 5 frame intervals) refuse. Each
     /// source is read by [`read_split`], which also cuts pauses longer than the readers' limit.
-    pub split_gaps_s: Option<f64>,
+    pub split_at_gaps_s: Option<f64>,
 }
 
-/// Shortest part [`ConvertOptions::split_gaps_s`] keeps, seconds: one feature window of the
+/// Shortest part [`ConvertOptions::split_at_gaps_s`] keeps, seconds: one feature window of the
 /// paper's models (200 frames at 200 Hz), the least anything can be tracked on.
 pub const SPLIT_MIN_PART_S: f64 = 1.0;
 
@@ -589,7 +589,7 @@ pub fn convert(
     let results: Vec<Result<Written, DataError>> = dirs
         .par_iter()
         .map(|dir| {
-            let loaded = match opts.split_gaps_s {
+            let loaded = match opts.split_at_gaps_s {
                 Some(max_gap) => read_split(dir, from, &opts.read, max_gap)?,
                 None => read_any(dir, from, &opts.read)?,
             };
@@ -686,7 +686,7 @@ pub fn convert(
             ));
         }
     }
-    if let Some(max_gap) = opts.split_gaps_s
+    if let Some(max_gap) = opts.split_at_gaps_s
         && summary.sequences.is_empty()
     {
         return Err(DataError::format(

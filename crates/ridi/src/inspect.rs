@@ -185,8 +185,8 @@ pub fn inspect_stream(mut rows: ridi_data::RowReader) -> crate::Result<Inspectio
 /// Everything `ridi inspect` prints, as JSON with `--json`.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct Inspection {
-    /// Format detected.
-    pub format: String,
+    /// Format detected (its [`Format::key`] in JSON, in words in text).
+    pub format: Format,
     /// Sequence name.
     pub name: String,
     /// The phone's model (`iPhone 4S`), when the source says.
@@ -203,7 +203,7 @@ pub struct Inspection {
     /// Mean rate, Hz.
     pub rate_hz: f64,
     /// Longest interval between frames, seconds.
-    pub max_gap_s: f64,
+    pub longest_gap_s: f64,
     /// Where the device orientation comes from (in JSON by its key, as in files:
     /// `rotation-vector`).
     pub orientation_source: Option<ridi_data::OrientationSource>,
@@ -267,7 +267,7 @@ fn report(s: Summary) -> Inspection {
     } else {
         0.0
     };
-    let max_gap_s = s.max_gap;
+    let longest_gap_s = s.max_gap;
     let mut warnings = Vec::new();
     let window = ridi_features::FeatureConfig::default().window;
     if s.frames < 2 {
@@ -288,15 +288,15 @@ fn report(s: Summary) -> Inspection {
     }
     // Warned of beyond what `ridi convert --rate` interpolates across.
     let median_rate = s.median_rate.unwrap_or(rate_hz);
-    if median_rate > 0.0 && max_gap_s > RESAMPLE_MAX_GAP_FRAMES / median_rate {
+    if median_rate > 0.0 && longest_gap_s > RESAMPLE_MAX_GAP_FRAMES / median_rate {
         let mut w = format!(
             "longest gap {:.3} s is {:.0} frame intervals",
-            max_gap_s,
-            max_gap_s * median_rate
+            longest_gap_s,
+            longest_gap_s * median_rate
         );
         // `ridi inspect` reads pauses the other commands refuse (`inspect_options`).
         let limit = ridi_data::Validation::default().max_gap_s;
-        if max_gap_s > limit {
+        if longest_gap_s > limit {
             w += &format!(
                 ", longer than the {limit} s the other commands read across: `ridi convert \
                  --split-at-gaps 0.1` cuts the recording at its gaps"
@@ -337,7 +337,7 @@ fn report(s: Summary) -> Inspection {
         warnings.push("no ground truth: usable for tracking, not for training".into());
     }
     Inspection {
-        format: s.format.to_string(),
+        format: s.format,
         name: s.name,
         device: s.device.as_ref().map(|d| d.model().to_string()),
         device_imu_rate_hz: s.device.as_ref().and_then(|d| d.imu_rate_hz()),
@@ -345,7 +345,7 @@ fn report(s: Summary) -> Inspection {
         frames: s.frames,
         duration_s: s.duration,
         rate_hz,
-        max_gap_s,
+        longest_gap_s,
         orientation_source: s.orientation_source,
         gravity_norm,
         upside_down_fraction,
@@ -387,7 +387,7 @@ impl std::fmt::Display for Inspection {
         writeln!(
             f,
             "rate:         {:.2} Hz mean, worst gap {:.4} s",
-            self.rate_hz, self.max_gap_s
+            self.rate_hz, self.longest_gap_s
         )?;
         writeln!(
             f,
@@ -442,6 +442,9 @@ pub struct ModelInspection {
     /// The model file's fingerprint, as an evaluation report records it
     /// ([`crate::Provenance::model_fingerprint`]): which model a report was made with.
     pub fingerprint: String,
+    /// The solver it was trained with, as `ridi train --solver` names it: `exact` or
+    /// `nystrom`.
+    pub solver: &'static str,
     /// Most landmarks one machine of a Nyström model holds (`None`: exact kernel machines,
     /// [`ridi_regress::Solver`]): the classifier's are drawn from all rows, each placement's
     /// regressors' from its own (its samples).
@@ -472,9 +475,9 @@ pub struct ModelInspection {
     pub stored_variance: f64,
     /// One entry per placement.
     pub placements: Vec<PlacementModel>,
-    /// Cross-validation results of the grid search (empty without a search); `channel` is 0
-    /// for S-x, 1 for S-z and 2 for the speed.
-    pub grid: Vec<GridRow>,
+    /// Cross-validation results of the grid search (`ridi train --grid`; empty without a
+    /// search); `channel` is 0 for S-x, 1 for S-z and 2 for the speed.
+    pub cross_validation: Vec<GridRow>,
 }
 
 /// The regressors of one placement ([`ModelInspection::placements`]).
@@ -542,6 +545,10 @@ pub fn inspect_model(model: &Cascade) -> ModelInspection {
         // A model that cannot be encoded (one serde built alone) has no file to name.
         fingerprint: crate::evaluate::model_fingerprint(model).unwrap_or_else(|_| "-".into()),
         format_version: model.format_version(),
+        solver: match model.solver() {
+            Solver::Exact => "exact",
+            Solver::Nystrom(_) => "nystrom",
+        },
         landmarks: match model.solver() {
             Solver::Exact => None,
             Solver::Nystrom(n) => Some(n.landmarks()),
@@ -562,7 +569,7 @@ pub fn inspect_model(model: &Cascade) -> ModelInspection {
         projected_components,
         stored_variance,
         placements,
-        grid: model.grid_results().to_vec(),
+        cross_validation: model.grid_results().to_vec(),
     }
 }
 
@@ -632,14 +639,14 @@ impl std::fmt::Display for ModelInspection {
                 p.s_z
             )?;
         }
-        if !self.grid.is_empty() {
+        if !self.cross_validation.is_empty() {
             writeln!(f, "cross-validation (MSE, (m/s)^2, mean over folds):")?;
             writeln!(
                 f,
                 "  {:<12} {:>7} {:>8} {:>8} {:>10}",
                 "placement", "channel", "C", "epsilon", "MSE"
             )?;
-            for r in &self.grid {
+            for r in &self.cross_validation {
                 writeln!(
                     f,
                     "  {:<12} {:>7} {:>8} {:>8} {:>10.5}",

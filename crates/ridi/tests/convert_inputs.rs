@@ -375,7 +375,7 @@ fn rate_resamples_every_sequence_and_refuses_to_fill_gaps() {
     // Split there first, it converts: two parts, each resampled, tracked as they are, the
     // frames on either side of the gap where they were.
     let split = ConvertOptions {
-        split_gaps_s: Some(0.1),
+        split_at_gaps_s: Some(0.1),
         ..to_200.clone()
     };
     let out3 = dir.path().join("out3");
@@ -461,7 +461,7 @@ fn rate_resamples_every_sequence_and_refuses_to_fill_gaps() {
     assert!(kept.starts_with("# warnings of `ridi convert "), "{kept}");
 
     let split_hard = ConvertOptions {
-        split_gaps_s: Some(0.001),
+        split_at_gaps_s: Some(0.001),
         ..split.clone()
     };
     let e = convert(
@@ -800,7 +800,7 @@ fn two_sequences_of_one_name_are_refused() {
     write_ridi_csv(&Sequence::new(parts).unwrap(), folder.join("data.csv")).unwrap();
     let out = dir.path().join("out");
     let split = ConvertOptions {
-        split_gaps_s: Some(0.1),
+        split_at_gaps_s: Some(0.1),
         ..ConvertOptions::default()
     };
     let e = convert(&src, &out, &split).unwrap_err().to_string();
@@ -887,7 +887,7 @@ fn a_recording_paused_for_seconds_converts_split_at_its_gaps() {
     );
 
     let split = ConvertOptions {
-        split_gaps_s: Some(0.5),
+        split_at_gaps_s: Some(0.5),
         ..ConvertOptions::default()
     };
     let out = dir.path().join("out2");
