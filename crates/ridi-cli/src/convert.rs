@@ -31,17 +31,35 @@ pub(crate) struct Args {
     split_at_gaps: Option<f64>,
 }
 
-/// `--from`: a [`Format`] by its key (`ridi-csv`, ...), each listed in `--help` in words.
+/// `--from`: a [`Format`] by its key (`ridi-csv`, ...), each listed in `--help` with what
+/// `ridi convert` takes of it.
 fn from_format() -> impl clap::builder::TypedValueParser<Value = Format> {
     use clap::builder::{PossibleValue, PossibleValuesParser, TypedValueParser as _};
-    PossibleValuesParser::new(Format::ALL.map(|f| PossibleValue::new(f.key()).help(f.to_string())))
+    PossibleValuesParser::new(Format::ALL.map(|f| PossibleValue::new(f.key()).help(from_help(f))))
         .try_map(|key| key.parse::<Format>())
 }
 
-/// `--rate`: within [`ridi::data::RESAMPLE_RATE_HZ`], the rates whose frames the readers accept
+fn from_help(format: Format) -> &'static str {
+    match format {
+        Format::RidiCsv => {
+            "RIDI processed data.csv (or data_plain.txt where a folder has no data.csv)"
+        }
+        Format::RidiPlain => "RIDI processed data_plain.txt (of a folder that has a data.csv too)",
+        Format::RidiRaw => "RIDI raw recorder folder (gyro.txt, acce.txt, ..., pose.txt)",
+        Format::Tyrex => "Tyrex smartphone benchmark (a run folder or the dataset root)",
+        Format::Ilc => {
+            "Indoor Location Competition 2.0 path files (a file, or a folder searched recursively)"
+        }
+        Format::Ronin => {
+            "RoNIN sequence folders (data.hdf5 and info.json; one, or a folder of them)"
+        }
+    }
+}
+
+/// `--rate`: within [`ridi::data::RESAMPLE_RATE_RANGE_HZ`], the rates whose frames the readers accept
 /// (less than 1 s apart, at least 0.1 ms in the median); phone sensors deliver 5-500 Hz.
 fn rate_hz(text: &str) -> std::result::Result<f64, String> {
-    let (min, max) = ridi::data::RESAMPLE_RATE_HZ;
+    let (min, max) = ridi::data::RESAMPLE_RATE_RANGE_HZ;
     match text.parse::<f64>() {
         Ok(x) if (min..=max).contains(&x) => Ok(x),
         _ => Err(format!(

@@ -86,7 +86,7 @@ pub(crate) fn run(args: Args) -> Result<()> {
             recorded_heading: args.heading.recorded_heading(),
             ..TrackOptions::default()
         },
-        metrics: EvalConfig {
+        config: EvalConfig {
             align: args.align,
             ..EvalConfig::default()
         },

@@ -1223,6 +1223,20 @@ fn from_ridi_plain_converts_the_data_plain_txt_of_a_folder_with_both() {
         let json: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
         assert_eq!(json["frames"], frames, "{from:?}");
     }
+    // The keys, each with what convert takes of it; another name is clap's usage error.
+    let help = String::from_utf8(ridi(&["convert", "--help"]).stdout).unwrap();
+    assert!(
+        help.contains("- ridi-plain: RIDI processed data_plain.txt (of a folder that has"),
+        "{help}"
+    );
+    let out = ridi(&["convert", s(&source), "--out", "x", "--from", "csv"]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(
+        stderr(&out)
+            .contains("[possible values: ridi-csv, ridi-plain, ridi-raw, tyrex, ilc, ronin]"),
+        "{}",
+        stderr(&out)
+    );
 }
 
 #[test]

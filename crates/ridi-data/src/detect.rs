@@ -120,7 +120,10 @@ impl std::str::FromStr for Format {
             .find(|f| f.key() == text)
             .ok_or_else(|| {
                 let keys: Vec<&str> = Format::ALL.iter().map(|f| f.key()).collect();
-                format!("`{text}` is no format: one of {}", keys.join(", "))
+                format!(
+                    "`{text}` is not a format; expected one of {}",
+                    keys.join(", ")
+                )
             })
     }
 }
@@ -349,11 +352,14 @@ mod tests {
     fn every_format_parses_from_its_key_and_serializes_as_it() {
         for f in Format::ALL {
             assert_eq!(f.key().parse::<Format>(), Ok(f));
-            assert_eq!(serde_json::to_string(&f).unwrap(), format!("\"{}\"", f.key()));
+            assert_eq!(
+                serde_json::to_string(&f).unwrap(),
+                format!("\"{}\"", f.key())
+            );
         }
         assert_eq!(
             "csv".parse::<Format>().unwrap_err(),
-            "`csv` is no format: one of ridi-csv, ridi-plain, ridi-raw, tyrex, ilc, ronin"
+            "`csv` is not a format; expected one of ridi-csv, ridi-plain, ridi-raw, tyrex, ilc, ronin"
         );
     }
 }

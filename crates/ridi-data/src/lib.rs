@@ -126,8 +126,8 @@ pub use options::ReadOptions;
 pub use processed::PROCESSED_COLUMNS;
 pub use ridi_frames;
 pub use sequence::{
-    Channel, GroundTruth, OrientationSource, RESAMPLE_RATE_HZ, Sequence, SequenceParts, SplitParts,
-    heading_reference, part_name,
+    Channel, GroundTruth, OrientationSource, RESAMPLE_RATE_RANGE_HZ, Sequence, SequenceParts,
+    SplitParts, heading_reference, part_name,
 };
 pub use sequence_error::{SequenceError, short};
 pub use sidecar::{SIDECAR_SUFFIX, sidecar_path};

@@ -305,7 +305,7 @@ pub fn heading_reference(source: Option<OrientationSource>) -> bool {
 /// (`max_gap_s`) and a median step under 0.1 ms (`time_step_range`); a uniform timeline at
 /// exactly 1 Hz or 10 kHz lands on either side of those bounds once its times are added up in
 /// floating point (and written as whole nanoseconds), so the range keeps 0.1 % from each.
-pub const RESAMPLE_RATE_HZ: (f64, f64) = (1.001, 9990.0);
+pub const RESAMPLE_RATE_RANGE_HZ: (f64, f64) = (1.001, 9990.0);
 
 /// `time` not empty, finite, strictly increasing, with no step longer than `max_gap_s`.
 fn check_time(time: &[f64], max_gap_s: f64) -> Result<(), SequenceError> {
@@ -671,7 +671,7 @@ impl Sequence {
     /// count frames of a 200 Hz stream); `ridi convert --rate` applies it.
     ///
     /// # Errors
-    /// [`SequenceError::InvalidRate`] for a `rate_hz` outside [`RESAMPLE_RATE_HZ`] or a
+    /// [`SequenceError::InvalidRate`] for a `rate_hz` outside [`RESAMPLE_RATE_RANGE_HZ`] or a
     /// `max_gap_s` that is not above 0 (infinity interpolates across every gap, unless the
     /// gaps over 1 s would be most of the result: [`SequenceError::ResampledAcrossGaps`]); a gap
     /// between two frames longer than `max_gap_s` (interpolating would invent the frames of a
@@ -682,7 +682,7 @@ impl Sequence {
         };
         // Checked before the frames are made: a rate the time-step check refuses could first
         // ask for billions of them. An infinite gap limit interpolates across every gap.
-        let (min, max) = RESAMPLE_RATE_HZ;
+        let (min, max) = RESAMPLE_RATE_RANGE_HZ;
         if !((min..=max).contains(&rate_hz) && max_gap_s > 0.0) {
             return Err(SequenceError::InvalidRate { rate_hz, max_gap_s });
         }

@@ -193,14 +193,14 @@ pub enum SequenceError {
         /// The shortest part asked for.
         min_duration_s: f64,
     },
-    /// A resampling rate outside [`RESAMPLE_RATE_HZ`](crate::RESAMPLE_RATE_HZ), or a gap
+    /// A resampling rate outside [`RESAMPLE_RATE_RANGE_HZ`](crate::RESAMPLE_RATE_RANGE_HZ), or a gap
     /// limit that is not a number above 0 ([`Sequence::resampled`](crate::Sequence::resampled)).
     #[error(
         "cannot resample to {rate_hz} Hz across gaps of up to {} s: the rate must be from {} \
          to {} Hz (the steps a sequence may have), the gap limit a number above 0",
         short(*max_gap_s),
-        crate::RESAMPLE_RATE_HZ.0,
-        crate::RESAMPLE_RATE_HZ.1
+        crate::RESAMPLE_RATE_RANGE_HZ.0,
+        crate::RESAMPLE_RATE_RANGE_HZ.1
     )]
     InvalidRate {
         /// The rate asked for.

@@ -233,7 +233,7 @@ impl Validation {
     /// The rates a uniform timeline may be built at, Hz, both included: one whose frames this
     /// validation accepts, with 0.1 % to spare from its bounds (a timeline at exactly the
     /// bound lands on either side of it once its times are added up in floating point and
-    /// written as whole nanoseconds). The default's is [`RESAMPLE_RATE_HZ`](crate::RESAMPLE_RATE_HZ).
+    /// written as whole nanoseconds). The default's is [`RESAMPLE_RATE_RANGE_HZ`](crate::RESAMPLE_RATE_RANGE_HZ).
     pub fn output_rate_range(&self) -> (f64, f64) {
         let (min_step, max_step) = self.time_step_range;
         (1.001 / max_step.min(self.max_gap_s), 0.999 / min_step)
@@ -961,14 +961,14 @@ mod tests {
     fn the_default_output_rates_are_the_resampling_rates() {
         assert_eq!(
             Validation::default().output_rate_range(),
-            crate::RESAMPLE_RATE_HZ
+            crate::RESAMPLE_RATE_RANGE_HZ
         );
         // Reading pauses (an unbounded gap) keeps the lowest rate at the time steps' bound.
         let pauses = Validation {
             max_gap_s: f64::INFINITY,
             ..Validation::default()
         };
-        assert_eq!(pauses.output_rate_range(), crate::RESAMPLE_RATE_HZ);
+        assert_eq!(pauses.output_rate_range(), crate::RESAMPLE_RATE_RANGE_HZ);
     }
 
     #[test]

@@ -235,12 +235,12 @@ fn splits_at_gaps_and_resampling_keep_every_channel() {
     }
     assert!(
         split[1]
-            .resampled(ridi_data::RESAMPLE_RATE_HZ.1, 0.05)
+            .resampled(ridi_data::RESAMPLE_RATE_RANGE_HZ.1, 0.05)
             .is_ok()
     );
     assert!(
         split[1]
-            .resampled(ridi_data::RESAMPLE_RATE_HZ.0, 5.0)
+            .resampled(ridi_data::RESAMPLE_RATE_RANGE_HZ.0, 5.0)
             .is_ok()
     );
     assert!(split[1].resampled(100.0, f64::INFINITY).is_ok());

@@ -82,7 +82,7 @@ pub(crate) fn evaluate<'py>(
             recorded_heading: options::recorded_heading(heading)?,
             ..TrackOptions::default()
         },
-        metrics: EvalConfig {
+        config: EvalConfig {
             align: match align {
                 Some(a) => options::align(a)?,
                 None => EvalConfig::default().align,

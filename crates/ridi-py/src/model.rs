@@ -93,8 +93,8 @@ impl Model {
     }
 
     /// What ``ridi inspect --json`` says of the model: placements, window, S, orientation,
-    /// fingerprint (a report's ``model_fingerprint``), regressors, stored samples,
-    /// cross-validation table.
+    /// fingerprint (a report's ``model_fingerprint``), solver (``"exact"`` or ``"nystrom"``),
+    /// regressors, stored samples, cross-validation table (``cross_validation``).
     fn describe<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
         let json = serde_json::to_string(&ridi::inspect_model(&self.inner))
             .map_err(|e| errors::value(e.to_string()))?;

@@ -167,6 +167,17 @@ def test_grid_search_with_too_few_sequences_says_how_to_train_without(tmp_path):
         ridi.train(seqs, grid="small")
 
 
+def test_a_searched_model_describes_its_cross_validation():
+    lists = [SAMPLE / "list_Guillaume.txt", SAMPLE / "list_Jakob.txt"]
+    model = ridi.train(lists, grid="small", solver="nystrom", landmarks=64, placement_map="tyrex4")
+    table = model.describe()["cross_validation"]
+    # Per placement and channel (S-x, S-z and the speed), the grid's rows.
+    assert {(r["placement"], r["channel"]) for r in table} == {
+        (p, c) for p in model.placement_names for c in (0, 1, 2)}
+    assert all(r["mse"] > 0 and len(r["fold_mse"]) >= 2 for r in table), table
+    assert "cross-validation" in str(model)
+
+
 def test_model_files(tmp_path, model):
     with pytest.raises(FileNotFoundError, match=r"cannot load model .*nowhere.ridi"):
         ridi.load(tmp_path / "nowhere.ridi")

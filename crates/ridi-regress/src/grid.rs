@@ -224,18 +224,18 @@ impl<'p> GridProgress<'p> {
 }
 
 /// Runs the grid for every channel of `targets` (`targets[ch][s]` for base sample `s`) and
-/// returns the table in `(channel, C, epsilon)` order. `solver.kernel_memory` bounds the copy
+/// returns the table in `(channel, C, epsilon)` order. `solver_config.kernel_memory` bounds the copy
 /// of a fold's kernel block.
 pub(crate) fn search(
     rows: &dyn KernelRows,
     targets: &[Vec<f64>],
     groups: &[u64],
     spec: &GridSpec,
-    solver: &SolverConfig,
+    solver_config: &SolverConfig,
     placement: &str,
     progress: &mut dyn Progress,
 ) -> Result<Vec<GridRow>, RegressError> {
-    let smo = &solver.smo;
+    let smo = &solver_config.smo;
     let (fold, k, cs, eps) = prepare(groups, spec, placement)?;
     let channels = targets.len();
     let total = k * channels * eps.len() * cs.len();
@@ -304,7 +304,7 @@ pub(crate) fn search(
             .iter()
             .map(|(train, _)| FullKernel::bytes_for(train.len()))
             .sum();
-        let blocks: Vec<FullKernel> = if block_bytes <= solver.kernel_memory {
+        let blocks: Vec<FullKernel> = if block_bytes <= solver_config.kernel_memory {
             split
                 .par_iter()
                 .map(|(train, _)| FullKernel::block(rows, train))

@@ -1130,19 +1130,19 @@ fn a_projected_nystrom_model_answers_as_it_was_trained() {
     // and it answers close to the same training on half-precision rows.
     let data = make_window(3, 4, 15, 1, 40);
     let d = data.config.feature_dim();
-    let method = Solver::Nystrom(Nystrom::new(32, 5).unwrap());
-    assert_eq!(Storage::projected_for(&method), Storage::NYSTROM_DEFAULT);
+    let solver = Solver::Nystrom(Nystrom::new(32, 5).unwrap());
+    assert_eq!(Storage::projected_for(&solver), Storage::NYSTROM_DEFAULT);
     assert_eq!(Storage::projected_for(&Solver::Exact), Storage::DEFAULT);
     let model = Cascade::train(
         &data.set(),
-        &fixed(Storage::projected_for(&method), method),
+        &fixed(Storage::projected_for(&solver), solver),
         &mut NoProgress,
     )
     .unwrap();
     let (components, energy) = projected(&model);
     assert_eq!(components, 64, "the floor");
     assert!((0.9..=1.0).contains(&energy), "{energy}");
-    let half = Cascade::train(&data.set(), &fixed(Storage::Half, method), &mut NoProgress).unwrap();
+    let half = Cascade::train(&data.set(), &fixed(Storage::Half, solver), &mut NoProgress).unwrap();
     let test = make_window(3, 2, 20, 99, 40);
     let xt = FeatureMatrixRef::new(&test.x, d).unwrap();
     let batch = model.predict(xt).unwrap();

@@ -61,7 +61,7 @@ pub struct ConvertOptions {
     /// How to read (validation limits).
     pub read: ReadOptions,
     /// Resample every sequence to this rate, Hz ([`Sequence::resampled`]), within
-    /// [`ridi_data::RESAMPLE_RATE_HZ`]; `None` keeps each sequence's timeline.
+    /// [`ridi_data::RESAMPLE_RATE_RANGE_HZ`]; `None` keeps each sequence's timeline.
     ///
     /// [`Sequence::resampled`]: ridi_data::Sequence::resampled
     pub rate_hz: Option<f64>,
@@ -267,9 +267,10 @@ fn sources(source: &Path, from: Option<Format>) -> Result<Sources, DataError> {
                 Location::file(source),
                 format!(
                     "no {want} here, but {} of another format (the first, {}, is {what}): \
-                     convert without --from, or with that format",
+                     convert without --from, or with that format's{}",
                     counted(other.len(), "source"),
-                    ridi_data::shown(&other[0])
+                    ridi_data::shown(&other[0]),
+                    detect(&other[0]).map_or(String::new(), |f| format!(" (--from {})", f.key()))
                 ),
             )
         }

@@ -37,10 +37,10 @@ use crate::train::ground_truth_view;
 pub struct EvalOptions {
     /// Methods, in report order.
     pub methods: Vec<Method>,
-    /// Regression step and correction of the model-based methods.
+    /// Frames between regressions, and the correction, of the model-based methods.
     pub track: TrackOptions,
-    /// Alignment and metric windows.
-    pub metrics: EvalConfig,
+    /// Alignment and metric windows (a report's `config`).
+    pub config: EvalConfig,
 }
 
 impl Default for EvalOptions {
@@ -48,7 +48,7 @@ impl Default for EvalOptions {
         Self {
             methods: Method::ALL.to_vec(),
             track: TrackOptions::default(),
-            metrics: EvalConfig::default(),
+            config: EvalConfig::default(),
         }
     }
 }
@@ -307,7 +307,7 @@ fn evaluate_one(seq: &Sequence, model: &Cascade, opts: &EvalOptions) -> Result<E
     let mut traced = Vec::new();
     for &m in &opts.methods {
         let est = baseline_trajectory(m, seq, &regressions, opts.track.correction_for(model))?;
-        let e = evaluate_trajectory(seq.time(), &est, &gt2, &opts.metrics)?;
+        let e = evaluate_trajectory(seq.time(), &est, &gt2, &opts.config)?;
         methods.insert(m.key().to_string(), e.metrics);
         traced.push((m, e.aligned));
     }
@@ -319,7 +319,7 @@ fn evaluate_one(seq: &Sequence, model: &Cascade, opts: &EvalOptions) -> Result<E
             device: seq.device().map(|d| d.model().to_string()),
             path_length_m: ridi_eval::path_length(&gt2)?,
             alignment_extent_m: ridi_eval::target_extent(
-                &gt2[..opts.metrics.align.frame_count(seq.time())?],
+                &gt2[..opts.config.align.frame_count(seq.time())?],
             ),
             placement_accuracy,
             velocity_mse: vel_mse,
@@ -388,12 +388,12 @@ pub fn placement_warnings(seqs: &[Sequence], model: &Cascade) -> Vec<String> {
 /// Refuses a sequence [`evaluate`] cannot evaluate with a model of feature configuration
 /// `config`: as tracking does (a gap longer than the correction's `max_dt`, a median rate
 /// outside 200 Hz ± 10 %, no whole feature window), and frames that do not average
-/// `opts.metrics.rate_hz` ± 10 %, at which the RTE windows are counted (many dropped frames,
+/// `opts.config.rate_hz` ± 10 %, at which the RTE windows are counted (many dropped frames,
 /// each gap short enough to track across). [`evaluate`] checks every sequence first; call it
 /// to check test sequences before training their model.
 pub fn check_evaluable(seq: &Sequence, config: &FeatureConfig, opts: &EvalOptions) -> Result<()> {
     check_trackable(seq, config, opts.track.correction.max_dt)?;
-    match ridi_eval::check_rate(seq.time(), &opts.metrics) {
+    match ridi_eval::check_rate(seq.time(), &opts.config) {
         Ok(_) => Ok(()),
         Err(ridi_eval::EvalError::RateMismatch {
             timeline_hz,
@@ -526,7 +526,7 @@ pub fn evaluate_cancellable(
     } else {
         Vec::new()
     };
-    warnings.extend(weak_alignment(&results, opts.metrics.align));
+    warnings.extend(weak_alignment(&results, opts.config.align));
     warnings.extend(still_ahead(&summary));
     warnings.extend(pdr_without_steps(&results));
     warnings.extend(too_few_runs(&results));
@@ -545,7 +545,7 @@ pub fn evaluate_cancellable(
             velocity_mse,
             placement_accuracy,
             placement_confusion,
-            config: opts.metrics,
+            config: opts.config,
             recorded_heading: opts.track.recorded_heading,
             methods: order,
             warnings,

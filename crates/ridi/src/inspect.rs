@@ -386,7 +386,7 @@ impl std::fmt::Display for Inspection {
         )?;
         writeln!(
             f,
-            "rate:         {:.2} Hz mean, worst gap {:.4} s",
+            "rate:         {:.2} Hz mean, longest gap {:.4} s",
             self.rate_hz, self.longest_gap_s
         )?;
         writeln!(
