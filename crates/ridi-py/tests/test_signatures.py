@@ -112,3 +112,15 @@ def test_the_stubs_orientation_sources_are_the_ones_taken(seq):
         ridi.Sequence(**args, orientation_source="compass")
     taken = set(re.findall(r"'([a-z-]+)'", str(refused.value).split("expected one of")[1]))
     assert stubbed == taken
+
+
+def test_the_stubs_formats_are_the_ones_taken():
+    # `Format` of the stub against the names `format=` takes (ridi_data::Format::ALL's keys).
+    tree = ast.parse(STUB.read_text())
+    alias = next(n for n in tree.body if isinstance(n, ast.Assign)
+                 and any(getattr(t, "id", None) == "Format" for t in n.targets))
+    stubbed = [c.value for c in ast.walk(alias.value) if isinstance(c, ast.Constant)]
+    with pytest.raises(ValueError) as refused:
+        ridi.read("anything", format="csv")
+    taken = re.findall(r"'([a-z-]+)'", str(refused.value).split("expected one of")[1])
+    assert stubbed == taken
