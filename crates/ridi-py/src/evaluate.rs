@@ -129,9 +129,10 @@ pub(crate) fn evaluate<'py>(
 /// Compares two evaluations of the same sequences, as ``ridi compare`` does: ``first`` and
 /// ``second`` are reports of ``ridi.evaluate`` (dicts) or of ``ridi eval`` (a report.json, or
 /// the folder holding it). Returns a dict: ``sequences`` and ``runs`` both hold, ``settings``
-/// (what differs between the two: model, frames between regressions (``regress_every``),
-/// placement window, heading, alignment, methods, version), ``figures`` (per method both have and metric: the ``first``
-/// and ``second`` means over the shared sequences, ``difference``, second minus first paired
+/// (what differs between the two: model, frames between regressions
+/// (``provenance.regress_every``), placement window, heading, alignment, methods, version),
+/// ``figures`` (per method both have and metric: the ``first`` and ``second`` means over the
+/// shared sequences, ``difference``, second minus first paired
 /// by sequence, and its 95 % ``interval``, None with fewer than 5 runs) and ``warnings``
 /// (also emitted as ``UserWarning``\ s).
 #[pyfunction]

@@ -259,18 +259,17 @@ fn sources(source: &Path, from: Option<Format>) -> Result<Sources, DataError> {
     // A folder of another format: say what it holds rather than only what it lacks.
     found.map_err(|e| match detected_sources(source) {
         Ok(Sources { paths: other, .. }) if !other.is_empty() => {
-            let what = detect(&other[0]).map_or_else(
-                |_| "a sequence".to_string(),
-                |f| with_article(&f.to_string()),
-            );
+            let (what, with) = match detect(&other[0]) {
+                Ok(f) => (with_article(&f.to_string()), format!("--from {}", f.key())),
+                Err(_) => ("a sequence".to_string(), "that format's --from".to_string()),
+            };
             DataError::format(
                 Location::file(source),
                 format!(
                     "no {want} here, but {} of another format (the first, {}, is {what}): \
-                     convert without --from, or with that format's{}",
+                     convert without --from, or with {with}",
                     counted(other.len(), "source"),
                     ridi_data::shown(&other[0]),
-                    detect(&other[0]).map_or(String::new(), |f| format!(" (--from {})", f.key()))
                 ),
             )
         }

@@ -294,8 +294,7 @@ fn list_labels_in_the_source_carry_over_and_a_folder_of_another_format_is_named(
         assert!(
             e.contains("but 3 sources of another format")
                 && e.contains(
-                    "is a RIDI processed csv): convert without --from, or with that \
-                               format's (--from ridi-csv)"
+                    "is a RIDI processed csv): convert without --from, or with --from ridi-csv"
                 ),
             "{e}"
         );
