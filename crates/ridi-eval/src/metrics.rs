@@ -62,7 +62,9 @@ pub struct TrajectoryMetrics {
     /// Relative trajectory error (long window), RoNIN per-coordinate RMS, metres.
     #[serde(deserialize_with = "crate::bootstrap::nan_if_null")]
     pub rte_ronin_m: f64,
-    /// Relative trajectory error (short window), Euclidean RMS, metres.
+    /// Relative trajectory error over [`EvalConfig::short_rte_window_s`], Euclidean RMS,
+    /// metres. Named for that window's default, 5 s, which the command line and Python keep: a
+    /// report made with another says so in its `config`.
     #[serde(deserialize_with = "crate::bootstrap::nan_if_null")]
     pub rte_5s_m: f64,
     /// Estimated over ground-truth horizontal path length.
