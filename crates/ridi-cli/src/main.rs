@@ -324,11 +324,7 @@ fn main() -> ExitCode {
         Command::Eval(args) => args.jobs,
         _ => None,
     };
-    if let Err(e) = start_workers(jobs) {
-        errln!("error: {}", shown(one_line(&e)));
-        return ExitCode::FAILURE;
-    }
-    let result = match cli.command {
+    let result = start_workers(jobs).and_then(|()| match cli.command {
         Command::Inspect(args) => inspect::run(args),
         Command::Convert(args) => convert::run(args),
         Command::Train(args) => train::run(args),
@@ -336,7 +332,7 @@ fn main() -> ExitCode {
         Command::Eval(args) => eval::run(args),
         Command::Compare(args) => compare::run(args),
         Command::Demo(args) => demo::run(args),
-    };
+    });
     match result {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {

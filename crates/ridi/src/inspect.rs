@@ -541,22 +541,17 @@ pub fn inspect_model(model: &Cascade) -> ModelInspection {
             }
         })
         .collect();
+    let (solver, landmarks, landmark_seed) = match model.solver() {
+        Solver::Exact => ("exact", None, None),
+        Solver::Nystrom(n) => ("nystrom", Some(n.landmarks()), Some(n.seed())),
+    };
     ModelInspection {
         // A model that cannot be encoded (one serde built alone) has no file to name.
         fingerprint: crate::evaluate::model_fingerprint(model).unwrap_or_else(|_| "-".into()),
         format_version: model.format_version(),
-        solver: match model.solver() {
-            Solver::Exact => "exact",
-            Solver::Nystrom(_) => "nystrom",
-        },
-        landmarks: match model.solver() {
-            Solver::Exact => None,
-            Solver::Nystrom(n) => Some(n.landmarks()),
-        },
-        landmark_seed: match model.solver() {
-            Solver::Exact => None,
-            Solver::Nystrom(n) => Some(n.seed()),
-        },
+        solver,
+        landmarks,
+        landmark_seed,
         window: config.window,
         step: config.step,
         feature_sigma: config.feature_sigma,

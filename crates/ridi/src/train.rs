@@ -326,21 +326,7 @@ pub fn training_warnings(seqs: &[Sequence]) -> Vec<String> {
     let straight: Vec<String> = seqs
         .iter()
         .filter_map(|s| {
-            let (t, p) = (s.time(), &s.ground_truth()?.position);
-            let velocity = |i: usize| {
-                let dt = t[i + 1] - t[i];
-                [
-                    (p[i + 1].x() - p[i].x()) / dt,
-                    (p[i + 1].y() - p[i].y()) / dt,
-                ]
-            };
-            let changes = (1..t.len().saturating_sub(1))
-                .filter(|&i| {
-                    let (a, b) = (velocity(i - 1), velocity(i));
-                    let dt = 0.5 * (t[i + 1] - t[i - 1]);
-                    (b[0] - a[0]).hypot(b[1] - a[1]) > VELOCITY_CHANGE_M_S2 * dt
-                })
-                .count();
+            let changes = velocity_changes(s)?;
             let per_s = changes as f64 / s.duration();
             (changes > 0 && per_s < MIN_VELOCITY_CHANGES_PER_S)
                 .then(|| format!("{} ({per_s:.1} a second)", ridi_data::shown(s.name())))
@@ -361,6 +347,25 @@ pub fn training_warnings(seqs: &[Sequence]) -> Vec<String> {
         ridi_data::first_few(straight.iter(), 3),
         if straight.len() == 1 { "has" } else { "have" },
     )]
+}
+
+/// How many times the horizontal velocity of `seq`'s ground truth changes between frames
+/// ([`VELOCITY_CHANGE_M_S2`]); `None` without ground truth.
+fn velocity_changes(seq: &Sequence) -> Option<usize> {
+    let (t, p) = (seq.time(), &seq.ground_truth()?.position);
+    let velocity: Vec<[f64; 2]> = t
+        .windows(2)
+        .zip(p.windows(2))
+        .map(|(t, p)| {
+            let dt = t[1] - t[0];
+            [(p[1].x() - p[0].x()) / dt, (p[1].y() - p[0].y()) / dt]
+        })
+        .collect();
+    let changes = velocity.windows(2).zip(t.windows(3)).filter(|(v, t)| {
+        let dt = 0.5 * (t[2] - t[0]);
+        (v[1][0] - v[0][0]).hypot(v[1][1] - v[0][1]) > VELOCITY_CHANGE_M_S2 * dt
+    });
+    Some(changes.count())
 }
 
 /// Trains the cascade on labelled sequences (placement and ground truth required).
