@@ -6,7 +6,7 @@ use std::path::Path;
 use std::process::ExitCode;
 
 use anyhow::{Context, Result};
-use clap::{Parser, Subcommand, ValueEnum};
+use clap::{CommandFactory, Parser, Subcommand, ValueEnum};
 
 use ridi::correct::PlacementSmoother;
 use ridi::data::{ListEntry, Listed, ReadOptions, shown};
@@ -318,6 +318,16 @@ fn clean_up_on_signals() {
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
+    if let Command::Train(args) = &cli.command
+        && let Some(message) = train::usage_error(args)
+    {
+        let mut cmd = Cli::command();
+        cmd.build();
+        let train = cmd.find_subcommand_mut("train").expect("a subcommand");
+        train
+            .error(clap::error::ErrorKind::ArgumentConflict, message)
+            .exit();
+    }
     clean_up_on_signals();
     let jobs = match &cli.command {
         Command::Train(args) => args.jobs,

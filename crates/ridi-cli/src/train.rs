@@ -186,12 +186,15 @@ fn exact_solver_note(windows: usize) -> Option<String> {
     })
 }
 
+/// Flags that contradict each other, which clap's own rules cannot see (`--solver` has a
+/// default): a usage error, exit code 2, as clap's.
+pub(crate) fn usage_error(args: &Args) -> Option<&'static str> {
+    (args.landmarks.is_some() && matches!(args.solver, SolverArg::Exact)).then_some(
+        "--landmarks is for --solver nystrom: the exact solver keeps every training window",
+    )
+}
+
 pub(crate) fn run(args: Args) -> Result<()> {
-    if args.landmarks.is_some() && matches!(args.solver, SolverArg::Exact) {
-        anyhow::bail!(
-            "--landmarks is for --solver nystrom: the exact solver keeps every training window"
-        );
-    }
     let out = &args.out;
     check_output_file(out)?;
     let entries = ListEntry::read(&args.list)?;

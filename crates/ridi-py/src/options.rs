@@ -341,7 +341,14 @@ pub(crate) fn interruptible<T: Send>(
             let cancel = &cancel;
             let work = std::thread::Builder::new()
                 .spawn_scoped(scope, move || tx.send(with_jobs(jobs, || f(cancel))))
-                .map_err(|e| errors::value(format!("cannot start the work's thread: {e}")))?;
+                // As a refused worker pool (`with_jobs`): a RuntimeError.
+                .map_err(|e| {
+                    errors::pipeline(ridi::PipelineError::Workers {
+                        threads: 1,
+                        variable: None,
+                        reason: e.to_string(),
+                    })
+                })?;
             loop {
                 match rx.recv_timeout(SIGNAL_POLL) {
                     Ok(done) => return done,

@@ -54,7 +54,8 @@ pub enum PipelineError {
     },
     /// The worker threads a run asked for could not be started ([`crate::start_workers`]).
     #[error(
-        "cannot start {threads} worker threads{}: {reason}",
+        "cannot start {threads} worker thread{}{}: {reason}",
+        if *threads == 1 { "" } else { "s" },
         variable.as_ref().map_or(String::new(), |v| format!(" ({v})"))
     )]
     Workers {
