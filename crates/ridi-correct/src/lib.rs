@@ -89,3 +89,8 @@ pub use tracker::{
     CorrectionOutcome, GapPolicy, MAX_BUFFER, RegressionOutcome, Revision, Segment, TrackError,
     Tracker, TrackerConfig, TrackerStats, Update,
 };
+
+/// The README's example, compiled by `cargo test --doc` so that it cannot drift from the API.
+#[cfg(doctest)]
+#[doc = include_str!("../README.md")]
+struct ReadmeDoctests;

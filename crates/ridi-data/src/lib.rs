@@ -148,3 +148,8 @@ pub use write::{
     PendingFile, Precision, RoundTrip, output_target, write_atomically, write_pending,
     write_ridi_csv, write_ridi_csv_with, write_ridi_plain,
 };
+
+/// The README's example, compiled by `cargo test --doc` so that it cannot drift from the API.
+#[cfg(doctest)]
+#[doc = include_str!("../README.md")]
+struct ReadmeDoctests;

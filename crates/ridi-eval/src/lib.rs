@@ -89,3 +89,8 @@ pub use report::{
     markdown_metric_table, markdown_table, paired_differences, run_of, summarize,
     summary_intervals,
 };
+
+/// The README's example, compiled by `cargo test --doc` so that it cannot drift from the API.
+#[cfg(doctest)]
+#[doc = include_str!("../README.md")]
+struct ReadmeDoctests;

@@ -102,3 +102,8 @@ pub use matrix::{FeatureMatrix, FeatureMatrixRef};
 pub use ridi_frames;
 pub use targets::{GroundTruthView, Targets, compute_targets, stabilized_velocity};
 pub use turn::{TurnedRows, YawTurn, turned_copies};
+
+/// The README's example, compiled by `cargo test --doc` so that it cannot drift from the API.
+#[cfg(doctest)]
+#[doc = include_str!("../README.md")]
+struct ReadmeDoctests;

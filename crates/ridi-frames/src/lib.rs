@@ -42,6 +42,13 @@
 //! tracks) takes the slow part of a recorded orientation's heading onto the estimate, whose
 //! heading drifts with the gyro bias, and keeps the estimate's tilt.
 //!
+//! # A recording's streams
+//!
+//! [`ImuFrames`] is the one borrowed view of a recording's IMU streams (time, gyro, linear
+//! acceleration, gravity, orientation), checked once for equal lengths, that features, the
+//! correction and a streaming regressor's window take; [`ImuSample`] is one frame of it, owned,
+//! what a live tracker is pushed.
+//!
 //! # Example
 //!
 //! ```
@@ -104,3 +111,8 @@ pub use vector::{DeviceVec, StabVec, Vec3, WorldVec};
 
 /// nalgebra, re-exported so downstream crates use the same version.
 pub use nalgebra;
+
+/// The README's example, compiled by `cargo test --doc` so that it cannot drift from the API.
+#[cfg(doctest)]
+#[doc = include_str!("../README.md")]
+struct ReadmeDoctests;

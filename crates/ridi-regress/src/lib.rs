@@ -222,3 +222,8 @@ pub use ridi_features;
 /// The versions the linfa adapters (feature `linfa`) are built against.
 #[cfg(feature = "linfa")]
 pub use {linfa, ndarray};
+
+/// The README's example, compiled by `cargo test --doc` so that it cannot drift from the API.
+#[cfg(doctest)]
+#[doc = include_str!("../README.md")]
+struct ReadmeDoctests;
