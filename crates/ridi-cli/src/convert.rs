@@ -44,7 +44,10 @@ fn from_help(format: Format) -> &'static str {
         Format::RidiCsv => {
             "RIDI processed data.csv (or data_plain.txt where a folder has no data.csv)"
         }
-        Format::RidiPlain => "RIDI processed data_plain.txt (of a folder that has a data.csv too)",
+        Format::RidiPlain => {
+            "RIDI processed data_plain.txt (also of a folder that has a data.csv, which detection \
+             prefers)"
+        }
         Format::RidiRaw => "RIDI raw recorder folder (gyro.txt, acce.txt, ..., pose.txt)",
         Format::Tyrex => "Tyrex smartphone benchmark (a run folder or the dataset root)",
         Format::Ilc => {

@@ -9,11 +9,9 @@ use indicatif::ProgressBar;
 use ridi::ReadFiles;
 use ridi::data::{ListEntry, counted, shown};
 use ridi::eval::{AlignWindow, EvalConfig};
-use ridi::{
-    EvalFolder, EvalOptions, EvalPlots, EvalWritten, Method, Purpose, Report, TrackOptions,
-};
+use ridi::{EvalFolder, EvalOptions, EvalPlots, EvalWritten, Method, Purpose, Report};
 
-use crate::{Heading, Plots, count, non_negative, parse_align, placement_smoothing};
+use crate::{Plots, Tracking, count, parse_align};
 
 #[derive(clap::Args)]
 pub(crate) struct Args {
@@ -43,16 +41,8 @@ pub(crate) struct Args {
     /// Worker threads (default: all cores).
     #[arg(long, value_parser = |s: &str| count(s, 1, ridi::MAX_JOBS))]
     pub(crate) jobs: Option<usize>,
-    /// Placement majority window, seconds: each regression takes the most frequent placement
-    /// label within it, centred on it; 0 keeps each window's own label, as in the paper.
-    #[arg(long, value_name = "SECONDS", default_value_t = 10.0, value_parser = non_negative)]
-    placement_window: f64,
-    /// With a model on the estimated orientation: `corrected` turns the gyro's heading onto
-    /// the slow part of the recorded orientation's, so that its drift does not bend the track
-    /// (resets and magnetic corrections pass at 0.1 rad/s at most); `gyro` keeps the gyro's
-    /// heading. A model on the recorded orientation tracks with that.
-    #[arg(long, value_enum, default_value = "corrected")]
-    heading: Heading,
+    #[command(flatten)]
+    tracking: Tracking,
     /// Stretch every trajectory is aligned to the ground truth on (2D rigid, no scale):
     /// its first SECONDS, as in the paper, or `all` for the whole run (a best case that
     /// hides initial-heading errors).
@@ -81,11 +71,7 @@ pub(crate) fn run(args: Args) -> Result<()> {
     let folder = folder.reading(ReadFiles::of(&read));
     let opts = EvalOptions {
         methods,
-        track: TrackOptions {
-            placement_smoothing: placement_smoothing(args.placement_window),
-            recorded_heading: args.heading.recorded_heading(),
-            ..TrackOptions::default()
-        },
+        track: args.tracking.options(false),
         config: EvalConfig {
             align: args.align,
             ..EvalConfig::default()

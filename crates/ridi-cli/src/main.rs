@@ -238,9 +238,50 @@ impl Heading {
     }
 }
 
-/// `--placement-window` (checked by clap: finite, at least 0): 0 turns the majority vote off.
-fn placement_smoothing(window_s: f64) -> Option<PlacementSmoother> {
-    (window_s > 0.0).then_some(PlacementSmoother { window_s })
+/// The tracking flags of `ridi track` and `ridi eval`: [`ridi::TrackOptions`].
+#[derive(clap::Args)]
+pub(crate) struct Tracking {
+    /// Frames between regressions.
+    #[arg(long, default_value_t = 50, value_parser = |s: &str| count(s, 1, MAX_FRAMES_APART))]
+    regress_every: usize,
+    /// Weight of the bias prior (paper: 0.1).
+    #[arg(long, default_value_t = 0.1, value_parser = positive)]
+    lambda: f64,
+    /// Estimate the initial velocity instead of assuming the walk starts at rest.
+    #[arg(long)]
+    estimate_initial_velocity: bool,
+    /// Placement majority window, seconds: each regression takes the most frequent placement
+    /// label within it (centred on it; with `ridi track --online` the seconds before it); 0
+    /// keeps each window's own label, as in the paper.
+    #[arg(long, value_name = "SECONDS", default_value_t = 10.0, value_parser = non_negative)]
+    placement_window: f64,
+    /// With a model on the estimated orientation: `corrected` turns the gyro's heading onto
+    /// the slow part of the recorded orientation's, so that its drift does not bend the track
+    /// (resets and magnetic corrections pass at 0.1 rad/s at most); `gyro` keeps the gyro's
+    /// heading. A model on the recorded orientation tracks with that.
+    #[arg(long, value_enum, default_value = "corrected")]
+    heading: Heading,
+}
+
+impl Tracking {
+    /// The facade's options with these flags (`online` for `ridi track --online`).
+    pub(crate) fn options(&self, online: bool) -> ridi::TrackOptions {
+        let mut opts = ridi::TrackOptions {
+            regress_every: self.regress_every,
+            online,
+            // 0 (clap checked it is finite and at least 0) turns the majority vote off.
+            placement_smoothing: (self.placement_window > 0.0).then_some(PlacementSmoother {
+                window_s: self.placement_window,
+            }),
+            recorded_heading: self.heading.recorded_heading(),
+            ..ridi::TrackOptions::default()
+        };
+        opts.correction.lambda = self.lambda;
+        if self.estimate_initial_velocity {
+            opts.correction.initial_velocity = ridi::correct::InitialVelocity::Estimate;
+        }
+        opts
+    }
 }
 
 /// The worker threads of the whole run, started before any work ([`ridi::start_workers`]):

@@ -6,9 +6,9 @@ use anyhow::{Context, Result, bail};
 
 use ridi::ReadFiles;
 use ridi::data::{ReadOptions, counted, shown};
-use ridi::{PipelineError, TrackOptions, TrackOutput, apply_orientation};
+use ridi::{PipelineError, TrackOutput, apply_orientation};
 
-use crate::{Heading, MAX_FRAMES_APART, count, non_negative, placement_smoothing, positive};
+use crate::Tracking;
 
 #[derive(clap::Args)]
 pub(crate) struct Args {
@@ -28,26 +28,8 @@ pub(crate) struct Args {
     /// Also draw the trajectory (and ground truth if any) to a .png or .svg file.
     #[arg(long)]
     plot: Option<PathBuf>,
-    /// Frames between regressions.
-    #[arg(long, default_value_t = 50, value_parser = |s: &str| count(s, 1, MAX_FRAMES_APART))]
-    regress_every: usize,
-    /// Weight of the bias prior (paper: 0.1).
-    #[arg(long, default_value_t = 0.1, value_parser = positive)]
-    lambda: f64,
-    /// Estimate the initial velocity instead of assuming the walk starts at rest.
-    #[arg(long)]
-    estimate_initial_velocity: bool,
-    /// Placement majority window, seconds: each regression takes the most frequent placement
-    /// label within it (centred in batch, the seconds before it with --online); 0 keeps each
-    /// window's own label, as in the paper.
-    #[arg(long, value_name = "SECONDS", default_value_t = 10.0, value_parser = non_negative)]
-    placement_window: f64,
-    /// With a model on the estimated orientation: `corrected` turns the gyro's heading onto
-    /// the slow part of the recorded orientation's, so that its drift does not bend the track
-    /// (resets and magnetic corrections pass at 0.1 rad/s at most); `gyro` keeps the gyro's
-    /// heading. A model on the recorded orientation tracks with that.
-    #[arg(long, value_enum, default_value = "corrected")]
-    heading: Heading,
+    #[command(flatten)]
+    tracking: Tracking,
 }
 
 pub(crate) fn run(args: Args) -> Result<()> {
@@ -59,7 +41,7 @@ pub(crate) fn run(args: Args) -> Result<()> {
         output = output.with_plot(plot, &inputs)?;
     }
     let model = crate::model_or_bundled(args.model.as_deref())?;
-    let opts = track_options(&args);
+    let opts = args.tracking.options(args.online);
     // Online, a recording that streams is tracked as it is read, in memory that does not grow
     // with its length but for a plot's points.
     if args.online && ridi::data::detect(&args.sequence).is_ok_and(|f| f.streams()) {
@@ -74,7 +56,7 @@ pub(crate) fn run(args: Args) -> Result<()> {
         print_tracked(&args, &track.name, track.frames, track.regressions);
         return Ok(());
     }
-    let mut loaded = ridi::read_any(&args.sequence, None, &ReadOptions::default())?;
+    let mut loaded = ridi::read_to_track(&args.sequence, None, &ReadOptions::default())?;
     for w in &loaded.warnings {
         errln!("warning: {}", shown(w));
     }
@@ -114,22 +96,6 @@ fn print_tracked(args: &Args, name: &str, frames: usize, n: usize) {
     if let Some(plot) = &args.plot {
         outln!("plot: {}", shown(plot));
     }
-}
-
-/// The tracking options `args` ask for.
-fn track_options(args: &Args) -> TrackOptions {
-    let mut opts = TrackOptions {
-        regress_every: args.regress_every,
-        online: args.online,
-        placement_smoothing: placement_smoothing(args.placement_window),
-        recorded_heading: args.heading.recorded_heading(),
-        ..TrackOptions::default()
-    };
-    opts.correction.lambda = args.lambda;
-    if args.estimate_initial_velocity {
-        opts.correction.initial_velocity = ridi::correct::InitialVelocity::Estimate;
-    }
-    opts
 }
 
 /// `text` as one shell word, to copy into a command line: as it is when no shell treats any of

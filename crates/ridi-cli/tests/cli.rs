@@ -382,6 +382,11 @@ fn the_nystrom_solver_keeps_its_own_share_of_the_variance() {
             text.contains("landmarks per machine drawn with seed 7"),
             "{text}"
         );
+        // Kernel ridge regressors: a C and no epsilon.
+        assert!(
+            text.contains("S-x: C=10  S-z: C=10") && !text.contains("eps="),
+            "{text}"
+        );
         let variance = json["stored_variance"].as_f64().unwrap();
         (json["projected_components"].as_u64(), variance)
     };
@@ -1223,10 +1228,22 @@ fn from_ridi_plain_converts_the_data_plain_txt_of_a_folder_with_both() {
         let json: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
         assert_eq!(json["frames"], frames, "{from:?}");
     }
+    // A folder without a data_plain.txt is no `ridi-plain` source (its data.csv is not read
+    // instead), nor is a data.csv.
+    std::fs::remove_file(both.join("data_plain.txt")).unwrap();
+    for source in [source.clone(), both.join("data.csv")] {
+        let out = ridi(&["convert", s(&source), "--out", "y", "--from", "ridi-plain"]);
+        assert_eq!(out.status.code(), Some(1));
+        assert!(
+            stderr(&out).contains("not a RIDI data_plain.txt (it is a RIDI processed csv)"),
+            "{}",
+            stderr(&out)
+        );
+    }
     // The keys, each with what convert takes of it; another name is clap's usage error.
     let help = String::from_utf8(ridi(&["convert", "--help"]).stdout).unwrap();
     assert!(
-        help.contains("- ridi-plain: RIDI processed data_plain.txt (of a folder that has"),
+        help.contains("- ridi-plain: RIDI processed data_plain.txt (also of a folder that has"),
         "{help}"
     );
     let out = ridi(&["convert", s(&source), "--out", "x", "--from", "csv"]);
@@ -1365,6 +1382,14 @@ fn demo_writes_model_reports_and_plots_all_or_nothing() {
     }
     let md = std::fs::read_to_string(out.join("report.md")).unwrap();
     assert!(md.contains("| iPhone 4S | 1 |"), "{md}");
+    // The header names the correction the evaluation used.
+    assert!(
+        md.contains(
+            "; correction lambda 0.1, a knot every 50 frames, weights 1 / 1 (horizontal / \
+             vertical), initial velocity at rest; ridi "
+        ),
+        "{md}"
+    );
     let report = std::fs::read(out.join("report.json")).unwrap();
     let model = std::fs::read(out.join("model.ridi")).unwrap();
     ridi::regress::Cascade::from_bytes(&model).unwrap();

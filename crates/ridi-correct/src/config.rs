@@ -7,6 +7,7 @@ use crate::error::CorrectError;
 
 /// How the velocity at the first frame is obtained.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
 pub enum InitialVelocity {
     /// Known initial world velocity (the paper: zero, the walker starts at rest).
     Fixed(WorldVec),

@@ -358,7 +358,7 @@ fn listed_twice(e: &ListEntry, first: &ListEntry) -> DataError {
         e.location().with_field("path"),
         format!(
             "sequence `{}` is the recording already listed at {}:{}; a recording listed \
-             twice would count twice, or be tested on after training on it",
+             twice would count twice in a training or in an evaluation's means",
             shown(&e.path),
             shown(&first.list),
             first.line
@@ -373,7 +373,7 @@ fn copy_error(e: &ListEntry, first: &ListEntry) -> DataError {
         format!(
             "sequence `{}` holds the same recording as `{}`, listed at {}:{} (the same \
              timestamps, gyro and accelerometer samples); a recording listed twice would \
-             count twice, or be tested on after training on it",
+             count twice in a training or in an evaluation's means",
             shown(&e.path),
             shown(&first.path),
             shown(&first.list),

@@ -5,7 +5,7 @@ use std::path::PathBuf;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use ridi::eval::EvalConfig;
-use ridi::{EvalOptions, Method, PipelineError, Purpose, Report, TrackOptions, load_listed};
+use ridi::{EvalOptions, Method, PipelineError, Purpose, Report, load_listed};
 
 use crate::errors;
 use crate::model::{Model, json_dict};
@@ -20,9 +20,10 @@ use crate::options::{self, Inputs};
 ///
 /// ``data`` is a list file, several, or a list of ``ridi.Sequence`` with ground truth.
 /// ``methods`` are keys of ``ridi.METHODS``, one or a list (default: all, in that order); ``placement_map``,
-/// ``placement_window`` (seconds, 0 for the paper's per-window labels), ``align`` (seconds,
-/// or ``"all"``), ``heading`` (``"corrected"`` or ``"gyro"``, as ``ridi.track``'s) and
-/// ``jobs`` are ``ridi eval``'s options with its defaults. Ctrl-C stops the evaluation once the
+/// ``regress_every``, ``lambda_``, ``estimate_initial_velocity`` (the correction's, as
+/// ``ridi.track``'s), ``placement_window`` (seconds, 0 for the paper's per-window labels),
+/// ``align`` (seconds, or ``"all"``), ``heading`` (``"corrected"`` or ``"gyro"``, as
+/// ``ridi.track``'s) and ``jobs`` are ``ridi eval``'s options with its defaults. Ctrl-C stops the evaluation once the
 /// sequences under way are done (``KeyboardInterrupt``).
 ///
 /// >>> report = ridi.evaluate("datasets/sample/list_test.txt", model,
@@ -31,8 +32,9 @@ use crate::options::{self, Inputs};
 /// 1.02
 #[pyfunction]
 #[pyo3(signature = (
-    data, model, *, methods=None, placement_map=None, placement_window=10.0, align=None,
-    heading="corrected", jobs=None,
+    data, model, *, methods=None, placement_map=None, regress_every=50, lambda_=0.1,
+    estimate_initial_velocity=false, placement_window=10.0, align=None, heading="corrected",
+    jobs=None,
 ))]
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn evaluate<'py>(
@@ -41,6 +43,9 @@ pub(crate) fn evaluate<'py>(
     #[pyo3(from_py_with = crate::options::model)] model: Bound<'py, Model>,
     methods: Option<&Bound<'py, PyAny>>,
     placement_map: Option<PathBuf>,
+    #[pyo3(from_py_with = crate::options::whole)] regress_every: i64,
+    #[pyo3(from_py_with = crate::options::real)] lambda_: f64,
+    estimate_initial_velocity: bool,
     #[pyo3(from_py_with = crate::options::real)] placement_window: f64,
     align: Option<&Bound<'py, PyAny>>,
     heading: &str,
@@ -77,11 +82,14 @@ pub(crate) fn evaluate<'py>(
     };
     let opts = EvalOptions {
         methods,
-        track: TrackOptions {
-            placement_smoothing: options::placement_smoothing(placement_window)?,
-            recorded_heading: options::recorded_heading(heading)?,
-            ..TrackOptions::default()
-        },
+        track: options::track_options(
+            false,
+            regress_every,
+            lambda_,
+            estimate_initial_velocity,
+            placement_window,
+            heading,
+        )?,
         config: EvalConfig {
             align: match align {
                 Some(a) => options::align(a)?,
@@ -130,8 +138,11 @@ pub(crate) fn evaluate<'py>(
 /// ``second`` are reports of ``ridi.evaluate`` (dicts) or of ``ridi eval`` (a report.json, or
 /// the folder holding it). Returns a dict: ``sequences`` and ``runs`` both hold, ``settings``
 /// (what differs between the two: model, frames between regressions
-/// (``provenance.regress_every``), placement window, heading, alignment, methods, version),
-/// ``figures`` (per method both have and metric: the ``first`` and ``second`` means over the
+/// (``provenance.regress_every``), correction (``provenance.correction``), placement window,
+/// heading, alignment, methods, version),
+/// ``figures`` (per method both have and metric, ``ridi`` also with the model's
+/// ``velocity_mse_x``, ``velocity_mse_z`` and ``placement_accuracy``: the ``first`` and
+/// ``second`` means over the
 /// shared sequences, ``difference``, second minus first paired
 /// by sequence, and its 95 % ``interval``, None with fewer than 5 runs) and ``warnings``
 /// (also emitted as ``UserWarning``\ s).

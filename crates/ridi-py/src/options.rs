@@ -188,8 +188,8 @@ pub(crate) fn align(value: &Bound<'_, PyAny>) -> PyResult<AlignWindow> {
     Ok(AlignWindow::Seconds(positive("align", seconds)?))
 }
 
-/// The tracking options of `ridi track` (and `ridi eval`'s `--placement-window`): the facade's
-/// defaults with the flags given.
+/// The tracking options of `ridi track` and `ridi eval`: the facade's defaults with the flags
+/// given.
 pub(crate) fn track_options(
     online: bool,
     regress_every: i64,

@@ -528,7 +528,8 @@ fn read_sequences(
 
 /// Reads the recording at `path`: a RIDI ``data.csv`` (or ``.csv.gz``), ``data_plain.txt``,
 /// RIDI raw recorder folder, Tyrex run folder, Indoor Location Competition path file or RoNIN
-/// sequence folder, as ``ridi track`` reads it. ``format`` forces one (``ridi-csv``, ``ridi-plain``, ``ridi-raw``,
+/// sequence folder, as ``ridi inspect`` reads it (a Tyrex run that mocap losses split is
+/// several sequences here: ``read_any``). ``format`` forces one (``ridi-csv``, ``ridi-plain``, ``ridi-raw``,
 /// ``tyrex``, ``ilc``, ``ronin``) instead of detecting it. The readers' warnings are ``UserWarning``\ s.
 ///
 /// ``split_at_gaps`` (seconds, above 0 and below 1) cuts the recording at every gap longer than that, as

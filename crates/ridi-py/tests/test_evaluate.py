@@ -59,14 +59,28 @@ def test_evaluate_equals_report_json(model, model_file, ridi_bin, test_list, tmp
 def test_evaluate_options_reach_the_cli_flags(model, model_file, ridi_bin, test_list, tmp_path):
     ridi_bin("eval", "--list", test_list, "--model", model_file, "--out", tmp_path / "out",
              "--placement-map", "tyrex4", "--plots", "none", "--methods", "ridi,pdr",
-             "--align", "all", "--placement-window", "0", "--jobs", "1")
+             "--align", "all", "--placement-window", "0", "--jobs", "1", "--regress-every", "25",
+             "--lambda", "0.3", "--estimate-initial-velocity")
     expected = json.loads((tmp_path / "out" / "report.json").read_text())
     expected["provenance"]["model_source"] = None
     assert expected["provenance"]["placement_window_s"] is None
+    assert expected["provenance"]["regress_every"] == 25
+    correction = expected["provenance"]["correction"]
+    assert (correction["lambda"], correction["initial_velocity"]) == (0.3, "estimate")
     report = ridi.evaluate([test_list], model, placement_map="tyrex4", methods=["ridi", "pdr"],
-                           align="all", placement_window=0, jobs=1)
+                           align="all", placement_window=0, jobs=1, regress_every=25,
+                           lambda_=0.3, estimate_initial_velocity=True)
     assert same(report, expected)
     assert report["methods"] == ["ridi", "pdr"]
+    # The tracking options change RIDI's trajectories, as they change `ridi.track`'s.
+    default = ridi.evaluate([test_list], model, placement_map="tyrex4", methods=["ridi", "pdr"],
+                            align="all", placement_window=0, jobs=1)
+    assert default["provenance"]["correction"]["lambda"] == 0.1
+    assert default["summary"]["ridi"]["ate_m"] != report["summary"]["ridi"]["ate_m"]
+    assert default["summary"]["pdr"] == report["summary"]["pdr"]
+    for bad, message in [(dict(regress_every=0), "regress_every"), (dict(lambda_=-1.0), "lambda_")]:
+        with pytest.raises(ValueError, match=message):
+            ridi.evaluate([test_list], model, placement_map="tyrex4", **bad)
 
 
 def test_evaluate_sequences_equals_the_list(model, test_list):
@@ -133,7 +147,7 @@ def test_bad_evaluations_are_refused(model, test_list, tmp_path):
 
 def test_one_method_by_name_and_warnings_as_python_warnings(model, test_list):
     # Labels the model does not know (no placement map): the report says so, and so does Python.
-    with pytest.warns(UserWarning, match=r"is not one of the model's classes"):
+    with pytest.warns(UserWarning, match=r"placement labels are not among the model's classes"):
         one = ridi.evaluate(test_list, model, methods="ridi")
     assert one["methods"] == ["ridi"] and one["warnings"]
     with pytest.warns(UserWarning):
@@ -203,6 +217,14 @@ def test_compare_pairs_two_evaluations_as_the_command_does(model, model_file, ri
                            placement_window=0)
     c = ridi.compare(first, second)
     assert c["settings"] == ["placement: 10 s against per regression"]
+    third = ridi.evaluate(listed, model, methods=["ridi", "pdr"], placement_map="tyrex4",
+                          lambda_=0.3)
+    assert ridi.compare(first, third)["settings"] == ["correction lambda: 0.1 against 0.3"]
+    # A report of an older ridi, without its correction: a warning says so.
+    older = json.loads(json.dumps(first))
+    del older["provenance"]["correction"]
+    with pytest.warns(UserWarning, match=r"the first report does not record its correction"):
+        assert ridi.compare(older, third)["settings"] == []
     assert (c["sequences"], c["runs"], c["warnings"]) == (5, 5, [])
     rte = {(f["method"], f["metric"]): f for f in c["figures"]}
     assert rte[("pdr", "rte_5s_m")]["difference"] == 0.0
@@ -219,9 +241,19 @@ def test_compare_pairs_two_evaluations_as_the_command_does(model, model_file, ri
     assert same_model["settings"] == [] and all(
         f["difference"] == 0.0 for f in same_model["figures"])
     # Read back to the last bit: each figure's mean is the report's own.
-    summary = json.loads((out / "report.json").read_text())["summary"]
+    saved = json.loads((out / "report.json").read_text())
+    model_figures = {"velocity_mse_x": 0, "velocity_mse_z": 1, "placement_accuracy": None}
     for f in same_model["figures"]:
-        assert f["first"] == summary[f["method"]][f["metric"]], f
+        if f["metric"] in model_figures:
+            # The model's own figures, `ridi`'s: means of the sequences' values.
+            assert f["method"] == "ridi"
+            channel = model_figures[f["metric"]]
+            values = [s["velocity_mse"][channel] if channel is not None
+                      else s["placement_accuracy"] for s in saved["sequences"]]
+            assert f["first"] == pytest.approx(sum(values) / len(values), rel=1e-12)
+        else:
+            assert f["first"] == saved["summary"][f["method"]][f["metric"]], f
+    assert {f["metric"] for f in same_model["figures"]} >= set(model_figures)
     printed = ridi_bin("compare", out, out)
     assert "Nothing recorded differs between the two" in printed
     # The command's JSON is ridi.compare's on the same files.

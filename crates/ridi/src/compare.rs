@@ -8,15 +8,76 @@ use std::fmt::Write as _;
 use ridi_eval::{Interval, Metric};
 use serde::Serialize;
 
+use crate::SequenceResult;
 use crate::error::{PipelineError, Result};
-use crate::evaluate::{Report, with_interval};
+use crate::evaluate::{Report, interval_text};
+
+/// A figure two reports are compared on: a method's trajectory metric, or one of the model's
+/// own, which a report gives per sequence beside `ridi`'s trajectory.
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum Figure {
+    Trajectory(Metric),
+    /// Velocity MSE of the regressions, channel 0 (S-x) or 1 (S-z).
+    VelocityMse(usize),
+    PlacementAccuracy,
+}
+
+impl Figure {
+    /// Every figure, in the order of the comparison's rows.
+    fn all() -> impl Iterator<Item = Figure> {
+        Metric::ALL.into_iter().map(Figure::Trajectory).chain([
+            Figure::VelocityMse(0),
+            Figure::VelocityMse(1),
+            Figure::PlacementAccuracy,
+        ])
+    }
+
+    /// Its key in [`ComparedFigure::metric`].
+    fn key(self) -> &'static str {
+        match self {
+            Figure::Trajectory(m) => m.key(),
+            Figure::VelocityMse(0) => "velocity_mse_x",
+            Figure::VelocityMse(_) => "velocity_mse_z",
+            Figure::PlacementAccuracy => "placement_accuracy",
+        }
+    }
+
+    fn label(self) -> &'static str {
+        match self {
+            Figure::Trajectory(m) => m.label(),
+            Figure::VelocityMse(0) => "velocity MSE S-x ((m/s)^2)",
+            Figure::VelocityMse(_) => "velocity MSE S-z ((m/s)^2)",
+            Figure::PlacementAccuracy => "placement accuracy",
+        }
+    }
+
+    /// Its value for `method` on sequence `s`: the model's figures are `ridi`'s.
+    fn value(self, s: &SequenceResult, method: &str) -> Option<f64> {
+        match self {
+            Figure::Trajectory(m) => s.methods.get(method).and_then(|t| m.value(t)),
+            Figure::VelocityMse(c) => (method == "ridi").then(|| s.velocity_mse[c]),
+            Figure::PlacementAccuracy => s.placement_accuracy.filter(|_| method == "ridi"),
+        }
+        .filter(|v| v.is_finite())
+    }
+
+    /// As the report prints it: velocity MSE with 4 decimals, as report.md's.
+    fn format(self, v: Option<f64>) -> String {
+        match (self, v) {
+            (Figure::Trajectory(m), v) => m.format(v),
+            (Figure::VelocityMse(_), Some(v)) => format!("{v:.4}"),
+            (_, v) => Metric::AteM.format(v),
+        }
+    }
+}
 
 /// One method and metric of a [`Comparison`].
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct ComparedFigure {
     /// Method key (`ridi`, `pdr`, ...).
     pub method: String,
-    /// Metric key (`rte_5s_m`, ...).
+    /// Figure key: a metric's (`rte_5s_m`, ...), or for `ridi` also `velocity_mse_x`,
+    /// `velocity_mse_z` and `placement_accuracy`, the model's own.
     pub metric: String,
     /// Sequences where both reports have the figure.
     pub sequences: usize,
@@ -114,6 +175,16 @@ pub fn compare_reports(first: &Report, second: &Report) -> Result<Comparison> {
         ));
     }
     for (which, r) in [("first", first), ("second", second)] {
+        if r.provenance
+            .as_ref()
+            .is_some_and(|p| p.correction.is_none())
+        {
+            warnings.push(format!(
+                "the {which} report does not record its correction (a report of an older ridi, \
+                 whose commands corrected with lambda 0.1, a knot every 50 frames, from rest): \
+                 a difference there is not listed"
+            ));
+        }
         if r.provenance.is_none() {
             warnings.push(format!(
                 "the {which} report does not record its model and tracking settings (a report \
@@ -139,17 +210,11 @@ pub fn compare_reports(first: &Report, second: &Report) -> Result<Comparison> {
         .filter(|m| second.methods.contains(m))
         .collect();
     for &method in &shared {
-        for metric in Metric::ALL {
+        for figure in Figure::all() {
             let mut rows: Vec<(f64, f64, &str)> = Vec::new();
             let mut lacking = 0;
             for name in &both {
-                let value = |r: &Report, i: usize| {
-                    r.sequences[i]
-                        .methods
-                        .get(method)
-                        .and_then(|m| metric.value(m))
-                        .filter(|v| v.is_finite())
-                };
+                let value = |r: &Report, i: usize| figure.value(&r.sequences[i], method);
                 match (value(first, a[name]), value(second, b[name])) {
                     (Some(x), Some(y)) => rows.push((x, y, ridi_eval::run_of(name))),
                     (None, None) => {}
@@ -159,7 +224,7 @@ pub fn compare_reports(first: &Report, second: &Report) -> Result<Comparison> {
             if lacking > 0 {
                 one_sided.push(format!(
                     "{method} {}: {lacking} of {}",
-                    metric.label(),
+                    figure.label(),
                     rows.len() + lacking
                 ));
             }
@@ -171,7 +236,7 @@ pub fn compare_reports(first: &Report, second: &Report) -> Result<Comparison> {
             let column = |f: fn(&(f64, f64, &str)) -> f64| rows.iter().map(f).collect::<Vec<_>>();
             figures.push(ComparedFigure {
                 method: method.clone(),
-                metric: metric.key().to_string(),
+                metric: figure.key().to_string(),
                 sequences: rows.len(),
                 first: ridi_eval::ordered_mean(&column(|r| r.0)),
                 second: ridi_eval::ordered_mean(&column(|r| r.1)),
@@ -244,12 +309,17 @@ fn differing_settings(first: &Report, second: &Report) -> Vec<String> {
         .collect()
 }
 
+/// The correction `r` records.
+fn correction(r: &Report) -> Option<&ridi_correct::CorrectionConfig> {
+    r.provenance.as_ref()?.correction.as_ref()
+}
+
 /// A setting [`differing_settings`] compares: its name, and its value in a report (`None`
 /// where the report does not record it).
 type Setting = (&'static str, fn(&Report) -> Option<String>);
 
 /// Every setting that makes two reports' figures differ, in the order they are listed.
-const SETTINGS: [Setting; 9] = [
+const SETTINGS: [Setting; 14] = [
     ("model", |r| {
         let p = r.provenance.as_ref()?;
         Some(format!("{} ({})", p.model, p.model_fingerprint))
@@ -260,6 +330,28 @@ const SETTINGS: [Setting; 9] = [
     ("placement", |r| {
         let window = r.provenance.as_ref()?.placement_window_s;
         Some(window.map_or("per regression".to_string(), |w| format!("{w} s")))
+    }),
+    // The correction, field by field, so that only what differs is listed.
+    ("correction lambda", |r| {
+        Some(correction(r)?.lambda.to_string())
+    }),
+    ("correction knots", |r| {
+        Some(format!("every {} frames", correction(r)?.knot_spacing))
+    }),
+    ("correction weights", |r| {
+        let c = correction(r)?;
+        Some(format!(
+            "{} / {} (horizontal / vertical)",
+            c.horizontal_weight, c.vertical_weight
+        ))
+    }),
+    ("initial velocity", |r| {
+        Some(crate::evaluate::initial_velocity_text(
+            correction(r)?.initial_velocity,
+        ))
+    }),
+    ("largest time step", |r| {
+        Some(format!("{} s", correction(r)?.max_dt))
     }),
     ("placement map", |r| {
         let map = r.provenance.as_ref()?.placement_map.clone();
@@ -318,18 +410,19 @@ impl Comparison {
         out.push_str("| method | figure | sequences | first | second | second - first |\n");
         out.push_str("| --- | --- | --- | --- | --- | --- |\n");
         for f in &self.figures {
-            let Some(metric) = Metric::ALL.into_iter().find(|m| m.key() == f.metric) else {
+            let Some(figure) = Figure::all().find(|g| g.key() == f.metric) else {
                 continue;
             };
+            let difference = figure.format(Some(f.difference));
             let _ = writeln!(
                 out,
                 "| {} | {} | {} | {} | {} | {} |",
                 f.method,
-                metric.label(),
+                figure.label(),
                 f.sequences,
-                metric.format(Some(f.first)),
-                metric.format(Some(f.second)),
-                with_interval(metric, Some(f.difference), f.interval.as_ref(), true)
+                figure.format(Some(f.first)),
+                figure.format(Some(f.second)),
+                interval_text(difference, Some(f.difference), f.interval.as_ref(), true)
             );
         }
         out.split('\n')
@@ -372,6 +465,48 @@ mod tests {
                 })
                 .collect(),
         )
+    }
+
+    #[test]
+    fn the_models_own_figures_are_compared_as_ridis() {
+        let names = ["a", "b", "c", "d", "e"];
+        let with = |mse: f64, accuracy: f64| {
+            let mut r = report(&names.map(|n| (n, 1.0)));
+            for (i, s) in r.sequences.iter_mut().enumerate() {
+                s.velocity_mse = [mse + i as f64 * 0.01, 2.0 * mse];
+                s.placement_accuracy = Some(accuracy);
+            }
+            r
+        };
+        let c = compare_reports(&with(0.1, 0.5), &with(0.2, 0.9)).unwrap();
+        let figure = |key: &str| c.figures.iter().find(|f| f.metric == key).unwrap();
+        assert!((figure("velocity_mse_x").difference - 0.1).abs() < 1e-12);
+        assert!((figure("velocity_mse_z").difference - 0.2).abs() < 1e-12);
+        let accuracy = figure("placement_accuracy");
+        assert_eq!((accuracy.method.as_str(), accuracy.sequences), ("ridi", 5));
+        assert!((accuracy.difference - 0.4).abs() < 1e-12);
+        let markdown = c.to_markdown();
+        assert!(
+            markdown.contains(
+                "| ridi | placement accuracy | 5 | 0.500 | 0.900 | **+0.400 [0.40, 0.40]** |"
+            ),
+            "{markdown}"
+        );
+        assert!(markdown.contains("| ridi | velocity MSE S-x ((m/s)^2) | 5 |"));
+        // A resolved difference too small for two decimals is not printed as [0.00, 0.00]: with
+        // more decimals, or in scientific notation.
+        let row = |d: f64| {
+            let c = compare_reports(&with(0.1, 0.5), &with(0.1 + d, 0.5)).unwrap();
+            let markdown = c.to_markdown();
+            let line = markdown.lines().find(|l| l.contains("MSE S-x")).unwrap();
+            line.rsplit(" | ")
+                .next()
+                .unwrap()
+                .trim_end_matches(" |")
+                .to_string()
+        };
+        assert_eq!(row(6e-5), "**+0.0001 [0.0001, 0.0001]**");
+        assert_eq!(row(2e-7), "**+2.0e-7 [2.0e-7, 2.0e-7]**");
     }
 
     #[test]

@@ -332,6 +332,20 @@ struct ListLabels {
 /// parent folder's for a sequence given alone). A file that does not parse
 /// as a list is skipped; an entry may name the sequence folder or its `processed/` file; a
 /// sequence two lists label differently keeps the first label (lists by name), with a warning.
+/// The sequence folder a list entry or a source stands for, resolved: a file's folder, and
+/// for `<sequence>/processed/data.csv`, `<sequence>`.
+fn labelled(path: &Path) -> Option<PathBuf> {
+    let path = path.canonicalize().ok()?;
+    if !path.is_file() {
+        return Some(path);
+    }
+    let folder = match path.parent() {
+        Some(p) if p.ends_with("processed") => p.parent(),
+        other => other,
+    };
+    Some(folder.map_or(path.clone(), Path::to_path_buf))
+}
+
 fn labels_from_lists(source: &Path) -> ListLabels {
     let mut out = ListLabels::default();
     let Ok(entries) = std::fs::read_dir(source) else {
@@ -352,19 +366,9 @@ fn labels_from_lists(source: &Path) -> ListLabels {
         };
         out.lists.push(list.clone());
         for e in entries {
-            let (Some(label), Ok(mut path)) = (e.placement, e.path.canonicalize()) else {
+            let (Some(label), Some(path)) = (e.placement, labelled(&e.path)) else {
                 continue;
             };
-            // `<sequence>/processed/data.csv` labels `<sequence>`.
-            if path.is_file() {
-                let folder = match path.parent() {
-                    Some(p) if p.ends_with("processed") => p.parent(),
-                    other => other,
-                };
-                if let Some(folder) = folder {
-                    path = folder.to_path_buf();
-                }
-            }
             match labels.get(&path) {
                 None => {
                     labels.insert(path, label);
@@ -553,7 +557,8 @@ fn device_lists<'a>(
 /// `list_<device>.txt` per device the sequences name ([`DeviceInfo::key`]: `list_nexus5.txt`,
 /// `list_iphone4s.txt`). The placement of a Tyrex run is its motion name, that of an Indoor
 /// Location Competition path `hand`, that of a RIDI sequence the label list files directly in
-/// `source` give it (none otherwise).
+/// `source` give it, or for one sequence given alone (its folder or its `data.csv`) the lists
+/// beside its folder (none otherwise).
 ///
 /// All or nothing: every source is read and validated, and its files written to a staging
 /// folder in `out`, before any is moved into place; on an error `out` is left as it was (a
@@ -574,7 +579,7 @@ pub fn convert(
     // One sequence given alone: the RIDI layout keeps its lists beside it, in its folder's
     // parent (`datasets/sample/list_test.txt` labels `datasets/sample/<run>`).
     if let [only] = &dirs[..]
-        && let Ok(folder) = only.canonicalize()
+        && let Some(folder) = labelled(only)
         && !listed.labels.contains_key(&folder)
         && let Some(parent) = folder.parent()
     {
@@ -594,7 +599,7 @@ pub fn convert(
                 None => read_any(dir, from, &opts.read)?,
             };
             let mut written = Vec::new();
-            let listed = dir.canonicalize().ok().and_then(|d| labels.get(&d));
+            let listed = labelled(dir).and_then(|d| labels.get(&d));
             for seq in &loaded.sequences {
                 let resampled = match opts.rate_hz {
                     Some(rate) => {

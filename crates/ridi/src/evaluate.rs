@@ -174,6 +174,9 @@ pub struct Provenance {
     /// --placement-map`: `tyrex4` or a file); `None` without one, or when the caller did not
     /// say.
     pub placement_map: Option<String>,
+    /// The correction of the model's regressions ([`TrackOptions::correction_for`]: lambda,
+    /// knots, weights, initial velocity); `None` in a report that does not record it.
+    pub correction: Option<ridi_correct::CorrectionConfig>,
 }
 
 impl Provenance {
@@ -203,6 +206,7 @@ impl Provenance {
             regress_every: opts.track.regress_every,
             placement_window_s: opts.track.placement_smoothing.map(|p| p.window_s),
             placement_map: None,
+            correction: Some(opts.track.correction_for(model)),
         })
     }
 }
@@ -228,6 +232,32 @@ impl Report {
     }
 }
 
+/// The settings of a correction as report.md and `ridi compare` name them.
+pub(crate) fn correction_text(c: &ridi_correct::CorrectionConfig) -> String {
+    format!(
+        "lambda {}, a knot every {} frames, weights {} / {} (horizontal / vertical), initial \
+         velocity {}",
+        c.lambda,
+        c.knot_spacing,
+        c.horizontal_weight,
+        c.vertical_weight,
+        initial_velocity_text(c.initial_velocity)
+    )
+}
+
+/// A correction's initial velocity as report.md and `ridi compare` name it.
+pub(crate) fn initial_velocity_text(v: ridi_correct::InitialVelocity) -> String {
+    match v {
+        ridi_correct::InitialVelocity::Estimate => "estimated".to_string(),
+        ridi_correct::InitialVelocity::Fixed(v) if v == ridi_frames::WorldVec::ZERO => {
+            "at rest".to_string()
+        }
+        ridi_correct::InitialVelocity::Fixed(v) => {
+            format!("({}, {}, {}) m/s", v.x(), v.y(), v.z())
+        }
+    }
+}
+
 /// A mean as report tables print it ([`Metric::format`]) with its interval when known, `1.033
 /// [0.90, 1.19]`; a difference (`signed`) with its sign, bold when the interval leaves out 0.
 pub(crate) fn with_interval(
@@ -236,17 +266,38 @@ pub(crate) fn with_interval(
     interval: Option<&ridi_eval::Interval>,
     signed: bool,
 ) -> String {
-    let value = metric.format(mean);
+    interval_text(metric.format(mean), mean, interval, signed)
+}
+
+/// [`with_interval`] for a value already formatted as `value`.
+pub(crate) fn interval_text(
+    value: String,
+    mean: Option<f64>,
+    interval: Option<&ridi_eval::Interval>,
+    signed: bool,
+) -> String {
     let value = if signed && mean.is_some() && !value.starts_with('-') {
         format!("+{value}")
     } else {
         value
     };
-    let Some(i) = interval.filter(|i| mean.is_some() && i.is_bounded()) else {
+    let (Some(i), Some(mean)) = (interval.filter(|i| i.is_bounded()), mean) else {
         return value;
     };
-    let text = format!("{value} [{:.2}, {:.2}]", i.low, i.high);
-    if signed && (i.low > 0.0 || i.high < 0.0) {
+    let resolved = signed && (i.low > 0.0 || i.high < 0.0);
+    // A resolved interval whose bound rounds to 0 would read as touching 0 (`[-0.02, -0.00]`,
+    // or `+0.000 [0.00, 0.00]` for a tiny one): more decimals, up to 5, then scientific.
+    let shows = |x: f64, d: usize| {
+        format!("{:.d$}", x.abs())
+            .bytes()
+            .any(|b| (b'1'..=b'9').contains(&b))
+    };
+    let text = match (2..=5).find(|&d| !resolved || (shows(i.low, d) && shows(i.high, d))) {
+        Some(2) => format!("{value} [{:.2}, {:.2}]", i.low, i.high),
+        Some(d) => format!("{mean:+.d$} [{:.d$}, {:.d$}]", i.low, i.high),
+        None => format!("{mean:+.1e} [{:.1e}, {:.1e}]", i.low, i.high),
+    };
+    if resolved {
         format!("**{text}**")
     } else {
         text
@@ -346,12 +397,13 @@ fn evaluate_one(seq: &Sequence, model: &Cascade, opts: &EvalOptions) -> Result<E
     })
 }
 
-/// One warning per placement label of `seqs` that is not one of the model's classes, naming
-/// its sequences: the classifier cannot predict it, so their placement accuracy is 0 (their
-/// trajectories are still worth evaluating). For example: "placement `swing` of 2 sequences
-/// (Thibaud_Nexus5_NoDist_Swinging, Jakob_Nexus5_NoDist_Swinging) is not one of the model's
-/// classes (hand, pocket): their placement accuracy is 0". A Tyrex motion name under a model of
-/// the Tyrex groups gets the placement map to give.
+/// One warning naming the placement labels of `seqs` that are not among the model's classes,
+/// with their sequences: the classifier cannot predict them, so their placement accuracy is 0
+/// (their trajectories are still worth evaluating). For example: "placement `swing` of 2
+/// sequences (Thibaud_Nexus5_NoDist_Swinging, Jakob_Nexus5_NoDist_Swinging) is not one of the
+/// model's classes (hand, pocket): their placement accuracy is 0"; several labels are listed in
+/// one warning. Tyrex motion names under a model of the Tyrex groups get the placement map to
+/// give.
 pub fn placement_warnings(seqs: &[Sequence], model: &Cascade) -> Vec<String> {
     let classes = model.placement_names();
     let mut unknown: BTreeMap<&str, Vec<&str>> = BTreeMap::new();
@@ -362,27 +414,50 @@ pub fn placement_warnings(seqs: &[Sequence], model: &Cascade) -> Vec<String> {
             unknown.entry(label).or_default().push(s.name());
         }
     }
+    if unknown.is_empty() {
+        return Vec::new();
+    }
+    // The map, where it takes every such label to one of the model's classes (with a label it
+    // lacks, giving it would be an error).
     let tyrex = crate::PlacementMap::tyrex4();
-    unknown
-        .into_iter()
-        .map(|(label, names)| {
-            let listed = ridi_data::first_few(names.iter(), 3);
-            let hint = match tyrex.class_of(label) {
-                Some(class) if classes.iter().any(|c| c == class) => {
-                    " (a Tyrex motion name: give `--placement-map tyrex4`, in Python \
-                     `placement_map=\"tyrex4\"`)"
-                }
-                _ => "",
-            };
-            format!(
-                "placement `{label}` of {} ({listed}) is not one of the model's classes ({}): \
-                 {} placement accuracy is 0{hint}",
-                ridi_data::counted(names.len(), "sequence"),
-                classes.join(", "),
-                if names.len() == 1 { "its" } else { "their" },
-            )
-        })
-        .collect()
+    let mapped = unknown.keys().all(|l| {
+        tyrex
+            .class_of(l)
+            .is_some_and(|class| classes.iter().any(|c| c == class))
+    });
+    let give = "give `--placement-map tyrex4`, in Python `placement_map=\"tyrex4\"`";
+    let hint = match (mapped, unknown.len()) {
+        (false, _) => String::new(),
+        (true, 1) => format!(" (a Tyrex motion name: {give})"),
+        (true, _) => format!(" (Tyrex motion names: {give})"),
+    };
+    let of = |names: &[&str]| {
+        format!(
+            "{} ({})",
+            ridi_data::counted(names.len(), "sequence"),
+            ridi_data::first_few(names.iter(), 3)
+        )
+    };
+    let classes = classes.join(", ");
+    let warning = match unknown.into_iter().collect::<Vec<_>>().as_slice() {
+        [(label, names)] => format!(
+            "placement `{label}` of {} is not one of the model's classes ({classes}): {} \
+             placement accuracy is 0{hint}",
+            of(names),
+            if names.len() == 1 { "its" } else { "their" },
+        ),
+        labels => format!(
+            "{} placement labels are not among the model's classes ({classes}), so their \
+             sequences' placement accuracy is 0: {}{hint}",
+            labels.len(),
+            labels
+                .iter()
+                .map(|(label, names)| format!("`{label}` of {}", of(names)))
+                .collect::<Vec<_>>()
+                .join(", ")
+        ),
+    };
+    vec![warning]
 }
 
 /// Refuses a sequence [`evaluate`] cannot evaluate with a model of feature configuration
@@ -817,8 +892,8 @@ impl Report {
         if let Some(p) = &self.provenance {
             let _ = writeln!(
                 out,
-                "Model: {} (fingerprint {}{}); regressions every {} frames, placement {}; ridi \
-                 {}.\n",
+                "Model: {} (fingerprint {}{}); regressions every {} frames, placement {}{}; \
+                 ridi {}.\n",
                 p.model,
                 p.model_fingerprint,
                 p.model_source
@@ -829,6 +904,10 @@ impl Report {
                     .map_or("per regression".to_string(), |w| format!(
                         "by majority over {w} s"
                     )),
+                p.correction.as_ref().map_or(String::new(), |c| format!(
+                    "; correction {}",
+                    correction_text(c)
+                )),
                 p.ridi_version
             );
         }

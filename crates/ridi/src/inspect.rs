@@ -497,7 +497,8 @@ pub struct PlacementModel {
     pub speed: Option<RegressorSummary>,
 }
 
-/// Hyper-parameters of one epsilon-SVR ([`PlacementModel`]).
+/// Hyper-parameters of one regressor ([`PlacementModel`]): an epsilon-SVR's, or a Nyström
+/// model's kernel ridge regression's, whose `epsilon` is 0 (it has none).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 pub struct RegressorSummary {
     /// `C`.
@@ -622,16 +623,23 @@ impl std::fmt::Display for ModelInspection {
                 100.0 * self.stored_variance
             )?,
         }
+        // A Nyström model's regressors are kernel ridge regressions: no epsilon to show.
+        let params = |r: RegressorSummary| match self.landmarks {
+            Some(_) => format!("C={}", r.c),
+            None => r.to_string(),
+        };
         for p in &self.placements {
-            let speed = p.speed.map_or(String::new(), |s| format!("  speed: {s}"));
+            let speed = p
+                .speed
+                .map_or(String::new(), |s| format!("  speed: {}", params(s)));
             writeln!(
                 f,
                 "  {:<12} {:>6} samples of {:>7} windows  S-x: {}  S-z: {}{speed}",
                 shown(&p.name),
                 p.samples,
                 p.windows,
-                p.s_x,
-                p.s_z
+                params(p.s_x),
+                params(p.s_z)
             )?;
         }
         if !self.cross_validation.is_empty() {

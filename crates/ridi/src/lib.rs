@@ -134,7 +134,7 @@ pub use output::{
     check_output_file, check_output_folder, save_model,
 };
 pub use placement::PlacementMap;
-pub use source::{Loaded, ReadFiles, read_any, source_format};
+pub use source::{Loaded, ReadFiles, read_any, read_to_track, source_format};
 pub use staging::Staging;
 pub use track::{
     StreamedTrack, TRACK_RATE_HZ, TRACK_RATE_TOLERANCE, Track, regress_sequence, track,

@@ -151,8 +151,8 @@ pub fn check_distinct_recordings(seqs: &[Sequence]) -> Result<()> {
             seqs[j].name(),
             format!(
                 "is the same recording as sequence {i}, `{}` (the same timestamps, gyro and \
-                 accelerometer samples); given twice it would count twice, or be tested on \
-                 after training on it",
+                 accelerometer samples); given twice it would count twice in a \
+                 training or in an evaluation's means",
                 ridi_data::shown(seqs[i].name())
             ),
         )),

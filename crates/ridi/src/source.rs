@@ -21,13 +21,16 @@ pub struct Loaded {
 
 /// Whether `path` is, by itself, one source of the format `want`. A folder with any RIDI raw
 /// file is a raw folder even when it also holds `processed/data.csv` (as RIDI capture folders
-/// do), and `data_plain.txt` counts as a RIDI processed csv.
+/// do); `data_plain.txt` counts as a RIDI processed csv, but only a `data_plain.txt` (or a
+/// folder holding one) is a `data_plain.txt`.
 pub(crate) fn is_a(path: &Path, want: Format) -> bool {
     match want {
         Format::RidiRaw => path.is_dir() && ridi_data::ridi_raw::looks_like(path),
-        Format::RidiCsv | Format::RidiPlain => {
-            matches!(detect(path), Ok(Format::RidiCsv | Format::RidiPlain))
+        Format::RidiCsv => matches!(detect(path), Ok(Format::RidiCsv | Format::RidiPlain)),
+        Format::RidiPlain if path.is_dir() => {
+            ridi_data::processed_file(path, Format::RidiPlain).is_some()
         }
+        Format::RidiPlain => detect(path).is_ok_and(|f| f == Format::RidiPlain),
         Format::Tyrex | Format::Ilc | Format::Ronin => detect(path).is_ok_and(|f| f == want),
     }
 }
@@ -72,7 +75,7 @@ pub(crate) fn with_article(name: &str) -> String {
 pub fn source_format(path: &Path, from: Option<Format>) -> Result<Format, DataError> {
     Ok(match from {
         None => detect(path)?,
-        Some(Format::RidiCsv | Format::RidiPlain) if is_a(path, Format::RidiCsv) => detect(path)?,
+        Some(Format::RidiCsv) if is_a(path, Format::RidiCsv) => detect(path)?,
         Some(want) if is_a(path, want) => want,
         Some(Format::RidiRaw) if path.is_dir() && detect(path).is_err() => Format::RidiRaw,
         Some(want) => return Err(not_a(path, want)),
@@ -131,6 +134,54 @@ pub fn read_any(
             warnings: Vec::new(),
         }),
     }
+}
+
+/// [`read_any`] for tracking, which needs no ground truth: a Tyrex run that the motion
+/// capture's losses split into parts is read again without ground truth, and a warning says
+/// so (`ridi convert` writes the parts with theirs): one recording where its phone streams are
+/// whole, else the fewer parts their own gaps make. Anything else, and a run whose second read
+/// fails a check, is [`read_any`]'s.
+///
+/// # Errors
+/// As [`read_any`].
+pub fn read_to_track(
+    path: &Path,
+    from: Option<Format>,
+    opts: &ReadOptions,
+) -> Result<Loaded, DataError> {
+    let loaded = read_any(path, from, opts)?;
+    let by_mocap = loaded.format == Format::Tyrex
+        && loaded.sequences.len() > 1
+        && loaded.sequences.iter().all(|s| s.ground_truth().is_some());
+    if !by_mocap {
+        return Ok(loaded);
+    }
+    let without = TyrexOptions {
+        ground_truth: false,
+        ..TyrexOptions::from(opts)
+    };
+    let Ok(whole) = tyrex::read(forced_file(path, from), &without) else {
+        return Ok(loaded);
+    };
+    if whole.sequences.is_empty() || whole.sequences.len() >= loaded.sequences.len() {
+        return Ok(loaded);
+    }
+    let read_as = match whole.sequences.len() {
+        1 => "tracked as one recording without it".to_string(),
+        n => format!("read without it: {n} parts, cut at gaps in the phone's own streams"),
+    };
+    let mut warnings = vec![format!(
+        "{}: mocap losses split the run into {} parts with ground truth; {read_as} (`ridi \
+         convert` writes the parts with theirs)",
+        ridi_data::shown(path),
+        loaded.sequences.len()
+    )];
+    warnings.extend(whole.warnings);
+    Ok(Loaded {
+        format: Format::Tyrex,
+        sequences: whole.sequences,
+        warnings,
+    })
 }
 
 /// The files a command reads, resolved once, to refuse an output that would replace one.

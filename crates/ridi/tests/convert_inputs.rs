@@ -917,4 +917,8 @@ fn a_sequence_converted_alone_keeps_the_label_the_lists_beside_it_give() {
     assert_eq!(summary.sequences[0].placement.as_deref(), Some("Texting"));
     let list = std::fs::read_to_string(out.join("list_all.txt")).unwrap();
     assert!(list.ends_with("\nwalk,Texting\n"), "{list}");
+    // Given as its data.csv, the sequence is its folder: the same label.
+    let file = src.join("walk/processed/data.csv");
+    let summary = convert(&file, &dir.path().join("out2"), &ConvertOptions::default()).unwrap();
+    assert_eq!(summary.sequences[0].placement.as_deref(), Some("Texting"));
 }

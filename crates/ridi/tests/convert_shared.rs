@@ -140,3 +140,40 @@ fn indoor_location_competition_paths_convert_with_the_hand_placement() {
         "{warnings:?}"
     );
 }
+
+/// `ridi track`'s reading: a run the mocap's losses split into parts is one recording without
+/// ground truth, its phone streams being whole; a run read whole stays as it was.
+#[test]
+#[ignore = "needs ../shared beside the checkout: `cargo test --workspace --tests -- --ignored` (.ci/run)"]
+fn a_run_split_by_the_mocap_is_tracked_whole_without_ground_truth() {
+    let root = shared_dataset("tyrex-attitude-smartphones", "datasets/android");
+    let opts = ReadOptions::default();
+    let split = root.join("datasets/android/Jakob_Nexus5_NoDist_Swinging");
+    let parts = ridi::read_any(&split, None, &opts).unwrap();
+    assert_eq!(parts.sequences.len(), 3, "{:?}", parts.warnings);
+    let whole = ridi::read_to_track(&split, None, &opts).unwrap();
+    let [seq] = &whole.sequences[..] else {
+        panic!("{} sequences", whole.sequences.len())
+    };
+    assert_eq!(seq.name(), "Jakob_Nexus5_NoDist_Swinging");
+    assert!(seq.ground_truth().is_none());
+    let framed: usize = parts.sequences.iter().map(|s| s.len()).sum();
+    assert!(seq.len() > framed, "{} against {framed}", seq.len());
+    assert!(
+        whole.warnings[0].contains(
+            "mocap losses split the run into 3 parts with ground truth; tracked as one \
+             recording without it"
+        ),
+        "{:?}",
+        whole.warnings
+    );
+    assert!(!whole.warnings.iter().any(|w| w.contains("mocap lost")));
+    let one = root.join("datasets/android/Guillaume_Nexus5_NoDist_Texting");
+    let read = ridi::read_to_track(&one, None, &opts).unwrap();
+    assert_eq!(read.sequences.len(), 1);
+    assert!(read.sequences[0].ground_truth().is_some());
+    // Tracked, it gives one pose per frame of the whole recording.
+    let model = ridi::bundled_model().unwrap();
+    let track = ridi::track(seq, &model, &ridi::TrackOptions::default()).unwrap();
+    assert_eq!(track.time.len(), seq.len());
+}

@@ -256,18 +256,37 @@ fn labels_the_model_does_not_know_are_a_warning_in_the_report() {
     let want = "placement `swing` of 1 sequence (Thibaud_Nexus5_NoDist_Swinging) is not one of \
                 the model's classes (hand, pocket): its placement accuracy is 0";
     assert_eq!(ridi::placement_warnings(&test, &model), [want]);
-    // Unmapped Tyrex motion names, one warning per label, with the map that would help.
+    // Unmapped Tyrex motion names, one warning for both labels; no map to give, as `Swinging`'s
+    // group, swing, is not the model's.
     let unmapped = load(&[&t], None, Purpose::Evaluation).unwrap();
-    let warnings = ridi::placement_warnings(&unmapped, &model);
-    assert_eq!(warnings.len(), 2, "{warnings:?}");
+    assert_eq!(
+        ridi::placement_warnings(&unmapped, &model),
+        [
+            "2 placement labels are not among the model's classes (hand, pocket), so their \
+          sequences' placement accuracy is 0: `Swinging` of 1 sequence \
+          (Thibaud_Nexus5_NoDist_Swinging), `Texting` of 1 sequence \
+          (Thibaud_Nexus5_NoDist_Texting)"
+        ]
+    );
+    // Where the map takes every label to one of the model's classes, the warning gives it.
+    let both = list(
+        dir.path(),
+        "both.txt",
+        &[
+            line("Thibaud_Nexus5_NoDist_Texting", "Texting"),
+            line("Thibaud_Nexus5_NoDist_BackPocket", "BackPocket"),
+        ],
+    );
+    let warnings =
+        ridi::placement_warnings(&load(&[&both], None, Purpose::Evaluation).unwrap(), &model);
     assert!(
-        warnings[1]
-            .starts_with("placement `Texting` of 1 sequence (Thibaud_Nexus5_NoDist_Texting)")
-            && warnings[1]
-                .ends_with("give `--placement-map tyrex4`, in Python `placement_map=\"tyrex4\"`)"),
+        warnings.len() == 1
+            && warnings[0].ends_with(
+                "(Thibaud_Nexus5_NoDist_Texting) (Tyrex motion names: give `--placement-map \
+                 tyrex4`, in Python `placement_map=\"tyrex4\"`)"
+            ),
         "{warnings:?}"
     );
-    assert!(!warnings[0].contains("tyrex4"), "{warnings:?}");
     let opts = EvalOptions {
         methods: vec![Method::Ridi],
         ..EvalOptions::default()
