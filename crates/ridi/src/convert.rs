@@ -427,17 +427,9 @@ fn stale_lists(
     unlisted: &[&Converted],
     read: &[PathBuf],
 ) -> Vec<StaleList> {
-    let Ok(entries) = std::fs::read_dir(out) else {
-        return Vec::new();
-    };
     let read: Vec<PathBuf> = read.iter().filter_map(|p| p.canonicalize().ok()).collect();
-    let mut stale: Vec<StaleList> = entries
-        .filter_map(|e| e.ok()?.file_name().into_string().ok())
-        .filter(|name| {
-            name.strip_prefix("list_")
-                .and_then(|n| n.strip_suffix(".txt"))
-                .is_some_and(|key| !lists.keys().any(|k| k.eq_ignore_ascii_case(key)))
-        })
+    let mut stale: Vec<StaleList> = lists_not_written(out, lists)
+        .into_iter()
         .filter(|name| {
             let path = out.join(name);
             path.is_file() && !path.canonicalize().is_ok_and(|p| read.contains(&p))
@@ -464,6 +456,51 @@ fn stale_lists(
         .collect();
     stale.sort_by(|a, b| a.name.cmp(&b.name));
     stale
+}
+
+/// The names of the `list_<key>.txt` files in `out` that are none of `lists` (keys compared
+/// ignoring case, as some file systems do).
+fn lists_not_written(out: &Path, lists: &BTreeMap<String, Vec<&Converted>>) -> Vec<String> {
+    let Ok(entries) = std::fs::read_dir(out) else {
+        return Vec::new();
+    };
+    entries
+        .filter_map(|e| e.ok()?.file_name().into_string().ok())
+        .filter(|name| {
+            name.strip_prefix("list_")
+                .and_then(|n| n.strip_suffix(".txt"))
+                .is_some_and(|key| !lists.keys().any(|k| k.eq_ignore_ascii_case(key)))
+        })
+        .collect()
+}
+
+/// The list files in `out` that an earlier `ridi convert` of another source wrote (by their
+/// first line) and this one neither writes (`lists`) nor rewrote (`rewritten`): other files in
+/// an output folder stay, but lists that disagree deserve a word.
+fn other_sources_lists(
+    out: &Path,
+    lists: &BTreeMap<String, Vec<&Converted>>,
+    rewritten: &[String],
+    source: &Path,
+) -> Vec<String> {
+    let ours = format!("# written by `ridi convert {}`", source.display());
+    let mut found: Vec<String> = lists_not_written(out, lists)
+        .into_iter()
+        .filter(|name| !rewritten.contains(name))
+        .filter(|name| {
+            // The first line only, and a bounded one: the file may be anything.
+            use std::io::{BufRead as _, Read as _};
+            let Ok(file) = std::fs::File::open(out.join(name)) else {
+                return false;
+            };
+            let mut first = String::new();
+            let read = std::io::BufReader::new(file.take(64 * 1024)).read_line(&mut first);
+            let first = first.trim_end_matches(['\n', '\r']);
+            read.is_ok() && first.starts_with("# written by `ridi convert ") && first != ours
+        })
+        .collect();
+    found.sort();
+    found
 }
 
 /// The warning naming the sequences without ground truth, which no list names.
@@ -722,8 +759,10 @@ pub fn convert(
     let (by_device, warnings) = device_lists(&listable, &lists);
     summary.warnings.extend(warnings);
     lists.extend(by_device);
+    let mut rewritten = Vec::new();
     if !unlisted.is_empty() {
         let stale = stale_lists(out, &lists, &unlisted, &listed.lists);
+        rewritten.extend(stale.iter().map(|l| l.name.clone()));
         for list in &stale {
             let rel = Path::new(&list.name);
             match &list.kept {
@@ -748,6 +787,15 @@ pub fn convert(
         written_lists.push(out.join(name));
     }
     check_overwrites(&dirs, &listed.lists, &summary.sequences, &written_lists)?;
+    let earlier = other_sources_lists(out, &lists, &rewritten, source);
+    if !earlier.is_empty() {
+        summary.warnings.push(format!(
+            "{} holds list files of a conversion of another source, left as they are: {} (the \
+             lists written now name this conversion's sequences alone)",
+            ridi_data::shown(out),
+            ridi_data::first_few(earlier.iter(), 5)
+        ));
+    }
     let warnings_file = Path::new(WARNINGS_FILE);
     if summary.warnings.is_empty() {
         staging.remove(warnings_file);

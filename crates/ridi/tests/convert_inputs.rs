@@ -905,6 +905,37 @@ fn a_recording_paused_for_seconds_converts_split_at_its_gaps() {
     assert!((b.time()[0] - paused.time()[2000]).abs() < 1e-9);
 }
 
+/// Lists an earlier conversion of another source left in the output folder stay, and a
+/// warning names them: they no longer agree with `list_all.txt`.
+#[test]
+fn lists_of_another_sources_conversion_in_the_output_are_named() {
+    let dir = tempfile::tempdir().unwrap();
+    let first = sources_named(&dir.path().join("a"), &["Bo_Nexus5_NoDist_Texting"]);
+    let second = sources_named(&dir.path().join("b"), &["walk"]);
+    let out = dir.path().join("out");
+    convert(&first, &out, &ConvertOptions::default()).unwrap();
+    assert!(out.join("list_Bo.txt").is_file());
+    let summary = convert(&second, &out, &ConvertOptions::default()).unwrap();
+    let named: Vec<&String> = summary
+        .warnings
+        .iter()
+        .filter(|w| w.contains("holds list files of a conversion of another source"))
+        .collect();
+    assert_eq!(named.len(), 1, "{:?}", summary.warnings);
+    assert!(
+        named[0].contains("left as they are: list_Bo.txt ("),
+        "{named:?}"
+    );
+    assert!(out.join("list_Bo.txt").is_file());
+    // The first source again: it writes list_Bo.txt itself, no warning.
+    let again = convert(&first, &out, &ConvertOptions::default()).unwrap();
+    assert!(
+        again.warnings.iter().all(|w| !w.contains("another source")),
+        "{:?}",
+        again.warnings
+    );
+}
+
 /// A sequence converted alone takes its placement from the lists beside it, in its parent
 /// folder, as a whole folder's sequences take theirs from the lists in it.
 #[test]
