@@ -643,20 +643,29 @@ impl std::fmt::Display for ModelInspection {
             )?;
         }
         if !self.cross_validation.is_empty() {
+            // Kernel ridge regressors (Nyström) have no epsilon: no column of zeros.
+            let epsilon = |e: &dyn std::fmt::Display| match self.landmarks {
+                Some(_) => String::new(),
+                None => format!(" {e:>8}"),
+            };
             writeln!(f, "cross-validation (MSE, (m/s)^2, mean over folds):")?;
             writeln!(
                 f,
-                "  {:<12} {:>7} {:>8} {:>8} {:>10}",
-                "placement", "channel", "C", "epsilon", "MSE"
+                "  {:<12} {:>7} {:>8}{} {:>10}",
+                "placement",
+                "channel",
+                "C",
+                epsilon(&"epsilon"),
+                "MSE"
             )?;
             for r in &self.cross_validation {
                 writeln!(
                     f,
-                    "  {:<12} {:>7} {:>8} {:>8} {:>10.5}",
+                    "  {:<12} {:>7} {:>8}{} {:>10.5}",
                     shown(&r.placement),
                     ["S-x", "S-z", "speed"][usize::from(r.channel.min(2))],
                     r.c,
-                    r.epsilon,
+                    epsilon(&r.epsilon),
                     r.mse
                 )?;
             }
