@@ -327,11 +327,6 @@ struct ListLabels {
     warnings: Vec<String>,
 }
 
-/// Placement labels that list files directly in a `source` folder (`list*.txt`) give its
-/// sequences: the RIDI layout keeps them there, not in the data ([`convert`] also reads the
-/// parent folder's for a sequence given alone). A file that does not parse
-/// as a list is skipped; an entry may name the sequence folder or its `processed/` file; a
-/// sequence two lists label differently keeps the first label (lists by name), with a warning.
 /// The sequence folder a list entry or a source stands for, resolved: a file's folder, and
 /// for `<sequence>/processed/data.csv`, `<sequence>`.
 fn labelled(path: &Path) -> Option<PathBuf> {
@@ -346,6 +341,11 @@ fn labelled(path: &Path) -> Option<PathBuf> {
     Some(folder.map_or(path.clone(), Path::to_path_buf))
 }
 
+/// Placement labels that list files directly in a `source` folder (`list*.txt`) give its
+/// sequences: the RIDI layout keeps them there, not in the data ([`convert`] also reads the
+/// parent folder's for a sequence given alone). A file that does not parse
+/// as a list is skipped; an entry may name the sequence folder or its `processed/` file; a
+/// sequence two lists label differently keeps the first label (lists by name), with a warning.
 fn labels_from_lists(source: &Path) -> ListLabels {
     let mut out = ListLabels::default();
     let Ok(entries) = std::fs::read_dir(source) else {
@@ -483,7 +483,14 @@ fn other_sources_lists(
     rewritten: &[String],
     source: &Path,
 ) -> Vec<String> {
-    let ours = format!("# written by `ridi convert {}`", source.display());
+    // The source as a list names it, resolved where it can be: `data`, `data/` and its absolute
+    // path are one source.
+    let same = |written: &str| {
+        written == source.display().to_string()
+            || Path::new(written)
+                .canonicalize()
+                .is_ok_and(|w| source.canonicalize().is_ok_and(|s| s == w))
+    };
     let mut found: Vec<String> = lists_not_written(out, lists)
         .into_iter()
         .filter(|name| !rewritten.contains(name))
@@ -496,7 +503,10 @@ fn other_sources_lists(
             let mut first = String::new();
             let read = std::io::BufReader::new(file.take(64 * 1024)).read_line(&mut first);
             let first = first.trim_end_matches(['\n', '\r']);
-            read.is_ok() && first.starts_with("# written by `ridi convert ") && first != ours
+            let written = first
+                .strip_prefix("# written by `ridi convert ")
+                .and_then(|rest| rest.strip_suffix('`'));
+            read.is_ok() && written.is_some_and(|w| !same(w))
         })
         .collect();
     found.sort();

@@ -927,12 +927,31 @@ fn lists_of_another_sources_conversion_in_the_output_are_named() {
         "{named:?}"
     );
     assert!(out.join("list_Bo.txt").is_file());
-    // The first source again: it writes list_Bo.txt itself, no warning.
-    let again = convert(&first, &out, &ConvertOptions::default()).unwrap();
+    // The first source again, spelt otherwise (a trailing `/`, its absolute path): it writes
+    // list_Bo.txt itself, and the second's lists are the first's too.
+    let spelt = std::path::PathBuf::from(format!("{}/", first.canonicalize().unwrap().display()));
+    let again = convert(&spelt, &out, &ConvertOptions::default()).unwrap();
     assert!(
         again.warnings.iter().all(|w| !w.contains("another source")),
         "{:?}",
         again.warnings
+    );
+    // A person's runs gone from the same source, spelt otherwise: their list is left, and is
+    // not another source's.
+    let both = sources_named(
+        &dir.path().join("c"),
+        &["Al_Nexus5_NoDist_Texting", "Bo_Nexus5_NoDist_Texting"],
+    );
+    let out = dir.path().join("out-c");
+    convert(&both, &out, &ConvertOptions::default()).unwrap();
+    std::fs::remove_dir_all(both.join("Al_Nexus5_NoDist_Texting")).unwrap();
+    let spelt = std::path::PathBuf::from(format!("{}/", both.canonicalize().unwrap().display()));
+    let later = convert(&spelt, &out, &ConvertOptions::default()).unwrap();
+    assert!(out.join("list_Al.txt").is_file());
+    assert!(
+        later.warnings.iter().all(|w| !w.contains("another source")),
+        "{:?}",
+        later.warnings
     );
 }
 
