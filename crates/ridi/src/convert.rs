@@ -436,7 +436,7 @@ fn stale_lists(
         })
         .filter_map(|name| {
             let text = std::fs::read_to_string(out.join(&name)).ok()?;
-            if !text.starts_with("# written by `ridi convert ") {
+            if !text.starts_with(LIST_HEADER) {
                 return None;
             }
             let names_one = |l: &str| {
@@ -457,6 +457,9 @@ fn stale_lists(
     stale.sort_by(|a, b| a.name.cmp(&b.name));
     stale
 }
+
+/// How a list file `ridi convert` writes begins: this, the source as given, and a backquote.
+const LIST_HEADER: &str = "# written by `ridi convert ";
 
 /// The names of the `list_<key>.txt` files in `out` that are none of `lists` (keys compared
 /// ignoring case, as some file systems do).
@@ -485,11 +488,9 @@ fn other_sources_lists(
 ) -> Vec<String> {
     // The source as a list names it, resolved where it can be: `data`, `data/` and its absolute
     // path are one source.
+    let (spelt, resolved) = (source.display().to_string(), source.canonicalize().ok());
     let same = |written: &str| {
-        written == source.display().to_string()
-            || Path::new(written)
-                .canonicalize()
-                .is_ok_and(|w| source.canonicalize().is_ok_and(|s| s == w))
+        written == spelt || resolved.is_some() && Path::new(written).canonicalize().ok() == resolved
     };
     let mut found: Vec<String> = lists_not_written(out, lists)
         .into_iter()
@@ -504,7 +505,7 @@ fn other_sources_lists(
             let read = std::io::BufReader::new(file.take(64 * 1024)).read_line(&mut first);
             let first = first.trim_end_matches(['\n', '\r']);
             let written = first
-                .strip_prefix("# written by `ridi convert ")
+                .strip_prefix(LIST_HEADER)
                 .and_then(|rest| rest.strip_suffix('`'));
             read.is_ok() && written.is_some_and(|w| !same(w))
         })
@@ -788,7 +789,7 @@ pub fn convert(
     for (key, entries) in &lists {
         let name = format!("list_{key}.txt");
         write_atomically(&staging.file(Path::new(&name))?, |w| {
-            writeln!(w, "# written by `ridi convert {}`", source.display())?;
+            writeln!(w, "{LIST_HEADER}{}`", source.display())?;
             for c in entries {
                 writeln!(w, "{},{}", c.name, c.placement.as_deref().unwrap_or(""))?;
             }
